@@ -1,0 +1,19 @@
+#pragma once
+// The `chromatrace` command: each subcommand lives in its own cmd_<name>.cpp and registers itself here.
+//
+// A subcommand's add function creates its CLI11 subcommand on `app` and returns the action to run when the
+// user chose it. Actions return the exit code (0 success, 3 reserved for `compare` disagreements) and
+// throw ct::InputError for bad input (exit 2, one line) or anything else for runtime failures (exit 1).
+
+#include <functional>
+
+#include <CLI/CLI.hpp>
+
+namespace ct::cli {
+
+using Action = std::function<int()>;
+
+Action add_info(CLI::App& app);
+Action add_check_scene(CLI::App& app);
+
+}  // namespace ct::cli

@@ -1,0 +1,49 @@
+// chromatrace: explains colour-histogram structure by simulating image formation.
+#include <cstdio>
+#include <exception>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <fmt/core.h>
+
+#include "cli/command.h"
+#include "core/error.h"
+
+int main(int argc, char** argv) {
+  CLI::App app{"chromatrace: simulate how an image was made and explain its colour histogram"};
+  app.require_subcommand(1);
+  app.set_version_flag("--version", "chromatrace 0.1.0");
+
+  std::vector<std::pair<CLI::App*, ct::cli::Action>> commands;
+  auto add = [&](ct::cli::Action action) { commands.emplace_back(app.get_subcommands().back(), std::move(action)); };
+  add(ct::cli::add_info(app));
+  add(ct::cli::add_check_scene(app));
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForVersion& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    fmt::print(stderr, "chromatrace: error: {}\n", e.what());
+    return 2;
+  }
+
+  for (auto& [sub, action] : commands) {
+    if (!sub->parsed()) continue;
+    try {
+      return action();
+    } catch (const ct::InputError& e) {
+      fmt::print(stderr, "chromatrace {}: error: {}\n", sub->get_name(), e.what());
+      return 2;
+    } catch (const std::exception& e) {
+      fmt::print(stderr, "chromatrace {}: failed: {}\n", sub->get_name(), e.what());
+      return 1;
+    }
+  }
+  return 2;
+}

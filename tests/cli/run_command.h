@@ -1,0 +1,18 @@
+#pragma once
+// Runs the real `chromatrace` executable for end-to-end tests and captures what it printed.
+
+#include <string>
+#include <vector>
+
+namespace ct::test {
+
+struct CommandResult {
+  int exit_code = -1;
+  std::string out;  // stdout
+  std::string err;  // stderr
+};
+
+// Runs CHROMATRACE_EXE with the given arguments (no shell involved).
+CommandResult run_chromatrace(const std::vector<std::string>& args);
+
+}  // namespace ct::test
