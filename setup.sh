@@ -1,0 +1,26 @@
+#!/usr/bin/env bash
+# Installs chromatrace's dependencies from Debian 12 packages and builds it into build/.
+# Usage: ./setup.sh            (as root, or with sudo available)
+set -euo pipefail
+cd "$(dirname "$0")"
+
+packages=(
+  build-essential cmake ninja-build pkg-config
+  libopenexr-dev libopenimageio-dev openimageio-tools libopencv-dev
+  libembree-dev libtbb-dev libeigen3-dev
+  nlohmann-json3-dev libcli11-dev libfmt-dev libgtest-dev
+)
+
+sudo=""
+[ "$(id -u)" -eq 0 ] || sudo="sudo"
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -gt 0 ]; then
+  $sudo apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}"
+fi
+
+cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release
+cmake --build build
