@@ -15,5 +15,6 @@ using Action = std::function<int()>;
 
 Action add_info(CLI::App& app);
 Action add_check_scene(CLI::App& app);
+Action add_render(CLI::App& app);
 
 }  // namespace ct::cli

@@ -16,9 +16,13 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", "chromatrace 0.1.0");
 
   std::vector<std::pair<CLI::App*, ct::cli::Action>> commands;
-  auto add = [&](ct::cli::Action action) { commands.emplace_back(app.get_subcommands().back(), std::move(action)); };
+  // Each add_* creates one subcommand; pair it with its action (the filter lists all, not just parsed ones).
+  auto add = [&](ct::cli::Action action) {
+    commands.emplace_back(app.get_subcommands([](CLI::App*) { return true; }).back(), std::move(action));
+  };
   add(ct::cli::add_info(app));
   add(ct::cli::add_check_scene(app));
+  add(ct::cli::add_render(app));
 
   try {
     app.parse(argc, argv);

@@ -1,0 +1,65 @@
+// chromatrace render SCENE.json -o OUT.exr: the reference path tracer.
+#include <fmt/core.h>
+
+#include "cli/command.h"
+#include "core/error.h"
+#include "core/scene.h"
+#include "core/spectral_exr.h"
+#include "reference_tracer/render.h"
+
+namespace ct::cli {
+
+Action add_render(CLI::App& app) {
+  auto* cmd = app.add_subcommand("render", "Render a scene with the reference spectral path tracer");
+  struct Options {
+    std::string scene, output, bands, mode, components = "paths,lights";
+    int spp = 0, max_bounces = -1, threads = 0;
+    std::uint64_t seed = 0;
+    bool seed_given = false;
+    double time_limit = 0.0;
+    bool quiet = false;
+  };
+  auto o = std::make_shared<Options>();
+  cmd->add_option("scene", o->scene, "Scene file (chromatrace-scene/1)")->required();
+  cmd->add_option("-o,--output", o->output, "Output spectral EXR")->required();
+  cmd->add_option("--spp", o->spp, "Paths per pixel (default: the scene's render.samples)");
+  cmd->add_option("--max-bounces", o->max_bounces, "Scattering events per path: 0 emitters, 1 direct, >= 2 global");
+  cmd->add_option("--bands", o->bands, "Band plan lo:hi:width in nm, e.g. 380:780:10");
+  cmd->add_option("--spectral-mode", o->mode, "bands (band averages, as Cycles) or continuous (hero wavelengths)");
+  cmd->add_option("--components", o->components,
+                  "Component families: paths, lights, bounces, all, none (comma-separated)")
+      ->capture_default_str();
+  cmd->add_option("--seed", o->seed, "Random seed (default: the scene's render.seed)")
+      ->each([o](const std::string&) { o->seed_given = true; });
+  cmd->add_option("--threads", o->threads, "Worker threads (0: all cores)")->capture_default_str();
+  cmd->add_option("--time-limit", o->time_limit, "Stop after the pass during which this many seconds ran out");
+  cmd->add_flag("-q,--quiet", o->quiet, "No progress output");
+
+  return [o] {
+    const Scene scene = load_scene(o->scene);
+    rt::RenderOptions options;
+    if (o->spp != 0) options.samples = o->spp;
+    if (o->max_bounces != -1) options.max_bounces = o->max_bounces;
+    if (!o->bands.empty()) options.bands = Bands::parse(o->bands, "--bands");
+    if (!o->mode.empty()) {
+      if (o->mode == "bands") options.mode = SpectralMode::Bands;
+      else if (o->mode == "continuous") options.mode = SpectralMode::Continuous;
+      else throw InputError(fmt::format("--spectral-mode: must be bands or continuous, got \"{}\"", o->mode));
+    }
+    if (o->seed_given) options.seed = o->seed;
+    options.components = rt::ComponentSelection::parse(o->components);
+    options.threads = o->threads;
+    options.time_limit_s = o->time_limit;
+    options.progress = !o->quiet;
+    if (o->output.empty()) throw InputError("--output: no file name");
+    set_exr_threads(o->threads == 1 ? 0 : o->threads);
+    const rt::RenderedImage image = rt::render(scene, options);
+    rt::write_render(o->output, scene, image);
+    if (!o->quiet)
+      fmt::print(stderr, "{}: {}×{}, {} bands, {} spp, {:.3g} Mpaths/s\n", o->output, image.width, image.height,
+                 image.bands.size(), image.samples, image.paths / image.seconds * 1e-6);
+    return 0;
+  };
+}
+
+}  // namespace ct::cli

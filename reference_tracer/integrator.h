@@ -1,0 +1,93 @@
+#pragma once
+// Unidirectional spectral path tracing with next-event estimation and multiple importance sampling (power
+// heuristic) on area lights, and unbiased Russian roulette.
+//
+// Path components (spectral-exr.md) are attributed exactly, not by sampling which lobe was chosen: at the
+// first scattering event the path's throughput splits into its diffuse and glossy parts, which are carried
+// on separately. A contribution after exactly one scattering event is "direct", after more "indirect"; one
+// with none (the camera sees an emitter) is "emission". Each contribution also goes to its light's group
+// and to bounce.<k>, k = number of scattering events. Each family of components sums to the total.
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "core/random.h"
+#include "core/scene.h"
+#include "reference_tracer/lanes.h"
+#include "reference_tracer/scene_data.h"
+
+namespace ct::rt {
+
+struct ComponentSelection {
+  bool paths = true;    // emission, diffuse_direct, diffuse_indirect, glossy_direct, glossy_indirect
+  bool lights = true;   // light.<group>
+  bool bounces = false; // bounce.0 .. bounce.<max_bounces>
+  // Parses a comma-separated list of "paths", "lights", "bounces", "all", "none"; errors name `what`.
+  static ComponentSelection parse(const std::string& list, const std::string& what = "--components");
+};
+
+// The output layers of a render: the total first, then the components in file order.
+struct LayerPlan {
+  std::vector<std::string> components;
+  int emission = -1, diffuse_direct = -1, diffuse_indirect = -1, glossy_direct = -1, glossy_indirect = -1;
+  std::vector<int> light_group;  // per group
+  std::vector<int> bounce;       // per k
+  int layer_count() const { return 1 + static_cast<int>(components.size()); }
+};
+LayerPlan plan_layers(const ComponentSelection& selection, const std::vector<std::string>& groups, int max_bounces);
+
+struct TracerSettings {
+  int max_bounces = 8;
+  SpectralMode mode = SpectralMode::Bands;
+  Bands bands;
+  std::uint64_t seed = 1;
+  bool box_filter = true;
+};
+
+// Accumulates one pixel's layers: layer-major, layer_count × bands doubles.
+class PixelAccumulator {
+ public:
+  PixelAccumulator(int layers, int bands) : bands_(bands), sum_(static_cast<std::size_t>(layers * bands), 0.0) {}
+  double* layer(int l) { return sum_.data() + static_cast<std::ptrdiff_t>(l) * bands_; }
+  const std::vector<double>& data() const { return sum_; }
+  void clear() { std::fill(sum_.begin(), sum_.end(), 0.0); }
+
+ private:
+  int bands_;
+  std::vector<double> sum_;
+};
+
+class PathTracer {
+ public:
+  PathTracer(const TracerScene& scene, TracerSettings settings, LayerPlan layers);
+
+  // Traces one path through image point (px, py) (pixels from the top-left) and adds its contributions
+  // to `pixel`. `stream` identifies the path for the random-number generator.
+  void trace(double px, double py, std::uint64_t stream, PixelAccumulator& pixel) const;
+  // The film position of sample `stream` in pixel (x, y): the centre, or uniform over the pixel (box).
+  std::pair<double, double> film_position(int x, int y, std::uint64_t stream) const;
+  // Object id seen through the centre of pixel (x, y); 0 for the background.
+  int object_id_at(int x, int y) const;
+
+  const LayerPlan& layers() const { return layers_; }
+  const TracerSettings& settings() const { return settings_; }
+
+ private:
+  struct Chunk {
+    int first_band, count;
+  };
+  struct Path;
+  void trace_lanes(const Vec3& origin, const Vec3& direction, Random& rng, const Chunk* chunk,
+                   PixelAccumulator& pixel) const;
+  Lanes lane_values(const PiecewiseLinearSpectrum& s, const Chunk* chunk, const Lanes& wavelengths) const;
+
+  const TracerScene& scene_;
+  TracerSettings settings_;
+  LayerPlan layers_;
+  std::vector<Chunk> chunks_;
+  // Band averages of every spectrum the tracer uses, for `bands` mode.
+  std::vector<std::pair<const PiecewiseLinearSpectrum*, std::vector<double>>> band_tables_;
+};
+
+}  // namespace ct::rt

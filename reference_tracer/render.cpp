@@ -1,0 +1,146 @@
+#include "reference_tracer/render.h"
+
+#include <algorithm>
+#include <chrono>
+#include <mutex>
+
+#include <fmt/core.h>
+#include <nlohmann/json.hpp>
+
+#include "core/error.h"
+#include "core/parallel.h"
+#include "core/progress.h"
+#include "core/spectral_exr.h"
+
+namespace ct::rt {
+namespace {
+
+constexpr int kTileSize = 16;
+
+void check_options(const RenderOptions& o) {
+  if (o.samples && *o.samples < 1) throw InputError(fmt::format("--spp: must be at least 1, got {}", *o.samples));
+  if (o.max_bounces && *o.max_bounces < 0)
+    throw InputError(fmt::format("--max-bounces: must be >= 0, got {}", *o.max_bounces));
+  if (o.time_limit_s < 0) throw InputError(fmt::format("--time-limit: must be >= 0 s, got {}", o.time_limit_s));
+  if (o.threads < 0) throw InputError(fmt::format("--threads: must be >= 0, got {}", o.threads));
+}
+
+}  // namespace
+
+RenderedImage render(const Scene& scene, const RenderOptions& options) {
+  check_options(options);
+  const auto start = std::chrono::steady_clock::now();
+  TracerSettings settings;
+  settings.max_bounces = options.max_bounces.value_or(scene.render.max_bounces);
+  settings.mode = options.mode.value_or(scene.render.spectral_mode);
+  settings.bands = options.bands.value_or(scene.render.bands);
+  settings.seed = options.seed.value_or(scene.render.seed);
+  settings.box_filter = scene.render.pixel_filter == PixelFilter::Box;
+  const int spp = options.samples.value_or(scene.render.samples);
+
+  const TracerScene tracer_scene(scene);
+  const LayerPlan plan = plan_layers(options.components, tracer_scene.groups(), settings.max_bounces);
+  const PathTracer tracer(tracer_scene, settings, plan);
+
+  RenderedImage image;
+  image.width = scene.camera.width;
+  image.height = scene.camera.height;
+  image.bands = settings.bands;
+  image.components = plan.components;
+  image.settings = settings;
+  const int w = image.width, h = image.height, nb = static_cast<int>(settings.bands.size());
+  const std::size_t layer_size = static_cast<std::size_t>(w) * h * nb;
+  image.layers.assign(static_cast<std::size_t>(plan.layer_count()), std::vector<float>(layer_size, 0.0f));
+  image.object_ids.resize(static_cast<std::size_t>(w) * h);
+  for (const Object& o : scene.objects) image.object_names[o.id] = o.name;
+  for (const Light& l : scene.lights) image.object_names[l.id] = l.name;
+
+  // Passes of samples: all at once without a time limit; otherwise growing passes so the limit is honoured
+  // to within about one pass while early passes stay cheap.
+  std::vector<int> passes;
+  if (options.time_limit_s <= 0.0) {
+    passes.push_back(spp);
+  } else {
+    for (int done = 0, step = 1; done < spp; done += step, step = std::min(step * 2, 64))
+      passes.push_back(std::min(step, spp - done));
+  }
+
+  const std::size_t tiles = tile_count(w, h, kTileSize);
+  Progress progress("render", tiles * passes.size(), options.progress);
+  int first_sample = 0;
+  for (const int pass : passes) {
+    parallel_for(tiles, options.threads, [&](std::size_t index) {
+      const Tile tile = tile_at(w, h, kTileSize, index);
+      PixelAccumulator pixel(plan.layer_count(), nb);
+      for (int y = tile.y0; y < tile.y1; ++y)
+        for (int x = tile.x0; x < tile.x1; ++x) {
+          pixel.clear();
+          const std::uint64_t pixel_index = static_cast<std::uint64_t>(y) * w + x;
+          for (int s = first_sample; s < first_sample + pass; ++s) {
+            const std::uint64_t stream = (pixel_index << 32) | static_cast<std::uint64_t>(s);
+            const auto [px, py] = tracer.film_position(x, y, stream);
+            tracer.trace(px, py, stream, pixel);
+          }
+          const std::size_t offset = pixel_index * nb;
+          for (int l = 0; l < plan.layer_count(); ++l) {
+            const double* sum = pixel.layer(l);
+            float* out = image.layers[static_cast<std::size_t>(l)].data() + offset;
+            for (int b = 0; b < nb; ++b) out[b] += static_cast<float>(sum[b]);
+          }
+          if (first_sample == 0) image.object_ids[pixel_index] = tracer.object_id_at(x, y);
+        }
+      progress.advance();
+    });
+    first_sample += pass;
+    const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    if (options.time_limit_s > 0.0 && elapsed >= options.time_limit_s) break;
+  }
+  progress.finish();
+
+  image.samples = first_sample;
+  const float inv = 1.0f / static_cast<float>(first_sample);
+  for (auto& layer : image.layers)
+    for (float& v : layer) v *= inv;
+  image.paths = static_cast<std::uint64_t>(w) * h * first_sample;
+  image.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return image;
+}
+
+void write_render(const std::filesystem::path& path, const Scene& scene, const RenderedImage& image) {
+  SpectralExrLayout layout;
+  layout.width = image.width;
+  layout.height = image.height;
+  layout.bands = image.bands;
+  layout.components = image.components;
+  layout.object_ids = true;
+  layout.object_names = image.object_names;
+  const Camera& c = scene.camera;
+  const nlohmann::json camera = {
+      {"position", {c.position.x(), c.position.y(), c.position.z()}},
+      {"look_at", {c.look_at.x(), c.look_at.y(), c.look_at.z()}},
+      {"up", {c.up.x(), c.up.y(), c.up.z()}},
+      {"fov_deg", c.fov_deg},
+      {"horizontal_fov_deg", 2.0 * std::atan(c.tan_half_width()) * 180.0 / M_PI},
+      {"vertical_fov_deg", 2.0 * std::atan(c.tan_half_height()) * 180.0 / M_PI},
+      {"sensor_width_mm", c.sensor_width_mm},
+      {"focal_length_mm", c.focal_length_mm()},
+      {"resolution", {c.width, c.height}}};
+  layout.attributes["chromatrace.renderer"] = fmt::format("chromatrace reference tracer ({} mode, max {} bounces)",
+                                              image.settings.mode == SpectralMode::Bands ? "bands" : "continuous",
+                                              image.settings.max_bounces);
+  layout.attributes["chromatrace.samples"] = std::to_string(image.samples);
+  layout.attributes["chromatrace.seed"] = std::to_string(image.settings.seed);
+  layout.attributes["chromatrace.scene"] = scene.json.dump();
+  layout.attributes["chromatrace.camera"] = camera.dump();
+
+  SpectralExrWriter writer(path, std::move(layout));
+  SpectralRowBlock block;
+  block.rows = image.height;
+  block.total = image.layers[0];
+  for (std::size_t l = 1; l < image.layers.size(); ++l) block.components.emplace_back(image.layers[l]);
+  block.object_ids = image.object_ids;
+  writer.write_rows(block);
+  writer.finish();
+}
+
+}  // namespace ct::rt
