@@ -80,6 +80,16 @@ bool Accelerator::occluded(const Vec3& origin, const Vec3& direction, double t_m
   return ray.tfar < 0.0f;  // Embree sets tfar to −∞ on a hit
 }
 
+bool Accelerator::visible(const Vec3& a, const Vec3& na, const Vec3& b, const Vec3& nb) const {
+  const Vec3 from = offset_origin(a, na, b - a, scale_);
+  const Vec3 to = offset_origin(b, nb, a - b, scale_);
+  const Vec3 d = to - from;
+  const double length = d.norm();
+  if (!(length > 0.0)) return true;
+  // The ends lie off both surfaces, so the full length can be tested, less float rounding of t.
+  return !occluded(from, d / length, length * (1.0 - 1e-6));
+}
+
 Vec3 offset_origin(const Vec3& p, const Vec3& n, const Vec3& towards, double scene_scale) {
   // Float positions carry a relative error of 2⁻²⁴; 1e-5 of the larger of |p| and the scene size clears it
   // by two orders of magnitude while staying far below any feature a scene should have.

@@ -30,6 +30,9 @@ class Accelerator {
 
   std::optional<Hit> intersect(const Vec3& origin, const Vec3& direction, double t_max) const;
   bool occluded(const Vec3& origin, const Vec3& direction, double t_max) const;
+  // Whether the segment between two surface points is unobstructed. Both ends are first moved off their
+  // surfaces (normals na, nb) towards each other, so neither surface itself can block it.
+  bool visible(const Vec3& a, const Vec3& na, const Vec3& b, const Vec3& nb) const;
 
   // The length scale of the scene, for ray offsets.
   double scale() const { return scale_; }

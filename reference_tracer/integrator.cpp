@@ -288,7 +288,7 @@ void PathTracer::trace_lanes(const Vec3& origin, const Vec3& direction, Random& 
           const double pdf_light = ls->pdf_area * dist * dist / cos_light;
           const double weight = material->is_delta() && !material->diffuse ? 1.0 : power_heuristic(pdf_light, f.pdf);
           if ((f.diffuse > 0.0 || f.glossy > 0.0) &&
-              !scene_.accel().occluded(offset_origin(s.p, s.ng, to_light, scale), to_light, dist * (1.0 - 1e-4))) {
+              scene_.accel().visible(s.p, s.ng, ls->p, ls->n)) {
             const Lanes le = lane_values(ls->light->radiance, chunk, wavelengths) * (weight / pdf_light);
             const Lanes fd = rho_d * f.diffuse, fg = k_s * f.glossy;
             if (first) contribute(1, *ls->light, fd * le, fg * le);

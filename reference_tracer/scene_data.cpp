@@ -80,14 +80,9 @@ TracerScene::TracerScene(const Scene& scene) : scene_(scene), meshes_(scene_mesh
     lights_.push_back(std::move(tl));
   }
   for (std::size_t l = 0; l < lights_.size(); ++l) {
-    const double prev = l == 0 ? 0.0 : light_cdf_[l - 1];
-    if (total_power > 0.0) {
-      lights_[l].select_probability = (light_cdf_[l] - prev) / total_power;
-      light_cdf_[l] /= total_power;
-    } else {
-      lights_[l].select_probability = 1.0 / lights_.size();
-      light_cdf_[l] = (l + 1.0) / lights_.size();
-    }
+    if (total_power > 0.0) light_cdf_[l] /= total_power;
+    else light_cdf_[l] = (l + 1.0) / static_cast<double>(lights_.size());
+    lights_[l].select_probability = light_cdf_[l] - (l == 0 ? 0.0 : light_cdf_[l - 1]);
   }
 }
 
