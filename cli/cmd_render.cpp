@@ -1,8 +1,13 @@
 // chromatrace render SCENE.json -o OUT.exr: the reference path tracer.
+#include <cstdio>
+#include <filesystem>
+#include <optional>
+
 #include <fmt/core.h>
 
 #include "cli/command.h"
 #include "core/error.h"
+#include "core/parallel.h"
 #include "core/scene.h"
 #include "core/spectral_exr.h"
 #include "reference_tracer/render.h"
@@ -12,10 +17,10 @@ namespace ct::cli {
 Action add_render(CLI::App& app) {
   auto* cmd = app.add_subcommand("render", "Render a scene with the reference spectral path tracer");
   struct Options {
-    std::string scene, output, bands, mode, components = "paths,lights";
-    int spp = 0, max_bounces = -1, threads = 0;
-    std::uint64_t seed = 0;
-    bool seed_given = false;
+    std::string scene, output, bands, mode, resolution, components = "paths,lights";
+    std::optional<int> spp, max_bounces;
+    std::optional<std::uint64_t> seed;
+    int threads = 0;
     double time_limit = 0.0;
     bool quiet = false;
   };
@@ -24,35 +29,47 @@ Action add_render(CLI::App& app) {
   cmd->add_option("-o,--output", o->output, "Output spectral EXR")->required();
   cmd->add_option("--spp", o->spp, "Paths per pixel (default: the scene's render.samples)");
   cmd->add_option("--max-bounces", o->max_bounces, "Scattering events per path: 0 emitters, 1 direct, >= 2 global");
+  cmd->add_option("--resolution", o->resolution, "Image size WxH, overriding the scene's camera (e.g. 64x64)");
   cmd->add_option("--bands", o->bands, "Band plan lo:hi:width in nm, e.g. 380:780:10");
   cmd->add_option("--spectral-mode", o->mode, "bands (band averages, as Cycles) or continuous (hero wavelengths)");
   cmd->add_option("--components", o->components,
                   "Component families: paths, lights, bounces, all, none (comma-separated)")
       ->capture_default_str();
-  cmd->add_option("--seed", o->seed, "Random seed (default: the scene's render.seed)")
-      ->each([o](const std::string&) { o->seed_given = true; });
+  cmd->add_option("--seed", o->seed, "Random seed (default: the scene's render.seed)");
   cmd->add_option("--threads", o->threads, "Worker threads (0: all cores)")->capture_default_str();
   cmd->add_option("--time-limit", o->time_limit, "Stop after the pass during which this many seconds ran out");
   cmd->add_flag("-q,--quiet", o->quiet, "No progress output");
 
   return [o] {
-    const Scene scene = load_scene(o->scene);
+    Scene scene = load_scene(o->scene);
+    if (!o->resolution.empty()) {
+      int w = 0, h = 0;
+      char x = 0, extra = 0;
+      if (std::sscanf(o->resolution.c_str(), "%d%c%d%c", &w, &x, &h, &extra) != 3 || x != 'x' || w < 1 || h < 1)
+        throw InputError(fmt::format("--resolution: expected WxH with positive integers, got \"{}\"", o->resolution));
+      scene.camera.width = w;
+      scene.camera.height = h;
+    }
     rt::RenderOptions options;
-    if (o->spp != 0) options.samples = o->spp;
-    if (o->max_bounces != -1) options.max_bounces = o->max_bounces;
+    options.samples = o->spp;
+    options.max_bounces = o->max_bounces;
     if (!o->bands.empty()) options.bands = Bands::parse(o->bands, "--bands");
     if (!o->mode.empty()) {
       if (o->mode == "bands") options.mode = SpectralMode::Bands;
       else if (o->mode == "continuous") options.mode = SpectralMode::Continuous;
       else throw InputError(fmt::format("--spectral-mode: must be bands or continuous, got \"{}\"", o->mode));
     }
-    if (o->seed_given) options.seed = o->seed;
+    options.seed = o->seed;
     options.components = rt::ComponentSelection::parse(o->components);
     options.threads = o->threads;
     options.time_limit_s = o->time_limit;
     options.progress = !o->quiet;
     if (o->output.empty()) throw InputError("--output: no file name");
-    set_exr_threads(o->threads == 1 ? 0 : o->threads);
+    // Fail before a long render, not after it.
+    const std::filesystem::path parent = std::filesystem::absolute(o->output).parent_path();
+    if (!std::filesystem::is_directory(parent))
+      throw InputError(fmt::format("{}: directory {} does not exist", o->output, parent.string()));
+    set_exr_threads(thread_count(o->threads));
     const rt::RenderedImage image = rt::render(scene, options);
     rt::write_render(o->output, scene, image);
     if (!o->quiet)

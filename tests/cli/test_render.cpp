@@ -1,0 +1,87 @@
+// `chromatrace render` end to end: a real render through the executable, and bad input.
+#include <gtest/gtest.h>
+
+#include <unistd.h>
+
+#include <filesystem>
+
+#include <fmt/core.h>
+
+#include "core/spectral_exr.h"
+#include "tests/cli/run_command.h"
+
+namespace ct {
+namespace {
+
+namespace fs = std::filesystem;
+using test::run_chromatrace;
+
+const std::string kBox = std::string(CHROMATRACE_SOURCE_DIR) + "/scenes/paper/box.json";
+
+class RenderCommand : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / fmt::format("ct-render-{}-{}", ::getpid(), counter_++);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  fs::path dir_;
+  static inline int counter_ = 0;
+};
+
+int line_count(const std::string& s) { return static_cast<int>(std::count(s.begin(), s.end(), '\n')); }
+
+TEST_F(RenderCommand, WritesASpectralExrWithComponentsAndObjectIds) {
+  const fs::path out = dir_ / "box.exr";
+  const auto r = run_chromatrace({"render", kBox, "-o", out.string(), "--spp", "2", "--resolution", "32x24",
+                                  "--bands", "400:700:20", "--components", "all", "--max-bounces", "3", "--quiet"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(r.err, "");
+  SpectralExrReader reader(out);
+  const SpectralExrInfo& info = reader.info();
+  EXPECT_EQ(info.width, 32);
+  EXPECT_EQ(info.height, 24);
+  EXPECT_EQ(info.bands.size(), 15u);
+  EXPECT_TRUE(info.has_object_ids);
+  EXPECT_EQ(info.object_names.at(6), "sphere");
+  for (const char* c : {"emission", "diffuse_direct", "glossy_indirect", "light.ceiling", "bounce.0", "bounce.3"})
+    EXPECT_NE(info.find_layer(c, SpectralQuantity::S0), nullptr) << c;
+  EXPECT_EQ(info.metadata.at("chromatrace.samples"), "2");
+
+  const auto check = run_chromatrace({"info", "--check", out.string()});
+  EXPECT_EQ(check.exit_code, 0) << check.out << check.err;
+}
+
+TEST_F(RenderCommand, BadInputGetsExitTwoAndOneLineNamingTheField) {
+  const fs::path out = dir_ / "out.exr";
+  struct Case {
+    std::vector<std::string> args;
+    std::string must_mention;
+  };
+  const std::vector<Case> cases = {
+      {{"render", (dir_ / "missing.json").string(), "-o", out.string()}, "missing.json"},
+      {{"render", kBox, "-o", out.string(), "--spp", "0"}, "--spp"},
+      {{"render", kBox, "-o", out.string(), "--max-bounces", "-2"}, "--max-bounces"},
+      {{"render", kBox, "-o", out.string(), "--bands", "380:785:10"}, "--bands"},
+      {{"render", kBox, "-o", out.string(), "--spectral-mode", "rgb"}, "--spectral-mode"},
+      {{"render", kBox, "-o", out.string(), "--components", "paths,colours"}, "--components"},
+      {{"render", kBox, "-o", out.string(), "--resolution", "64"}, "--resolution"},
+      {{"render", kBox, "-o", out.string(), "--time-limit", "-1"}, "--time-limit"},
+      {{"render", kBox, "-o", out.string(), "--threads", "-3"}, "--threads"},
+      {{"render", kBox, "-o", (dir_ / "no/such/dir/out.exr").string(), "--spp", "1", "--resolution", "4x4"}, "out.exr"},
+      {{"render", kBox}, "--output"},
+      {{"render", kBox, "-o", out.string(), "--no-such-option"}, "--no-such-option"},
+  };
+  for (const Case& c : cases) {
+    const auto r = run_chromatrace(c.args);
+    EXPECT_EQ(r.exit_code, 2) << c.must_mention << ": " << r.err;
+    EXPECT_EQ(line_count(r.err), 1) << r.err;
+    EXPECT_NE(r.err.find(c.must_mention), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(out)) << c.must_mention;
+  }
+  // Nothing half-written is left in the output directory.
+  EXPECT_TRUE(fs::is_empty(dir_));
+}
+
+}  // namespace
+}  // namespace ct
