@@ -1,7 +1,196 @@
+// chromatrace check-scene: validates a scene or an experiment series file and summarises it.
+#include <algorithm>
+#include <cstdio>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <fmt/core.h>
+#include <fmt/format.h>
+
 #include "cli/command.h"
+#include "core/geometry.h"
+#include "core/json_input.h"
+#include "core/scene.h"
+
 namespace ct::cli {
-Action add_check_scene(CLI::App& app) {
-  app.add_subcommand("check-scene", "Validate a scene");
-  return [] { return 0; };
+namespace {
+
+struct Options {
+  std::string file;
+  bool json = false;
+  bool quiet = false;
+  int threads = 0;
+};
+
+Json vec_json(const Vec3& v) { return Json::array({v.x(), v.y(), v.z()}); }
+
+const char* fov_axis_name(FovAxis axis) {
+  switch (axis) {
+    case FovAxis::Horizontal: return "horizontal";
+    case FovAxis::Vertical: return "vertical";
+    case FovAxis::Smaller: return "smaller";
+    case FovAxis::Larger: return "larger";
+  }
+  return "";
 }
+
+// What a person or a script wants to know about a valid scene; the text output is printed from this.
+Json scene_summary(const Scene& scene) {
+  std::size_t triangles = 0;
+  Bounds extent;
+  for (const TriangleMesh& mesh : scene_meshes(scene)) {
+    triangles += mesh.triangles.size();
+    extent.extend(bounds(mesh));
+  }
+  Json materials = Json::object();
+  for (const char* type : {"lambert", "dichromatic", "mirror"}) {
+    const auto n = std::count_if(scene.materials.begin(), scene.materials.end(),
+                                 [&](const Material& m) { return std::string_view(material_type_name(m)) == type; });
+    if (n > 0) materials[type] = n;
+  }
+  std::vector<std::string> groups;
+  for (const Light& light : scene.lights)
+    if (std::find(groups.begin(), groups.end(), light.group) == groups.end()) groups.push_back(light.group);
+
+  const Camera& c = scene.camera;
+  const RenderSettings& r = scene.render;
+  return {
+      {"name", scene.name},
+      {"spectra", scene.spectra.size()},
+      {"materials", materials},
+      {"objects", scene.objects.size()},
+      {"lights", scene.lights.size()},
+      {"light_groups", groups},
+      {"triangles", triangles},
+      {"extent_m", {{"min", vec_json(extent.lo)}, {"max", vec_json(extent.hi)}}},
+      {"camera",
+       {{"resolution", {c.width, c.height}},
+        {"fov_deg", c.fov_deg},
+        {"fov_axis", fov_axis_name(c.fov_axis)},
+        {"focal_length_mm", c.focal_length_mm()},
+        {"sensor_width_mm", c.sensor_width_mm},
+        {"position", vec_json(c.position)},
+        {"look_at", vec_json(c.look_at)}}},
+      {"render",
+       {{"samples", r.samples},
+        {"max_bounces", r.max_bounces},
+        {"seed", r.seed},
+        {"pixel_filter", r.pixel_filter == PixelFilter::Box ? "box" : "point"},
+        {"spectral_mode", r.spectral_mode == SpectralMode::Bands ? "bands" : "continuous"},
+        {"bands",
+         {{"count", r.bands.size()}, {"lo_nm", r.bands.min_wavelength()}, {"hi_nm", r.bands.max_wavelength()}}},
+        {"tessellation",
+         {{"segments", r.tessellation.segments},
+          {"rings", r.tessellation.rings.value_or(std::max(2, r.tessellation.segments / 2))}}}}},
+  };
+}
+
+std::string vec_text(const Json& v) {
+  return fmt::format("[{:.4g}, {:.4g}, {:.4g}]", v[0].get<double>(), v[1].get<double>(), v[2].get<double>());
+}
+
+std::string materials_text(const Json& by_type) {
+  std::string text;
+  int total = 0;
+  for (const auto& [type, n] : by_type.items()) {
+    text += fmt::format("{}{} {}", text.empty() ? "" : ", ", n.get<int>(), type);
+    total += n.get<int>();
+  }
+  return fmt::format("{} ({})", total, text);
+}
+
+std::string ids_text(int first, int last) {
+  return first == last ? fmt::format("id {}", first) : fmt::format("ids {}-{}", first, last);
+}
+
+void print_scene(const Json& s) {
+  const int objects = s["objects"].get<int>(), lights = s["lights"].get<int>();
+  const Json& c = s["camera"];
+  const Json& r = s["render"];
+  fmt::print("  spectra    {}\n", s["spectra"].get<int>());
+  fmt::print("  materials  {}\n", materials_text(s["materials"]));
+  fmt::print("  objects    {}{}\n", objects, objects ? fmt::format(" ({})", ids_text(1, objects)) : "");
+  fmt::print("  lights     {} ({}), groups: {}\n", lights, ids_text(objects + 1, objects + lights),
+             fmt::join(s["light_groups"].get<std::vector<std::string>>(), ", "));
+  fmt::print("  triangles  {}\n", s["triangles"].get<std::size_t>());
+  fmt::print("  extent     {} to {} m\n", vec_text(s["extent_m"]["min"]), vec_text(s["extent_m"]["max"]));
+  fmt::print(
+      "  camera     {}x{}, fov {:.6g} deg ({} axis), focal length {:.4g} mm on a {:.4g} mm wide sensor,\n"
+      "             at {} looking at {}\n",
+      c["resolution"][0].get<int>(), c["resolution"][1].get<int>(), c["fov_deg"].get<double>(),
+      c["fov_axis"].get<std::string>(), c["focal_length_mm"].get<double>(), c["sensor_width_mm"].get<double>(),
+      vec_text(c["position"]), vec_text(c["look_at"]));
+  fmt::print(
+      "  render     {} samples, max {} bounces, seed {}, {} pixel filter, {} spectral mode, {} bands over "
+      "{:.6g}-{:.6g} nm,\n             tessellation {} segments x {} rings\n",
+      r["samples"].get<int>(), r["max_bounces"].get<int>(), r["seed"].get<std::uint64_t>(),
+      r["pixel_filter"].get<std::string>(), r["spectral_mode"].get<std::string>(), r["bands"]["count"].get<int>(),
+      r["bands"]["lo_nm"].get<double>(), r["bands"]["hi_nm"].get<double>(), r["tessellation"]["segments"].get<int>(),
+      r["tessellation"]["rings"].get<int>());
+}
+
+// One line per variant: what sets it apart and what it should show.
+void print_variant(const Json& v) {
+  const Json& s = v["scene"];
+  const std::string extends = v["extends"].get<std::string>();
+  fmt::print("  {}: from {}; materials {}, {} light(s), max {} bounces, {} pixels; sensor {}; expects {}\n",
+             v["name"].get<std::string>(), extends.empty() ? "the base" : extends, materials_text(s["materials"]),
+             s["lights"].get<int>(), s["render"]["max_bounces"].get<int>(),
+             s["render"]["pixel_filter"].get<std::string>(), v["sensor"].dump(),
+             fmt::join(v["expect"].get<std::vector<std::string>>(), ", "));
+}
+
+int check(const Options& options) {
+  const Json document = read_json(options.file);
+  Json report;
+  if (document_format(document) == kSeriesFormat) {
+    const Series series = load_series(options.file, options.threads);
+    Json variants = Json::array();
+    for (const SeriesVariant& v : series.variants)
+      variants.push_back({{"name", v.name},
+                          {"extends", v.extends},
+                          {"expect", v.expect},
+                          {"sensor", v.sensor},
+                          {"scene", scene_summary(v.scene)}});
+    report = {{"file", options.file}, {"format", kSeriesFormat}, {"valid", true},
+              {"name", series.name},  {"base", series.base},     {"variants", variants}};
+  } else {
+    report = {{"file", options.file},
+              {"format", kSceneFormat},
+              {"valid", true},
+              {"scene", scene_summary(load_scene(options.file))}};
+  }
+
+  if (options.quiet) return 0;
+  if (options.json) {
+    fmt::print("{}\n", report.dump(2));
+    return 0;
+  }
+  if (report.contains("scene")) {
+    fmt::print("{}: valid scene \"{}\"\n", options.file, report["scene"]["name"].get<std::string>());
+    print_scene(report["scene"]);
+    return 0;
+  }
+  fmt::print("{}: valid series \"{}\" of {} variants on {}\n", options.file, report["name"].get<std::string>(),
+             report["variants"].size(), report["base"].get<std::string>());
+  for (const Json& v : report["variants"]) print_variant(v);
+  return 0;
+}
+
+}  // namespace
+
+Action add_check_scene(CLI::App& app) {
+  auto options = std::make_shared<Options>();
+  CLI::App* command = app.add_subcommand(
+      "check-scene",
+      "Validate a scene (chromatrace-scene/1) or an experiment series (chromatrace-series/1) and summarise it");
+  command->add_option("file", options->file, "scene or series JSON file")->required();
+  command->add_flag("--json", options->json, "print the summary as JSON");
+  command->add_flag("-q,--quiet", options->quiet, "print nothing when the file is valid (errors still go to stderr)");
+  command->add_option("--threads", options->threads, "threads for checking series variants (0: all)")
+      ->check(CLI::NonNegativeNumber);
+  return [options] { return check(*options); };
+}
+
 }  // namespace ct::cli

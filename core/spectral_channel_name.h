@@ -25,10 +25,10 @@ enum class SpectralQuantity { S0, S1, S2, S3, T };
 std::string_view quantity_name(SpectralQuantity quantity);
 
 struct SpectralChannelName {
-  std::string layer;                      // component layer, "" for the total (e.g. "light.ceiling")
+  std::string layer;  // component layer, "" for the total (e.g. "light.ceiling")
   SpectralQuantity quantity = SpectralQuantity::S0;
-  double wavelength_nm = 0;               // the band centre (for T.a.b: the incident wavelength a)
-  std::optional<double> reradiated_nm;    // T.a.b (bi-spectral re-radiation): the re-emitted wavelength b
+  double wavelength_nm = 0;             // the band centre (for T.a.b: the incident wavelength a)
+  std::optional<double> reradiated_nm;  // T.a.b (bi-spectral re-radiation): the re-emitted wavelength b
 
   bool operator==(const SpectralChannelName&) const = default;
 };
@@ -60,5 +60,8 @@ ComponentFamily component_family(std::string_view layer);
 std::string_view family_name(ComponentFamily family);
 // The seven path-type components, in the order the layout lists them.
 const std::vector<std::string>& path_type_components();
+// Whether a set of path-type components covers all light: emission and the four diffuse and glossy ones,
+// plus both transmission ones or neither (files of scenes without transmissive materials omit them).
+bool path_types_complete(const std::vector<std::string>& components);
 
 }  // namespace ct

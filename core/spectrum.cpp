@@ -176,15 +176,18 @@ double planck(double nm, double kelvin) {
 
 PiecewiseLinearSpectrum blackbody(double kelvin, double lo, double hi, double step_nm, bool normalise) {
   if (!(kelvin > 0)) throw InputError(fmt::format("blackbody: temperature must be > 0 K, got {}", kelvin));
-  std::vector<double> lambda, value;
-  for (double nm = lo; nm <= hi + 1e-9; nm += step_nm) {
-    lambda.push_back(nm);
-    value.push_back(planck(nm, kelvin));
+  // The peak (Wien) is a sample of its own, so a normalised spectrum reaches exactly 1 there.
+  const double peak_nm = kWien / kelvin * 1e9;
+  std::vector<double> lambda;
+  for (double nm = lo; nm <= hi + 1e-9; nm += step_nm) lambda.push_back(nm);
+  if (peak_nm > lo && peak_nm < hi) {
+    const auto at = std::lower_bound(lambda.begin(), lambda.end(), peak_nm);
+    if (*at != peak_nm) lambda.insert(at, peak_nm);
   }
+  std::vector<double> value;
+  for (double nm : lambda) value.push_back(planck(nm, kelvin));
   if (normalise) {
-    // Peak of the continuous function (Wien), clipped to the sampled range.
-    const double peak_nm = std::clamp(kWien / kelvin * 1e9, lo, hi);
-    const double peak = std::max(planck(peak_nm, kelvin), *std::max_element(value.begin(), value.end()));
+    const double peak = *std::max_element(value.begin(), value.end());
     for (double& v : value) v /= peak;
   }
   return PiecewiseLinearSpectrum(std::move(lambda), std::move(value), Extrapolation::Zero, "blackbody");

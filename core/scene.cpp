@@ -1,0 +1,644 @@
+#include "core/scene.h"
+
+#include <algorithm>
+#include <cmath>
+#include <exception>
+#include <limits>
+#include <map>
+#include <numbers>
+
+#include <fmt/core.h>
+#include <fmt/format.h>
+
+#include "core/cie.h"
+#include "core/csv.h"
+#include "core/error.h"
+#include "core/parallel.h"
+#include "core/ply.h"
+#include "core/rgb_to_spectrum.h"
+
+namespace ct {
+namespace {
+
+// Every spectrum must reach into the range of the CIE observer; a spectrum that does not was almost
+// certainly written in µm or m instead of nm.
+constexpr double kVisibleLo = 360.0;
+constexpr double kVisibleHi = 830.0;
+// Upper bound on tessellation parameters: 4096 × 2048 sphere triangles (16.7 M) is already far beyond
+// what convergence needs, and a typo such as 64000 must not exhaust memory.
+constexpr std::int64_t kMaxSegments = 4096;
+constexpr std::int64_t kMaxIntSetting = std::numeric_limits<int>::max();
+
+template <typename T>
+std::string names_of(const std::vector<T>& items) {
+  std::string text;
+  for (const T& item : items) text += (text.empty() ? "" : ", ") + item.name;
+  return text;
+}
+
+template <typename T>
+const T* find_by_name(const std::vector<T>& items, std::string_view name) {
+  for (const T& item : items)
+    if (item.name == name) return &item;
+  return nullptr;
+}
+
+// The largest or smallest sample of a spectrum, with its wavelength. The extremes of a piecewise-linear
+// function lie on its samples (and extrapolation adds only zero or the end values).
+struct Sample {
+  double value, nm;
+};
+Sample extreme_sample(const PiecewiseLinearSpectrum& s, bool largest) {
+  const std::vector<double>& v = s.values();
+  const auto it = largest ? std::max_element(v.begin(), v.end()) : std::min_element(v.begin(), v.end());
+  return {*it, s.wavelengths()[static_cast<std::size_t>(it - v.begin())]};
+}
+
+std::string describe_sample(const PiecewiseLinearSpectrum& s, const Sample& sample) {
+  return s.wavelengths().size() == 1 ? fmt::format("{}", sample.value)
+                                     : fmt::format("{} at {} nm", sample.value, sample.nm);
+}
+
+void check_visible_overlap(const JsonNode& node, double lo, double hi) {
+  if (hi < kVisibleLo || lo > kVisibleHi)
+    node.fail(fmt::format("wavelengths {} to {} do not overlap the visible range {}-{} nm (wavelengths are in nm)", lo,
+                          hi, kVisibleLo, kVisibleHi));
+}
+
+bool valid_group_name(std::string_view name) {
+  return !name.empty() && std::all_of(name.begin(), name.end(), [](char c) {
+    return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' || c == '-';
+  });
+}
+
+Vec3 nonzero_vec3(const JsonNode& node) {
+  const Vec3 v = node.vec3();
+  if (!(v.norm() > 0.0)) node.fail("must not be the zero vector");
+  return v;
+}
+
+int segments_setting(const JsonNode& node) { return static_cast<int>(node.integer_in(3, kMaxSegments)); }
+int rings_setting(const JsonNode& node) { return static_cast<int>(node.integer_in(2, kMaxSegments)); }
+
+QuadShape read_quad(const JsonNode& node) {
+  node.expect_object({"type", "corner", "edge1", "edge2"});
+  const QuadShape quad{node["corner"].vec3(), node["edge1"].vec3(), node["edge2"].vec3()};
+  if (!(surface_area(quad) > 0.0)) node.fail("edge1 and edge2 are parallel or zero, so the quad has no area");
+  return quad;
+}
+
+SphereShape read_sphere(const JsonNode& node, const Tessellation& defaults) {
+  node.expect_object({"type", "center", "radius", "segments", "rings"});
+  SphereShape sphere;
+  sphere.center = node["center"].vec3();
+  sphere.radius = node["radius"].number_above(0.0);
+  const auto segments = node.find("segments");
+  const auto rings = node.find("rings");
+  sphere.segments = segments ? segments_setting(*segments) : defaults.segments;
+  sphere.rings = rings ? rings_setting(*rings) : defaults.rings.value_or(std::max(2, sphere.segments / 2));
+  return sphere;
+}
+
+CylinderShape read_cylinder(const JsonNode& node, const Tessellation& defaults) {
+  node.expect_object({"type", "base", "axis", "radius", "height", "caps", "segments"});
+  CylinderShape cylinder;
+  cylinder.base = node["base"].vec3();
+  cylinder.axis = nonzero_vec3(node["axis"]).normalized();
+  cylinder.radius = node["radius"].number_above(0.0);
+  cylinder.height = node["height"].number_above(0.0);
+  const auto caps = node.find("caps");
+  cylinder.caps = caps ? caps->boolean() : true;
+  const auto segments = node.find("segments");
+  cylinder.segments = segments ? segments_setting(*segments) : defaults.segments;
+  return cylinder;
+}
+
+BoxShape read_box(const JsonNode& node) {
+  node.expect_object({"type", "corner", "edge1", "edge2", "edge3"});
+  const BoxShape box{node["corner"].vec3(), node["edge1"].vec3(), node["edge2"].vec3(), node["edge3"].vec3()};
+  if (!(std::abs(box.edge1.cross(box.edge2).dot(box.edge3)) > 0.0))
+    node.fail("edge1, edge2 and edge3 are coplanar, so the box has no volume");
+  return box;
+}
+
+MeshShape read_mesh(const JsonNode& node, const std::filesystem::path& directory) {
+  node.expect_object({"type", "file"});
+  const JsonNode file = node["file"];
+  MeshShape mesh;
+  mesh.file = file.non_empty_string();
+  const std::filesystem::path path = (directory / mesh.file).lexically_normal();
+  try {
+    mesh.mesh = read_ply(path);
+  } catch (const InputError& e) {
+    file.fail(e.what());
+  }
+  if (mesh.mesh.triangles.empty()) file.fail(fmt::format("{}: has no faces", path.string()));
+  return mesh;
+}
+
+Camera read_camera(const JsonNode& node) {
+  node.expect_object({"position", "look_at", "up", "fov_deg", "fov_axis", "resolution", "sensor_width_mm"});
+  Camera camera;
+  camera.position = node["position"].vec3();
+  camera.look_at = node["look_at"].vec3();
+  if (!((camera.look_at - camera.position).norm() > 0.0)) node["look_at"].fail("must differ from position");
+  const auto up = node.find("up");
+  camera.up = up ? nonzero_vec3(*up) : Vec3(Vec3::UnitZ());
+  if (camera.forward().cross(camera.up.normalized()).norm() < 1e-9) {
+    if (up) up->fail("is parallel to the viewing direction");
+    node.fail("the default up [0, 0, 1] is parallel to the viewing direction; give \"up\"");
+  }
+
+  const JsonNode fov = node["fov_deg"];
+  camera.fov_deg = fov.number_above(0.0);
+  if (!(camera.fov_deg < 180.0)) fov.fail(fmt::format("must be < 180, got {}", camera.fov_deg));
+  if (const auto axis = node.find("fov_axis")) {
+    const std::string name = axis->choice({"horizontal", "vertical", "smaller", "larger"});
+    camera.fov_axis = name == "horizontal" ? FovAxis::Horizontal
+                      : name == "vertical" ? FovAxis::Vertical
+                      : name == "smaller"  ? FovAxis::Smaller
+                                           : FovAxis::Larger;
+  }
+
+  const JsonNode resolution = node["resolution"];
+  const std::vector<JsonNode> size = resolution.elements();
+  if (size.size() != 2) resolution.fail(fmt::format("must be [width, height], got {} numbers", size.size()));
+  camera.width = static_cast<int>(size[0].integer_in(1, 65536));
+  camera.height = static_cast<int>(size[1].integer_in(1, 65536));
+
+  if (const auto sensor = node.find("sensor_width_mm")) {
+    camera.sensor_width_mm = sensor->number();
+    // Real sensors are a few mm to a few hundred mm wide; 0.036 is a width in metres.
+    if (!(camera.sensor_width_mm >= 1.0 && camera.sensor_width_mm <= 1000.0))
+      sensor->fail(fmt::format("must be a width in mm within [1, 1000], got {}", camera.sensor_width_mm));
+  }
+  return camera;
+}
+
+RenderSettings read_render(const JsonNode& node) {
+  node.expect_object({"samples", "max_bounces", "seed", "pixel_filter", "bands", "spectral_mode", "tessellation"});
+  RenderSettings render;
+  if (const auto n = node.find("samples")) render.samples = static_cast<int>(n->integer_in(1, kMaxIntSetting));
+  if (const auto n = node.find("max_bounces")) render.max_bounces = static_cast<int>(n->integer_in(0, kMaxIntSetting));
+  if (const auto n = node.find("seed"))
+    render.seed = static_cast<std::uint64_t>(n->integer_in(0, std::numeric_limits<std::int64_t>::max()));
+  if (const auto n = node.find("pixel_filter"))
+    render.pixel_filter = n->choice({"box", "point"}) == "box" ? PixelFilter::Box : PixelFilter::Point;
+  if (const auto n = node.find("spectral_mode"))
+    render.spectral_mode =
+        n->choice({"bands", "continuous"}) == "bands" ? SpectralMode::Bands : SpectralMode::Continuous;
+  if (const auto n = node.find("bands")) {
+    render.bands = Bands::parse(n->string(), n->location());
+    check_visible_overlap(*n, render.bands.min_wavelength(), render.bands.max_wavelength());
+  }
+  if (const auto t = node.find("tessellation")) {
+    t->expect_object({"segments", "rings"});
+    if (const auto n = t->find("segments")) render.tessellation.segments = segments_setting(*n);
+    if (const auto n = t->find("rings")) render.tessellation.rings = rings_setting(*n);
+  }
+  return render;
+}
+
+// Reads the parts of one scene document that refer to each other: spectra by name, materials by name,
+// and CSV tables, each file read once however many spectra use it.
+class SceneReader {
+ public:
+  explicit SceneReader(std::filesystem::path directory) : directory_(std::move(directory)) {}
+
+  Scene read(const JsonNode& root);
+
+ private:
+  PiecewiseLinearSpectrum spectrum_source(const JsonNode& node);
+  PiecewiseLinearSpectrum csv_spectrum(const JsonNode& node);
+  PiecewiseLinearSpectrum illuminant_spectrum(const JsonNode& node);
+  PiecewiseLinearSpectrum samples_spectrum(const JsonNode& node);
+  SpectrumRef spectrum_ref(const JsonNode& node);
+  SpectrumRef reflectance(const JsonNode& node);
+  Material material(const std::string& name, const JsonNode& node);
+  std::size_t material_index(const JsonNode& node) const;
+  Shape object_shape(const JsonNode& node) const;
+  LightShape light_shape(const JsonNode& node) const;
+  Light light(const JsonNode& node);
+
+  std::filesystem::path directory_;
+  std::map<std::string, CsvTable> csv_tables_;
+  Scene scene_;
+};
+
+constexpr std::string_view kSpectrumObject =
+    "an object with one of \"csv\", \"constant\", \"blackbody_k\", \"illuminant\", \"samples\", \"rgb\"";
+
+PiecewiseLinearSpectrum SceneReader::spectrum_source(const JsonNode& node) {
+  static constexpr std::string_view kinds[] = {"csv", "constant", "blackbody_k", "illuminant", "samples", "rgb"};
+  if (!node.json().is_object())
+    node.fail(fmt::format("must be {}, got {}", kSpectrumObject, describe_json(node.json())));
+  std::vector<std::string_view> given;
+  for (std::string_view kind : kinds)
+    if (node.has(kind)) given.push_back(kind);
+  if (given.size() != 1)
+    node.fail(given.empty()
+                  ? fmt::format("must be {}", kSpectrumObject)
+                  : fmt::format("gives both \"{}\" and \"{}\"; a spectrum has one source", given[0], given[1]));
+
+  PiecewiseLinearSpectrum spectrum;
+  const std::string_view kind = given[0];
+  if (kind == "csv") {
+    spectrum = csv_spectrum(node);
+  } else if (kind == "constant") {
+    node.expect_object({"constant"});
+    spectrum = PiecewiseLinearSpectrum::constant(node["constant"].number());
+  } else if (kind == "blackbody_k") {
+    node.expect_object({"blackbody_k"});
+    // Normalised to 1 at its maximum over 300-830 nm: the light's scale sets the absolute radiance.
+    spectrum = blackbody(node["blackbody_k"].number_in(100.0, 100000.0), 300.0, 830.0, 1.0, true);
+  } else if (kind == "illuminant") {
+    spectrum = illuminant_spectrum(node);
+  } else if (kind == "samples") {
+    spectrum = samples_spectrum(node);
+  } else {
+    node.expect_object({"rgb"});
+    const JsonNode rgb = node["rgb"];
+    const std::vector<JsonNode> c = rgb.elements();
+    if (c.size() != 3) rgb.fail(fmt::format("must be [r, g, b], got {} numbers", c.size()));
+    spectrum = rgb_to_spectrum({c[0].number_in(0.0, 1.0), c[1].number_in(0.0, 1.0), c[2].number_in(0.0, 1.0)});
+  }
+
+  const Sample lowest = extreme_sample(spectrum, false);
+  if (lowest.value < 0.0) node.fail(fmt::format("values must be >= 0, got {}", describe_sample(spectrum, lowest)));
+  check_visible_overlap(node, spectrum.min_wavelength(), spectrum.max_wavelength());
+  return spectrum;
+}
+
+PiecewiseLinearSpectrum SceneReader::csv_spectrum(const JsonNode& node) {
+  node.expect_object({"csv", "column", "extend"});
+  const JsonNode csv = node["csv"];
+  const std::string path = (directory_ / csv.non_empty_string()).lexically_normal().string();
+  auto cached = csv_tables_.find(path);
+  if (cached == csv_tables_.end()) {
+    try {
+      cached = csv_tables_.emplace(path, read_csv(path)).first;
+    } catch (const InputError& e) {
+      csv.fail(e.what());
+    }
+  }
+  const CsvTable& table = cached->second;
+
+  std::string column;
+  if (const auto name = node.find("column")) {
+    column = name->string();
+    if (std::find(table.columns.begin(), table.columns.end(), column) == table.columns.end())
+      name->fail(fmt::format("{} has no column \"{}\" (columns: {})", path, column, fmt::join(table.columns, ", ")));
+  } else if (table.columns.size() == 1) {
+    column = table.columns[0];
+  } else {
+    node.fail(
+        fmt::format("{} has several columns ({}); choose one with \"column\"", path, fmt::join(table.columns, ", ")));
+  }
+
+  PiecewiseLinearSpectrum spectrum;
+  try {
+    spectrum = table.spectrum(column);
+  } catch (const InputError& e) {
+    csv.fail(e.what());
+  }
+  const bool clamp = node.has("extend") && node["extend"].choice({"zero", "clamp"}) == "clamp";
+  return clamp ? PiecewiseLinearSpectrum(spectrum.wavelengths(), spectrum.values(), Extrapolation::Clamp, path)
+               : spectrum;
+}
+
+PiecewiseLinearSpectrum SceneReader::illuminant_spectrum(const JsonNode& node) {
+  node.expect_object({"illuminant", "cct_k"});
+  const JsonNode name = node["illuminant"];
+  const std::string illuminant = name.string();
+  if (illuminant == "D") return cie::daylight(node["cct_k"].number_in(4000.0, 25000.0));
+  if (const auto cct = node.find("cct_k")) cct->fail("applies only to \"illuminant\": \"D\" (daylight at a CCT)");
+  try {
+    return cie::illuminant(illuminant);
+  } catch (const InputError& e) {
+    name.fail(e.what());
+  }
+}
+
+PiecewiseLinearSpectrum SceneReader::samples_spectrum(const JsonNode& node) {
+  node.expect_object({"samples", "extend"});
+  const JsonNode samples = node["samples"];
+  std::vector<double> wavelengths, values;
+  for (const JsonNode& pair : samples.elements()) {
+    const std::vector<JsonNode> nm_value = pair.elements();
+    if (nm_value.size() != 2) pair.fail(fmt::format("must be [wavelength_nm, value], got {} numbers", nm_value.size()));
+    const double nm = nm_value[0].number();
+    if (!wavelengths.empty() && !(nm > wavelengths.back()))
+      nm_value[0].fail(fmt::format("wavelengths must increase, but {} follows {}", nm, wavelengths.back()));
+    wavelengths.push_back(nm);
+    values.push_back(nm_value[1].number());
+  }
+  if (wavelengths.size() < 2) samples.fail(fmt::format("needs at least 2 samples, got {}", wavelengths.size()));
+  const bool clamp = node.has("extend") && node["extend"].choice({"zero", "clamp"}) == "clamp";
+  return PiecewiseLinearSpectrum(std::move(wavelengths), std::move(values),
+                                 clamp ? Extrapolation::Clamp : Extrapolation::Zero, samples.location());
+}
+
+SpectrumRef SceneReader::spectrum_ref(const JsonNode& node) {
+  if (node.json().is_object()) return {"", spectrum_source(node)};
+  if (!node.json().is_string())
+    node.fail(fmt::format("must be a spectrum name or {}, got {}", kSpectrumObject, describe_json(node.json())));
+  const std::string name = node.string();
+  if (const NamedSpectrum* named = scene_.find_spectrum(name)) return {name, named->spectrum};
+  node.fail(scene_.spectra.empty()
+                ? fmt::format("unknown spectrum \"{}\" (the scene defines no spectra)", name)
+                : fmt::format("unknown spectrum \"{}\" (spectra: {})", name, names_of(scene_.spectra)));
+}
+
+SpectrumRef SceneReader::reflectance(const JsonNode& node) {
+  SpectrumRef ref = spectrum_ref(node);
+  const Sample highest = extreme_sample(ref.spectrum, true);
+  if (highest.value > 1.0)
+    node.fail(fmt::format("{} reaches {}, but a reflectance must be in [0, 1]",
+                          ref.name.empty() ? std::string("the spectrum") : fmt::format("spectrum \"{}\"", ref.name),
+                          describe_sample(ref.spectrum, highest)));
+  return ref;
+}
+
+Material SceneReader::material(const std::string& name, const JsonNode& node) {
+  const std::string type = node["type"].choice({"lambert", "dichromatic", "mirror"});
+  if (type == "lambert") {
+    node.expect_object({"type", "reflectance"});
+    return {name, LambertMaterial{reflectance(node["reflectance"])}};
+  }
+  if (type == "mirror") {
+    node.expect_object({"type", "reflectance"});
+    return {name, MirrorMaterial{reflectance(node["reflectance"])}};
+  }
+
+  node.expect_object({"type", "diffuse", "specular", "lobe", "roughness", "exponent"});
+  DichromaticMaterial dichromatic;
+  dichromatic.diffuse = reflectance(node["diffuse"]);
+  dichromatic.specular = node["specular"].number_in(0.0, 1.0);
+  const bool ggx = !node.has("lobe") || node["lobe"].choice({"ggx", "phong"}) == "ggx";
+  if (const auto other = node.find(ggx ? "exponent" : "roughness"))
+    other->fail(fmt::format("applies only to \"lobe\": \"{}\"", ggx ? "phong" : "ggx"));
+  if (ggx)
+    dichromatic.lobe = DichromaticMaterial::Ggx{node["roughness"].number_in(0.0, 1.0)};
+  else
+    dichromatic.lobe = DichromaticMaterial::Phong{node["exponent"].number_at_least(0.0)};
+  // Neither lobe reflects more than k_s, so this bound keeps the material from creating energy.
+  const double body = extreme_sample(dichromatic.diffuse.spectrum, true).value;
+  if (body + dichromatic.specular > 1.0)
+    node["specular"].fail(
+        fmt::format("the diffuse maximum {} plus specular {} exceeds 1, so the material would "
+                    "reflect more light than it receives",
+                    body, dichromatic.specular));
+  return {name, std::move(dichromatic)};
+}
+
+std::size_t SceneReader::material_index(const JsonNode& node) const {
+  const std::string name = node.string();
+  const Material* material = scene_.find_material(name);
+  if (!material) node.fail(fmt::format("unknown material \"{}\" (materials: {})", name, names_of(scene_.materials)));
+  return static_cast<std::size_t>(material - scene_.materials.data());
+}
+
+Shape SceneReader::object_shape(const JsonNode& node) const {
+  const std::string type = node["type"].choice({"quad", "sphere", "cylinder", "box", "mesh"});
+  const Tessellation& defaults = scene_.render.tessellation;
+  if (type == "quad") return read_quad(node);
+  if (type == "sphere") return read_sphere(node, defaults);
+  if (type == "cylinder") return read_cylinder(node, defaults);
+  if (type == "box") return read_box(node);
+  return read_mesh(node, directory_);
+}
+
+LightShape SceneReader::light_shape(const JsonNode& node) const {
+  if (node["type"].choice({"quad", "sphere"}) == "quad") return read_quad(node);
+  return read_sphere(node, scene_.render.tessellation);
+}
+
+Light SceneReader::light(const JsonNode& node) {
+  node.expect_object({"name", "shape", "radiance", "scale", "group", "two_sided", "material"});
+  Light light;
+  light.name = node["name"].non_empty_string();
+  light.shape = light_shape(node["shape"]);
+  light.radiance = spectrum_ref(node["radiance"]);
+  if (const auto scale = node.find("scale")) light.scale = scale->number_at_least(0.0);
+  if (const auto group = node.find("group")) {
+    light.group = group->string();
+    if (!valid_group_name(light.group))
+      group->fail(
+          fmt::format("\"{}\" cannot name an output component: use letters, digits, \"_\" and \"-\"", light.group));
+  } else {
+    light.group = light.name;
+    if (!valid_group_name(light.group))
+      node["name"].fail(
+          fmt::format("\"{}\" is also the light's group, which names an output component: use "
+                      "letters, digits, \"_\" and \"-\", or give \"group\"",
+                      light.name));
+  }
+  if (const auto two_sided = node.find("two_sided")) light.two_sided = two_sided->boolean();
+  if (const auto material = node.find("material")) light.material = material_index(*material);
+  return light;
+}
+
+Scene SceneReader::read(const JsonNode& root) {
+  const std::string format = root["format"].string();
+  if (format != kSceneFormat) root["format"].fail(fmt::format("must be \"{}\", got \"{}\"", kSceneFormat, format));
+  root.expect_object(
+      {"format", "name", "description", "spectra", "materials", "objects", "lights", "camera", "render"});
+  if (const auto name = root.find("name")) scene_.name = name->non_empty_string();
+  if (const auto description = root.find("description")) scene_.description = description->string();
+  // Render settings first: they hold the tessellation defaults the shapes use.
+  if (const auto render = root.find("render")) scene_.render = read_render(*render);
+
+  if (const auto spectra = root.find("spectra"))
+    for (const auto& [name, node] : spectra->members()) scene_.spectra.push_back({name, spectrum_source(node)});
+  for (const auto& [name, node] : root["materials"].members()) scene_.materials.push_back(material(name, node));
+
+  // Objects and lights share one namespace, as their names label the same object-id image.
+  std::map<std::string, std::string> owner_of_name;
+  auto claim_name = [&](const JsonNode& node) {
+    const std::string name = node["name"].non_empty_string();
+    const auto [it, fresh] = owner_of_name.emplace(name, node.path());
+    if (!fresh) node["name"].fail(fmt::format("\"{}\" is already the name of {}", name, it->second));
+  };
+  int id = 1;
+  for (const JsonNode& node : root["objects"].elements()) {
+    node.expect_object({"name", "shape", "material"});
+    claim_name(node);
+    scene_.objects.push_back(
+        {node["name"].string(), id++, material_index(node["material"]), object_shape(node["shape"])});
+  }
+  const JsonNode lights = root["lights"];
+  for (const JsonNode& node : lights.elements()) {
+    Light light = this->light(node);
+    claim_name(node);
+    light.id = id++;
+    scene_.lights.push_back(std::move(light));
+  }
+  if (scene_.lights.empty()) lights.fail("a scene needs at least one light");
+
+  scene_.camera = read_camera(root["camera"]);
+  return std::move(scene_);
+}
+
+}  // namespace
+
+const char* material_type_name(const Material& material) {
+  static constexpr const char* names[] = {"lambert", "dichromatic", "mirror"};
+  return names[material.model.index()];
+}
+
+Vec3 Camera::forward() const { return (look_at - position).normalized(); }
+Vec3 Camera::right() const { return forward().cross(up).normalized(); }
+Vec3 Camera::image_up() const { return right().cross(forward()); }
+
+double Camera::tan_half_width() const {
+  const double t = std::tan(fov_deg * std::numbers::pi / 360.0);
+  const bool horizontal = fov_axis == FovAxis::Horizontal || (fov_axis == FovAxis::Smaller && width <= height) ||
+                          (fov_axis == FovAxis::Larger && width >= height);
+  return horizontal ? t : t * width / height;
+}
+
+double Camera::tan_half_height() const { return tan_half_width() * height / width; }
+
+double Camera::focal_length_mm() const { return 0.5 * sensor_width_mm / tan_half_width(); }
+
+Vec3 Camera::ray_direction(double px, double py) const {
+  const double x = (2.0 * px / width - 1.0) * tan_half_width();
+  const double y = (1.0 - 2.0 * py / height) * tan_half_height();
+  return (forward() + x * right() + y * image_up()).normalized();
+}
+
+double Camera::off_axis_angle(double px, double py) const {
+  const double x = (2.0 * px / width - 1.0) * tan_half_width();
+  const double y = (1.0 - 2.0 * py / height) * tan_half_height();
+  return std::atan(std::hypot(x, y));
+}
+
+const Material* Scene::find_material(std::string_view name) const { return find_by_name(materials, name); }
+const NamedSpectrum* Scene::find_spectrum(std::string_view name) const { return find_by_name(spectra, name); }
+
+Scene parse_scene(const Json& document, const std::string& source, const std::filesystem::path& directory) {
+  const JsonNode root(document, source);
+  Scene scene = SceneReader(directory).read(root);
+  scene.source = source;
+  scene.directory = directory;
+  scene.json = document;
+  return scene;
+}
+
+Scene load_scene(const std::filesystem::path& file) {
+  Scene scene = parse_scene(read_json(file), file.string(), file.parent_path());
+  if (scene.name.empty()) scene.name = file.stem().string();
+  return scene;
+}
+
+std::vector<TriangleMesh> scene_meshes(const Scene& scene) {
+  std::vector<TriangleMesh> meshes;
+  for (const Object& object : scene.objects) meshes.push_back(tessellate(object.shape));
+  for (const Light& light : scene.lights)
+    meshes.push_back(std::visit([](const auto& shape) { return tessellate(shape); }, light.shape));
+  return meshes;
+}
+
+std::string document_format(const Json& document) {
+  if (!document.is_object()) return "";
+  const auto format = document.find("format");
+  return format != document.end() && format->is_string() ? format->get<std::string>() : "";
+}
+
+const std::vector<std::string>& histogram_structures() {
+  static const std::vector<std::string> names = {
+      "linear",        // matte surface under one light: a line along the body colour (LD)
+      "planar",        // body plus interface reflection: a plane spanned by LD and LS
+      "L",             // sharp highlight: the plane's points veer sharply towards the light colour
+      "P",             // broad highlight
+      "T",             // highlight leaving the body line part-way (skewed T)
+      "superposed",    // several luminaires of different spectra: their structures add
+      "thickened",     // interreflection (or noise): clusters gain volume off their line or plane
+      "fork",          // two surfaces dominate the indirect light on one object
+      "banana",        // highlights meeting interreflection: curved clusters
+      "interpolated",  // pixel area integration / demosaicing: colours between clusters
+      "bent",          // gamma: clusters curve (lines through the origin stay lines)
+      "clipped",       // saturation: clusters flattened onto faces of the RGB cube
+      "shifted",       // dark current and black level: clusters move off the origin
+  };
+  return names;
+}
+
+Series load_series(const std::filesystem::path& file, int threads) {
+  const Json document = read_json(file);
+  const JsonNode root(document, file.string());
+  const std::string format = root["format"].string();
+  if (format != kSeriesFormat) root["format"].fail(fmt::format("must be \"{}\", got \"{}\"", kSeriesFormat, format));
+  root.expect_object({"format", "name", "description", "base", "variants"});
+
+  Series series;
+  series.source = file.string();
+  series.name = root.find("name") ? root["name"].non_empty_string() : file.stem().string();
+  if (const auto description = root.find("description")) series.description = description->string();
+  series.base = root["base"].non_empty_string();
+  try {
+    series.base_scene = load_scene((file.parent_path() / series.base).lexically_normal());
+  } catch (const InputError& e) {
+    root["base"].fail(e.what());
+  }
+
+  // Merge in order (a variant may extend an earlier one), then validate the merged scenes in parallel.
+  const JsonNode variants = root["variants"];
+  std::vector<Json> merged;  // merged[i]: variant i's scene document
+  for (const JsonNode& node : variants.elements()) {
+    node.expect_object({"name", "description", "extends", "patch", "sensor", "expect"});
+    SeriesVariant variant;
+    variant.name = node["name"].non_empty_string();
+    if (find_by_name(series.variants, variant.name))
+      node["name"].fail(fmt::format("\"{}\" is already the name of an earlier variant", variant.name));
+    if (const auto description = node.find("description")) variant.description = description->string();
+
+    Json scene_json = series.base_scene.json;
+    variant.sensor = Json::object();
+    if (const auto extends = node.find("extends")) {
+      variant.extends = extends->string();
+      const SeriesVariant* earlier = find_by_name(series.variants, variant.extends);
+      if (!earlier) extends->fail(fmt::format("\"{}\" is not the name of an earlier variant", variant.extends));
+      scene_json = merged[static_cast<std::size_t>(earlier - series.variants.data())];
+      variant.sensor = earlier->sensor;
+    }
+    auto merge_patch_at = [&](const char* key, Json& target) {
+      const auto patch = node.find(key);
+      if (!patch) return Json::object();
+      if (!patch->json().is_object())
+        patch->fail(fmt::format("must be an object (a JSON Merge Patch), got {}", describe_json(patch->json())));
+      target.merge_patch(patch->json());
+      return patch->json();
+    };
+    variant.patch = merge_patch_at("patch", scene_json);
+    merge_patch_at("sensor", variant.sensor);
+
+    for (const JsonNode& structure : node["expect"].elements()) {
+      const std::string name = structure.string();
+      const std::vector<std::string>& known = histogram_structures();
+      if (std::find(known.begin(), known.end(), name) == known.end())
+        structure.fail(fmt::format("unknown structure \"{}\" (known: {})", name, fmt::join(known, ", ")));
+      variant.expect.push_back(name);
+    }
+    merged.push_back(std::move(scene_json));
+    series.variants.push_back(std::move(variant));
+  }
+  if (series.variants.empty()) variants.fail("a series needs at least one variant");
+
+  std::vector<std::exception_ptr> errors(series.variants.size());
+  parallel_for(series.variants.size(), threads, [&](std::size_t i) {
+    try {
+      SeriesVariant& variant = series.variants[i];
+      const std::string source = fmt::format("{}: variants[{}] \"{}\"", file.string(), i, variant.name);
+      variant.scene = parse_scene(merged[i], source, series.base_scene.directory);
+      if (variant.scene.name.empty()) variant.scene.name = series.base_scene.name;
+    } catch (...) {
+      errors[i] = std::current_exception();
+    }
+  });
+  for (const std::exception_ptr& error : errors)
+    if (error) std::rethrow_exception(error);
+  return series;
+}
+
+}  // namespace ct

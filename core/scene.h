@@ -1,0 +1,208 @@
+#pragma once
+// Scenes (`chromatrace-scene/1`) and experiment series (`chromatrace-series/1`): reading, validation and
+// the resolved data model that the reference tracer and the exporters use. The format, every key, its
+// units and each material's BRDF are documented in docs/scene-format.md.
+//
+// Loading validates everything a renderer relies on (types, ranges, references by name, that files exist
+// and parse, that meshes load), so that code using a Scene needs no checks of its own. Every problem is a
+// ct::InputError of one line naming the file and the JSON path, e.g.
+//   "box.json: objects[3].material: unknown material \"plstic\" (materials: wall, plastic)".
+
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <variant>
+#include <vector>
+
+#include "core/geometry.h"
+#include "core/json_input.h"
+#include "core/spectrum.h"
+
+namespace ct {
+
+inline constexpr std::string_view kSceneFormat = "chromatrace-scene/1";
+inline constexpr std::string_view kSeriesFormat = "chromatrace-series/1";
+
+// ---- Spectra and materials --------------------------------------------------------------------------
+
+struct NamedSpectrum {
+  std::string name;
+  PiecewiseLinearSpectrum spectrum;
+};
+
+// A spectrum as a material or light uses it: resolved, and named when it came from `spectra`.
+struct SpectrumRef {
+  std::string name;  // key in the scene's `spectra`; empty when given inline
+  PiecewiseLinearSpectrum spectrum;
+};
+
+// f = R(λ) / π
+struct LambertMaterial {
+  SpectrumRef reflectance;
+};
+
+// f = ρ_d(λ) / π + k_s · f_lobe: a Lambertian body term plus a spectrally flat interface lobe (the
+// reference tracer's reference_tracer/bsdf.h evaluates the lobes). Validation guarantees max ρ_d + k_s <= 1.
+struct DichromaticMaterial {
+  // GGX microfacet lobe, alpha = roughness² (Blender's convention), separable Smith masking, no Fresnel
+  // factor; roughness 0 is a perfect mirror lobe.
+  struct Ggx {
+    double roughness;
+    double alpha() const { return roughness * roughness; }
+  };
+  // Normalised modified Phong lobe (n + 2) / (2π) · cos^n of the angle to the mirror direction.
+  struct Phong {
+    double exponent;
+  };
+
+  SpectrumRef diffuse;
+  double specular = 0.0;  // k_s
+  std::variant<Ggx, Phong> lobe;
+};
+
+// Perfect specular reflection scaled by R(λ).
+struct MirrorMaterial {
+  SpectrumRef reflectance;
+};
+
+struct Material {
+  std::string name;
+  std::variant<LambertMaterial, DichromaticMaterial, MirrorMaterial> model;
+};
+
+// "lambert", "dichromatic" or "mirror".
+const char* material_type_name(const Material& material);
+
+// ---- Lights and objects ------------------------------------------------------------------------------
+
+using LightShape = std::variant<QuadShape, SphereShape>;
+
+struct Light {
+  std::string name;
+  int id = 0;  // object id: the lights follow the objects (see Object::id)
+  LightShape shape;
+  SpectrumRef radiance;  // relative spectrum; radiance · scale is in W m⁻² sr⁻¹ nm⁻¹
+  double scale = 1.0;
+  std::string group;                    // names the light's output component `light.<group>`; defaults to the name
+  bool two_sided = false;               // a one-sided quad emits on the side of edge1 × edge2; a sphere emits outward
+  std::optional<std::size_t> material;  // index into Scene::materials: the emitter also reflects with it
+
+  PiecewiseLinearSpectrum emitted_radiance() const { return radiance.spectrum.scaled(scale); }
+};
+
+struct Object {
+  std::string name;
+  int id = 0;                // 1, 2, ... in file order; 0 is the background
+  std::size_t material = 0;  // index into Scene::materials
+  Shape shape;
+};
+
+// ---- Camera and render settings -----------------------------------------------------------------------
+
+enum class FovAxis { Horizontal, Vertical, Smaller, Larger };
+
+// A pinhole camera. The sensor is `sensor_width_mm` wide along the image's horizontal axis with square
+// pixels, which with the field of view fixes the focal length (and so cos⁴ fall-off and f-number).
+struct Camera {
+  Vec3 position = Vec3::Zero();
+  Vec3 look_at = Vec3::UnitY();
+  Vec3 up = Vec3::UnitZ();
+  double fov_deg = 40.0;  // along fov_axis
+  FovAxis fov_axis = FovAxis::Horizontal;
+  int width = 256, height = 256;
+  double sensor_width_mm = 36.0;
+
+  Vec3 forward() const;            // unit, towards look_at
+  Vec3 right() const;              // unit, forward × up
+  Vec3 image_up() const;           // unit, right × forward
+  double tan_half_width() const;   // tan(horizontal field of view / 2)
+  double tan_half_height() const;  // tan(vertical field of view / 2)
+  double focal_length_mm() const;
+  // Unit world direction of the ray through image point (px, py), in pixels from the top-left corner of
+  // the image: px in [0, width], py in [0, height]; pixel (i, j) has its centre at (i + 0.5, j + 0.5).
+  Vec3 ray_direction(double px, double py) const;
+  // The angle α (radians) between that ray and the optical axis: paper eq. (2), cos⁴α fall-off.
+  double off_axis_angle(double px, double py) const;
+};
+
+enum class PixelFilter { Box, Point };
+enum class SpectralMode { Bands, Continuous };
+
+struct Tessellation {
+  int segments = kDefaultSegments;  // around spheres and cylinders
+  std::optional<int> rings;         // pole to pole on spheres; unset: half the sphere's segments
+};
+
+// Defaults that command-line options override.
+struct RenderSettings {
+  int samples = 64;     // paths per pixel
+  int max_bounces = 8;  // scattering events per path: 0 emitters only, 1 direct light, >= 2 global
+  std::uint64_t seed = 1;
+  PixelFilter pixel_filter = PixelFilter::Box;  // box: integrate over the pixel area; point: its centre
+  SpectralMode spectral_mode = SpectralMode::Bands;
+  Bands bands = Bands::uniform(380.0, 780.0, 10.0);
+  Tessellation tessellation;
+};
+
+// ---- Scene ---------------------------------------------------------------------------------------------
+
+struct Scene {
+  std::string source;               // names the scene in messages: its file, or a series variant
+  std::filesystem::path directory;  // paths inside the scene are relative to it
+  std::string name;                 // `name`, or the file's stem
+  std::string description;
+  Json json;  // the document as given (a series variant: patched), for embedding
+  std::vector<NamedSpectrum> spectra;
+  std::vector<Material> materials;
+  std::vector<Object> objects;
+  std::vector<Light> lights;
+  Camera camera;
+  RenderSettings render;
+
+  const Material* find_material(std::string_view name) const;
+  const NamedSpectrum* find_spectrum(std::string_view name) const;
+  // Number of object ids in use: objects then lights, so ids run 1 .. id_count().
+  int id_count() const { return static_cast<int>(objects.size() + lights.size()); }
+};
+
+Scene load_scene(const std::filesystem::path& file);
+// Validates a scene document. `source` prefixes every message; relative paths resolve against `directory`.
+Scene parse_scene(const Json& document, const std::string& source, const std::filesystem::path& directory);
+
+// World-space triangles of every object and then every light: element i has object id i + 1.
+std::vector<TriangleMesh> scene_meshes(const Scene& scene);
+
+// ---- Experiment series ---------------------------------------------------------------------------------
+
+// The colour-histogram structures a variant can be expected to show (paper-summary.md).
+const std::vector<std::string>& histogram_structures();
+
+struct SeriesVariant {
+  std::string name;
+  std::string description;
+  std::string extends;  // an earlier variant whose merged scene and sensor this one patches; empty: the base
+  Json patch;           // JSON Merge Patch (RFC 7386) as given
+  Json sensor;          // sensor settings (free-form), merged along `extends`; an empty object if none
+  std::vector<std::string> expect;  // from histogram_structures()
+  Scene scene;                      // the patched scene, validated
+};
+
+struct Series {
+  std::string source;
+  std::string name;
+  std::string description;
+  std::string base;  // the base scene's path as written, relative to the series file
+  Scene base_scene;
+  std::vector<SeriesVariant> variants;
+};
+
+// Loads a series: the base scene must be valid on its own, and each variant's merged scene is validated,
+// on up to `threads` threads (0: all); the error reported is that of the first invalid variant in file order.
+Series load_series(const std::filesystem::path& file, int threads = 0);
+
+// The "format" of a scene or series document, so tools can accept either; "" if there is none.
+std::string document_format(const Json& document);
+
+}  // namespace ct

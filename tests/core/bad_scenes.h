@@ -1,0 +1,59 @@
+#pragma once
+// The bad scenes in tests/data/scenes/bad/ and the one-line error each must get, shared by the library
+// tests (tests/core/test_scene.cpp) and the end-to-end tests of `chromatrace check-scene`.
+
+#include <string>
+#include <vector>
+
+namespace ct::test {
+
+struct BadScene {
+  std::string file;  // under tests/data/scenes/bad/
+  // The message after "<scene path>: ". "{dir}" stands for the folder of the bad scenes.
+  std::string message;
+};
+
+inline const std::vector<BadScene>& bad_scenes() {
+  static const std::vector<BadScene> cases = {
+      {"unknown_top_key.json",
+       "colour: unknown key (allowed: \"format\", \"name\", \"description\", \"spectra\", \"materials\", "
+       "\"objects\", \"lights\", \"camera\", \"render\")"},
+      {"unknown_nested_key.json", "materials.wall.colour: unknown key (allowed: \"type\", \"reflectance\")"},
+      {"missing_material.json", "objects[0].material: unknown material \"plstic\" (materials: wall)"},
+      {"negative_radius.json", "objects[1].shape.radius: must be > 0, got -0.2"},
+      {"wavelengths_not_increasing.json",
+       "spectra.paint.csv: {dir}/wavelengths_not_increasing.csv: line 4: wavelength_nm 500 does not increase "
+       "(previous 550)"},
+      {"wrong_format.json", "format: must be \"chromatrace-scene/1\", got \"chromatrace-scene/2\""},
+      {"syntax_error.json",
+       "line 3, column 56: syntax error while parsing object - unexpected string literal; expected '}'"},
+      {"unknown_spectrum.json", "materials.wall.reflectance: unknown spectrum \"whte\" (spectra: white)"},
+      {"roughness_out_of_range.json", "materials.red_plastic.roughness: must be in [0, 1], got 1.5"},
+      {"duplicate_key.json", "materials.wall.reflectance: key appears twice in one object"},
+      {"reflectance_above_one.json",
+       "materials.wall.reflectance: spectrum \"glow\" reaches 1.2 at 650 nm, but a reflectance must be in [0, 1]"},
+      {"energy_gain.json",
+       "materials.plastic.specular: the diffuse maximum 0.95 plus specular 0.1 exceeds 1, so the material would "
+       "reflect more light than it receives"},
+      {"wavelengths_in_micrometres.json",
+       "spectra.paint: wavelengths 0.4 to 0.7 do not overlap the visible range 360-830 nm (wavelengths are in nm)"},
+      {"sensor_in_metres.json", "camera.sensor_width_mm: must be a width in mm within [1, 1000], got 0.036"},
+      {"missing_mesh.json", "objects[0].shape.file: {dir}/meshes/bunny.ply: cannot open file"},
+      {"no_light.json", "lights: a scene needs at least one light"},
+      {"duplicate_name.json", "lights[0].name: \"floor\" is already the name of objects[0]"},
+      {"series_bad_variant.json", "variants[1] \"rough\": materials.plastic.roughness: must be in [0, 1], got 1.5"},
+  };
+  return cases;
+}
+
+inline std::string bad_scenes_dir() { return std::string(CHROMATRACE_TEST_DATA) + "/scenes/bad"; }
+
+// The full message for a case: "<path>: <message>" with {dir} filled in.
+inline std::string expected_message(const BadScene& bad) {
+  std::string message = bad.message;
+  const std::string token = "{dir}";
+  if (const auto at = message.find(token); at != std::string::npos) message.replace(at, token.size(), bad_scenes_dir());
+  return bad_scenes_dir() + "/" + bad.file + ": " + message;
+}
+
+}  // namespace ct::test
