@@ -9,7 +9,12 @@ packages=(
   libopenexr-dev libopenimageio-dev openimageio-tools libopencv-dev
   libembree-dev libtbb-dev libeigen3-dev
   nlohmann-json3-dev libcli11-dev libfmt-dev libgtest-dev
+  chromium  # the browser test of analyze's report.html (tests/browser)
+  blender  # the Blender add-on (blender_addon/) and its headless tests (tests/blender)
 )
+# The report viewer is bundled from npm packages (package.json): node and npm from Debian unless a node
+# with its own npm (e.g. NodeSource's) is already there.
+command -v npm >/dev/null || packages+=(nodejs npm)
 
 sudo=""
 [ "$(id -u)" -eq 0 ] || sudo="sudo"
@@ -22,5 +27,6 @@ if [ ${#missing[@]} -gt 0 ]; then
   DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}"
 fi
 
+npm ci --no-audit --no-fund
 cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release
 cmake --build build

@@ -1,6 +1,7 @@
 // chromatrace check-scene: validates a scene or an experiment series file and summarises it.
 #include <algorithm>
 #include <cstdio>
+#include <filesystem>
 #include <memory>
 #include <string>
 #include <vector>
@@ -12,6 +13,7 @@
 #include "core/geometry.h"
 #include "core/json_input.h"
 #include "core/scene.h"
+#include "sensor_sim/config.h"
 
 namespace ct::cli {
 namespace {
@@ -146,6 +148,12 @@ int check(const Options& options) {
   Json report;
   if (document_format(document) == kSeriesFormat) {
     const Series series = load_series(options.file, options.threads);
+    // Each variant's sensor settings, merged along "extends", must be valid for the sensor simulator.
+    for (std::size_t i = 0; i < series.variants.size(); ++i)
+      sensor::resolve_config({sensor::config_patch(
+          series.variants[i].sensor,
+          fmt::format("{}: variants[{}] \"{}\" sensor", options.file, i, series.variants[i].name),
+          std::filesystem::path(options.file).parent_path())});
     Json variants = Json::array();
     for (const SeriesVariant& v : series.variants)
       variants.push_back({{"name", v.name},

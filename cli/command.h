@@ -16,5 +16,11 @@ using Action = std::function<int()>;
 Action add_info(CLI::App& app);
 Action add_check_scene(CLI::App& app);
 Action add_render(CLI::App& app);
+Action add_analyze(CLI::App& app);
+Action add_sensor(CLI::App& app);
+// Helpers of the Blender add-on (blender_addon/): spectra, meshes and the final file come from core.
+Action add_scene_bands(CLI::App& app);
+Action add_export_meshes(CLI::App& app);
+Action add_assemble(CLI::App& app);
 
 }  // namespace ct::cli

@@ -23,6 +23,11 @@ int main(int argc, char** argv) {
   add(ct::cli::add_info(app));
   add(ct::cli::add_check_scene(app));
   add(ct::cli::add_render(app));
+  add(ct::cli::add_analyze(app));
+  add(ct::cli::add_sensor(app));
+  add(ct::cli::add_scene_bands(app));
+  add(ct::cli::add_export_meshes(app));
+  add(ct::cli::add_assemble(app));
 
   try {
     app.parse(argc, argv);

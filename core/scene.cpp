@@ -206,6 +206,7 @@ class SceneReader {
   explicit SceneReader(std::filesystem::path directory) : directory_(std::move(directory)) {}
 
   Scene read(const JsonNode& root);
+  std::vector<NamedSpectrum> read_spectra(const JsonNode& root);
 
  private:
   PiecewiseLinearSpectrum spectrum_source(const JsonNode& node);
@@ -479,6 +480,15 @@ Scene SceneReader::read(const JsonNode& root) {
   return std::move(scene_);
 }
 
+std::vector<NamedSpectrum> SceneReader::read_spectra(const JsonNode& root) {
+  const std::string format = root["format"].string();
+  if (format != kSpectraFormat) root["format"].fail(fmt::format("must be \"{}\", got \"{}\"", kSpectraFormat, format));
+  root.expect_object({"format", "spectra"});
+  std::vector<NamedSpectrum> spectra;
+  for (const auto& [name, node] : root["spectra"].members()) spectra.push_back({name, spectrum_source(node)});
+  return spectra;
+}
+
 }  // namespace
 
 const char* material_type_name(const Material& material) {
@@ -537,6 +547,15 @@ std::vector<TriangleMesh> scene_meshes(const Scene& scene) {
   for (const Light& light : scene.lights)
     meshes.push_back(std::visit([](const auto& shape) { return tessellate(shape); }, light.shape));
   return meshes;
+}
+
+std::vector<NamedSpectrum> load_spectra(const std::filesystem::path& file) {
+  return parse_spectra(read_json(file), file.string(), file.parent_path());
+}
+
+std::vector<NamedSpectrum> parse_spectra(const Json& document, const std::string& source,
+                                         const std::filesystem::path& directory) {
+  return SceneReader(directory).read_spectra(JsonNode(document, source));
 }
 
 std::string document_format(const Json& document) {

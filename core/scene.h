@@ -24,6 +24,7 @@ namespace ct {
 
 inline constexpr std::string_view kSceneFormat = "chromatrace-scene/1";
 inline constexpr std::string_view kSeriesFormat = "chromatrace-series/1";
+inline constexpr std::string_view kSpectraFormat = "chromatrace-spectra/1";
 
 // ---- Spectra and materials --------------------------------------------------------------------------
 
@@ -170,6 +171,13 @@ struct Scene {
 Scene load_scene(const std::filesystem::path& file);
 // Validates a scene document. `source` prefixes every message; relative paths resolve against `directory`.
 Scene parse_scene(const Json& document, const std::string& source, const std::filesystem::path& directory);
+
+// A list of named spectra on their own (`chromatrace-spectra/1`): {"format": ..., "spectra": {name: source}},
+// each source as in a scene's `spectra` (docs/scene-format.md), paths relative to the file. Tools that
+// need spectra outside a scene (the Blender add-on's band averages) use it.
+std::vector<NamedSpectrum> load_spectra(const std::filesystem::path& file);
+std::vector<NamedSpectrum> parse_spectra(const Json& document, const std::string& source,
+                                         const std::filesystem::path& directory);
 
 // World-space triangles of every object and then every light: element i has object id i + 1.
 std::vector<TriangleMesh> scene_meshes(const Scene& scene);

@@ -21,7 +21,9 @@ std::string drain(int fd) {
 
 }  // namespace
 
-CommandResult run_chromatrace(const std::vector<std::string>& args) {
+CommandResult run_chromatrace(const std::vector<std::string>& args) { return run_program(CHROMATRACE_EXE, args); }
+
+CommandResult run_program(const std::string& program, const std::vector<std::string>& args) {
   // stdout and stderr go to unlinked temporary files, so a chatty command cannot dead-lock on a full pipe.
   char out_name[] = "/tmp/chromatrace-out-XXXXXX";
   char err_name[] = "/tmp/chromatrace-err-XXXXXX";
@@ -32,7 +34,7 @@ CommandResult run_chromatrace(const std::vector<std::string>& args) {
   unlink(err_name);
 
   std::vector<char*> argv;
-  std::string exe = CHROMATRACE_EXE;
+  std::string exe = program;
   argv.push_back(exe.data());
   std::vector<std::string> copies = args;
   for (std::string& a : copies) argv.push_back(a.data());

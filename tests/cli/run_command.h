@@ -14,5 +14,7 @@ struct CommandResult {
 
 // Runs CHROMATRACE_EXE with the given arguments (no shell involved).
 CommandResult run_chromatrace(const std::vector<std::string>& args);
+// Runs any program (a path) the same way; it inherits this process's environment.
+CommandResult run_program(const std::string& program, const std::vector<std::string>& args);
 
 }  // namespace ct::test

@@ -406,9 +406,9 @@ TEST(Series, PaperSeriesValidatesEveryStep) {
 
   // Sensor settings merge along "extends": 7d adds noise to step 1's ideal sensor.
   const Json& sensor = variant("7d-noise").sensor;
-  EXPECT_EQ(sensor["noise"], true);
-  EXPECT_EQ(sensor["gamma"], 1.0);
-  EXPECT_EQ(sensor["bits"], 8);
+  EXPECT_EQ(sensor["noise"]["enabled"], true);
+  EXPECT_EQ(sensor["rendering"]["curve"], "linear");
+  EXPECT_EQ(sensor["adc"]["bits"], 8);
 
   for (const SeriesVariant& v : series.variants)
     for (const std::string& s : v.expect)

@@ -16,4 +16,10 @@ fail() { echo "install: $*" >&2; exit 1; }
 "$prefix/bin/chromatrace" --version | grep -q '^chromatrace ' || fail "installed command does not run"
 "$prefix/bin/chromatrace" check-scene --quiet "$prefix/share/chromatrace/scenes/paper/box.json" \
   || fail "installed scene does not validate"
+addon="$prefix/share/chromatrace/blender_addon"
+[ -f "$addon/chromatrace/__init__.py" ] && [ -f "$addon/batch.py" ] || fail "Blender add-on missing"
+[ ! -d "$addon/chromatrace/__pycache__" ] || fail "Blender add-on installed with __pycache__"
+( cd / && env -u CHROMATRACE_EXE PATH=/usr/bin:/bin python3 -c "import sys; sys.path.insert(0, '$addon'); \
+  from chromatrace import spectra, tool; assert tool.find_executable() == '$prefix/bin/chromatrace', tool.find_executable(); \
+  assert 'cornell_box.csv:red' in spectra.library_entries()" ) || fail "installed add-on does not find bin/chromatrace or the spectra"
 echo "install: ok"

@@ -19,6 +19,7 @@
 #include "core/scene.h"
 #include "core/spectral_exr.h"
 #include "reference_tracer/render.h"
+#include "tests/common/view_factor.h"
 
 namespace ct::rt {
 namespace {
@@ -118,21 +119,7 @@ TEST(Furnace, EachBounceOrderIsEmissionTimesAlbedoToTheK) {
   EXPECT_NEAR(total.mean, geometric_sum, 4.0 * total.se + 1e-6);
 }
 
-// Irradiance view factor from a point to a rectangle in a parallel plane at height h, the point below one
-// corner and the rectangle extending a × b from it (Howell's catalogue, configuration B-3).
-double corner_view_factor(double a, double b, double h) {
-  if (a == 0.0 || b == 0.0) return 0.0;
-  const double sign = (a < 0) != (b < 0) ? -1.0 : 1.0;
-  const double A = std::abs(a) / h, B = std::abs(b) / h;
-  const double sa = std::sqrt(1 + A * A), sb = std::sqrt(1 + B * B);
-  return sign / (2 * kPi) * (A / sa * std::atan(B / sa) + B / sb * std::atan(A / sb));
-}
-
-// View factor to the rectangle [x0, x1] × [y0, y1] at height h from the point (px, py) by superposition.
-double rectangle_view_factor(double px, double py, double x0, double x1, double y0, double y1, double h) {
-  return corner_view_factor(x1 - px, y1 - py, h) - corner_view_factor(x0 - px, y1 - py, h) -
-         corner_view_factor(x1 - px, y0 - py, h) + corner_view_factor(x0 - px, y0 - py, h);
-}
+using test::rectangle_view_factor;
 
 TEST(DirectLight, LambertianPlaneUnderRectangularEmitterMatchesClosedForm) {
   // A plane of albedo 0.5 at z = 0, a 1 m × 0.6 m emitter of radiance 2 facing down at z = 0.8, and a

@@ -1,0 +1,71 @@
+#include "analyzer/analysis.h"
+
+#include <algorithm>
+
+#include <fmt/core.h>
+
+#include "core/error.h"
+#include "core/progress.h"
+
+namespace ct::analyzer {
+namespace {
+
+void check_size(const LabelImage& image, const RgbImage& layer, const std::string& file) {
+  if (image.width != layer.width || image.height != layer.height)
+    throw InputError(fmt::format("{}: is {}×{}, the image is {}×{}", file, image.width, image.height, layer.width, layer.height));
+}
+
+}  // namespace
+
+std::vector<Region> select_regions(const AnalysisImage& input, const RgbImage& layer, const RegionOptions& options) {
+  std::vector<Region> regions{whole_image_region(layer.width, layer.height)};
+  auto append = [&](std::vector<Region> more) { std::move(more.begin(), more.end(), std::back_inserter(regions)); };
+  // Id 0 is "no object" by convention, unless the file gives it a name.
+  const std::vector<std::int32_t> skip = input.object_names.contains(0) ? std::vector<std::int32_t>{} : std::vector<std::int32_t>{0};
+  if (options.labels == "object_id" || (options.labels.empty() && !options.no_labels && !input.object_ids.empty())) {
+    if (input.object_ids.empty()) throw InputError(fmt::format("{}: --labels object_id: the image has no object_id channel", input.file));
+    append(label_regions(input.object_ids, "object", input.object_names, skip));
+  } else if (!options.labels.empty()) {
+    const LabelImage labels = read_label_image(options.labels);
+    check_size(labels, layer, options.labels);
+    append(label_regions(labels.labels, "label", {}, {0}));
+  }
+  for (const std::string& m : options.masks) {
+    const LabelImage mask = read_label_image(m);
+    check_size(mask, layer, m);
+    regions.push_back(mask_region(mask, fmt::format("mask {}", std::filesystem::path(m).filename().string())));
+  }
+  for (const Rect& r : options.rects) regions.push_back(rect_region(r, layer.width, layer.height));
+  if (options.segment) append(segment_regions(layer, options.segmentation));
+  return regions;
+}
+
+ImageAnalysis analyse_image(const AnalysisImage& input, const std::string& layer, std::vector<Region> regions,
+                            const AnalyzeOptions& options, const std::optional<Vec3>& known_illuminant, bool progress) {
+  ImageAnalysis a;
+  a.file = input.file;
+  a.layer = layer.empty() ? "final" : layer;
+  const RgbImage& pixels = select_layer(input, layer);
+  a.width = pixels.width;
+  a.height = pixels.height;
+  a.encoding = a.layer == "final" ? input.encoding : ImageEncoding{};
+  a.context = layer_context(pixels, a.encoding, options.bins);
+  a.options = options;
+  a.regions = std::move(regions);
+  Progress bar("analyze", a.regions.size(), progress);
+  for (const Region& r : a.regions) {
+    a.results.push_back(analyse_region(pixels, a.context, r, options));
+    if (!input.components.empty()) a.explanations.push_back(explain_region(input, r));
+    bar.advance();
+  }
+  bar.finish();
+  a.illuminant = estimate_illuminant(a.results, pixels.rgb, known_illuminant);
+  const std::size_t non_finite = a.results.empty() ? 0 : a.results.front().non_finite;  // the whole image
+  if (non_finite > 0)
+    a.notes.push_back(fmt::format("{} pixel{} NaN or infinite: left out of every histogram", non_finite, non_finite == 1 ? " is" : "s are"));
+  for (const RegionAnalysis& r : a.results)
+    if (r.shape.shape == ShapeClass::None) a.notes.push_back(fmt::format("{}: {}", r.name, r.shape.reason));
+  return a;
+}
+
+}  // namespace ct::analyzer

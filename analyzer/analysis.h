@@ -1,0 +1,48 @@
+#pragma once
+// A whole analysis: which regions, each region's histogram, shape and light-path explanation, and the
+// illuminant estimated from all of them. analysis_json.h, plots.h and report.h present the result.
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "analyzer/explain.h"
+#include "analyzer/illuminant.h"
+#include "analyzer/region_analysis.h"
+#include "analyzer/segmentation.h"
+
+namespace ct::analyzer {
+
+struct RegionOptions {
+  std::string labels;               // a channel of the image ("object_id") or a label image file; "" = object_id if present
+  bool no_labels = false;           // ignore the image's object ids
+  std::vector<std::string> masks;   // mask image files (non-zero = in)
+  std::vector<Rect> rects;
+  bool segment = false;             // automatic segmentation
+  SegmentationOptions segmentation;
+};
+
+// The whole image first, then labels (id 0, "no object", left out unless the file names it), masks,
+// rectangles and segments, in that order. Label and mask images must match the image's size
+// (InputError naming the file otherwise).
+std::vector<Region> select_regions(const AnalysisImage& input, const RgbImage& layer, const RegionOptions& options);
+
+struct ImageAnalysis {
+  std::string file;
+  std::string layer;  // "final", "linear" or a component
+  int width = 0, height = 0;
+  ImageEncoding encoding;  // of the analysed layer
+  LayerContext context;
+  AnalyzeOptions options;
+  std::vector<Region> regions;
+  std::vector<RegionAnalysis> results;            // one per region
+  std::vector<std::optional<Explanation>> explanations;  // one per region; empty without component layers
+  IlluminantAnalysis illuminant;
+  std::vector<std::string> notes;  // what a person should know (non-finite pixels, empty regions …)
+};
+
+// progress: shows a bar on stderr over the regions.
+ImageAnalysis analyse_image(const AnalysisImage& input, const std::string& layer, std::vector<Region> regions,
+                            const AnalyzeOptions& options, const std::optional<Vec3>& known_illuminant, bool progress);
+
+}  // namespace ct::analyzer

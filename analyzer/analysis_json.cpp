@@ -1,0 +1,211 @@
+#include "analyzer/analysis_json.h"
+
+#include <fmt/core.h>
+
+namespace ct::analyzer {
+namespace {
+
+using nlohmann::json;
+
+json vec(const Vec3& v) { return json::array({v[0], v[1], v[2]}); }
+json mat(const Mat3& m) {
+  json rows = json::array();
+  for (int r = 0; r < 3; ++r) rows.push_back(vec(m.row(r).transpose()));
+  return rows;
+}
+json axes(const Mat3& m) {  // columns are the axes; listed one axis per entry
+  json list = json::array();
+  for (int c = 0; c < 3; ++c) list.push_back(vec(m.col(c)));
+  return list;
+}
+
+json line_json(const Line& l) {
+  return {{"point", vec(l.point)},   {"direction", vec(l.direction)}, {"t_min", l.t_min},
+          {"t_max", l.t_max},        {"start", vec(l.at(l.t_min))},   {"end", vec(l.at(l.t_max))},
+          {"inliers", l.inliers},    {"rms", l.rms}};
+}
+
+json plane_json(const Plane& p) { return {{"normal", vec(p.normal)}, {"offset", p.offset}, {"rms", p.rms}}; }
+
+template <class T, class F>
+json optional_json(const std::optional<T>& v, F&& f) {
+  return v ? f(*v) : json(nullptr);
+}
+
+json estimate_json(const IlluminantEstimate& e) {
+  json j = {{"method", e.method}, {"rgb", vec(e.rgb)}, {"regions", e.regions}};
+  j["error_deg"] = e.error_deg ? json(*e.error_deg) : json(nullptr);
+  return j;
+}
+
+json explanation_json(const Explanation& e) {
+  json families = json::array();
+  for (const FamilyShares& f : e.families) {
+    json components = json::array();
+    for (const ComponentShare& c : f.components)
+      components.push_back({{"name", c.name}, {"energy_share", c.energy_share}, {"dominant_pixels", c.dominant_pixels}});
+    families.push_back({{"family", family_name(f.family)}, {"components", components}});
+  }
+  auto number = [](const std::optional<double>& v) { return v ? json(*v) : json(nullptr); };
+  return {{"families", families},
+          {"direct_share", number(e.direct_share)},
+          {"indirect_share", number(e.indirect_share)},
+          {"diffuse_share", number(e.diffuse_share)},
+          {"glossy_share", number(e.glossy_share)},
+          {"off_structure", optional_json(e.off_structure,
+                                          [](const OffStructure& o) {
+                                            return json{{"structure", o.structure},
+                                                        {"direction", vec(o.direction)},
+                                                        {"rms_total", o.rms_total},
+                                                        {"rms_direct", o.rms_direct},
+                                                        {"indirect_share", o.indirect_share}};
+                                          })},
+          {"notes", e.notes}};
+}
+
+}  // namespace
+
+std::string region_stem(std::size_t index) { return fmt::format("region-{:02}", index); }
+
+json shape_to_json(const ClusterShape& s) {
+  json decisions = json::array();
+  for (const Decision& d : s.decisions)
+    decisions.push_back({{"test", d.test}, {"value", d.value}, {"threshold", d.threshold}, {"passed", d.passed}});
+  json faces = json::array();
+  for (const ClippedFace& f : s.clipping.faces)
+    faces.push_back({{"channel", std::string(1, "RGB"[f.channel])}, {"side", f.high ? "high" : "low"}, {"level", f.level},
+                     {"pixels", f.count}, {"fraction", f.fraction}});
+  json j = {
+      {"class", class_name(s.shape)},
+      {"reason", s.reason},
+      {"decisions", decisions},
+      {"samples", s.samples},
+      {"fit_points", s.fit_points},
+      {"clipping", {{"fraction", s.clipping.fraction}, {"pixels", s.clipping.clipped}, {"faces", faces}}},
+  };
+  if (s.samples == 0) return j;
+  j["mean"] = vec(s.moments.mean);
+  j["covariance"] = mat(s.moments.covariance);
+  j["eigenvalues"] = vec(s.moments.eigenvalues);
+  j["axes"] = axes(s.moments.axes);
+  j["sigma"] = vec(s.sigma);
+  j["noise_sigma"] = vec(s.noise_sigma);
+  j["significant_axes"] = s.significant_axes;
+  j["linearity"] = s.linearity;
+  j["planarity"] = s.planarity;
+  j["scattering"] = s.scattering;
+  j["line"] = optional_json(s.line, line_json);
+  j["body_line"] = optional_json(s.body_only, [](const LineSearch& b) { return line_json(b.line); });
+  j["two_lines"] = optional_json(s.two_lines, [](const TwoLines& t) {
+    return json{{"body", line_json(t.body)},
+                {"highlight", line_json(t.highlight)},
+                {"junction", vec(t.junction)},
+                {"junction_on_body", t.junction_on_body},
+                {"junction_on_highlight", t.junction_on_highlight},
+                {"gap", t.gap},
+                {"angle_deg", t.angle_deg},
+                {"body_fraction", t.body_fraction},
+                {"highlight_fraction", t.highlight_fraction}};
+  });
+  j["plane"] = optional_json(s.plane, plane_json);
+  j["dichromatic_plane"] = optional_json(s.black_plane, plane_json);
+  if (s.plane) j["thickness_over_noise"] = s.sigma[2] / std::max(1e-300, s.noise_sigma[2]);
+  j["curve"] = optional_json(s.curve, [](const PrincipalCurve& c) {
+    json points = json::array();  // the curve itself, for drawing
+    for (int k = 0; k <= 16; ++k) points.push_back(vec(c.at(c.t_min + (c.t_max - c.t_min) * k / 16.0)));
+    return json{{"bend", c.bend},           {"curvature", c.curvature}, {"curve_rms", c.curve_rms},
+                {"straight_rms", c.straight_rms}, {"explained", c.explained}, {"points", points}};
+  });
+  j["gamma"] = optional_json(s.gamma, [](const GammaFit& g) {
+    return json{{"gamma", g.gamma},
+                {"straightness_as_is", g.straightness_as_is},
+                {"straightness_linearised", g.straightness_linearised},
+                {"used", g.used}};
+  });
+  if (!s.unclipped.empty()) j["unclipped"] = shape_to_json(s.unclipped.front());
+  return j;
+}
+
+json analysis_to_json(const ImageAnalysis& a) {
+  json regions = json::array();
+  for (std::size_t i = 0; i < a.results.size(); ++i) {
+    const RegionAnalysis& r = a.results[i];
+    const std::string stem = region_stem(i);
+    json j = {{"index", i},
+              {"name", r.name},
+              {"source", r.source},
+              {"label", r.label >= 0 ? json(r.label) : json(nullptr)},
+              {"pixels", r.pixels},
+              {"non_finite_pixels", r.non_finite},
+              {"valid_pixels", r.shape.samples},
+              {"occupied_bins", r.histogram.cells.size()},
+              {"shape", shape_to_json(r.shape)},
+              {"files", {{"histogram", "histograms/" + stem + ".json"}, {"plot", "plots/" + stem + ".png"}}}};
+    j["explanation"] = i < a.explanations.size() ? optional_json(a.explanations[i], explanation_json) : json(nullptr);
+    regions.push_back(std::move(j));
+  }
+  const HistogramSpec& spec = a.context.spec;
+  const ShapeCriteria& k = a.options.criteria;
+  const IlluminantAnalysis& il = a.illuminant;
+  return {{"format", kAnalysisFormat},
+          {"image", {{"file", a.file}, {"width", a.width}, {"height", a.height}, {"layer", a.layer},
+                     {"integer", a.encoding.integer}, {"bits", a.encoding.bits}, {"full_scale", a.encoding.full_scale}}},
+          {"histogram", {{"bins", spec.bins}, {"lo", spec.lo}, {"hi", spec.hi}}},
+          {"clipping_levels", a.context.high_levels},
+          {"quantisation_sigma", a.context.quantisation_sigma},
+          {"criteria",
+           {{"min_samples", k.min_samples},
+            {"max_points", k.max_points},
+            {"noise_factor", k.noise_factor},
+            {"relative_floor", k.relative_floor},
+            {"clipped_fraction", k.clipped_fraction},
+            {"body_only_fraction", k.body_only_fraction},
+            {"two_line_residual", k.two_line_residual},
+            {"min_highlight_fraction", k.min_highlight_fraction},
+            {"min_line_angle_deg", k.min_line_angle_deg},
+            {"highlight_end", k.highlight_end},
+            {"l_junction", k.l_junction},
+            {"t_junction", k.t_junction},
+            {"max_bend_for_straight", k.max_bend_for_straight},
+            {"curve_residual", k.curve_residual},
+            {"gamma_straightening", k.gamma_straightening},
+            {"min_gamma_departure", k.min_gamma_departure},
+            {"thickened_ratio", k.thickened_ratio},
+            {"p_body_fraction", k.p_body_fraction},
+            {"p_one_side", k.p_one_side},
+            {"p_area_ratio", k.p_area_ratio}}},
+          {"regions", regions},
+          {"illuminant",
+           {{"estimate", estimate_json(il.best())},
+            {"highlight_lines", optional_json(il.highlight_lines, estimate_json)},
+            {"dichromatic_planes", optional_json(il.planes, estimate_json)},
+            {"grey_world", estimate_json(il.grey_world)},
+            {"known", optional_json(il.known, vec)},
+            {"notes", il.notes}}},
+          {"notes", a.notes}};
+}
+
+json histogram_to_json(const Histogram3& h, const Histogram2& chromaticity) {
+  json cells = json::array();
+  for (const HistogramCell& c : h.cells) {
+    const auto bin = h.bin_of(c.index);
+    cells.push_back({bin[0], bin[1], bin[2], c.count});
+  }
+  json projections = json::object();
+  const auto p = analyzer::projections(h);
+  const char* names[] = {"RG", "RB", "GB"};
+  for (int k = 0; k < 3; ++k) projections[names[k]] = p[k].counts;
+  return {{"bins", h.spec.bins},
+          {"lo", h.spec.lo},
+          {"hi", h.spec.hi},
+          {"total", h.total},
+          {"max_count", h.max_count},
+          {"cells", cells},
+          {"cells_format", "[r_bin, g_bin, b_bin, count]"},
+          {"projections", projections},
+          {"projections_format", "bins × bins counts, row = first channel, column = second"},
+          {"chromaticity", {{"bins", chromaticity.bins}, {"counts", chromaticity.counts},
+                            {"format", "bins × bins counts, row = r = R/(R+G+B), column = g = G/(R+G+B), over [0, 1]"}}}};
+}
+
+}  // namespace ct::analyzer

@@ -1,0 +1,56 @@
+#include "analyzer/clipping.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace ct::analyzer {
+
+Clipping find_clipping(std::span<const float> rgb, const std::array<double, 3>& high_levels) {
+  Clipping result;
+  const std::size_t n = rgb.size() / 3;
+  if (n == 0) return result;
+  // count[c][0] low face, count[c][1] high face
+  std::array<std::array<std::size_t, 2>, 3> count{};
+  auto side = [&](std::size_t i, int c) {
+    const double v = rgb[i * 3 + static_cast<std::size_t>(c)];
+    if (v >= high_levels[c]) return 1;
+    if (v <= 0 && (rgb[i * 3] > 0 || rgb[i * 3 + 1] > 0 || rgb[i * 3 + 2] > 0)) return 0;
+    return -1;
+  };
+  // The other two channels' extremes on each face: on a true clipping face they keep changing.
+  std::array<std::array<std::array<float, 2>, 2>, 3> lo{}, hi{};
+  for (auto& a : lo) for (auto& b : a) b.fill(std::numeric_limits<float>::max());
+  for (auto& a : hi) for (auto& b : a) b.fill(std::numeric_limits<float>::lowest());
+  for (std::size_t i = 0; i < n; ++i)
+    for (int c = 0; c < 3; ++c)
+      if (const int s = side(i, c); s >= 0) {
+        ++count[c][s];
+        for (int o = 1; o < 3; ++o) {
+          const float v = rgb[i * 3 + static_cast<std::size_t>((c + o) % 3)];
+          lo[c][s][o - 1] = std::min(lo[c][s][o - 1], v);
+          hi[c][s][o - 1] = std::max(hi[c][s][o - 1], v);
+        }
+      }
+  std::array<std::array<bool, 2>, 3> kept{};
+  for (int c = 0; c < 3; ++c)
+    for (int s = 0; s < 2; ++s) {
+      const double fraction = static_cast<double>(count[c][s]) / static_cast<double>(n);
+      if (count[c][s] < 3 || fraction < kFaceFraction) continue;
+      const double spread = std::max(hi[c][s][0] - lo[c][s][0], hi[c][s][1] - lo[c][s][1]);
+      const double scale = std::max({std::abs(high_levels[c]) < 1e300 ? std::abs(high_levels[c]) : 0.0,
+                                     static_cast<double>(std::abs(hi[c][s][0])), static_cast<double>(std::abs(hi[c][s][1]))});
+      if (spread <= kFaceSpread * scale) continue;
+      kept[c][s] = true;
+      result.faces.push_back({c, s == 1, s == 1 ? high_levels[c] : 0.0, count[c][s], fraction});
+    }
+  result.on_face.assign(n, 0);
+  for (std::size_t i = 0; i < n; ++i)
+    for (int c = 0; c < 3; ++c)
+      if (const int s = side(i, c); s >= 0 && kept[c][s]) result.on_face[i] = 1;
+  for (const std::uint8_t f : result.on_face) result.clipped += f;
+  result.fraction = static_cast<double>(result.clipped) / static_cast<double>(n);
+  return result;
+}
+
+}  // namespace ct::analyzer

@@ -1,0 +1,41 @@
+#pragma once
+// Clipping: samples pressed onto a face of the RGB cube, where one channel stopped at the sensor's or
+// the encoding's limit while the others went on changing (the paper's over-exposure artefact), or at
+// black.
+
+#include <array>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+namespace ct::analyzer {
+
+struct ClippedFace {
+  int channel = 0;     // 0 R, 1 G, 2 B
+  bool high = true;    // the channel's upper limit (else 0)
+  double level = 0;    // the limit's value
+  std::size_t count = 0;
+  double fraction = 0;  // of the samples
+};
+
+struct Clipping {
+  std::vector<ClippedFace> faces;  // faces holding at least kFaceFraction of the samples (and 3 samples)
+  std::size_t clipped = 0;         // samples on any of those faces
+  double fraction = 0;
+  std::vector<std::uint8_t> on_face;  // per sample: 1 if on one of the faces
+};
+
+// A face counts when at least this share of the samples lies on it: a few pixels exactly at a channel's
+// maximum happen without clipping.
+constexpr double kFaceFraction = 0.005;
+// … and only when the other channels keep changing on it (their range above this share of the level): a
+// flat patch that happens to hold a channel's largest value is not clipped.
+constexpr double kFaceSpread = 0.01;
+
+// Samples [i][channel] at or above high_levels[c] lie on the high face of c; at or below 0, with another
+// channel above 0, on its low face (a pixel black in all three channels is dark, not clipped).
+// high_levels: the integer format's full scale, or for float images the channel's largest value in the
+// image (a float file clipped by a simulated sensor holds that value in many pixels).
+Clipping find_clipping(std::span<const float> rgb, const std::array<double, 3>& high_levels);
+
+}  // namespace ct::analyzer

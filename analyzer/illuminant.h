@@ -1,0 +1,50 @@
+#pragma once
+// The illuminant's colour, inferred from the clusters as the dichromatic reflection model allows:
+//  - highlight lines: the specular part of a dichromatic surface has the illuminant's colour, so the
+//    highlight line of an L or skewed-T points along it (weighted by the line's pixel count);
+//  - plane intersection: every dichromatic object's plane through black holds the illuminant's
+//    direction, so that direction is the one closest to all the planes (the eigenvector of Σ n nᵀ with
+//    the smallest eigenvalue; for two planes, the cross product of their normals);
+//  - grey world, beside them for comparison: the image's mean colour.
+// Directions are unit RGB vectors in the analysed layer's space, oriented with a positive sum.
+
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "analyzer/region_analysis.h"
+
+namespace ct::analyzer {
+
+struct IlluminantEstimate {
+  std::string method;  // "highlight lines", "dichromatic planes", "grey world"
+  Vec3 rgb = Vec3::Zero();
+  std::vector<std::string> regions;  // the regions it came from (empty for grey world)
+  std::optional<double> error_deg;   // against the known illuminant, when given
+};
+
+struct IlluminantAnalysis {
+  std::optional<IlluminantEstimate> highlight_lines, planes;
+  IlluminantEstimate grey_world;
+  std::optional<Vec3> known;  // as given, normalised
+  std::vector<std::string> notes;  // why an estimate is missing
+
+  // The estimate to trust most: the planes' intersection (unbiased), else the highlight lines (tilted
+  // towards the body colours when shading changes across a highlight), else grey world.
+  const IlluminantEstimate& best() const { return planes ? *planes : highlight_lines ? *highlight_lines : grey_world; }
+};
+
+// From the regions other than the whole image (which mixes objects) when there are any. The grey world
+// averages `rgb`, the whole layer's finite pixels.
+IlluminantAnalysis estimate_illuminant(const std::vector<RegionAnalysis>& regions, std::span<const float> rgb,
+                                       const std::optional<Vec3>& known);
+
+// The angle between two colour directions, in degrees.
+double angular_error_deg(const Vec3& a, const Vec3& b);
+
+// Plane-intersection direction of planes through black with these normals; nullopt with fewer than two
+// planes or when they are all (nearly, within 1°) the same plane.
+std::optional<Vec3> intersect_planes(const std::vector<Vec3>& normals);
+
+}  // namespace ct::analyzer

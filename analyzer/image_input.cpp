@@ -1,0 +1,187 @@
+#include "analyzer/image_input.h"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include <OpenImageIO/imageio.h>
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "core/error.h"
+
+namespace ct::analyzer {
+namespace {
+
+struct RawImage {
+  int width = 0, height = 0, channels = 0;
+  std::vector<std::string> names;
+  std::vector<float> values;  // [y][x][channel], integer files already scaled to their stored integers
+  ImageEncoding encoding;
+  std::string objects_attribute, components_attribute;
+};
+
+RawImage read_raw(const std::filesystem::path& file) {
+  const std::string name = file.string();
+  if (!std::filesystem::is_regular_file(file)) throw InputError(fmt::format("{}: cannot open file", name));
+  auto in = OIIO::ImageInput::open(name);
+  if (!in) {
+    std::string why = OIIO::geterror();
+    std::replace(why.begin(), why.end(), '\n', ' ');
+    throw InputError(fmt::format("{}: cannot read image: {}", name, why.empty() ? "unknown format" : why));
+  }
+  const OIIO::ImageSpec& spec = in->spec();
+  RawImage raw;
+  raw.width = spec.width;
+  raw.height = spec.height;
+  raw.channels = spec.nchannels;
+  raw.names = spec.channelnames;
+  const OIIO::TypeDesc type = spec.format;
+  if (type.basetype == OIIO::TypeDesc::UINT8 || type.basetype == OIIO::TypeDesc::UINT16 ||
+      type.basetype == OIIO::TypeDesc::UINT32) {
+    raw.encoding.integer = true;
+    raw.encoding.bits = static_cast<int>(type.size() * 8);
+    raw.encoding.full_scale = std::ldexp(1.0, raw.encoding.bits) - 1.0;
+  }
+  raw.objects_attribute = spec.get_string_attribute("chromatrace.objects");
+  raw.components_attribute = spec.get_string_attribute("chromatrace.components");
+  if (raw.width < 1 || raw.height < 1) throw InputError(fmt::format("{}: image has no pixels", name));
+  raw.values.resize(static_cast<std::size_t>(raw.width) * static_cast<std::size_t>(raw.height) *
+                    static_cast<std::size_t>(raw.channels));
+  // OpenImageIO hands integer samples over as fractions of full scale; scaling back keeps digital numbers.
+  if (!in->read_image(0, 0, 0, raw.channels, OIIO::TypeDesc::FLOAT, raw.values.data())) {
+    std::string why = in->geterror();
+    std::replace(why.begin(), why.end(), '\n', ' ');
+    throw InputError(fmt::format("{}: cannot read pixels: {}", name, why));
+  }
+  if (raw.encoding.integer) {
+    const auto scale = static_cast<float>(raw.encoding.full_scale);
+    for (float& v : raw.values) v = std::round(v * scale);
+  }
+  return raw;
+}
+
+int channel_index(const RawImage& raw, const std::string& name) {
+  const auto it = std::find(raw.names.begin(), raw.names.end(), name);
+  return it == raw.names.end() ? -1 : static_cast<int>(it - raw.names.begin());
+}
+
+// The layer <prefix>.R/G/B ("" for R, G, B), if all three channels are present.
+std::optional<RgbImage> extract_rgb(const RawImage& raw, const std::string& prefix) {
+  const std::string p = prefix.empty() ? "" : prefix + ".";
+  const int c[3] = {channel_index(raw, p + "R"), channel_index(raw, p + "G"), channel_index(raw, p + "B")};
+  if (c[0] < 0 || c[1] < 0 || c[2] < 0) return std::nullopt;
+  RgbImage out{raw.width, raw.height, {}};
+  const std::size_t n = out.pixel_count();
+  out.rgb.resize(n * 3);
+  const auto stride = static_cast<std::size_t>(raw.channels);
+  for (std::size_t i = 0; i < n; ++i)
+    for (int k = 0; k < 3; ++k) out.rgb[i * 3 + static_cast<std::size_t>(k)] = raw.values[i * stride + static_cast<std::size_t>(c[k])];
+  return out;
+}
+
+std::vector<std::int32_t> whole_numbers(const std::string& file, const std::string& what, const RawImage& raw, int channel) {
+  std::vector<std::int32_t> out(static_cast<std::size_t>(raw.width) * static_cast<std::size_t>(raw.height));
+  const auto stride = static_cast<std::size_t>(raw.channels);
+  for (std::size_t i = 0; i < out.size(); ++i) {
+    const float v = raw.values[i * stride + static_cast<std::size_t>(channel)];
+    if (!(v >= 0.0f && v <= 16777216.0f) || v != std::floor(v))
+      throw InputError(fmt::format("{}: {}: pixel ({}, {}) holds {}, not a whole number in [0, 2^24]", file, what,
+                                   i % static_cast<std::size_t>(raw.width), i / static_cast<std::size_t>(raw.width), v));
+    out[i] = static_cast<std::int32_t>(v);
+  }
+  return out;
+}
+
+std::map<std::int32_t, std::string> parse_object_names(const std::string& file, const std::string& text) {
+  std::map<std::int32_t, std::string> names;
+  if (text.empty()) return names;
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(text);
+  } catch (const nlohmann::json::exception& e) {
+    throw InputError(fmt::format("{}: attribute chromatrace.objects: not JSON: {}", file, e.what()));
+  }
+  if (!j.is_object()) throw InputError(fmt::format("{}: attribute chromatrace.objects: must be a JSON object", file));
+  for (const auto& [key, value] : j.items()) {
+    std::size_t used = 0;
+    int id = -1;
+    try {
+      id = std::stoi(key, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used != key.size() || id < 0 || !value.is_string())
+      throw InputError(fmt::format("{}: attribute chromatrace.objects: entry \"{}\" must map a whole number to a name", file, key));
+    names[id] = value.get<std::string>();
+  }
+  return names;
+}
+
+std::vector<std::string> component_names(const RawImage& raw) {
+  std::vector<std::string> names;
+  if (!raw.components_attribute.empty()) {
+    std::stringstream list(raw.components_attribute);
+    for (std::string item; std::getline(list, item, ',');) {
+      item.erase(0, item.find_first_not_of(' '));
+      item.erase(item.find_last_not_of(' ') + 1);
+      if (!item.empty()) names.push_back(item);
+    }
+    return names;
+  }
+  // Without the attribute, any <prefix>.R/G/B triplet other than linear is a component.
+  for (const std::string& c : raw.names) {
+    if (c.size() < 3 || c.compare(c.size() - 2, 2, ".R") != 0) continue;
+    const std::string prefix = c.substr(0, c.size() - 2);
+    if (prefix != "linear" && extract_rgb(raw, prefix)) names.push_back(prefix);
+  }
+  return names;
+}
+
+}  // namespace
+
+AnalysisImage read_analysis_image(const std::filesystem::path& file) {
+  const std::string name = file.string();
+  RawImage raw = read_raw(file);
+  AnalysisImage out;
+  out.file = name;
+  out.encoding = raw.encoding;
+  if (auto rgb = extract_rgb(raw, "")) {
+    out.image = std::move(*rgb);
+  } else if (raw.channels >= 3 && channel_index(raw, "R") < 0) {
+    // Files whose channels are not named R, G, B (some TIFFs, unnamed EXR layers): the first three.
+    out.image = RgbImage{raw.width, raw.height, std::vector<float>(raw.width * static_cast<std::size_t>(raw.height) * 3)};
+    const auto stride = static_cast<std::size_t>(raw.channels);
+    for (std::size_t i = 0; i < out.image.pixel_count(); ++i)
+      for (std::size_t k = 0; k < 3; ++k) out.image.rgb[i * 3 + k] = raw.values[i * stride + k];
+  } else {
+    throw InputError(fmt::format("{}: needs channels R, G, B; has {}", name,
+                                 raw.names.empty() ? std::string("none") : fmt::format("{}", fmt::join(raw.names, ", "))));
+  }
+  out.linear = extract_rgb(raw, "linear");
+  // A renderer's spectral EXR names its components too, but holds them as spectra, not as camera RGB:
+  // only RGB layers explain a camera image.
+  for (const std::string& c : component_names(raw))
+    if (auto layer = extract_rgb(raw, c)) out.components.push_back({c, std::move(*layer)});
+  if (const int id = channel_index(raw, "object_id"); id >= 0) out.object_ids = whole_numbers(name, "object_id", raw, id);
+  out.object_names = parse_object_names(name, raw.objects_attribute);
+  return out;
+}
+
+const RgbImage& select_layer(const AnalysisImage& input, const std::string& layer) {
+  if (layer.empty() || layer == "final") return input.image;
+  if (layer == "linear" && input.linear) return *input.linear;
+  for (const ComponentLayer& c : input.components)
+    if (c.name == layer) return c.image;
+  std::vector<std::string> have{"final"};
+  if (input.linear) have.push_back("linear");
+  for (const ComponentLayer& c : input.components) have.push_back(c.name);
+  throw InputError(fmt::format("{}: --layer: no layer \"{}\" (the file has {})", input.file, layer, fmt::join(have, ", ")));
+}
+
+LabelImage read_label_image(const std::filesystem::path& file) {
+  const RawImage raw = read_raw(file);
+  return LabelImage{raw.width, raw.height, whole_numbers(file.string(), "labels", raw, 0)};
+}
+
+}  // namespace ct::analyzer

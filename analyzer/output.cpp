@@ -1,0 +1,55 @@
+#include "analyzer/output.h"
+
+#include <fmt/core.h>
+#include <opencv2/imgcodecs.hpp>
+
+#include "analyzer/analysis_json.h"
+#include "analyzer/plots.h"
+#include "analyzer/report.h"
+#include "core/error.h"
+#include "core/file_io.h"
+
+namespace ct::analyzer {
+namespace {
+
+void write_png(const std::filesystem::path& file, const cv::Mat& image) {
+  std::vector<std::uint8_t> bytes;
+  if (!cv::imencode(".png", image, bytes)) throw std::runtime_error(fmt::format("{}: PNG encoding failed", file.string()));
+  write_file_atomically(file, std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()));
+}
+
+}  // namespace
+
+void write_analysis(const std::filesystem::path& dir, const AnalysisImage& input, const ImageAnalysis& analysis,
+                    const OutputOptions& options) {
+  const std::filesystem::path parent = std::filesystem::absolute(dir).parent_path();
+  if (!std::filesystem::is_directory(parent))
+    throw InputError(fmt::format("{}: directory {} does not exist", dir.string(), parent.string()));
+  if (std::filesystem::exists(dir) && !std::filesystem::is_directory(dir))
+    throw InputError(fmt::format("{}: exists and is not a directory", dir.string()));
+  std::filesystem::create_directories(dir / "histograms");
+  if (options.plots) std::filesystem::create_directories(dir / "plots");
+
+  const RgbImage& layer = select_layer(input, analysis.layer);
+  ComponentMap components;
+  if (options.plots && !input.components.empty()) {
+    components.dominant = dominant_component_map(input);
+    for (const ComponentLayer& c : input.components) components.names.push_back(c.name);
+  }
+  for (std::size_t i = 0; i < analysis.results.size(); ++i) {
+    const std::string stem = region_stem(i);
+    const RegionSamples samples = gather_samples(layer, analysis.regions[i]);
+    write_file_atomically(dir / "histograms" / (stem + ".json"),
+                          histogram_to_json(analysis.results[i].histogram, chromaticity_histogram(samples.rgb, analysis.context.spec.bins)).dump());
+    if (!options.plots) continue;
+    write_png(dir / "plots" / (stem + ".png"), plot_region(layer, analysis, i, PlotColouring::Own, components));
+    write_png(dir / "plots" / (stem + "-density.png"), plot_region(layer, analysis, i, PlotColouring::Density, components));
+    if (!components.dominant.empty())
+      write_png(dir / "plots" / (stem + "-components.png"), plot_region(layer, analysis, i, PlotColouring::Component, components));
+  }
+  if (options.report) write_file_atomically(dir / "report.html", report_html(input, analysis, options.report_points));
+  // Last, so that a complete analysis.json means a complete directory.
+  write_file_atomically(dir / "analysis.json", analysis_to_json(analysis).dump(1));
+}
+
+}  // namespace ct::analyzer

@@ -1,0 +1,76 @@
+#include "analyzer/regions.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <numeric>
+
+#include <fmt/core.h>
+
+#include "core/error.h"
+
+namespace ct::analyzer {
+
+Region whole_image_region(int width, int height) {
+  Region r{"image", "image", -1, std::vector<std::uint32_t>(static_cast<std::size_t>(width) * static_cast<std::size_t>(height))};
+  std::iota(r.pixels.begin(), r.pixels.end(), 0u);
+  return r;
+}
+
+std::vector<Region> label_regions(const std::vector<std::int32_t>& labels, const std::string& what,
+                                  const std::map<std::int32_t, std::string>& names, const std::vector<std::int32_t>& skip) {
+  std::map<std::int32_t, std::vector<std::uint32_t>> by_label;
+  for (std::size_t i = 0; i < labels.size(); ++i) {
+    if (std::find(skip.begin(), skip.end(), labels[i]) != skip.end()) continue;
+    by_label[labels[i]].push_back(static_cast<std::uint32_t>(i));
+  }
+  std::vector<Region> regions;
+  for (auto& [label, pixels] : by_label) {
+    const auto name = names.find(label);
+    regions.push_back({name == names.end() ? fmt::format("{} {}", what, label) : fmt::format("{} {} ({})", what, label, name->second),
+                       "labels", label, std::move(pixels)});
+  }
+  return regions;
+}
+
+Region mask_region(const LabelImage& mask, const std::string& name) {
+  Region r{name, "mask", -1, {}};
+  for (std::size_t i = 0; i < mask.labels.size(); ++i)
+    if (mask.labels[i] != 0) r.pixels.push_back(static_cast<std::uint32_t>(i));
+  return r;
+}
+
+Region rect_region(const Rect& rect, int width, int height) {
+  Region r{fmt::format("rect {},{} {}x{}", rect.x, rect.y, rect.width, rect.height), "rect", -1, {}};
+  const int x0 = std::max(rect.x, 0), y0 = std::max(rect.y, 0);
+  const int x1 = std::min(rect.x + rect.width, width), y1 = std::min(rect.y + rect.height, height);
+  for (int y = y0; y < y1; ++y)
+    for (int x = x0; x < x1; ++x) r.pixels.push_back(static_cast<std::uint32_t>(y) * static_cast<std::uint32_t>(width) + static_cast<std::uint32_t>(x));
+  return r;
+}
+
+Rect parse_rect(const std::string& text, const std::string& option) {
+  Rect r;
+  char extra = 0;
+  if (std::sscanf(text.c_str(), "%d,%d,%d,%d%c", &r.x, &r.y, &r.width, &r.height, &extra) != 4 || r.width < 0 || r.height < 0)
+    throw InputError(fmt::format("{}: expected x,y,width,height with width, height >= 0, got \"{}\"", option, text));
+  return r;
+}
+
+RegionSamples gather_samples(const RgbImage& image, const Region& region) {
+  RegionSamples s;
+  s.rgb.reserve(region.pixels.size() * 3);
+  s.pixels.reserve(region.pixels.size());
+  for (const std::uint32_t p : region.pixels) {
+    const float* v = &image.rgb[static_cast<std::size_t>(p) * 3];
+    if (!std::isfinite(v[0]) || !std::isfinite(v[1]) || !std::isfinite(v[2])) {
+      ++s.non_finite;
+      continue;
+    }
+    s.rgb.insert(s.rgb.end(), v, v + 3);
+    s.pixels.push_back(p);
+  }
+  return s;
+}
+
+}  // namespace ct::analyzer

@@ -1,0 +1,314 @@
+#include "analyzer/report.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "analyzer/plots.h"
+#include "analyzer/viewer_bundle.h"
+#include "core/colour.h"
+
+namespace ct::analyzer {
+namespace {
+
+using nlohmann::json;
+
+std::string base64(std::string_view bytes) {
+  static constexpr char table[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  std::string out;
+  out.reserve((bytes.size() + 2) / 3 * 4);
+  for (std::size_t i = 0; i < bytes.size(); i += 3) {
+    const std::uint32_t b0 = static_cast<std::uint8_t>(bytes[i]);
+    const std::uint32_t b1 = i + 1 < bytes.size() ? static_cast<std::uint8_t>(bytes[i + 1]) : 0;
+    const std::uint32_t b2 = i + 2 < bytes.size() ? static_cast<std::uint8_t>(bytes[i + 2]) : 0;
+    const std::uint32_t v = (b0 << 16) | (b1 << 8) | b2;
+    out += table[(v >> 18) & 63];
+    out += table[(v >> 12) & 63];
+    out += i + 1 < bytes.size() ? table[(v >> 6) & 63] : '=';
+    out += i + 2 < bytes.size() ? table[v & 63] : '=';
+  }
+  return out;
+}
+
+template <class T>
+std::string base64_of(const std::vector<T>& values) {  // little-endian, as typed arrays read them on x86 and ARM
+  return base64(std::string_view(reinterpret_cast<const char*>(values.data()), values.size() * sizeof(T)));
+}
+
+std::string escape_html(std::string_view text) {
+  std::string out;
+  for (const char c : text) {
+    switch (c) {
+      case '<': out += "&lt;"; break;
+      case '>': out += "&gt;"; break;
+      case '&': out += "&amp;"; break;
+      case '"': out += "&quot;"; break;
+      default: out += c;
+    }
+  }
+  return out;
+}
+
+// Inside <script>, "</" would end the element early; "<\/" means the same to JSON and JavaScript.
+std::string script_safe(std::string text) {
+  for (std::size_t at = text.find("</"); at != std::string::npos; at = text.find("</", at + 3)) text.replace(at, 2, "<\\/");
+  return text;
+}
+
+struct Display {
+  int width = 0, height = 0;
+  double scale = 1;  // display pixels per image pixel
+};
+
+Display display_size(int width, int height) {
+  const double scale = std::min(1.0, static_cast<double>(kReportImageSize) / std::max(width, height));
+  return {std::max(1, static_cast<int>(std::lround(width * scale))), std::max(1, static_cast<int>(std::lround(height * scale))), scale};
+}
+
+// The image as 8-bit sRGB for the page: integer files as stored; float files scaled so that the 99.5th
+// percentile of the brightest channel is white, then sRGB-encoded.
+std::string image_png(const RgbImage& layer, const ImageAnalysis& a, const Display& d) {
+  double white = a.encoding.integer ? a.encoding.full_scale : 0.0;
+  if (!a.encoding.integer) {
+    std::vector<float> brightest;
+    for (std::size_t p = 0; p < layer.pixel_count(); ++p) {
+      const float m = std::max({layer.rgb[p * 3], layer.rgb[p * 3 + 1], layer.rgb[p * 3 + 2]});
+      if (std::isfinite(m)) brightest.push_back(m);
+    }
+    if (!brightest.empty()) {
+      const auto k = static_cast<std::ptrdiff_t>(0.995 * static_cast<double>(brightest.size() - 1));
+      std::nth_element(brightest.begin(), brightest.begin() + k, brightest.end());
+      white = brightest[static_cast<std::size_t>(k)];
+    }
+    if (!(white > 0)) white = 1;
+  }
+  cv::Mat full(layer.height, layer.width, CV_8UC3);
+  for (int y = 0; y < layer.height; ++y)
+    for (int x = 0; x < layer.width; ++x) {
+      const std::size_t p = static_cast<std::size_t>(y) * static_cast<std::size_t>(layer.width) + static_cast<std::size_t>(x);
+      cv::Vec3b& out = full.at<cv::Vec3b>(y, x);
+      for (int c = 0; c < 3; ++c) {
+        double v = layer.rgb[p * 3 + static_cast<std::size_t>(c)] / white;
+        v = std::isfinite(v) ? std::clamp(v, 0.0, 1.0) : 0.0;
+        out[2 - c] = cv::saturate_cast<std::uint8_t>(255.0 * (a.encoding.integer ? v : srgb_encode(v)));
+      }
+    }
+  cv::Mat shown;
+  if (d.scale < 1) cv::resize(full, shown, cv::Size(d.width, d.height), 0, 0, cv::INTER_AREA);
+  else shown = full;
+  std::vector<std::uint8_t> bytes;
+  cv::imencode(".png", shown, bytes);
+  return "data:image/png;base64," + base64(std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()));
+}
+
+// Per displayed pixel: the index of the smallest region that holds it (the whole image, 0, if none other).
+std::vector<std::uint16_t> label_map(const ImageAnalysis& a, const Display& d) {
+  std::vector<std::uint16_t> smallest(static_cast<std::size_t>(a.width) * static_cast<std::size_t>(a.height), 0);
+  std::vector<std::size_t> order(std::min<std::size_t>(a.regions.size(), 65535));
+  std::iota(order.begin(), order.end(), 0);
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t i, std::size_t j) { return a.regions[i].pixels.size() > a.regions[j].pixels.size(); });
+  for (const std::size_t i : order)
+    for (const std::uint32_t p : a.regions[i].pixels) smallest[p] = static_cast<std::uint16_t>(i);
+  std::vector<std::uint16_t> shown(static_cast<std::size_t>(d.width) * static_cast<std::size_t>(d.height));
+  for (int y = 0; y < d.height; ++y)
+    for (int x = 0; x < d.width; ++x) {
+      const int sx = std::min(a.width - 1, static_cast<int>((x + 0.5) / d.scale));
+      const int sy = std::min(a.height - 1, static_cast<int>((y + 0.5) / d.scale));
+      shown[static_cast<std::size_t>(y) * static_cast<std::size_t>(d.width) + static_cast<std::size_t>(x)] =
+          smallest[static_cast<std::size_t>(sy) * static_cast<std::size_t>(a.width) + static_cast<std::size_t>(sx)];
+    }
+  return shown;
+}
+
+json unit(const Vec3& x, const HistogramSpec& s) {
+  return json::array({(x[0] - s.lo[0]) / (s.hi[0] - s.lo[0]), (x[1] - s.lo[1]) / (s.hi[1] - s.lo[1]), (x[2] - s.lo[2]) / (s.hi[2] - s.lo[2])});
+}
+
+json fits_json(const ClusterShape& s, const HistogramSpec& spec) {
+  if (!s.unclipped.empty()) return fits_json(s.unclipped.front(), spec);  // the fits of the pixels off the faces
+  json lines = json::array(), curve = json::array(), plane = json::array();
+  auto add = [&](const Line& l, const char* kind) { lines.push_back({{"from", unit(l.at(l.t_min), spec)}, {"to", unit(l.at(l.t_max), spec)}, {"kind", kind}}); };
+  if (s.line) add(*s.line, "line");
+  if (s.two_lines && (s.shape == ShapeClass::L || s.shape == ShapeClass::SkewedT)) add(s.two_lines->body, "body"), add(s.two_lines->highlight, "highlight");
+  if (s.body_only && s.shape == ShapeClass::P) add(s.body_only->line, "body");
+  if (s.curve && (s.shape == ShapeClass::Curved || s.shape == ShapeClass::Gamma))
+    for (int k = 0; k <= 32; ++k) curve.push_back(unit(s.curve->at(s.curve->t_min + (s.curve->t_max - s.curve->t_min) * k / 32.0), spec));
+  if (s.plane && s.significant_axes >= 2) {
+    const Vec3 m = s.moments.mean, u = 2 * s.sigma[0] * s.moments.axes.col(0), v = 2 * s.sigma[1] * s.moments.axes.col(1);
+    for (const Vec3& c : {Vec3(m - u - v), Vec3(m + u - v), Vec3(m + u + v), Vec3(m - u + v)}) plane.push_back(unit(c, spec));
+  }
+  return {{"lines", lines}, {"curve", curve}, {"plane", plane}};
+}
+
+std::string rgb_text(const Vec3& v) { return fmt::format("({:.4g}, {:.4g}, {:.4g})", v[0], v[1], v[2]); }
+std::string percent(double v) { return fmt::format("{:.1f} %", 100 * v); }
+
+// The numbers a person reads first; analysis.json has them all.
+json summary(const RegionAnalysis& r, const std::optional<Explanation>& e) {
+  const ClusterShape& s = r.shape;
+  json rows = json::array();
+  auto row = [&](std::string key, std::string value) { rows.push_back({std::move(key), std::move(value)}); };
+  row("pixels", fmt::format("{} ({} valid)", r.pixels, s.samples));
+  if (s.samples > 0) {
+    row("mean", rgb_text(s.moments.mean));
+    row("σ along axes", rgb_text(s.sigma));
+    row("noise σ along axes", rgb_text(s.noise_sigma));
+    row("linearity / planarity / scattering", fmt::format("{:.3f} / {:.3f} / {:.3f}", s.linearity, s.planarity, s.scattering));
+  }
+  if (s.line) row("line direction", rgb_text(s.line->direction));
+  if (s.two_lines && (s.shape == ShapeClass::L || s.shape == ShapeClass::SkewedT)) {
+    row("body line", rgb_text(s.two_lines->body.direction));
+    row("highlight line", rgb_text(s.two_lines->highlight.direction));
+    row("highlight leaves body line at", percent(s.two_lines->junction_on_body));
+    row("angle between lines", fmt::format("{:.1f}°", s.two_lines->angle_deg));
+  }
+  if (s.black_plane && s.significant_axes >= 2) row("dichromatic plane normal", rgb_text(s.black_plane->normal));
+  if (s.plane && s.significant_axes >= 2) row("thickness off plane / noise", fmt::format("{:.2f}", s.sigma[2] / std::max(1e-300, s.noise_sigma[2])));
+  if (s.curve && (s.shape == ShapeClass::Curved || s.shape == ShapeClass::Gamma)) row("bend (sagitta / chord)", fmt::format("{:.3f}", s.curve->bend));
+  if (s.gamma && s.shape == ShapeClass::Gamma) row("γ", fmt::format("{:.3f}", s.gamma->gamma));
+  if (!s.clipping.faces.empty()) row("clipped", percent(s.clipping.fraction));
+  if (e) {
+    if (e->direct_share) row("direct / indirect", percent(*e->direct_share) + " / " + percent(e->indirect_share.value_or(0)));
+    if (e->diffuse_share) row("diffuse / glossy", percent(*e->diffuse_share) + " / " + percent(e->glossy_share.value_or(0)));
+    if (e->off_structure) row("off-" + e->off_structure->structure + " spread from indirect light", percent(e->off_structure->indirect_share));
+    for (const FamilyShares& f : e->families)
+      for (const ComponentShare& c : f.components) row(c.name, percent(c.energy_share));
+  }
+  return rows;
+}
+
+json region_json(const RgbImage& layer, const ImageAnalysis& a, std::size_t i, const Display& d, const std::vector<int>& dominant,
+                 std::size_t max_points) {
+  const RegionAnalysis& r = a.results[i];
+  const RegionSamples samples = gather_samples(layer, a.regions[i]);
+  const HistogramSpec spec = display_range(a, samples);
+  const std::size_t stride = std::max<std::size_t>(1, (samples.size() + max_points - 1) / std::max<std::size_t>(1, max_points));
+  std::vector<std::uint16_t> rgb, pixels;
+  std::vector<std::uint8_t> component;
+  for (std::size_t k = 0; k < samples.size(); k += stride) {
+    for (std::size_t c = 0; c < 3; ++c) {
+      const double q = (samples.rgb[k * 3 + c] - spec.lo[c]) / (spec.hi[c] - spec.lo[c]);
+      rgb.push_back(static_cast<std::uint16_t>(std::lround(65535 * std::clamp(q, 0.0, 1.0))));
+    }
+    const std::uint32_t p = samples.pixels[k];
+    pixels.push_back(static_cast<std::uint16_t>(std::min<double>(d.width - 1, (p % static_cast<std::uint32_t>(a.width) + 0.5) * d.scale)));
+    pixels.push_back(static_cast<std::uint16_t>(std::min<double>(d.height - 1, (p / static_cast<std::uint32_t>(a.width) + 0.5) * d.scale)));
+    if (!dominant.empty()) component.push_back(static_cast<std::uint8_t>(std::clamp(dominant[p], 0, 255)));
+  }
+  json points = {{"rgb", base64_of(rgb)}, {"pixels", base64_of(pixels)}};
+  if (!dominant.empty()) points["component"] = base64_of(component);
+  const std::optional<Explanation> none;
+  return {{"name", r.name},
+          {"range", {spec.lo[0], spec.hi[0]}},
+          {"class", class_name(r.shape.shape)},
+          {"reason", r.shape.reason},
+          {"points", points},
+          {"fits", fits_json(r.shape, spec)},
+          {"summary", summary(r, i < a.explanations.size() ? a.explanations[i] : none)}};
+}
+
+constexpr const char* kStyle = R"css(
+body { margin: 0; font: 14px/1.4 system-ui, sans-serif; background: #111; color: #ddd; }
+header { padding: 10px 16px; border-bottom: 1px solid #333; }
+header h1 { font-size: 17px; margin: 0 0 4px; }
+main { display: flex; gap: 16px; padding: 12px 16px; flex-wrap: wrap; }
+#image-pane { flex: 1 1 420px; max-width: 640px; }
+#image-wrap { position: relative; line-height: 0; }
+#image, #overlay { width: 100%; image-rendering: pixelated; }
+#overlay { position: absolute; left: 0; top: 0; height: 100%; cursor: crosshair; }
+#histogram-pane { flex: 1 1 480px; }
+#histogram { position: relative; width: 100%; height: 520px; border: 1px solid #333; }
+#selection { position: absolute; display: none; border: 1px dashed #f0f; background: rgba(255,0,255,0.08); pointer-events: none; }
+#region-list { display: flex; flex-wrap: wrap; gap: 4px; margin-top: 8px; }
+#region-list button { background: #222; color: #ddd; border: 1px solid #444; padding: 3px 8px; cursor: pointer; }
+#region-list button.current { border-color: #f0f; color: #fff; }
+#details table, #illuminant table { border-collapse: collapse; }
+#details th, #details td, #illuminant th, #illuminant td { text-align: left; padding: 1px 10px 1px 0; font-weight: normal; }
+#details th, #illuminant th { color: #999; }
+.class { font-size: 18px; color: #fff; margin: 0; }
+.hint { color: #888; font-size: 12px; }
+)css";
+
+}  // namespace
+
+std::string report_html(const AnalysisImage& input, const ImageAnalysis& a, std::size_t max_points) {
+  const RgbImage& layer = select_layer(input, a.layer);
+  const Display d = display_size(a.width, a.height);
+  const std::vector<int> dominant = input.components.empty() ? std::vector<int>{} : dominant_component_map(input);
+  json regions = json::array();
+  for (std::size_t i = 0; i < a.results.size(); ++i) regions.push_back(region_json(layer, a, i, d, dominant, max_points));
+  json colours = json::array();
+  for (std::size_t k = 0; k < input.components.size(); ++k) {
+    const cv::Scalar c = component_colour(k);
+    colours.push_back({c[0], c[1], c[2]});
+  }
+  const json data = {{"display", {{"width", d.width}, {"height", d.height}}},
+                     {"encodeSrgb", !a.encoding.integer},
+                     {"labels", base64_of(label_map(a, d))},
+                     {"componentColours", colours},
+                     {"regions", regions}};
+
+  std::string illuminant = "<table>";
+  const IlluminantAnalysis& il = a.illuminant;
+  for (const auto* e : {il.planes ? &*il.planes : nullptr, il.highlight_lines ? &*il.highlight_lines : nullptr, &il.grey_world})
+    if (e)
+      illuminant += fmt::format("<tr><th>{}</th><td>{}</td><td>{}</td></tr>", escape_html(e->method), rgb_text(e->rgb),
+                                e->error_deg ? fmt::format("{:.2f}° from the known illuminant", *e->error_deg) : "");
+  illuminant += "</table>";
+  for (const std::string& n : il.notes) illuminant += "<p class=\"hint\">" + escape_html(n) + "</p>";
+  std::string notes;
+  for (const std::string& n : a.notes) notes += "<p class=\"hint\">" + escape_html(n) + "</p>";
+  std::string legend;
+  for (std::size_t k = 0; k < input.components.size(); ++k) {
+    if (std::find(dominant.begin(), dominant.end(), static_cast<int>(k)) == dominant.end()) continue;  // another family's
+    const cv::Scalar c = component_colour(k);
+    legend += fmt::format("<span style=\"color: rgb({},{},{})\">■</span> {} ", c[2], c[1], c[0], escape_html(input.components[k].name));
+  }
+
+  return fmt::format(
+      R"html(<!DOCTYPE html>
+<html lang="en">
+<head>
+<meta charset="utf-8">
+<title>chromatrace analysis — {title}</title>
+<style>{style}</style>
+</head>
+<body data-ready="0">
+<header>
+<h1>chromatrace analysis — {title}</h1>
+<div>{width}×{height}, layer {layer}, {regions} region{plural}. Numbers: <a href="analysis.json">analysis.json</a>, plots in <a href="plots/">plots/</a>.</div>
+{notes}
+</header>
+<main>
+<section id="image-pane">
+<div id="image-wrap" data-selected-pixels="0"><img id="image" alt="analysed image" src="{image}"><canvas id="overlay"></canvas></div>
+<p class="hint">Click a region in the image, or pick one below.</p>
+<div id="region-list"></div>
+<h2>Illuminant</h2>
+<div id="illuminant">{illuminant}</div>
+</section>
+<section id="histogram-pane">
+<div id="histogram" data-points-drawn="0" data-region="-1"><div id="selection"></div></div>
+<p class="hint">Drag to rotate, scroll to zoom; shift-drag a rectangle to highlight those points' pixels in the image.
+Colour: <select id="colour-mode"><option value="own">own colour</option><option value="component">dominant component</option></select> {legend}</p>
+<div id="details"></div>
+</section>
+</main>
+<script id="analysis-data" type="application/json">{data}</script>
+<script>{bundle}</script>
+</body>
+</html>
+)html",
+      fmt::arg("title", escape_html(std::filesystem::path(a.file).filename().string())), fmt::arg("style", kStyle),
+      fmt::arg("width", a.width), fmt::arg("height", a.height), fmt::arg("layer", escape_html(a.layer)),
+      fmt::arg("regions", a.results.size()), fmt::arg("plural", a.results.size() == 1 ? "" : "s"), fmt::arg("notes", notes),
+      fmt::arg("image", image_png(layer, a, d)), fmt::arg("illuminant", illuminant), fmt::arg("legend", legend),
+      fmt::arg("data", script_safe(data.dump())), fmt::arg("bundle", script_safe(std::string(viewer_bundle()))));
+}
+
+}  // namespace ct::analyzer

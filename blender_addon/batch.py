@@ -1,0 +1,99 @@
+"""Headless spectral rendering with Blender and Cycles.
+
+    blender --background --factory-startup --python blender_addon/batch.py -- \
+        --scene SCENE.json --out OUT.exr [--samples N] [--bands lo:hi:w | --bands-file F] [--max-bounces K]
+        [--components paths,lights,bounces] [--resolution WxH] [--seed S] [--cache-dir DIR] [--keep-cache]
+    (or --blend FILE.blend instead of --scene; the .blend is never written)
+
+Exit status 0 on success, 1 on a runtime failure, 2 on bad input, with one line on stderr naming the file,
+field or option at fault (as the `chromatrace` command). Progress lines go to stderr (--quiet: none).
+A run that is killed resumes from the band groups already rendered when run again with the same input.
+
+For tests: CHROMATRACE_TEST_FAIL_AT_RENDER=N raises an exception just before the N-th new Cycles render
+(counting from 0), CHROMATRACE_TEST_KILL_AT_RENDER=N kills the process there (SIGKILL).
+"""
+
+import os
+import signal
+import sys
+import traceback
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+
+from chromatrace.batch_args import parse_batch_args  # noqa: E402
+from chromatrace.errors import BadInput  # noqa: E402
+
+PROG = "batch.py"
+
+
+def _log(message):
+    print(f"chromatrace: {message}", file=sys.stderr, flush=True)
+
+
+def _test_hook():
+    fail_at = os.environ.get("CHROMATRACE_TEST_FAIL_AT_RENDER")
+    kill_at = os.environ.get("CHROMATRACE_TEST_KILL_AT_RENDER")
+    if fail_at is None and kill_at is None:
+        return None
+
+    def hook(event, rendered, **info):
+        if kill_at is not None and rendered == int(kill_at):
+            sys.stderr.flush()
+            os.kill(os.getpid(), signal.SIGKILL)
+        if fail_at is not None and rendered == int(fail_at):
+            raise RuntimeError(f"test hook: failing before render {rendered} (group {info['group']})")
+    return hook
+
+
+def _empty_startup_scene(bpy):
+    for collection in (bpy.data.objects, bpy.data.meshes, bpy.data.materials, bpy.data.lights, bpy.data.cameras):
+        for item in list(collection):
+            collection.remove(item)
+
+
+def run(argv):
+    args = parse_batch_args(argv)
+    import bpy
+    import chromatrace
+    from chromatrace import scene_import, spectral_render, tool
+
+    chromatrace.register()
+    log = (lambda message: None) if args.quiet else _log
+    chromatrace_tool = tool.Tool(tool.find_executable())
+    if args.scene:
+        _empty_startup_scene(bpy)
+        scene_import.import_scene(args.scene, bpy.context.scene, chromatrace_tool, log)
+    else:
+        bpy.ops.wm.open_mainfile(filepath=os.path.abspath(args.blend))
+    scene = bpy.context.scene
+    families = args.components
+    request = spectral_render.Request.from_scene(
+        scene, output=os.path.abspath(args.out), samples=args.samples, max_bounces=args.max_bounces, seed=args.seed,
+        bands=args.bands, bands_file=args.bands_file, families=families, resolution=args.resolution,
+        cache_root=args.cache_dir, keep_cache=args.keep_cache or None, log=log,
+        on_mixing_nodes=args.on_mixing_nodes, bands_per_render=args.bands_per_render)
+    if args.bands_file:
+        request.bands = None
+    elif args.bands:
+        request.bands_file = None
+    spectral_render.TEST_HOOK = _test_hook()
+    spectral_render.SpectralRender(scene, request, chromatrace_tool).run()
+
+
+def main():
+    argv = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else []
+    try:
+        run(argv)
+    except BadInput as e:
+        print(f"{PROG}: error: {e}", file=sys.stderr, flush=True)
+        sys.exit(2)
+    except Exception as e:  # a runtime failure: the reason on one line, the traceback for a bug report
+        if os.environ.get("CHROMATRACE_TRACEBACK"):
+            traceback.print_exc()
+        print(f"{PROG}: failed: {str(e).strip().splitlines()[-1] if str(e).strip() else type(e).__name__}",
+              file=sys.stderr, flush=True)
+        sys.exit(1)
+    sys.exit(0)
+
+
+main()

@@ -1,0 +1,42 @@
+"""Band multiplexing: which bands share a Cycles render, and what goes into each colour channel.
+
+Pure Python (no bpy). Band edges and band averages come from the `chromatrace` command (core/spectrum.h);
+this module only decides how the bands are packed into renders.
+"""
+
+CHANNELS = ("R", "G", "B")
+
+
+def band_groups(band_count, per_render=3):
+    """Consecutive groups of band indices, `per_render` (1 to 3) to a render: 7 bands -> [0,1,2], [3,4,5], [6]."""
+    if not 1 <= per_render <= len(CHANNELS):
+        raise ValueError(f"per_render must be 1 to {len(CHANNELS)}, got {per_render}")
+    if band_count < 1:
+        raise ValueError(f"band_count must be at least 1, got {band_count}")
+    return [list(range(first, min(first + per_render, band_count))) for first in range(0, band_count, per_render)]
+
+
+def channel_of(group, band):
+    """The colour channel ("R", "G" or "B") that carries `band` in the render of `group`."""
+    return CHANNELS[group.index(band)]
+
+
+def group_colour(band_values, group, replicate=False):
+    """The RGB triple a colour input gets in the render of `group`, from its per-band values.
+
+    Bands fill R, G, B in order; channels without a band get 0. With `replicate` (one band per render,
+    the fallback for node trees that mix channels) the single band fills all three channels, so such
+    nodes see a grey input and act on it as on a monochrome scene; only R is read back.
+    """
+    if replicate:
+        if len(group) != 1:
+            raise ValueError("replicating needs one band per render")
+        v = band_values[group[0]]
+        return (v, v, v)
+    values = [band_values[b] for b in group]
+    return tuple(values + [0.0] * (len(CHANNELS) - len(values)))
+
+
+def describe_band_range(edges_nm, group):
+    """'400-550 nm' for the bands of a group, for progress messages."""
+    return f"{edges_nm[group[0]]:g}-{edges_nm[group[-1] + 1]:g} nm"

@@ -1,0 +1,82 @@
+"""Command line of blender_addon/batch.py (pure Python, no bpy).
+
+    blender --background --factory-startup --python blender_addon/batch.py -- \
+        (--scene SCENE.json | --blend FILE.blend) --out OUT.exr [options]
+
+Every mistake is a BadInput with one line naming the option, as the `chromatrace` command reports.
+"""
+
+import argparse
+import os
+import re
+
+from .components import ComponentError, parse_components
+from .errors import BadInput
+
+
+class _Parser(argparse.ArgumentParser):
+    def error(self, message):  # argparse prints usage and exits; we want one line and exit code 2
+        raise BadInput(message)
+
+
+def _parser():
+    p = _Parser(prog="batch.py", add_help=True,
+                description="Render a chromatrace scene or a .blend spectrally with Cycles (bands multiplexed 3 per render).")
+    source = p.add_mutually_exclusive_group()
+    source.add_argument("--scene", help="scene file (chromatrace-scene/1)")
+    source.add_argument("--blend", help=".blend file with chromatrace settings (never written)")
+    p.add_argument("--out", help="output spectral EXR (written atomically)")
+    p.add_argument("--samples", type=int, help="samples per pixel (default: the scene's)")
+    p.add_argument("--bands", help="band plan lo:hi:width in nm (default: the scene's)")
+    p.add_argument("--bands-file", help="band plan file (chromatrace-bands/1)")
+    p.add_argument("--max-bounces", type=int, help="scattering events per path: 0 emitters, 1 direct, >= 2 global")
+    p.add_argument("--components", help="component families: paths, lights, bounces, all, none (default: the scene's)")
+    p.add_argument("--resolution", help="image size WxH, overriding the camera's")
+    p.add_argument("--seed", type=int, help="Cycles seed (default: the scene's)")
+    p.add_argument("--on-mixing-nodes", choices=["refuse", "one-band"],
+                   help="node trees that mix colour channels: refuse to render, or render one band per render")
+    p.add_argument("--bands-per-render", type=int, choices=[1, 2, 3],
+                   help="bands multiplexed into one render (default 3; fewer for comparisons)")
+    p.add_argument("--cache-dir", help="where finished band groups are kept for resuming "
+                                       "(default: $XDG_CACHE_HOME/chromatrace/blender)")
+    p.add_argument("--keep-cache", action="store_true", help="keep the band-group renders after success")
+    p.add_argument("-q", "--quiet", action="store_true", help="no progress lines on stderr")
+    return p
+
+
+def parse_batch_args(argv):
+    """Parses the arguments after Blender's `--`; returns an argparse.Namespace with `components` a set or None
+    and `resolution` a (width, height) pair or None."""
+    args = _parser().parse_args(argv)
+    if not args.scene and not args.blend:
+        raise BadInput("--scene: give a scene file (--scene SCENE.json) or a .blend (--blend FILE.blend)")
+    source_option = "--scene" if args.scene else "--blend"
+    source = args.scene or args.blend
+    if not os.path.isfile(source):
+        raise BadInput(f"{source_option}: {source}: no such file")
+    if not args.out:
+        raise BadInput("--out: no output file given")
+    out_dir = os.path.dirname(os.path.abspath(args.out))
+    if not os.path.isdir(out_dir):
+        raise BadInput(f"--out: {args.out}: directory {out_dir} does not exist")
+    if args.samples is not None and args.samples < 1:
+        raise BadInput(f"--samples: must be at least 1, got {args.samples}")
+    if args.max_bounces is not None and args.max_bounces < 0:
+        raise BadInput(f"--max-bounces: must be >= 0, got {args.max_bounces}")
+    if args.seed is not None and args.seed < 0:
+        raise BadInput(f"--seed: must be >= 0, got {args.seed}")
+    if args.bands and args.bands_file:
+        raise BadInput("--bands-file: give either --bands or --bands-file, not both")
+    if args.bands_file and not os.path.isfile(args.bands_file):
+        raise BadInput(f"--bands-file: {args.bands_file}: no such file")
+    if args.components is not None:
+        try:
+            args.components = parse_components(args.components)
+        except ComponentError as e:
+            raise BadInput(str(e)) from None
+    if args.resolution is not None:
+        match = re.fullmatch(r"([1-9][0-9]*)x([1-9][0-9]*)", args.resolution)
+        if not match:
+            raise BadInput(f"--resolution: expected WxH with positive integers, got \"{args.resolution}\"")
+        args.resolution = (int(match.group(1)), int(match.group(2)))
+    return args

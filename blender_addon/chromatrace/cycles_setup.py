@@ -1,0 +1,77 @@
+"""Cycles settings that keep every colour channel linear and unbiased on its own, so that each channel of a
+render is an independent estimate of its band (applied through the journal, so they are undone after).
+
+Off: clamping (direct and indirect), Filter Glossy, denoising, adaptive sampling, the light threshold,
+path guiding, fast GI, simplify, motion blur, Freestyle, compositing and the sequencer. On: both kinds of
+caustics. Box pixel filter of width 1 (0.01 for the scene format's "point"), Standard view transform with
+look None, exposure 0 and gamma 1, Cycles film exposure 1, 32-bit float multilayer OpenEXR.
+"""
+
+VIEW_LAYER_PASSES = {
+    "Emit": "use_pass_emit",
+    "DiffDir": "use_pass_diffuse_direct", "DiffInd": "use_pass_diffuse_indirect", "DiffCol": "use_pass_diffuse_color",
+    "GlossDir": "use_pass_glossy_direct", "GlossInd": "use_pass_glossy_indirect", "GlossCol": "use_pass_glossy_color",
+    "TransDir": "use_pass_transmission_direct", "TransInd": "use_pass_transmission_indirect",
+    "TransCol": "use_pass_transmission_color",
+    "IndexOB": "use_pass_object_index",
+}
+
+
+def _set_if(journal, target, attribute, value):
+    if target is not None and hasattr(target, attribute):
+        journal.set(target, attribute, value)
+
+
+def apply(journal, scene, view_layer, samples, seed, point_filter, resolution, passes):
+    render = scene.render
+    journal.set(render, "engine", "CYCLES")
+    c = scene.cycles
+    journal.set(c, "device", "CPU")
+    journal.set(c, "samples", samples)
+    journal.set(c, "seed", seed)
+    for attribute, value in (("use_animated_seed", False), ("use_adaptive_sampling", False),
+                             ("use_denoising", False), ("sample_clamp_direct", 0.0), ("sample_clamp_indirect", 0.0),
+                             ("blur_glossy", 0.0), ("light_sampling_threshold", 0.0), ("caustics_reflective", True),
+                             ("caustics_refractive", True), ("pixel_filter_type", "BOX"),
+                             ("filter_width", 0.01 if point_filter else 1.0), ("use_layer_samples", "IGNORE"),
+                             ("time_limit", 0.0), ("use_guiding", False), ("use_fast_gi", False),
+                             ("film_exposure", 1.0), ("sample_offset", 0), ("volume_bounces", 0)):
+        _set_if(journal, c, attribute, value)
+    for attribute, value in (("film_transparent", False), ("use_motion_blur", False), ("use_compositing", False),
+                             ("use_sequencer", False), ("use_freestyle", False), ("use_simplify", False),
+                             ("use_border", False), ("use_file_extension", False), ("use_persistent_data", True),
+                             ("pixel_aspect_x", 1.0), ("pixel_aspect_y", 1.0), ("resolution_percentage", 100),
+                             ("use_single_layer", False), ("use_multiview", False)):
+        _set_if(journal, render, attribute, value)
+    if resolution is not None:
+        journal.set(render, "resolution_x", resolution[0])
+        journal.set(render, "resolution_y", resolution[1])
+
+    image = render.image_settings
+    # The valid bit depths depend on the format: set (and restore) the format first.
+    journal.set_together(image, [("file_format", "OPEN_EXR_MULTILAYER"), ("color_depth", "32"), ("exr_codec", "ZIP")]
+                         + [(a, v) for a, v in (("use_preview", False), ("color_management", "FOLLOW_SCENE"))
+                            if hasattr(image, a)])
+
+    view = scene.view_settings
+    journal.set(scene.display_settings, "display_device", "sRGB")
+    journal.set(view, "view_transform", "Standard")
+    journal.set(view, "look", "None")
+    journal.set(view, "exposure", 0.0)
+    journal.set(view, "gamma", 1.0)
+    journal.set(view, "use_curve_mapping", False)
+
+    for layer in scene.view_layers:
+        journal.set(layer, "use", layer == view_layer)
+    journal.set(view_layer, "use_pass_combined", True)
+    for name, attribute in VIEW_LAYER_PASSES.items():
+        if name in passes:
+            journal.set(view_layer, attribute, True)
+    _set_if(journal, view_layer, "samples", 0)
+    _set_if(journal, getattr(view_layer, "cycles", None), "denoising_store_passes", False)
+
+
+def set_bounces(journal, scene, cycles_max_bounces):
+    c = scene.cycles
+    for attribute in ("max_bounces", "diffuse_bounces", "glossy_bounces", "transmission_bounces"):
+        journal.set(c, attribute, cycles_max_bounces)

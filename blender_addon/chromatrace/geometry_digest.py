@@ -1,0 +1,26 @@
+"""Digests that tell whether an imported object or camera is still as imported (then export writes the
+analytic shape or camera of the scene file, exactly, instead of what Blender's float32 data says)."""
+
+import hashlib
+from array import array
+
+
+def object_digest(ob):
+    digest = hashlib.sha256()
+    digest.update(repr([list(row) for row in ob.matrix_world]).encode())
+    mesh = ob.data
+    co = array("f", [0.0]) * (len(mesh.vertices) * 3)
+    mesh.vertices.foreach_get("co", co)
+    loops = array("i", [0]) * len(mesh.loops)
+    mesh.loops.foreach_get("vertex_index", loops)
+    digest.update(co.tobytes())
+    digest.update(loops.tobytes())
+    digest.update(repr([(m.name, m.type) for m in ob.modifiers]).encode())  # a modifier changes the mesh
+    return digest.hexdigest()
+
+
+def camera_digest(ob):
+    data = ob.data
+    text = repr(([list(row) for row in ob.matrix_world], data.lens, data.sensor_width, data.sensor_height,
+                 data.sensor_fit, data.shift_x, data.shift_y, data.type))
+    return hashlib.sha256(text.encode()).hexdigest()

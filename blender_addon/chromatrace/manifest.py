@@ -1,0 +1,59 @@
+"""The manifest that `chromatrace assemble` turns into a spectral EXR (pure Python, no bpy).
+
+Format `chromatrace-assemble/1`, documented in cli/cmd_assemble.cpp.
+"""
+
+import os
+
+from .bands import channel_of
+
+FORMAT = "chromatrace-assemble/1"
+
+
+def render_file_name(group_index, variant):
+    """File of one Cycles render in the cache: g003_main.exr, g003_k2.exr."""
+    return f"g{group_index:03d}_{variant}.exr"
+
+
+def build_manifest(edges_nm, groups, variants, view_layer, total, components, object_names=None,
+                   attributes=None, replicate=False, sum_tolerance=1e-4):
+    """The manifest dict, with file paths relative to the directory the manifest is written to.
+
+    groups: lists of band indices, one per render; variants: names of the renders every group has
+    (components.render_variants); object_names: {id: name} when the renders carry the Object Index pass;
+    replicate: one band per render copied to R, G and B (read back from R).
+    """
+    band_count = len(edges_nm) - 1
+    bands = [None] * band_count
+    for g, group in enumerate(groups):
+        for band in group:
+            bands[band] = {"channel": "R" if replicate else channel_of(group, band),
+                           "files": {v: render_file_name(g, v) for v in variants}}
+    missing = [i for i, b in enumerate(bands) if b is None]
+    if missing:
+        raise ValueError(f"bands {missing} are in no group")
+    manifest = {
+        "format": FORMAT,
+        "edges_nm": list(edges_nm),
+        "view_layer": view_layer,
+        "bands": bands,
+        "total": total,
+        "components": components,
+        "sum_tolerance": sum_tolerance,
+    }
+    if object_names is not None:
+        manifest["object_ids"] = {"file": render_file_name(0, "main"), "channel": _join(view_layer, "IndexOB.X")}
+        manifest["object_names"] = {str(i): name for i, name in sorted(object_names.items())}
+    if attributes:
+        manifest["attributes"] = dict(attributes)
+    return manifest
+
+
+def _join(view_layer, name):
+    return f"{view_layer}.{name}" if view_layer else name
+
+
+def missing_renders(directory, groups, variants):
+    """(group index, variant) of the renders not yet in `directory` (a resumed run renders only these)."""
+    return [(g, v) for g in range(len(groups)) for v in variants
+            if not os.path.isfile(os.path.join(directory, render_file_name(g, v)))]

@@ -1,0 +1,198 @@
+"""Operators: the spectral render (modal, with progress and Esc to cancel), scene import and export, and
+small helpers for materials and the spectrum table."""
+
+import bpy
+from bpy.props import StringProperty
+from bpy_extras.io_utils import ExportHelper, ImportHelper
+
+from . import materials, scene_export, scene_import, spectral_render, tool
+from .errors import BadInput
+from .properties import executable_preference
+
+
+def _tool(context):
+    return tool.Tool(tool.find_executable(executable_preference(context)))
+
+
+class CHROMATRACE_OT_render_spectral(bpy.types.Operator):
+    """Render the scene spectrally with Cycles (bands multiplexed three per render) into a spectral EXR"""
+
+    bl_idname = "chromatrace.render_spectral"
+    bl_label = "Render Spectral"
+
+    _steps = None
+    _timer = None
+
+    def _start(self, context):
+        self._messages = []
+        request = spectral_render.Request.from_scene(context.scene, log=self._messages.append)
+        return spectral_render.SpectralRender(context.scene, request, _tool(context))
+
+    def execute(self, context):  # synchronous: background mode and scripts
+        try:
+            self._start(context).run()
+        except BadInput as e:
+            self.report({"ERROR"}, str(e))
+            return {"CANCELLED"}
+        self.report({"INFO"}, f"wrote {bpy.path.abspath(context.scene.chromatrace.output_path)}")
+        return {"FINISHED"}
+
+    def invoke(self, context, event):
+        if bpy.app.background:
+            return self.execute(context)
+        try:
+            self._steps = self._start(context).steps()
+        except BadInput as e:
+            self.report({"ERROR"}, str(e))
+            return {"CANCELLED"}
+        wm = context.window_manager
+        self._timer = wm.event_timer_add(0.05, window=context.window)
+        wm.modal_handler_add(self)
+        wm.progress_begin(0, 1)
+        context.workspace.status_text_set("chromatrace: preparing the spectral render (Esc cancels)")
+        return {"RUNNING_MODAL"}
+
+    def _finish(self, context):
+        wm = context.window_manager
+        wm.event_timer_remove(self._timer)
+        wm.progress_end()
+        context.workspace.status_text_set(None)
+
+    def modal(self, context, event):
+        if event.type == "ESC":
+            self._steps.close()  # the render's finally restores every setting
+            self._finish(context)
+            self.report({"WARNING"}, "spectral render cancelled; finished band groups stay in the cache")
+            return {"CANCELLED"}
+        if event.type != "TIMER":
+            return {"PASS_THROUGH"}
+        try:
+            done, total, message = next(self._steps)
+        except StopIteration:
+            self._finish(context)
+            self.report({"INFO"}, self._messages[-1] if self._messages else "spectral render finished")
+            return {"FINISHED"}
+        except BadInput as e:
+            self._finish(context)
+            self.report({"ERROR"}, str(e))
+            return {"CANCELLED"}
+        except Exception as e:
+            self._finish(context)
+            self.report({"ERROR"}, f"spectral render failed: {e}")
+            return {"CANCELLED"}
+        context.window_manager.progress_update(done / total)
+        context.workspace.status_text_set(f"chromatrace: {message} (Esc cancels)")
+        return {"RUNNING_MODAL"}
+
+
+class CHROMATRACE_OT_import_scene(bpy.types.Operator, ImportHelper):
+    """Import a chromatrace scene (chromatrace-scene/1) into the current scene"""
+
+    bl_idname = "chromatrace.import_scene"
+    bl_label = "Import chromatrace Scene"
+    bl_options = {"REGISTER", "UNDO"}
+    filename_ext = ".json"
+    filter_glob: StringProperty(default="*.json", options={"HIDDEN"})
+
+    def execute(self, context):
+        try:
+            scene_import.import_scene(self.filepath, context.scene, _tool(context),
+                                      lambda m: self.report({"INFO"}, m))
+        except BadInput as e:
+            self.report({"ERROR"}, str(e))
+            return {"CANCELLED"}
+        return {"FINISHED"}
+
+
+class CHROMATRACE_OT_export_scene(bpy.types.Operator, ExportHelper):
+    """Export the scene as a chromatrace scene (chromatrace-scene/1), meshes as PLY files beside it"""
+
+    bl_idname = "chromatrace.export_scene"
+    bl_label = "Export chromatrace Scene"
+    filename_ext = ".json"
+    filter_glob: StringProperty(default="*.json", options={"HIDDEN"})
+
+    def execute(self, context):
+        try:
+            scene_export.export_scene(context.scene, self.filepath, _tool(context),
+                                      lambda m: self.report({"INFO"}, m))
+        except BadInput as e:
+            self.report({"ERROR"}, str(e))
+            return {"CANCELLED"}
+        return {"FINISHED"}
+
+
+class CHROMATRACE_OT_build_material(bpy.types.Operator):
+    """Rebuild the material's nodes from its chromatrace model"""
+
+    bl_idname = "chromatrace.build_material"
+    bl_label = "Rebuild Nodes"
+    bl_options = {"REGISTER", "UNDO"}
+
+    @classmethod
+    def poll(cls, context):
+        m = getattr(context, "material", None)
+        return m is not None and m.chromatrace.model != "NODES"
+
+    def execute(self, context):
+        materials.build_material_nodes(context.material)
+        return {"FINISHED"}
+
+
+class CHROMATRACE_OT_spectrum_add(bpy.types.Operator):
+    """Add a named spectrum to the scene's spectrum table"""
+
+    bl_idname = "chromatrace.spectrum_add"
+    bl_label = "Add Spectrum"
+    bl_options = {"REGISTER", "UNDO"}
+
+    def execute(self, context):
+        s = context.scene.chromatrace
+        entry = s.spectra.add()
+        entry.name = f"spectrum{len(s.spectra)}"
+        s.active_spectrum = len(s.spectra) - 1
+        return {"FINISHED"}
+
+
+class CHROMATRACE_OT_spectrum_remove(bpy.types.Operator):
+    """Remove the selected spectrum from the scene's spectrum table"""
+
+    bl_idname = "chromatrace.spectrum_remove"
+    bl_label = "Remove Spectrum"
+    bl_options = {"REGISTER", "UNDO"}
+
+    @classmethod
+    def poll(cls, context):
+        return len(context.scene.chromatrace.spectra) > 0
+
+    def execute(self, context):
+        s = context.scene.chromatrace
+        s.spectra.remove(s.active_spectrum)
+        s.active_spectrum = max(0, min(s.active_spectrum, len(s.spectra) - 1))
+        return {"FINISHED"}
+
+
+def _menu_import(self, context):
+    self.layout.operator(CHROMATRACE_OT_import_scene.bl_idname, text="chromatrace scene (.json)")
+
+
+def _menu_export(self, context):
+    self.layout.operator(CHROMATRACE_OT_export_scene.bl_idname, text="chromatrace scene (.json)")
+
+
+_classes = (CHROMATRACE_OT_render_spectral, CHROMATRACE_OT_import_scene, CHROMATRACE_OT_export_scene,
+            CHROMATRACE_OT_build_material, CHROMATRACE_OT_spectrum_add, CHROMATRACE_OT_spectrum_remove)
+
+
+def register():
+    for cls in _classes:
+        bpy.utils.register_class(cls)
+    bpy.types.TOPBAR_MT_file_import.append(_menu_import)
+    bpy.types.TOPBAR_MT_file_export.append(_menu_export)
+
+
+def unregister():
+    bpy.types.TOPBAR_MT_file_export.remove(_menu_export)
+    bpy.types.TOPBAR_MT_file_import.remove(_menu_import)
+    for cls in reversed(_classes):
+        bpy.utils.unregister_class(cls)

@@ -1,0 +1,178 @@
+"""Importing a `chromatrace-scene/1` file into a Blender scene.
+
+`chromatrace check-scene` validates the file (and gives the camera's focal length), `chromatrace
+export-meshes` tessellates every shape into PLY files with core's one rule, so Cycles renders the triangles
+the reference tracer traces. Objects and lights become mesh objects with their object ids as pass
+indices; lights are one-sided (or two-sided) emitters in their light groups; materials get the node
+trees of their models. What the format says and Blender cannot hold (analytic shapes, the camera as
+given, spectrum sources, render defaults) is kept in chromatrace properties, so export writes it back.
+"""
+
+import json
+import os
+import shutil
+import tempfile
+
+import bpy
+from mathutils import Matrix
+
+from . import camera_math, materials, ply
+from .geometry_digest import camera_digest, object_digest
+
+
+def _spectrum(settings, source, scene_dir):
+    settings.set_from_json(source, scene_dir)
+
+
+def _material(name, entry, scene_dir):
+    material = bpy.data.materials.new(name)
+    s = material.chromatrace
+    s.scene_name = name
+    kind = entry["type"]
+    if kind == "dichromatic":
+        _spectrum(s.reflectance, entry["diffuse"], scene_dir)
+        s.specular = entry["specular"]
+        s.lobe = entry.get("lobe", "ggx")
+        if s.lobe == "ggx":
+            s.roughness = entry["roughness"]
+        else:
+            s.exponent = entry["exponent"]
+    else:
+        _spectrum(s.reflectance, entry["reflectance"], scene_dir)
+    s.model = kind.upper()  # builds the nodes
+    materials.build_material_nodes(material)
+    return material
+
+
+def _emitter_material(light, reflect, scene_dir):
+    material = bpy.data.materials.new(f"{light['name']} (emitter)")
+    s = material.chromatrace
+    if reflect is not None:
+        r = reflect.chromatrace
+        s.reflectance.set_from_json(json.loads(_source_of(r.reflectance)), scene_dir)
+        s.specular, s.lobe, s.roughness, s.exponent = r.specular, r.lobe, r.roughness, r.exponent
+    s.emissive = True
+    _spectrum(s.emission, light["radiance"], scene_dir)
+    s.emission_scale = light.get("scale", 1.0)
+    s.two_sided = light.get("two_sided", False)
+    s.model = reflect.chromatrace.model if reflect is not None else "NONE"
+    materials.build_material_nodes(material)
+    return material
+
+
+def _source_of(settings):
+    return json.dumps(settings.to_json())
+
+
+def _mesh_object(name, path, collection):
+    data = ply.read_ply(path)
+    mesh = bpy.data.meshes.new(name)
+    mesh.from_pydata(data.positions, [], data.triangles)
+    if data.normals:
+        mesh.polygons.foreach_set("use_smooth", [True] * len(mesh.polygons))
+        if hasattr(mesh, "use_auto_smooth"):  # Blender < 4.1 applies custom normals only with auto smooth
+            mesh.use_auto_smooth = True
+        mesh.normals_split_custom_set_from_vertices(data.normals)
+    mesh.update()
+    ob = bpy.data.objects.new(name, mesh)
+    collection.objects.link(ob)
+    return ob
+
+
+def _ensure_lightgroup(view_layer, group):
+    if group not in view_layer.lightgroups.keys():
+        view_layer.lightgroups.add(name=group)
+
+
+def import_scene(path, scene, tool, log=print):
+    """Adds the scene file's objects, lights and camera to `scene` and sets its chromatrace settings."""
+    summary = tool.check_scene(path)["scene"]
+    with open(path) as f:
+        document = json.load(f)
+    scene_dir = os.path.dirname(os.path.abspath(path))
+    s = scene.chromatrace
+    s.scene_name = document.get("name", "")
+    s.description = document.get("description", "")
+    s.source_file = os.path.abspath(path)
+    s.source_json = json.dumps(document)
+
+    s.spectra.clear()
+    for name, source in document.get("spectra", {}).items():
+        entry = s.spectra.add()
+        entry.name = name
+        entry.source.set_from_json(source, scene_dir)
+
+    render = document.get("render", {})
+    s.samples = render.get("samples", 64)
+    s.max_bounces = render.get("max_bounces", 8)
+    s.seed = render.get("seed", 1)
+    s.pixel_filter = render.get("pixel_filter", "box")
+    s.spectral_mode = render.get("spectral_mode", "bands")
+    s.band_plan = "RANGE"
+    lo, hi, width = (float(v) for v in render.get("bands", "380:780:10").split(":"))
+    s.bands_lo, s.bands_hi, s.bands_width = lo, hi, width
+    tessellation = render.get("tessellation", {})
+    s.tessellation_segments = tessellation.get("segments", 0)
+    s.tessellation_rings = tessellation.get("rings", 0)
+    scene.render.engine = "CYCLES"
+    scene.cycles.samples = s.samples
+
+    mesh_dir = tempfile.mkdtemp(prefix="chromatrace-import-")
+    try:
+        index = tool.export_meshes(path, mesh_dir)
+        collection = bpy.data.collections.new(s.scene_name or os.path.splitext(os.path.basename(path))[0])
+        scene.collection.children.link(collection)
+
+        built = {name: _material(name, entry, scene_dir) for name, entry in document["materials"].items()}
+        for entry, obj in zip(index["objects"], document["objects"]):
+            ob = _mesh_object(obj["name"], os.path.join(mesh_dir, entry["file"]), collection)
+            ob.data.materials.append(built[obj["material"]])
+            ob.pass_index = entry["id"]
+            ob.chromatrace.role = "OBJECT"
+            ob.chromatrace.scene_name = obj["name"]
+            ob.chromatrace.shape_json = json.dumps(obj["shape"])
+        view_layer = scene.view_layers[0]
+        for entry, light in zip(index["lights"], document["lights"]):
+            reflect = built.get(light["material"]) if "material" in light else None
+            ob = _mesh_object(light["name"], os.path.join(mesh_dir, entry["file"]), collection)
+            ob.data.materials.append(_emitter_material(light, reflect, scene_dir))
+            ob.pass_index = entry["id"]
+            group = light.get("group", light["name"])
+            ob.chromatrace.role = "LIGHT"
+            ob.chromatrace.scene_name = light["name"]
+            ob.chromatrace.shape_json = json.dumps(light["shape"])
+            ob.chromatrace.light_group = group
+            ob.chromatrace.light_material = light.get("material", "")
+            if hasattr(ob, "lightgroup"):
+                _ensure_lightgroup(view_layer, group)
+                ob.lightgroup = group
+        for material in built.values():
+            if material.users == 0:
+                material.use_fake_user = True  # a scene material no object uses: keep it for export
+
+        camera = document["camera"]
+        data = bpy.data.cameras.new("camera")
+        data.sensor_fit = "HORIZONTAL"
+        data.sensor_width = summary["camera"]["sensor_width_mm"]
+        data.lens = summary["camera"]["focal_length_mm"]
+        data.clip_start, data.clip_end = 1e-4, 1e5  # the format's pinhole clips nothing
+        ob = bpy.data.objects.new("camera", data)
+        collection.objects.link(ob)
+        basis = camera_math.camera_basis(camera["position"], camera["look_at"], camera.get("up", [0, 0, 1]))
+        ob.matrix_world = Matrix([basis[0] + [camera["position"][0]], basis[1] + [camera["position"][1]],
+                                  basis[2] + [camera["position"][2]], [0, 0, 0, 1]])
+        scene.camera = ob
+        width, height = camera["resolution"]
+        scene.render.resolution_x, scene.render.resolution_y = width, height
+        scene.render.resolution_percentage = 100
+        view_layer.update()  # matrices as Blender keeps them, for the digests
+        for imported in collection.objects:
+            if imported.type == "MESH":
+                imported.chromatrace.geometry_digest = object_digest(imported)
+        data.chromatrace.scene_json = json.dumps(camera)
+        data.chromatrace.digest = camera_digest(ob)
+    finally:
+        shutil.rmtree(mesh_dir, ignore_errors=True)
+    log(f"imported {path}: {len(document['objects'])} objects, {len(document['lights'])} lights, "
+        f"{len(document['materials'])} materials")
+    return collection

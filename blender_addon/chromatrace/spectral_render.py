@@ -1,0 +1,476 @@
+"""The spectral render: Cycles renders three bands at a time, chromatrace assembles the spectral EXR.
+
+    render = SpectralRender(scene, Request.from_scene(scene, output="out.exr"), Tool(executable))
+    for done, total, message in render.steps():   # one step per Cycles render; render.run() does them all
+        ...
+
+What it guarantees:
+- Everything it changes (colours, Cycles and colour-management settings, passes, light groups, object
+  indices, the world's strength) goes through a Journal and is put back in a `finally`, whether the render
+  succeeds, fails or is cancelled (closing the generator). It never saves the .blend.
+- Each finished Cycles render is moved into a cache directory keyed by a hash of the scene and settings
+  (cache.py); a run that was killed resumes with the renders still missing. The final EXR is written
+  atomically by `chromatrace assemble`.
+"""
+
+import hashlib
+import json
+import os
+import re
+import shutil
+import sys
+import tempfile
+import time
+from array import array
+
+import bpy
+
+from . import VERSION, cache, components, cycles_setup, manifest, materials, node_rules
+from .bands import band_groups, describe_band_range, group_colour
+from .errors import BadInput
+from .journal import Journal
+from .spectra import SourceError, rgb_for_upsampling
+
+# Tests set this to a callable f(event, **info); an exception it raises aborts the render at that point.
+TEST_HOOK = None
+
+_GEOMETRY_TYPES = {"MESH", "CURVE", "SURFACE", "META", "FONT", "CURVES", "POINTCLOUD", "VOLUME"}
+
+
+class Request:
+    """What to render: the scene's chromatrace settings, optionally overridden (batch.py's options)."""
+
+    def __init__(self, **values):
+        self.samples = 64
+        self.max_bounces = 8
+        self.seed = 1
+        self.bands = "380:780:10"
+        self.bands_file = None
+        self.families = {"paths", "lights"}
+        self.object_ids = True
+        self.resolution = None
+        self.point_filter = False
+        self.on_mixing_nodes = "refuse"  # or "one-band"
+        self.bands_per_render = 3
+        self.output = None
+        self.cache_root = None
+        self.keep_cache = False
+        self.log = _stderr_log
+        for key, value in values.items():
+            if not hasattr(self, key):
+                raise TypeError(f"unknown request setting {key}")
+            setattr(self, key, value)
+
+    @classmethod
+    def from_scene(cls, scene, **overrides):
+        s = scene.chromatrace
+        values = dict(samples=s.samples, max_bounces=s.max_bounces, seed=s.seed, bands=s.bands_argument(),
+                      bands_file=bpy.path.abspath(s.bands_file) if s.band_plan == "FILE" else None,
+                      families=s.families(), object_ids=s.use_object_ids, point_filter=s.pixel_filter == "point",
+                      on_mixing_nodes="one-band" if s.on_mixing_nodes == "ONE_BAND" else "refuse",
+                      output=bpy.path.abspath(s.output_path),
+                      cache_root=bpy.path.abspath(s.cache_dir) if s.cache_dir else None)
+        values.update({k: v for k, v in overrides.items() if v is not None})
+        return cls(**values)
+
+
+def _stderr_log(message):
+    print(f"chromatrace: {message}", file=sys.stderr, flush=True)
+
+
+def _group_name(name):
+    return re.sub(r"[^A-Za-z0-9_-]", "_", name) or "group"
+
+
+def _rna_plain(struct):
+    values = {}
+    for prop in struct.bl_rna.properties:
+        if prop.type in ("BOOLEAN", "INT", "FLOAT", "ENUM", "STRING") and prop.identifier != "rna_type":
+            value = getattr(struct, prop.identifier)
+            values[prop.identifier] = materials._plain(value)
+    return values
+
+
+class SpectralRender:
+    def __init__(self, scene, request, tool):
+        self.scene = scene
+        self.request = request
+        self.tool = tool
+        self.rendered = 0  # Cycles renders made by this run (not found in the cache)
+        self.cached = 0
+        self.cache_dir = None
+
+    def run(self):
+        for _ in self.steps():
+            pass
+
+    # ---- preparation ---------------------------------------------------------------------------------
+
+    def _view_layer(self):
+        for layer in self.scene.view_layers:
+            if layer.use:
+                return layer
+        raise BadInput(f"scene \"{self.scene.name}\": no view layer is enabled for rendering")
+
+    def _objects(self, view_layer):
+        return [ob for ob in view_layer.objects if not ob.hide_render and (ob.type in _GEOMETRY_TYPES or ob.type == "LIGHT")]
+
+    def _check_nodes(self, used_materials):
+        issues = []
+        for material in used_materials:
+            nodes, volume = materials.describe_node_tree(material)
+            issues += node_rules.tree_issues(material.name, nodes, volume)
+            s = material.chromatrace
+            if s.model == "DICHROMATIC" and s.lobe == "phong":
+                raise BadInput(f"material \"{material.name}\": the phong lobe has no Cycles counterpart "
+                               "(only the reference tracer renders it); use ggx")
+        hard = [i for i in issues if not i["fallback"]]
+        if hard:
+            raise BadInput(f"cannot render spectrally: {node_rules.summarise(hard)}")
+        mixing = [i for i in issues if i["fallback"]]
+        if mixing and self.request.on_mixing_nodes != "one-band":
+            raise BadInput(f"nodes mix colour channels: {node_rules.summarise(mixing)} "
+                           "(choose one band per render to render anyway)")
+        if mixing:
+            self.request.log(f"one band per render: {node_rules.summarise(mixing)}")
+        return bool(mixing)
+
+    def _resolve(self, spectrum_settings, current_rgb, what):
+        """The source JSON of a spectrum setting, table names resolved."""
+        try:
+            source = spectrum_settings.to_json(current_rgb=current_rgb)
+        except (SourceError, ValueError) as e:
+            raise BadInput(f"{what}: {e}") from None
+        if isinstance(source, str):
+            entry = self.scene.chromatrace.spectra.get(source)
+            if entry is None:
+                raise BadInput(f"{what}: unknown spectrum \"{source}\" (not in the scene's spectrum table)")
+            source = entry.source.to_json()
+            if isinstance(source, str):
+                raise BadInput(f"{what}: spectrum table entry \"{entry.name}\" refers to another name")
+        return source
+
+    def _input_source(self, material, spectral_input):
+        """(source JSON, scale) of one spectral colour input of a material."""
+        s = material.chromatrace
+        what = f"material \"{material.name}\""
+        rgb = spectral_input.current_rgb
+        if spectral_input.role == "interface":
+            return {"constant": rgb[0]}, 1.0
+        if spectral_input.role == "reflectance":
+            settings = s.reflectance
+            if settings.kind == "RGB" and settings.use_current_colour and (max(rgb) > 1.0 or min(rgb) < 0.0):
+                raise BadInput(f"{what}: colour {tuple(round(c, 4) for c in rgb)} of {spectral_input.label} "
+                               "is outside [0, 1], so it is not a reflectance")
+            return self._resolve(settings, rgb, what), 1.0
+        if spectral_input.managed or s.emissive:
+            settings = s.emission
+            scale = 1.0 if spectral_input.managed else s.emission_scale
+            if settings.kind == "RGB" and settings.use_current_colour:
+                rgb, factor = rgb_for_upsampling(rgb)
+                return self._resolve(settings, rgb, what), scale * factor
+            return self._resolve(settings, None, what), scale
+        rgb, factor = rgb_for_upsampling(rgb)
+        return {"rgb": rgb}, factor
+
+    def _prepare(self, work_dir):
+        scene, request = self.scene, self.request
+        view_layer = self._view_layer()
+        if scene.camera is None:
+            raise BadInput(f"scene \"{scene.name}\": no camera")
+        objects = self._objects(view_layer)
+        used = []
+        for ob in objects:
+            for slot in getattr(ob, "material_slots", []):
+                if slot.material is not None and slot.material not in used:
+                    used.append(slot.material)
+        replicate = self._check_nodes(used)
+
+        # Every spectral input, its source and scale; identical sources are evaluated once.
+        keys, inputs = {}, []
+
+        def key_of(source):
+            text = json.dumps(source, sort_keys=True)
+            return keys.setdefault(text, f"s{len(keys)}")
+
+        emitters = set()
+        for material in used:
+            for spectral_input in materials.spectral_inputs(material):
+                source, scale = self._input_source(material, spectral_input)
+                inputs.append((spectral_input, key_of(source), scale, material.name))
+                if spectral_input.role == "emission":
+                    emitters.add(material.name)
+        lights = [ob for ob in objects if ob.type == "LIGHT"]
+        for ob in lights:
+            light = ob.data
+            settings = light.chromatrace
+            what = f"light \"{ob.name}\""
+            if settings.emission.kind == "RGB" and settings.emission.use_current_colour:
+                rgb, factor = rgb_for_upsampling(tuple(light.color))
+                source, scale = self._resolve(settings.emission, rgb, what), settings.emission_scale * factor
+            else:
+                source, scale = self._resolve(settings.emission, None, what), settings.emission_scale
+            inputs.append((materials.SpectralInput(light, "color", "emission", tuple(light.color), None,
+                                                   what, False), key_of(source), scale, ob.name))
+
+        request_file = os.path.join(work_dir, "spectra.json")
+        with open(request_file, "w") as f:
+            json.dump({"format": "chromatrace-spectra/1", "spectra": {k: json.loads(t) for t, k in keys.items()}}, f)
+        if not keys:  # nothing spectral: still ask for the band edges
+            with open(request_file, "w") as f:
+                json.dump({"format": "chromatrace-spectra/1", "spectra": {"flat": {"constant": 1.0}}}, f)
+        bands = self.tool.band_averages(request_file, request.bands, request.bands_file)
+        for spectral_input, key, _scale, owner in inputs:
+            entry = bands["spectra"][key]
+            if spectral_input.role == "reflectance" and entry["max"] > 1.0:
+                raise BadInput(f"material \"{owner}\": the reflectance of {spectral_input.label} reaches "
+                               f"{entry['max']:g} at {entry['max_nm']:g} nm, but a reflectance must be in [0, 1]")
+
+        edges = bands["bands"]["edges_nm"]
+        per_render = 1 if replicate else request.bands_per_render
+        groups = band_groups(len(edges) - 1, per_render)
+        transmission = any(materials.has_transmission(m) for m in used)
+
+        # Light groups: every emitter in one (its own, or one named after it).
+        light_groups, assignments = [], {}
+        if "lights" in request.families:
+            if not hasattr(view_layer, "lightgroups"):
+                raise BadInput("light-group components need Blender 3.2 or later (or leave out the lights family)")
+            for ob in objects:
+                emits = ob.type == "LIGHT" or any(
+                    slot.material is not None and slot.material.name in emitters for slot in ob.material_slots)
+                if not emits:
+                    continue
+                group = ob.lightgroup or _group_name(ob.name)
+                assignments[ob.name] = group
+                if group not in light_groups:
+                    light_groups.append(group)
+        total, planned = components.component_plan(request.families, light_groups, request.max_bounces, transmission)
+        variants = components.render_variants(request.max_bounces, "bounces" in request.families)
+        passes = components.passes_needed(planned)
+
+        ids = {}
+        if request.object_ids:
+            passes.add("IndexOB")
+            geometry = [ob for ob in objects if ob.type in _GEOMETRY_TYPES]
+            indices = [ob.pass_index for ob in geometry]
+            if all(i > 0 for i in indices) and len(set(indices)) == len(indices):
+                ids = {ob.name: ob.pass_index for ob in geometry}
+            else:
+                ids = {ob.name: i + 1 for i, ob in enumerate(sorted(geometry, key=lambda o: o.name))}
+
+        plan = dict(view_layer=view_layer, objects=objects, materials=used, inputs=inputs, bands=bands, edges=edges, groups=groups,
+                    replicate=replicate, per_render=per_render, light_groups=light_groups, assignments=assignments,
+                    total=total, components=planned, variants=variants, passes=passes, ids=ids)
+        plan["key"] = cache.cache_key(self._cache_description(plan))
+        return plan
+
+    def _cache_description(self, plan):
+        scene, request = self.scene, self.request
+        depsgraph = bpy.context.evaluated_depsgraph_get()
+        geometry = {}
+        for ob in plan["objects"]:
+            digest = hashlib.sha256()
+            digest.update(repr([list(row) for row in ob.matrix_world]).encode())
+            if ob.type == "LIGHT":
+                digest.update(json.dumps(_rna_plain(ob.data), sort_keys=True).encode())
+            else:
+                evaluated = ob.evaluated_get(depsgraph)
+                mesh = evaluated.to_mesh()
+                if mesh is not None:
+                    co = array("f", [0.0]) * (len(mesh.vertices) * 3)
+                    mesh.vertices.foreach_get("co", co)
+                    loops = array("i", [0]) * len(mesh.loops)
+                    mesh.loops.foreach_get("vertex_index", loops)
+                    digest.update(co.tobytes())
+                    digest.update(loops.tobytes())
+                    digest.update(repr([p.use_smooth for p in mesh.polygons]).encode())
+                    evaluated.to_mesh_clear()
+                digest.update(repr([s.material.name if s.material else None for s in ob.material_slots]).encode())
+            geometry[ob.name] = digest.hexdigest()
+        camera = scene.camera
+        world = scene.world
+        return {
+            "addon": list(VERSION), "blender": bpy.app.version_string,
+            "edges": plan["edges"], "per_render": plan["per_render"], "replicate": plan["replicate"],
+            "inputs": [[i.label, i.role, key, scale] for i, key, scale, _owner in plan["inputs"]],
+            "averages": {k: v["bands"] for k, v in plan["bands"]["spectra"].items()},
+            "samples": request.samples, "seed": request.seed, "max_bounces": request.max_bounces,
+            "variants": plan["variants"], "point_filter": request.point_filter, "resolution": self._resolution(),
+            "passes": sorted(plan["passes"]), "light_groups": plan["assignments"], "ids": plan["ids"],
+            "geometry": geometry,
+            "nodes": {m.name: materials.node_tree_digest(m.node_tree) for m in plan["materials"]},
+            "camera": [repr([list(r) for r in camera.matrix_world]), _rna_plain(camera.data)],
+            "world": materials.node_tree_digest(world.node_tree) if world and world.use_nodes else None,
+        }
+
+    def _resolution(self):
+        if self.request.resolution:
+            return list(self.request.resolution)
+        r = self.scene.render
+        return [r.resolution_x * r.resolution_percentage // 100, r.resolution_y * r.resolution_percentage // 100]
+
+    # ---- rendering -----------------------------------------------------------------------------------
+
+    def _apply_settings(self, journal, plan):
+        scene, request = self.scene, self.request
+        view_layer = plan["view_layer"]
+        cycles_setup.apply(journal, scene, view_layer, request.samples, request.seed, request.point_filter,
+                           self._resolution(), plan["passes"])
+        world = scene.world
+        if world is not None:
+            journal.set(world, "color", (0.0, 0.0, 0.0))
+            if world.use_nodes and world.node_tree is not None:
+                for node in world.node_tree.nodes:
+                    if node.bl_idname == "ShaderNodeBackground":
+                        journal.set(node.inputs["Strength"], "default_value", 0.0)
+        existing = set(view_layer.lightgroups.keys()) if hasattr(view_layer, "lightgroups") else set()
+        for group in plan["light_groups"]:
+            if group not in existing:
+                view_layer.lightgroups.add(name=group)
+                existing.add(group)
+                journal.call_on_restore(lambda name=group: _remove_lightgroup(scene, view_layer, name))
+        for ob in plan["objects"]:
+            if ob.name in plan["assignments"] and ob.lightgroup != plan["assignments"][ob.name]:
+                journal.set(ob, "lightgroup", plan["assignments"][ob.name])
+            if ob.name in plan["ids"] and ob.pass_index != plan["ids"][ob.name]:
+                journal.set(ob, "pass_index", plan["ids"][ob.name])
+
+    def _set_colours(self, journal, plan, group):
+        no_reflection = self.request.max_bounces == 0  # emitters only
+        for spectral_input, key, scale, _owner in plan["inputs"]:
+            values = plan["bands"]["spectra"][key]["bands"]
+            r, g, b = group_colour(values, group, plan["replicate"])
+            factor = 0.0 if no_reflection and spectral_input.role != "emission" else scale
+            colour = (r * factor, g * factor, b * factor)
+            if spectral_input.alpha is not None:
+                colour = (*colour, spectral_input.alpha)
+            journal.set(spectral_input.target, spectral_input.attribute, colour)
+
+    def steps(self):
+        """Generator: yields (renders done, renders in all, message) after each Cycles render."""
+        request = self.request
+        if not request.output:
+            raise BadInput("output: no file name")
+        out_dir = os.path.dirname(os.path.abspath(request.output))
+        if not os.path.isdir(out_dir):
+            raise BadInput(f"output: {request.output}: directory {out_dir} does not exist")
+        journal = Journal()
+        work_dir = tempfile.mkdtemp(prefix="chromatrace-")
+        try:
+            plan = self._prepare(work_dir)
+            self.cache_dir = cache.cache_directory(request.cache_root, plan["key"])
+            groups, variants = plan["groups"], plan["variants"]
+            total = len(groups) * len(variants)
+            request.log(f"{len(plan['edges']) - 1} bands in {len(groups)} renders of {plan['per_render']} band(s)"
+                        f"{' x ' + str(len(variants)) + ' bounce limits' if len(variants) > 1 else ''}; "
+                        f"cache {self.cache_dir}")
+            todo = set(manifest.missing_renders(self.cache_dir, groups, list(variants)))
+            applied = False
+            done = 0
+            for g, group in enumerate(groups):
+                colours_set = False
+                for variant, cycles_bounces in variants.items():
+                    final = os.path.join(self.cache_dir, manifest.render_file_name(g, variant))
+                    if (g, variant) not in todo:
+                        self.cached += 1
+                        done += 1
+                        request.log(f"render {done}/{total} ({describe_band_range(plan['edges'], group)}, {variant}): "
+                                    "already in the cache")
+                        yield done, total, "cached"
+                        continue
+                    if not applied:
+                        self._apply_settings(journal, plan)
+                        applied = True
+                    if not colours_set:
+                        self._set_colours(journal, plan, group)
+                        colours_set = True
+                    cycles_setup.set_bounces(journal, self.scene, cycles_bounces)
+                    if TEST_HOOK is not None:
+                        TEST_HOOK("before_render", group=g, variant=variant, rendered=self.rendered)
+                    temporary = final + ".partial"
+                    journal.set(self.scene.render, "filepath", temporary)
+                    start, start_cpu = time.monotonic(), time.process_time()
+                    bpy.ops.render.render(write_still=True, scene=self.scene.name)
+                    if not os.path.isfile(temporary):
+                        raise RuntimeError(f"Cycles wrote no file for render {done + 1} ({temporary})")
+                    cache.commit(temporary, final)
+                    self.rendered += 1
+                    done += 1
+                    message = (f"render {done}/{total} ({describe_band_range(plan['edges'], group)}, {variant}): "
+                               f"{time.monotonic() - start:.2f} s, {time.process_time() - start_cpu:.2f} s CPU")
+                    request.log(message)
+                    yield done, total, message
+            journal.restore()
+            self._assemble(plan)
+            if not request.keep_cache:
+                cache.remove(self.cache_dir)
+        finally:
+            journal.restore()
+            shutil.rmtree(work_dir, ignore_errors=True)
+
+    def _assemble(self, plan):
+        request = self.request
+        names = None
+        if request.object_ids:
+            names = {}
+            for ob in plan["objects"]:
+                if ob.name in plan["ids"]:
+                    names[plan["ids"][ob.name]] = ob.chromatrace.scene_name or ob.name
+        document = manifest.build_manifest(
+            plan["edges"], plan["groups"], list(plan["variants"]), plan["view_layer"].name, plan["total"],
+            plan["components"], object_names=names, attributes=self._attributes(plan), replicate=plan["replicate"])
+        manifest_file = os.path.join(self.cache_dir, "manifest.json")
+        with open(manifest_file, "w") as f:
+            json.dump(document, f, indent=1)
+        self.tool.assemble(manifest_file, os.path.abspath(request.output))
+        request.log(f"wrote {request.output} ({self.rendered} renders made, {self.cached} from the cache)")
+
+    def _attributes(self, plan):
+        scene, request = self.scene, self.request
+        s = scene.chromatrace
+        source = s.source_json or json.dumps({"blend": bpy.data.filepath, "scene": scene.name})
+        return {
+            "chromatrace.renderer": (f"Cycles (Blender {bpy.app.version_string}) via the chromatrace add-on: "
+                                     f"{plan['per_render']} band(s) per render, max {request.max_bounces} bounces"),
+            "chromatrace.samples": str(request.samples),
+            "chromatrace.seed": str(request.seed),
+            "chromatrace.scene": source,
+            "chromatrace.camera": json.dumps(camera_description(scene, self._resolution())),
+        }
+
+
+def camera_description(scene, resolution):
+    """The camera as `chromatrace render` describes it in the header."""
+    import math
+    camera = scene.camera
+    width, height = resolution
+    data = camera.data
+    m = camera.matrix_world
+    position = [m[i][3] for i in range(3)]
+    forward = [-m[i][2] for i in range(3)]
+    up = [m[i][1] for i in range(3)]
+    fit = data.sensor_fit
+    if fit == "VERTICAL" or (fit == "AUTO" and height > width):
+        sensor = (data.sensor_height if fit == "VERTICAL" else data.sensor_width) * width / height
+    else:
+        sensor = data.sensor_width
+    tan_w = 0.5 * sensor / data.lens
+    tan_h = tan_w * height / width
+    return {"position": position, "look_at": [position[i] + forward[i] for i in range(3)], "up": up,
+            "horizontal_fov_deg": math.degrees(2 * math.atan(tan_w)), "vertical_fov_deg": math.degrees(2 * math.atan(tan_h)),
+            "sensor_width_mm": sensor, "focal_length_mm": data.lens, "resolution": [width, height]}
+
+
+def _remove_lightgroup(scene, view_layer, name):
+    groups = view_layer.lightgroups
+    if name not in groups.keys():
+        return
+    if hasattr(groups, "remove"):
+        groups.remove(groups[name])
+        return
+    previous = view_layer.active_lightgroup_index
+    view_layer.active_lightgroup_index = groups.keys().index(name)
+    with bpy.context.temp_override(scene=scene, view_layer=view_layer):
+        bpy.ops.scene.view_layer_remove_lightgroup()
+    view_layer.active_lightgroup_index = min(previous, max(len(groups) - 1, 0))

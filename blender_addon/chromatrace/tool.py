@@ -1,0 +1,74 @@
+"""Running the `chromatrace` command, which owns every spectrum operation, the tessellation and the spectral
+EXR writer (pure Python, no bpy).
+
+The executable is, in order: the add-on preference, the CHROMATRACE_EXE environment variable, the one
+installed beside the add-on by `cmake --install` (<prefix>/bin/chromatrace for the add-on in
+<prefix>/share/chromatrace/blender_addon/chromatrace), then `chromatrace` on PATH.
+"""
+
+import json
+import os
+import re
+import shutil
+import subprocess
+
+from .errors import BadInput
+
+ENV_VAR = "CHROMATRACE_EXE"
+
+
+def installed_executable():
+    here = os.path.dirname(os.path.realpath(__file__))  # through a symlink in Blender's add-ons folder
+    return os.path.normpath(os.path.join(here, "..", "..", "..", "..", "bin", "chromatrace"))
+
+
+def find_executable(preference=""):
+    candidates = [preference, os.environ.get(ENV_VAR, ""), installed_executable()]
+    for path in candidates:
+        if path and os.path.isfile(path) and os.access(path, os.X_OK):
+            return path
+    found = shutil.which("chromatrace")
+    if found:
+        return found
+    raise BadInput("chromatrace executable not found: set the add-on preference, the CHROMATRACE_EXE environment "
+                   "variable, or put chromatrace on PATH")
+
+
+class Tool:
+    def __init__(self, executable):
+        self.executable = executable
+
+    def run(self, *args, json_output=False):
+        """Runs a subcommand. Exit 2 (bad input) raises BadInput with the command's one-line message;
+        other failures raise RuntimeError."""
+        result = subprocess.run([self.executable, *map(str, args)], capture_output=True, text=True)
+        if result.returncode == 2:
+            raise BadInput(_last_line(result.stderr) or f"chromatrace {args[0]}: bad input")
+        if result.returncode != 0:
+            raise RuntimeError(_last_line(result.stderr) or f"chromatrace {args[0]} failed ({result.returncode})")
+        return json.loads(result.stdout) if json_output else result.stdout
+
+    def band_averages(self, spectra_file, bands=None, bands_file=None):
+        args = ["scene-bands", spectra_file, "--json"]
+        if bands:
+            args += ["--bands", bands]
+        if bands_file:
+            args += ["--bands-file", bands_file]
+        return self.run(*args, json_output=True)
+
+    def check_scene(self, scene_file):
+        return self.run("check-scene", scene_file, "--json", json_output=True)
+
+    def export_meshes(self, scene_file, directory):
+        return self.run("export-meshes", scene_file, directory, "--json", json_output=True)
+
+    def assemble(self, manifest_file, output):
+        return self.run("assemble", manifest_file, "-o", output, "--quiet")
+
+
+def _last_line(text):
+    """The command's one-line message, without its "chromatrace <command>: error: " prefix."""
+    lines = [line for line in text.strip().splitlines() if line.strip()]
+    if not lines:
+        return ""
+    return re.sub(r"^chromatrace [a-z-]+: (error|failed): ", "", lines[-1])

@@ -1,0 +1,145 @@
+"""Panels: spectral settings in the Render, Material, Light and Object properties."""
+
+import bpy
+
+
+class _Panel:
+    bl_space_type = "PROPERTIES"
+    bl_region_type = "WINDOW"
+
+
+class CHROMATRACE_PT_render(_Panel, bpy.types.Panel):
+    bl_label = "chromatrace Spectral"
+    bl_context = "render"
+
+    def draw(self, context):
+        s = context.scene.chromatrace
+        layout = self.layout
+        layout.use_property_split = True
+        layout.operator("chromatrace.render_spectral", icon="RENDER_STILL")
+        layout.prop(s, "output_path")
+        col = layout.column(heading="Bands")
+        col.prop(s, "band_plan")
+        if s.band_plan == "RANGE":
+            col.prop(s, "bands_lo")
+            col.prop(s, "bands_hi")
+            col.prop(s, "bands_width")
+        else:
+            col.prop(s, "bands_file")
+        col = layout.column(heading="Sampling")
+        col.prop(s, "samples")
+        col.prop(s, "max_bounces")
+        col.prop(s, "seed")
+        col.prop(s, "pixel_filter")
+        col = layout.column(heading="Components")
+        col.prop(s, "use_paths")
+        col.prop(s, "use_lights")
+        col.prop(s, "use_bounces")
+        col.prop(s, "use_object_ids")
+        layout.prop(s, "on_mixing_nodes")
+        layout.prop(s, "cache_dir")
+
+
+class CHROMATRACE_UL_spectra(bpy.types.UIList):
+    def draw_item(self, context, layout, data, item, icon, active_data, active_property, index=0, flt_flag=0):
+        layout.prop(item, "name", text="", emboss=False)
+        layout.label(text=item.source.kind.title())
+
+
+class CHROMATRACE_PT_spectra(_Panel, bpy.types.Panel):
+    bl_label = "Spectrum Table"
+    bl_context = "render"
+    bl_parent_id = "CHROMATRACE_PT_render"
+    bl_options = {"DEFAULT_CLOSED"}
+
+    def draw(self, context):
+        s = context.scene.chromatrace
+        row = self.layout.row()
+        row.template_list("CHROMATRACE_UL_spectra", "", s, "spectra", s, "active_spectrum", rows=3)
+        col = row.column(align=True)
+        col.operator("chromatrace.spectrum_add", icon="ADD", text="")
+        col.operator("chromatrace.spectrum_remove", icon="REMOVE", text="")
+        if 0 <= s.active_spectrum < len(s.spectra):
+            s.spectra[s.active_spectrum].source.draw(self.layout.column(), allow_rgb_current=False)
+
+
+class CHROMATRACE_PT_material(_Panel, bpy.types.Panel):
+    bl_label = "chromatrace Spectra"
+    bl_context = "material"
+
+    @classmethod
+    def poll(cls, context):
+        return getattr(context, "material", None) is not None
+
+    def draw(self, context):
+        s = context.material.chromatrace
+        layout = self.layout
+        layout.use_property_split = True
+        row = layout.row(align=True)
+        row.prop(s, "model")
+        row.operator("chromatrace.build_material", text="", icon="FILE_REFRESH")
+        if s.model != "NONE":
+            box = layout.box()
+            box.label(text="Reflectance" if s.model != "DICHROMATIC" else "Diffuse reflectance")
+            s.reflectance.draw(box.column())
+        if s.model == "DICHROMATIC":
+            layout.prop(s, "specular")
+            layout.prop(s, "lobe")
+            layout.prop(s, "roughness" if s.lobe == "ggx" else "exponent")
+        layout.prop(s, "emissive")
+        if s.emissive:
+            box = layout.box()
+            box.label(text="Emission (W·m⁻²·sr⁻¹·nm⁻¹ = spectrum × scale)")
+            s.emission.draw(box.column())
+            box.prop(s, "emission_scale")
+            box.prop(s, "two_sided")
+
+
+class CHROMATRACE_PT_light(_Panel, bpy.types.Panel):
+    bl_label = "chromatrace Spectrum"
+    bl_context = "data"
+
+    @classmethod
+    def poll(cls, context):
+        return isinstance(getattr(context, "light", None), bpy.types.Light)
+
+    def draw(self, context):
+        s = context.light.chromatrace
+        layout = self.layout
+        layout.use_property_split = True
+        s.emission.draw(layout.column())
+        layout.prop(s, "emission_scale")
+
+
+class CHROMATRACE_PT_object(_Panel, bpy.types.Panel):
+    bl_label = "chromatrace"
+    bl_context = "object"
+    bl_options = {"DEFAULT_CLOSED"}
+
+    @classmethod
+    def poll(cls, context):
+        return context.object is not None and context.object.type == "MESH"
+
+    def draw(self, context):
+        ob = context.object
+        layout = self.layout
+        layout.use_property_split = True
+        layout.prop(ob.chromatrace, "role")
+        layout.prop(ob.chromatrace, "scene_name")
+        layout.prop(ob, "pass_index", text="Object id")
+        if ob.chromatrace.role == "LIGHT" and hasattr(ob, "lightgroup"):
+            layout.prop(ob, "lightgroup", text="Light group")
+
+
+_classes = (CHROMATRACE_PT_render, CHROMATRACE_UL_spectra, CHROMATRACE_PT_spectra, CHROMATRACE_PT_material,
+            CHROMATRACE_PT_light, CHROMATRACE_PT_object)
+
+
+def register():
+    for cls in _classes:
+        bpy.utils.register_class(cls)
+
+
+def unregister():
+    for cls in reversed(_classes):
+        bpy.utils.unregister_class(cls)

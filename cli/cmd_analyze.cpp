@@ -1,0 +1,88 @@
+// chromatrace analyze IMAGE -o DIR: colour-histogram analysis of image regions (docs/analyze.md).
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <optional>
+
+#include <fmt/core.h>
+
+#include "analyzer/analysis.h"
+#include "analyzer/output.h"
+#include "cli/command.h"
+#include "core/error.h"
+
+namespace ct::cli {
+namespace {
+
+analyzer::Vec3 parse_colour(const std::string& text) {
+  analyzer::Vec3 v;
+  char extra = 0;
+  if (std::sscanf(text.c_str(), "%lf,%lf,%lf%c", &v[0], &v[1], &v[2], &extra) != 3 || !v.allFinite() || v.minCoeff() < 0 || v.sum() <= 0)
+    throw InputError(fmt::format("--illuminant: expected R,G,B with non-negative numbers, not all 0, got \"{}\"", text));
+  return v;
+}
+
+}  // namespace
+
+Action add_analyze(CLI::App& app) {
+  auto* cmd = app.add_subcommand("analyze", "Analyse the colour histograms of image regions: shapes, illuminant, light paths");
+  struct Options {
+    std::string image, output, layer, illuminant;
+    analyzer::RegionOptions regions;
+    std::vector<std::string> rects;
+    int bins = 64, threads = 0;
+    std::size_t report_points = 20000;
+    std::uint64_t seed = 1;
+    bool no_plots = false, no_report = false, quiet = false;
+  };
+  auto o = std::make_shared<Options>();
+  cmd->add_option("image", o->image, "Image: PNG, TIFF, EXR … (the sensor simulator's EXR adds layers and object ids)")->required();
+  cmd->add_option("-o,--output", o->output, "Output directory (created; its parent must exist)")->required();
+  cmd->add_option("--layer", o->layer, "RGB layer to analyse: final (R,G,B), linear, or a component name")->default_str("final");
+  cmd->add_option("--labels", o->regions.labels, "Label regions: an id channel of the image (object_id) or a label image file");
+  cmd->add_flag("--no-labels", o->regions.no_labels, "Ignore the image's object_id channel");
+  cmd->add_option("--mask", o->regions.masks, "Mask image (non-zero pixels form a region); repeatable");
+  cmd->add_option("--rect", o->rects, "Rectangle x,y,width,height; repeatable");
+  cmd->add_flag("--segment", o->regions.segment, "Add automatic segments (mean-shift on chromaticity)");
+  cmd->add_option("--bins", o->bins, "Histogram bins per channel (2–1024)")->capture_default_str();
+  cmd->add_option("--illuminant", o->illuminant, "Known illuminant R,G,B in the layer's units: report angular errors");
+  cmd->add_option("--report-points", o->report_points, "Points per region in report.html")->capture_default_str();
+  cmd->add_option("--seed", o->seed, "Seed of the robust line fits")->capture_default_str();
+  cmd->add_flag("--no-plots", o->no_plots, "Write no PNG plots");
+  cmd->add_flag("--no-report", o->no_report, "Write no report.html");
+  cmd->add_option("--threads", o->threads, "Worker threads (0: all cores)")->capture_default_str();
+  cmd->add_flag("-q,--quiet", o->quiet, "No progress output");
+
+  return [o] {
+    if (o->bins < 2 || o->bins > 1024) throw InputError(fmt::format("--bins: must be in [2, 1024], got {}", o->bins));
+    if (o->threads < 0) throw InputError(fmt::format("--threads: must be >= 0, got {}", o->threads));
+    if (o->report_points < 1) throw InputError("--report-points: must be >= 1");
+    const std::optional<analyzer::Vec3> known = o->illuminant.empty() ? std::nullopt : std::optional(parse_colour(o->illuminant));
+    for (const std::string& r : o->rects) o->regions.rects.push_back(analyzer::parse_rect(r, "--rect"));
+    const std::filesystem::path parent = std::filesystem::absolute(o->output).parent_path();
+    if (!std::filesystem::is_directory(parent))
+      throw InputError(fmt::format("{}: directory {} does not exist", o->output, parent.string()));
+
+    const analyzer::AnalysisImage input = analyzer::read_analysis_image(o->image);
+    const analyzer::RgbImage& layer = analyzer::select_layer(input, o->layer);
+    std::vector<analyzer::Region> regions = analyzer::select_regions(input, layer, o->regions);
+    analyzer::AnalyzeOptions options;
+    options.bins = o->bins;
+    options.threads = o->threads;
+    options.seed = o->seed;
+    const analyzer::ImageAnalysis analysis = analyzer::analyse_image(input, o->layer, std::move(regions), options, known, !o->quiet);
+    analyzer::write_analysis(o->output, input, analysis, {!o->no_plots, !o->no_report, o->report_points});
+    if (!o->quiet) {
+      for (const analyzer::RegionAnalysis& r : analysis.results)
+        fmt::print(stderr, "{}: {} ({} px){}\n", r.name, analyzer::class_name(r.shape.shape), r.pixels,
+                   r.shape.shape == analyzer::ShapeClass::None ? " — " + r.shape.reason : "");
+      const auto& best = analysis.illuminant.best();
+      fmt::print(stderr, "illuminant ({}): ({:.4f}, {:.4f}, {:.4f}){}\n", best.method, best.rgb[0], best.rgb[1], best.rgb[2],
+                 best.error_deg ? fmt::format(", {:.2f}° from the known one", *best.error_deg) : "");
+      fmt::print(stderr, "{}: analysis.json, report.html\n", o->output);
+    }
+    return 0;
+  };
+}
+
+}  // namespace ct::cli

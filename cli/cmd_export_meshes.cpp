@@ -1,0 +1,88 @@
+// chromatrace export-meshes SCENE.json DIR: the triangles of every object and light as PLY files, made by the
+// one tessellation rule (core/geometry.h), so that another renderer (Cycles through the Blender add-on) sees
+// exactly the triangles the reference tracer traces.
+#include <cctype>
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <system_error>
+
+#include <fmt/core.h>
+
+#include "cli/command.h"
+#include "core/error.h"
+#include "core/json_input.h"
+#include "core/ply.h"
+#include "core/scene.h"
+
+namespace ct::cli {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct Options {
+  std::string scene, directory;
+  bool ascii = false, json = false, quiet = false;
+};
+
+// "007_left wall" -> "007_left_wall.ply": the id keeps names unique, the name keeps files readable.
+std::string mesh_file_name(int id, const std::string& name) {
+  std::string safe;
+  for (const char c : name)
+    safe += (std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_' || c == '.') ? c : '_';
+  return fmt::format("{:03d}_{}.ply", id, safe);
+}
+
+int run(const Options& o) {
+  const Scene scene = load_scene(o.scene);
+  const fs::path dir(o.directory);
+  std::error_code error;
+  if (fs::exists(dir, error) && !fs::is_directory(dir, error))
+    throw InputError(fmt::format("{}: exists and is not a directory", o.directory));
+  fs::path absolute = fs::absolute(dir);
+  if (!absolute.has_filename()) absolute = absolute.parent_path();  // "meshes/"
+  if (!fs::is_directory(absolute.parent_path()))
+    throw InputError(fmt::format("{}: directory {} does not exist", o.directory, absolute.parent_path().string()));
+  fs::create_directories(dir);
+
+  const PlyFormat format = o.ascii ? PlyFormat::Ascii : PlyFormat::BinaryLittleEndian;
+  const std::vector<TriangleMesh> meshes = scene_meshes(scene);
+  Json objects = Json::array(), lights = Json::array();
+  std::size_t triangles = 0;
+  for (std::size_t i = 0; i < meshes.size(); ++i) {
+    const bool is_light = i >= scene.objects.size();
+    const std::string& name = is_light ? scene.lights[i - scene.objects.size()].name : scene.objects[i].name;
+    const int id = static_cast<int>(i) + 1;
+    const std::string file = mesh_file_name(id, name);
+    write_ply(dir / file, meshes[i], format);
+    triangles += meshes[i].triangles.size();
+    (is_light ? lights : objects)
+        .push_back({{"name", name},
+                    {"id", id},
+                    {"file", file},
+                    {"triangles", meshes[i].triangles.size()},
+                    {"smooth", !meshes[i].normals.empty()}});
+  }
+  if (o.json)
+    fmt::print("{}\n", Json({{"scene", o.scene}, {"directory", o.directory}, {"objects", objects}, {"lights", lights}}).dump(1));
+  else if (!o.quiet)
+    fmt::print("{}: {} meshes, {} triangles\n", o.directory, meshes.size(), triangles);
+  return 0;
+}
+
+}  // namespace
+
+Action add_export_meshes(CLI::App& app) {
+  auto o = std::make_shared<Options>();
+  auto* cmd = app.add_subcommand("export-meshes",
+                                 "Write every object and light of a scene as a world-space PLY mesh (with normals "
+                                 "where shading is smooth), tessellated as the reference tracer does");
+  cmd->add_option("scene", o->scene, "Scene file (chromatrace-scene/1)")->required();
+  cmd->add_option("directory", o->directory, "Output directory (created if missing; its parent must exist)")->required();
+  cmd->add_flag("--ascii", o->ascii, "Write ASCII PLY instead of binary little-endian");
+  cmd->add_flag("--json", o->json, "Print the list of files (name, object id, file, triangles, smooth) as JSON");
+  cmd->add_flag("-q,--quiet", o->quiet, "Print nothing on success");
+  return [o] { return run(*o); };
+}
+
+}  // namespace ct::cli

@@ -1,0 +1,142 @@
+// chromatrace scene-bands FILE: the band averages of every spectrum a scene (or a spectra list) uses, so that
+// a renderer working in RGB (Cycles through the Blender add-on) only has to plug numbers into colour inputs.
+#include <algorithm>
+#include <memory>
+#include <optional>
+#include <string>
+#include <type_traits>
+#include <variant>
+#include <vector>
+
+#include <fmt/core.h>
+#include <fmt/format.h>
+
+#include "cli/command.h"
+#include "core/band_plan.h"
+#include "core/error.h"
+#include "core/json_input.h"
+#include "core/scene.h"
+
+namespace ct::cli {
+namespace {
+
+struct Options {
+  std::string file, bands, bands_file;
+  bool json = false;
+};
+
+Json averages(const PiecewiseLinearSpectrum& spectrum, const Bands& bands) { return band_averages(spectrum, bands); }
+
+// Band averages, plus the largest sample (so a caller can check a reflectance against 1 before rendering).
+Json spectrum_entry(const PiecewiseLinearSpectrum& spectrum, const Bands& bands) {
+  const auto& values = spectrum.values();
+  const auto peak = std::max_element(values.begin(), values.end());
+  return {{"bands", averages(spectrum, bands)},
+          {"max", *peak},
+          {"max_nm", spectrum.wavelengths()[static_cast<std::size_t>(peak - values.begin())]}};
+}
+
+Json material_entry(const Material& material, const Bands& bands) {
+  return std::visit(
+      [&](const auto& m) -> Json {
+        using M = std::decay_t<decltype(m)>;
+        if constexpr (std::is_same_v<M, LambertMaterial>) {
+          return {{"type", "lambert"}, {"reflectance", averages(m.reflectance.spectrum, bands)}};
+        } else if constexpr (std::is_same_v<M, MirrorMaterial>) {
+          return {{"type", "mirror"}, {"reflectance", averages(m.reflectance.spectrum, bands)}};
+        } else {
+          Json entry = {{"type", "dichromatic"}, {"diffuse", averages(m.diffuse.spectrum, bands)}, {"specular", m.specular}};
+          if (const auto* ggx = std::get_if<DichromaticMaterial::Ggx>(&m.lobe)) {
+            entry["lobe"] = "ggx";
+            entry["roughness"] = ggx->roughness;
+          } else {
+            entry["lobe"] = "phong";
+            entry["exponent"] = std::get<DichromaticMaterial::Phong>(m.lobe).exponent;
+          }
+          return entry;
+        }
+      },
+      material.model);
+}
+
+int run(const Options& o) {
+  if (!o.bands.empty() && !o.bands_file.empty())
+    throw InputError("--bands-file: give either --bands or --bands-file, not both");
+  const Json document = read_json(o.file);
+  const bool spectra_only = document_format(document) == kSpectraFormat;
+  std::optional<Scene> scene;
+  std::vector<NamedSpectrum> spectra;
+  if (spectra_only) {
+    spectra = parse_spectra(document, o.file, std::filesystem::path(o.file).parent_path());
+  } else {
+    scene = load_scene(o.file);
+    spectra = scene->spectra;
+  }
+  Bands bands = scene ? scene->render.bands : RenderSettings{}.bands;
+  if (!o.bands.empty()) bands = Bands::parse(o.bands, "--bands");
+  if (!o.bands_file.empty()) bands = read_band_plan(o.bands_file);
+
+  std::vector<double> centres;
+  for (std::size_t i = 0; i < bands.size(); ++i) centres.push_back(bands.centre(i));
+  Json report = {{"file", o.file},
+                 {"bands", {{"count", bands.size()}, {"edges_nm", bands.edges()}, {"centres_nm", centres}}}};
+  Json spectra_json = Json::object();
+  for (const NamedSpectrum& s : spectra) spectra_json[s.name] = spectrum_entry(s.spectrum, bands);
+  report["spectra"] = spectra_json;
+  if (scene) {
+    Json materials = Json::object();
+    for (const Material& m : scene->materials) materials[m.name] = material_entry(m, bands);
+    Json objects = Json::array();
+    for (const Object& object : scene->objects)
+      objects.push_back({{"name", object.name}, {"id", object.id}, {"material", scene->materials[object.material].name}});
+    Json lights = Json::array();
+    for (const Light& light : scene->lights)
+      lights.push_back({{"name", light.name},
+                        {"id", light.id},
+                        {"group", light.group},
+                        {"two_sided", light.two_sided},
+                        {"radiance", averages(light.emitted_radiance(), bands)},
+                        {"material", light.material ? Json(scene->materials[*light.material].name) : Json()}});
+    report["materials"] = materials;
+    report["objects"] = objects;
+    report["lights"] = lights;
+  }
+
+  if (o.json) {
+    fmt::print("{}\n", report.dump(1));
+    return 0;
+  }
+  auto row = [](const Json& values) {
+    std::vector<std::string> cells;
+    for (const Json& v : values) cells.push_back(fmt::format("{:.4g}", v.get<double>()));
+    return fmt::format("{}", fmt::join(cells, " "));
+  };
+  fmt::print("{}: {} bands over {:.6g}-{:.6g} nm, centres {} nm\n", o.file, bands.size(), bands.min_wavelength(),
+             bands.max_wavelength(), row(report["bands"]["centres_nm"]));
+  for (const auto& [name, entry] : report["spectra"].items()) fmt::print("  spectrum {}: {}\n", name, row(entry["bands"]));
+  if (!scene) return 0;
+  for (const auto& [name, entry] : report["materials"].items()) {
+    const char* key = entry.contains("diffuse") ? "diffuse" : "reflectance";
+    fmt::print("  material {} ({}) {}: {}\n", name, entry["type"].get<std::string>(), key, row(entry[key]));
+  }
+  for (const Json& light : report["lights"])
+    fmt::print("  light {} (group {}) radiance: {} W/(m2 sr nm)\n", light["name"].get<std::string>(),
+               light["group"].get<std::string>(), row(light["radiance"]));
+  return 0;
+}
+
+}  // namespace
+
+Action add_scene_bands(CLI::App& app) {
+  auto o = std::make_shared<Options>();
+  auto* cmd = app.add_subcommand(
+      "scene-bands",
+      "Band averages of the spectra, materials and lights of a scene (or of a chromatrace-spectra/1 list)");
+  cmd->add_option("file", o->file, "scene (chromatrace-scene/1) or spectra list (chromatrace-spectra/1)")->required();
+  cmd->add_option("--bands", o->bands, "Band plan lo:hi:width in nm (default: the scene's render.bands, else 380:780:10)");
+  cmd->add_option("--bands-file", o->bands_file, "Band plan file (chromatrace-bands/1: {\"edges_nm\": [...]})");
+  cmd->add_flag("--json", o->json, "Print the result as JSON");
+  return [o] { return run(*o); };
+}
+
+}  // namespace ct::cli

@@ -1,0 +1,189 @@
+#include "sensor_sim/output.h"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <fstream>
+#include <stdexcept>
+
+#include <fmt/core.h>
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include <ImfChannelList.h>
+#include <ImfFrameBuffer.h>
+#include <ImfHeader.h>
+#include <ImfOutputFile.h>
+#include <ImfStdIO.h>
+#include <ImfStringAttribute.h>
+#include <ImfThreading.h>
+#include <OpenImageIO/imageio.h>
+
+#include "core/error.h"
+#include "core/file_io.h"
+
+namespace ct::sensor {
+namespace {
+
+namespace fs = std::filesystem;
+
+const char* const kRgb[] = {"R", "G", "B"};
+
+std::string lower_extension(const fs::path& file) {
+  std::string ext = file.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  return ext;
+}
+
+std::string layer_channel(const std::string& layer, int c) {
+  return layer.empty() ? kRgb[c] : fmt::format("{}.{}", layer, kRgb[c]);
+}
+
+// Slices for one [row][x][3] block of the layer (R, G, B of `layer`), for rows [y0, y0 + rows).
+void insert_rgb(Imf::FrameBuffer& frame, const std::string& layer, const float* block, int width, int y0, int rows) {
+  const Imath::Box2i window({0, y0}, {width - 1, y0 + rows - 1});
+  for (int c = 0; c < 3; ++c)
+    frame.insert(layer_channel(layer, c), Imf::Slice::Make(Imf::FLOAT, block + c, window, 3 * sizeof(float),
+                                                           3 * sizeof(float) * static_cast<std::size_t>(width)));
+}
+
+}  // namespace
+
+OutputFormat output_format(const fs::path& file) {
+  const std::string ext = lower_extension(file);
+  if (ext == ".exr") return OutputFormat::Exr;
+  if (ext == ".tif" || ext == ".tiff") return OutputFormat::Tiff;
+  if (ext == ".png") return OutputFormat::Png;
+  throw InputError(fmt::format("{}: unknown output format \"{}\" (the name must end in .exr, .tif, .tiff or .png)",
+                               file.string(), ext));
+}
+
+struct SensorImageWriter::File {
+  explicit File(const fs::path& target) : output(target) {}
+  AtomicFile output;  // declared first: destroyed last, after the writers have let go of the file
+  // EXR
+  std::ofstream stream;
+  std::unique_ptr<Imf::StdOFStream> exr_stream;
+  std::unique_ptr<Imf::OutputFile> exr;
+  std::vector<float> ids;  // object ids as floats, for the current block
+  // TIFF / PNG
+  std::unique_ptr<OIIO::ImageOutput> image;
+};
+
+SensorImageWriter::SensorImageWriter(const fs::path& path, OutputLayout layout)
+    : path_(path), layout_(std::move(layout)) {
+  const std::string name = path_.string();
+  if (layout_.width < 1 || layout_.height < 1)
+    throw InputError(
+        fmt::format("{}: image size must be at least 1 x 1, got {} x {}", name, layout_.width, layout_.height));
+  auto file = std::make_unique<File>(path_);
+  const std::string temporary = file->output.temporary().string();
+
+  if (layout_.format == OutputFormat::Exr) {
+    Imf::Header header(layout_.width, layout_.height);
+    header.compression() = Imf::ZIP_COMPRESSION;
+    for (const std::string& layer : [&] {
+           std::vector<std::string> layers = {"", "linear"};
+           layers.insert(layers.end(), layout_.components.begin(), layout_.components.end());
+           return layers;
+         }())
+      for (int c = 0; c < 3; ++c) header.channels().insert(layer_channel(layer, c), Imf::Channel(Imf::FLOAT));
+    if (layout_.object_ids) {
+      header.channels().insert("object_id", Imf::Channel(Imf::FLOAT));
+      nlohmann::json names = nlohmann::json::object();
+      for (const auto& [id, object] : layout_.object_names) names[std::to_string(id)] = object;
+      header.insert("chromatrace.objects", Imf::StringAttribute(names.dump()));
+    }
+    for (const auto& [key, value] : layout_.attributes) header.insert(key, Imf::StringAttribute(value));
+    file->stream.open(temporary, std::ios::binary | std::ios::trunc);
+    if (!file->stream) throw std::runtime_error(fmt::format("{}: cannot open {} for writing", name, temporary));
+    file->exr_stream = std::make_unique<Imf::StdOFStream>(file->stream, temporary.c_str());
+    file->exr = std::make_unique<Imf::OutputFile>(*file->exr_stream, header, Imf::globalThreadCount());
+  } else {
+    const char* format = layout_.format == OutputFormat::Tiff ? "tiff" : "png";
+    file->image = OIIO::ImageOutput::create(format);
+    if (!file->image) throw std::runtime_error(fmt::format("{}: OpenImageIO cannot write {}", name, format));
+    OIIO::ImageSpec spec(layout_.width, layout_.height, 3,
+                         layout_.bits == 8 ? OIIO::TypeDesc::UINT8 : OIIO::TypeDesc::UINT16);
+    if (layout_.format == OutputFormat::Tiff) spec.attribute("compression", "zip");
+    if (!layout_.colour_space.empty()) spec.attribute("oiio:ColorSpace", layout_.colour_space);
+    if (!file->image->open(temporary, spec))
+      throw std::runtime_error(fmt::format("{}: cannot start writing: {}", name, file->image->geterror()));
+  }
+  file_ = std::move(file);
+}
+
+SensorImageWriter::~SensorImageWriter() = default;
+
+void SensorImageWriter::write_rows(const OutputRows& block) {
+  if (!file_) throw std::logic_error(fmt::format("{}: write_rows after finish", path_.string()));
+  const std::size_t width = static_cast<std::size_t>(layout_.width);
+  const std::size_t values = static_cast<std::size_t>(block.rows) * width * 3;
+  if (block.rows < 0 || rows_written_ + block.rows > layout_.height || block.image.size() != values)
+    throw std::invalid_argument(fmt::format("{}: row block does not fit the layout", path_.string()));
+  if (block.rows == 0) return;
+  const int y0 = rows_written_;
+
+  if (layout_.format == OutputFormat::Exr) {
+    const bool sizes_match =
+        block.linear.size() == values && block.components.size() == layout_.components.size() &&
+        std::all_of(block.components.begin(), block.components.end(), [&](auto c) { return c.size() == values; }) &&
+        block.object_ids.size() == (layout_.object_ids ? values / 3 : 0);
+    if (!sizes_match) throw std::invalid_argument(fmt::format("{}: row block layers do not match", path_.string()));
+    Imf::FrameBuffer frame;
+    insert_rgb(frame, "", block.image.data(), layout_.width, y0, block.rows);
+    insert_rgb(frame, "linear", block.linear.data(), layout_.width, y0, block.rows);
+    for (std::size_t c = 0; c < layout_.components.size(); ++c)
+      insert_rgb(frame, layout_.components[c], block.components[c].data(), layout_.width, y0, block.rows);
+    if (layout_.object_ids) {
+      file_->ids.assign(block.object_ids.begin(), block.object_ids.end());
+      const Imath::Box2i window({0, y0}, {layout_.width - 1, y0 + block.rows - 1});
+      frame.insert("object_id",
+                   Imf::Slice::Make(Imf::FLOAT, file_->ids.data(), window, sizeof(float), sizeof(float) * width));
+    }
+    try {
+      file_->exr->setFrameBuffer(frame);
+      file_->exr->writePixels(block.rows);
+    } catch (const std::exception& e) {
+      throw std::runtime_error(
+          fmt::format("{}: cannot write rows {}-{}: {}", path_.string(), y0, y0 + block.rows - 1, e.what()));
+    }
+  } else {
+    const double top = std::ldexp(1.0, layout_.bits) - 1.0;
+    const auto code = [&](float v) { return std::clamp(std::round(v * layout_.code_scale), 0.0, top); };
+    bool written = false;
+    if (layout_.bits == 8) {
+      std::vector<std::uint8_t> codes(values);
+      for (std::size_t i = 0; i < values; ++i) codes[i] = static_cast<std::uint8_t>(code(block.image[i]));
+      written = file_->image->write_scanlines(y0, y0 + block.rows, 0, OIIO::TypeDesc::UINT8, codes.data());
+    } else {
+      std::vector<std::uint16_t> codes(values);
+      for (std::size_t i = 0; i < values; ++i) codes[i] = static_cast<std::uint16_t>(code(block.image[i]));
+      written = file_->image->write_scanlines(y0, y0 + block.rows, 0, OIIO::TypeDesc::UINT16, codes.data());
+    }
+    if (!written)
+      throw std::runtime_error(fmt::format("{}: cannot write rows {}-{}: {}", path_.string(), y0, y0 + block.rows - 1,
+                                           file_->image->geterror()));
+  }
+  rows_written_ += block.rows;
+}
+
+void SensorImageWriter::finish() {
+  if (!file_) throw std::logic_error(fmt::format("{}: finish called twice", path_.string()));
+  if (rows_written_ != layout_.height)
+    throw std::logic_error(
+        fmt::format("{}: finish after {} of {} rows", path_.string(), rows_written_, layout_.height));
+  if (file_->exr) {
+    // OpenEXR writes the line offset table while closing and swallows errors there; the stream keeps them.
+    file_->exr.reset();
+    file_->stream.flush();
+    if (!file_->stream) throw std::runtime_error(fmt::format("{}: cannot write the file", path_.string()));
+    file_->stream.close();
+  } else if (!file_->image->close()) {
+    throw std::runtime_error(fmt::format("{}: cannot complete the file: {}", path_.string(), file_->image->geterror()));
+  }
+  file_->output.commit();
+  file_.reset();
+}
+
+}  // namespace ct::sensor

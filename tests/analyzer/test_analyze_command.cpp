@@ -1,0 +1,155 @@
+// chromatrace analyze end to end: outputs, regions, and bad input (unreadable image, empty, one-pixel,
+// all-black and all-NaN regions) answered with a reason, never a crash.
+#include <cmath>
+#include <fstream>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "core/file_io.h"
+#include "tests/analyzer/synthetic.h"
+#include "tests/cli/run_command.h"
+#include "tests/core/spectral_exr_fixtures.h"
+
+namespace ct::test {
+namespace {
+
+nlohmann::json analysis(const std::filesystem::path& dir) { return nlohmann::json::parse(read_file(dir / "analysis.json")); }
+
+const nlohmann::json* region_named(const nlohmann::json& a, const std::string& name) {
+  for (const auto& r : a["regions"])
+    if (r["name"] == name) return &r;
+  return nullptr;
+}
+
+TEST(AnalyzeCommand, WritesJsonPlotsHistogramsAndReport) {
+  TempDir dir;
+  write_sensor_exr(dir.file("scene.exr"), scene_with_components());
+  const auto out = dir.file("out");
+  const CommandResult r = run_chromatrace({"analyze", dir.file("scene.exr").string(), "-o", out.string(), "--illuminant", "1,0.9,0.75", "-q"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(r.err, "");
+  const nlohmann::json a = analysis(out);
+  EXPECT_EQ(a["format"], "chromatrace-analysis/1");
+  ASSERT_EQ(a["regions"].size(), 5u);  // the image and four objects
+  EXPECT_EQ(a["regions"][3]["name"], "object 3 (blue)");
+  EXPECT_EQ(a["regions"][3]["explanation"]["families"][0]["family"], "path types");
+  EXPECT_LT(a["illuminant"]["estimate"]["error_deg"].get<double>(), 3.0);
+  EXPECT_TRUE(a["illuminant"]["grey_world"]["error_deg"].is_number());
+  for (int i = 0; i < 5; ++i) {
+    const std::string stem = "region-0" + std::to_string(i);
+    EXPECT_TRUE(std::filesystem::is_regular_file(out / "plots" / (stem + ".png")));
+    EXPECT_TRUE(std::filesystem::is_regular_file(out / "plots" / (stem + "-density.png")));
+    EXPECT_TRUE(std::filesystem::is_regular_file(out / "plots" / (stem + "-components.png")));
+    EXPECT_TRUE(std::filesystem::is_regular_file(out / "histograms" / (stem + ".json")));
+  }
+  const std::string html = read_file(out / "report.html");
+  EXPECT_NE(html.find("data:image/png;base64,"), std::string::npos);
+  EXPECT_EQ(html.find("<script src"), std::string::npos);  // self-contained
+  // No temporary files left behind.
+  for (const auto& e : std::filesystem::recursive_directory_iterator(out)) EXPECT_EQ(e.path().filename().string().find(".tmp"), std::string::npos);
+}
+
+TEST(AnalyzeCommand, ReadsEightBitImagesWithRegionsFromRectanglesAndSegments) {
+  TempDir dir;
+  write_rgb(dir.file("scene.png"), dichromatic_scene(Vec3(1, 0.85, 0.6)).image, 8);
+  const auto out = dir.file("out");
+  const CommandResult r = run_chromatrace({"analyze", dir.file("scene.png").string(), "-o", out.string(), "--rect", "0,0,96,96", "--segment",
+                                           "--no-plots", "--no-report", "-q"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const nlohmann::json a = analysis(out);
+  EXPECT_EQ(a["image"]["bits"], 8);
+  EXPECT_EQ(a["image"]["full_scale"], 255);
+  const nlohmann::json* rect = region_named(a, "rect 0,0 96x96");
+  ASSERT_TRUE(rect);
+  EXPECT_EQ((*rect)["pixels"], 96 * 96);
+  int segments = 0;
+  for (const auto& region : a["regions"]) segments += region["source"] == "segment";
+  EXPECT_EQ(segments, 4) << a["regions"].dump(1);  // one per sphere; the black background is left out
+  EXPECT_FALSE(std::filesystem::exists(out / "report.html"));
+}
+
+TEST(AnalyzeCommand, LabelAndMaskImagesGiveRegions) {
+  TempDir dir;
+  const Scene scene = dichromatic_scene(Vec3(1, 0.85, 0.6));
+  write_rgb(dir.file("scene.png"), scene.image, 8);
+  RgbImage labels = scene.image, mask = scene.image;
+  for (std::size_t p = 0; p < scene.ids.size(); ++p)
+    for (std::size_t c = 0; c < 3; ++c) {
+      labels.rgb[p * 3 + c] = static_cast<float>(scene.ids[p]) / 255.0f;  // stored as the digital number of the id
+      mask.rgb[p * 3 + c] = scene.ids[p] == 2 ? 1.0f : 0.0f;
+    }
+  write_rgb(dir.file("labels.png"), labels, 8);
+  write_rgb(dir.file("green.png"), mask, 8);
+  const auto out = dir.file("out");
+  const CommandResult r = run_chromatrace({"analyze", dir.file("scene.png").string(), "-o", out.string(), "--labels", dir.file("labels.png").string(),
+                                           "--mask", dir.file("green.png").string(), "--no-plots", "--no-report", "-q"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const nlohmann::json a = analysis(out);
+  ASSERT_EQ(a["regions"].size(), 6u);  // image, labels 1–4, mask
+  EXPECT_EQ(a["regions"][2]["name"], "label 2");
+  EXPECT_EQ(a["regions"][5]["name"], "mask green.png");
+  EXPECT_EQ(a["regions"][5]["pixels"], a["regions"][2]["pixels"]);
+  EXPECT_EQ(a["regions"][5]["shape"]["mean"], a["regions"][2]["shape"]["mean"]);
+}
+
+TEST(AnalyzeCommand, DegenerateRegionsSayWhyNoShapeWasMeasured) {
+  TempDir dir;
+  const RgbImage black = make_image(16, 16, [](double, double) -> Vec3 { return Vec3::Zero(); });
+  const RgbImage nan = make_image(16, 16, [](double, double) -> Vec3 { return Vec3::Constant(std::nan("")); });
+  write_sensor_exr(dir.file("black.exr"), {black, black, {}, {}, {}});
+  write_sensor_exr(dir.file("nan.exr"), {nan, nan, {}, {}, {}});
+  write_sensor_exr(dir.file("line.exr"), {matte_line(), matte_line(), {}, {}, {}});
+  struct Case {
+    std::string file;
+    std::vector<std::string> extra;
+    std::string region, reason;
+  };
+  const Case cases[] = {
+      {"black.exr", {}, "image", "all pixels are black"},
+      {"nan.exr", {}, "image", "every pixel of the region is NaN or infinite"},
+      {"line.exr", {"--rect", "500,500,10,10"}, "rect 500,500 10x10", "the region is empty"},
+      {"line.exr", {"--rect", "3,4,1,1"}, "rect 3,4 1x1", "1 valid pixel: a shape needs at least 10"},
+  };
+  for (const Case& c : cases) {
+    const auto out = dir.file(c.file + c.region);
+    std::vector<std::string> args{"analyze", dir.file(c.file).string(), "-o", out.string(), "-q"};
+    args.insert(args.end(), c.extra.begin(), c.extra.end());
+    const CommandResult r = run_chromatrace(args);
+    ASSERT_EQ(r.exit_code, 0) << c.file << ": " << r.err;
+    const nlohmann::json a = analysis(out);
+    const nlohmann::json* region = region_named(a, c.region);
+    ASSERT_TRUE(region) << c.region;
+    EXPECT_EQ((*region)["shape"]["class"], "none");
+    EXPECT_NE((*region)["shape"]["reason"].get<std::string>().find(c.reason), std::string::npos) << (*region)["shape"]["reason"];
+    EXPECT_TRUE(std::filesystem::is_regular_file(out / "report.html"));
+  }
+}
+
+TEST(AnalyzeCommand, BadInputIsOneLineAndExitTwo) {
+  TempDir dir;
+  std::ofstream(dir.file("junk.png")) << "not an image";
+  write_sensor_exr(dir.file("line.exr"), {matte_line(), matte_line(), {}, {}, {}});
+  const std::string line = dir.file("line.exr").string(), out = dir.file("out").string();
+  const std::vector<std::pair<std::vector<std::string>, std::string>> cases = {
+      {{"analyze", dir.file("missing.png").string(), "-o", out}, "missing.png: cannot open file"},
+      {{"analyze", dir.file("junk.png").string(), "-o", out}, "junk.png: cannot read image"},
+      {{"analyze", line, "-o", dir.file("no/such/dir").string()}, "does not exist"},
+      {{"analyze", line, "-o", out, "--bins", "1"}, "--bins: must be in [2, 1024]"},
+      {{"analyze", line, "-o", out, "--rect", "1,2,3"}, "--rect: expected x,y,width,height"},
+      {{"analyze", line, "-o", out, "--layer", "glossy_direct"}, "--layer: no layer \"glossy_direct\""},
+      {{"analyze", line, "-o", out, "--labels", "object_id"}, "no object_id channel"},
+      {{"analyze", line, "-o", out, "--mask", dir.file("junk.png").string()}, "junk.png: cannot read image"},
+      {{"analyze", line, "-o", out, "--illuminant", "1,x,2"}, "--illuminant: expected R,G,B"},
+  };
+  for (const auto& [args, message] : cases) {
+    const CommandResult r = run_chromatrace(args);
+    EXPECT_EQ(r.exit_code, 2) << args[1];
+    EXPECT_NE(r.err.find(message), std::string::npos) << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  }
+  EXPECT_FALSE(std::filesystem::exists(out));
+}
+
+}  // namespace
+}  // namespace ct::test

@@ -1,0 +1,127 @@
+// Synthetic clusters of known structure are classified right, and noise-free fits find the true
+// directions (the dichromatic body and illuminant colours, the plane they span) within 0.5°.
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+#include "analyzer/region_analysis.h"
+#include "tests/analyzer/synthetic.h"
+
+namespace ct::test {
+namespace {
+
+using namespace ct::analyzer;
+
+ClusterShape shape_of(const RgbImage& image, const ImageEncoding& encoding = {}) {
+  const LayerContext context = layer_context(image, encoding, 64);
+  return analyse_region(image, context, whole_image_region(image.width, image.height), AnalyzeOptions{}).shape;
+}
+
+std::string describe(const ClusterShape& s) {
+  std::string text = std::string(class_name(s.shape)) + ": " + s.reason + "\n";
+  for (const Decision& d : s.decisions)
+    text += "  " + d.test + ": " + std::to_string(d.value) + " vs " + std::to_string(d.threshold) + (d.passed ? " yes\n" : " no\n");
+  return text;
+}
+
+constexpr double kDegrees = 0.5;
+
+TEST(ClusterShape, MatteLineIsLinearAlongTheBodyColour) {
+  const ClusterShape s = shape_of(matte_line());
+  ASSERT_EQ(s.shape, ShapeClass::Linear) << describe(s);
+  ASSERT_TRUE(s.line);
+  EXPECT_LT(line_angle_degrees(s.line->direction, kBody), kDegrees);
+  EXPECT_GT(s.linearity, 0.99);
+}
+
+TEST(ClusterShape, NarrowHighlightAtTheBrightEndIsAnL) {
+  const ClusterShape s = shape_of(l_shape());
+  ASSERT_EQ(s.shape, ShapeClass::L) << describe(s);
+  EXPECT_LT(line_angle_degrees(s.two_lines->body.direction, kBody), kDegrees);
+  EXPECT_LT(line_angle_degrees(s.two_lines->highlight.direction, kIlluminant), kDegrees);
+  EXPECT_NEAR(s.two_lines->junction_on_body, 1.0, 0.02);
+  // The highlight leaves the body line at m_b = 1.
+  EXPECT_LT((s.two_lines->junction - kBody).norm(), 0.01);
+  const Vec3 normal = kBody.cross(kIlluminant).normalized();
+  EXPECT_LT(line_angle_degrees(s.plane->normal, normal), kDegrees);
+  EXPECT_LT(line_angle_degrees(s.black_plane->normal, normal), kDegrees);
+}
+
+TEST(ClusterShape, HighlightLeavingHalfWayIsASkewedT) {
+  const ClusterShape s = shape_of(skewed_t());
+  ASSERT_EQ(s.shape, ShapeClass::SkewedT) << describe(s);
+  EXPECT_NEAR(s.two_lines->junction_on_body, 0.5, 0.02);
+  EXPECT_LT(line_angle_degrees(s.two_lines->body.direction, kBody), kDegrees);
+  EXPECT_LT(line_angle_degrees(s.two_lines->highlight.direction, kIlluminant), kDegrees);
+  EXPECT_LT(line_angle_degrees(s.black_plane->normal, kBody.cross(kIlluminant)), kDegrees);
+}
+
+TEST(ClusterShape, BroadHighlightIsAP) {
+  const ClusterShape s = shape_of(p_shape());
+  ASSERT_EQ(s.shape, ShapeClass::P) << describe(s);
+  EXPECT_LT(line_angle_degrees(s.body_only->line.direction, kBody), kDegrees);
+  EXPECT_LT(line_angle_degrees(s.plane->normal, kBody.cross(kIlluminant)), kDegrees);
+  EXPECT_LT(line_angle_degrees(s.black_plane->normal, kBody.cross(kIlluminant)), kDegrees);
+}
+
+TEST(ClusterShape, BentClusterIsCurved) {
+  const ClusterShape s = shape_of(curved_cluster());
+  ASSERT_EQ(s.shape, ShapeClass::Curved) << describe(s);
+  EXPECT_GT(s.curve->bend, 0.1);
+}
+
+TEST(ClusterShape, OverExposedLineIsClippedOnTheRedFace) {
+  const ClusterShape s = shape_of(clipped_line());
+  ASSERT_EQ(s.shape, ShapeClass::Clipped) << describe(s);
+  ASSERT_EQ(s.clipping.faces.size(), 1u);
+  EXPECT_EQ(s.clipping.faces[0].channel, 0);
+  EXPECT_TRUE(s.clipping.faces[0].high);
+  ASSERT_EQ(s.unclipped.size(), 1u);
+  EXPECT_EQ(s.unclipped[0].shape, ShapeClass::Linear) << describe(s.unclipped[0]);
+  EXPECT_LT(line_angle_degrees(s.unclipped[0].line->direction, kBody), kDegrees);
+}
+
+TEST(ClusterShape, PowerCurveBendsALineAndTheFitFindsGamma) {
+  const ClusterShape s = shape_of(gamma_line());
+  ASSERT_EQ(s.shape, ShapeClass::Gamma) << describe(s);
+  EXPECT_NEAR(s.gamma->gamma, kGamma, 0.005);
+}
+
+TEST(ClusterShape, SpreadOffThePlaneIsThickening) {
+  const ClusterShape s = shape_of(thickened_plane());
+  ASSERT_EQ(s.shape, ShapeClass::Thickened) << describe(s);
+}
+
+TEST(ClusterShape, SensorNoiseAloneDoesNotThickenALine) {
+  const ClusterShape s = shape_of(add_sensor_noise(matte_line(), 20000, 5, 7));
+  EXPECT_EQ(s.shape, ShapeClass::Linear) << describe(s);
+  EXPECT_LT(line_angle_degrees(s.line->direction, kBody), 1.0);
+}
+
+TEST(ClusterShape, NoisyLStaysAnL) {
+  const ClusterShape s = shape_of(add_sensor_noise(l_shape(), 20000, 5, 8));
+  EXPECT_EQ(s.shape, ShapeClass::L) << describe(s);
+}
+
+TEST(ClusterShape, UniformPatchIsAPoint) {
+  const ClusterShape s = shape_of(add_sensor_noise(make_image(32, 32, [](double, double) { return Vec3(0.4, 0.3, 0.2); }), 20000, 5, 9));
+  EXPECT_EQ(s.shape, ShapeClass::Point) << describe(s);
+}
+
+TEST(ClusterShape, RandomColoursAreAVolume) {
+  const ClusterShape s = shape_of(make_image(64, 64, [](double u, double v) -> Vec3 {
+    return Vec3(0.5 + 0.4 * std::sin(40 * u + 3 * v), 0.5 + 0.4 * std::sin(31 * v + 7 * u), 0.5 + 0.4 * std::cos(23 * u * v + 5 * u));
+  }));
+  EXPECT_EQ(s.shape, ShapeClass::Volume) << describe(s);
+}
+
+TEST(ClusterShape, IntegerImagesAreJudgedInDigitalNumbers) {
+  RgbImage image = l_shape();
+  for (float& v : image.rgb) v = std::round(v * 200.0f);  // the highlight stays below 255
+  const ClusterShape s = shape_of(image, ImageEncoding{true, 8, 255});
+  EXPECT_EQ(s.shape, ShapeClass::L) << describe(s);
+  EXPECT_LT(line_angle_degrees(s.two_lines->body.direction, kBody), 1.0);
+}
+
+}  // namespace
+}  // namespace ct::test

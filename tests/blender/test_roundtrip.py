@@ -1,0 +1,141 @@
+"""Inside Blender: importing a chromatrace scene and exporting it again loses nothing the format holds.
+
+For the paper box (analytic shapes, named spectra) and the Cornell box (PLY meshes, a light that also
+reflects, an inline spectrum), import -> export -> compare, semantically and through chromatrace itself:
+- the documents: every object, light, camera and render setting equal, spectra equal once CSV paths are
+  resolved against each file's directory;
+- `chromatrace scene-bands` at 1 nm over 360-830 nm (every spectrum, material and light as the renderers
+  see them) and `chromatrace check-scene --json` (ids, groups, camera focal length, triangle count) equal;
+- `chromatrace export-meshes` of both: the same triangles, bit for bit.
+Then an object moved in Blender is exported as a world-space PLY mesh whose vertices moved with it.
+
+Run: CHROMATRACE_EXE=... CHROMATRACE_SOURCE_DIR=... blender -b --factory-startup --python-exit-code 1 \
+         --python tests/blender/test_roundtrip.py
+"""
+
+import json
+import os
+import sys
+import tempfile
+
+import bpy
+
+SOURCE = os.environ["CHROMATRACE_SOURCE_DIR"]
+sys.path.insert(0, os.path.join(SOURCE, "blender_addon"))
+import chromatrace  # noqa: E402
+from chromatrace import ply, scene_export, scene_import, tool  # noqa: E402
+
+chromatrace.register()
+TOOL = tool.Tool(tool.find_executable())
+failures = []
+
+
+def expect(condition, message):
+    if not condition:
+        failures.append(message)
+
+
+def fresh_scene():
+    for collection in (bpy.data.objects, bpy.data.meshes, bpy.data.materials, bpy.data.lights, bpy.data.cameras,
+                       bpy.data.collections):
+        for item in list(collection):
+            collection.remove(item)
+    return bpy.context.scene
+
+
+def resolved(document, directory):
+    """The document with every file path absolute, so documents in different places compare."""
+    document = json.loads(json.dumps(document))
+    for source in document.get("spectra", {}).values():
+        if isinstance(source, dict) and "csv" in source:
+            source["csv"] = os.path.normpath(os.path.join(directory, source["csv"]))
+    for entry in document["objects"] + document["lights"]:
+        if entry["shape"].get("type") == "mesh":
+            entry["shape"]["file"] = os.path.normpath(os.path.join(directory, entry["shape"]["file"]))
+    return document
+
+
+def normalised(document):
+    """Defaults spelled out, as the format defines them."""
+    d = json.loads(json.dumps(document))
+    for light in d["lights"]:
+        light.setdefault("scale", 1)
+        light.setdefault("group", light["name"])
+        light.setdefault("two_sided", False)
+    d["camera"].setdefault("up", [0, 0, 1])
+    d["camera"].setdefault("fov_axis", "horizontal")
+    d["camera"].setdefault("sensor_width_mm", 36)
+    r = d.setdefault("render", {})
+    for key, value in (("samples", 64), ("max_bounces", 8), ("seed", 1), ("pixel_filter", "box"),
+                       ("spectral_mode", "bands"), ("bands", "380:780:10")):
+        r.setdefault(key, value)
+    return d
+
+
+def same_numbers(a, b):
+    return json.dumps(a, sort_keys=True) == json.dumps(b, sort_keys=True)
+
+
+def meshes_of(scene_file, directory):
+    index = TOOL.export_meshes(scene_file, directory)
+    return [ply.read_ply(os.path.join(directory, e["file"])) for e in index["objects"] + index["lights"]]
+
+
+def round_trip(original):
+    work = tempfile.mkdtemp(prefix="chromatrace-roundtrip-")
+    name = os.path.basename(original)
+    scene = fresh_scene()
+    scene_import.import_scene(original, scene, TOOL, print)
+    exported = os.path.join(work, "exported", name)
+    os.makedirs(os.path.dirname(exported))
+    scene_export.export_scene(scene, exported, TOOL, print)
+
+    with open(original) as f:
+        a = normalised(resolved(json.load(f), os.path.dirname(original)))
+    with open(exported) as f:
+        b = normalised(resolved(json.load(f), os.path.dirname(exported)))
+    for key in sorted(set(a) | set(b)):
+        expect(same_numbers(a.get(key), b.get(key)), f"{name}: \"{key}\" differs:\n  {a.get(key)}\n  {b.get(key)}")
+
+    bands_a = TOOL.band_averages(original, bands="360:830:1")
+    bands_b = TOOL.band_averages(exported, bands="360:830:1")
+    for key in ("spectra", "materials", "lights", "objects"):
+        expect(bands_a[key] == bands_b[key], f"{name}: scene-bands {key} differ")
+    summary_a, summary_b = TOOL.check_scene(original)["scene"], TOOL.check_scene(exported)["scene"]
+    expect(summary_a == summary_b, f"{name}: check-scene summaries differ:\n  {summary_a}\n  {summary_b}")
+    for i, (ma, mb) in enumerate(zip(meshes_of(original, os.path.join(work, "a")),
+                                     meshes_of(exported, os.path.join(work, "b")))):
+        expect((ma.positions, ma.triangles) == (mb.positions, mb.triangles), f"{name}: mesh {i} differs")
+    print(f"ok: {name} round trip", flush=True)
+    return scene, work
+
+
+round_trip(os.path.join(SOURCE, "scenes", "cornell_box", "cornell_box.json"))
+scene, work = round_trip(os.path.join(SOURCE, "scenes", "paper", "box.json"))
+
+# An object moved in Blender: written as a world-space mesh that moved with it.
+sphere = bpy.data.objects["sphere"]
+sphere.location.x += 0.1
+bpy.context.view_layer.update()
+moved = os.path.join(work, "moved", "box.json")
+os.makedirs(os.path.dirname(moved))
+scene_export.export_scene(scene, moved, TOOL, print)
+with open(moved) as f:
+    document = json.load(f)
+shape = document["objects"][5]["shape"]
+expect(shape["type"] == "mesh" and os.path.isfile(os.path.join(os.path.dirname(moved), shape["file"])),
+       f"moved sphere not written as a mesh: {shape}")
+before = meshes_of(os.path.join(SOURCE, "scenes", "paper", "box.json"), os.path.join(work, "c"))[5]
+after = meshes_of(moved, os.path.join(work, "d"))[5]
+expect(len(before.triangles) == len(after.triangles), "moved sphere: triangle count changed")
+shift = max(max(abs(pa[0] + 0.1 - pb[0]), abs(pa[1] - pb[1]), abs(pa[2] - pb[2]))
+            for pa, pb in zip(before.positions, after.positions))
+expect(shift < 1e-6, f"moved sphere: vertices off by {shift}")
+expect(len(after.normals) == len(after.positions), "moved sphere: smooth shading (vertex normals) lost")
+expect(document["objects"][0]["shape"]["type"] == "quad", "an unmoved quad was not written as a quad")
+
+if failures:
+    for f in failures:
+        print(f"FAIL: {f}", file=sys.stderr)
+    sys.exit(1)
+print("round trip: all ok")

@@ -1,0 +1,133 @@
+"""Inside Blender: the add-on's panels, operators and property updates, as an artist uses them.
+
+Panels are drawn into a stand-in layout that checks every property and operator they name exists (Blender
+draws nothing in background mode); the operators run from Python as the UI calls them (the spectral render
+synchronously, as it does in background mode); choosing a material model builds its nodes; the add-on
+unregisters and registers again cleanly.
+"""
+
+import os
+import sys
+import tempfile
+
+import bpy
+
+SOURCE = os.environ["CHROMATRACE_SOURCE_DIR"]
+sys.path.insert(0, os.path.join(SOURCE, "blender_addon"))
+import chromatrace  # noqa: E402
+from chromatrace import ui  # noqa: E402
+
+chromatrace.register()
+failures = []
+
+
+class Layout:
+    """Records what a panel draws and checks that it exists."""
+
+    use_property_split = False
+
+    def __init__(self):
+        self.drawn = []
+
+    def prop(self, data, name, **kwargs):
+        if name not in data.bl_rna.properties:
+            failures.append(f"panel draws unknown property {type(data).__name__}.{name}")
+        self.drawn.append(name)
+
+    def operator(self, idname, **kwargs):
+        module, name = idname.split(".")
+        if not hasattr(getattr(bpy.ops, module), name):
+            failures.append(f"panel draws unknown operator {idname}")
+        self.drawn.append(idname)
+
+    def template_list(self, *args, **kwargs):
+        self.drawn.append("list")
+
+    def label(self, **kwargs):
+        pass
+
+    def row(self, **kwargs):
+        return self
+
+    column = box = row
+
+
+class Context:
+    def __init__(self, **values):
+        self.__dict__.update(values)
+
+
+def draw(panel, context):
+    holder = Context(layout=Layout())
+    if hasattr(panel, "poll") and not panel.poll(context):
+        failures.append(f"{panel.__name__}.poll is false")
+        return []
+    panel.draw(holder, context)
+    return holder.layout.drawn
+
+
+scene = bpy.context.scene
+cube = bpy.data.objects["Cube"]
+material = cube.material_slots[0].material
+light = bpy.data.objects["Light"].data
+context = Context(scene=scene, material=material, light=light, object=cube, preferences=bpy.context.preferences)
+
+drawn = draw(ui.CHROMATRACE_PT_render, context)
+if "chromatrace.render_spectral" not in drawn or "bands_width" not in drawn:
+    failures.append(f"render panel lacks the render button or the band plan: {drawn}")
+scene.chromatrace.band_plan = "FILE"
+draw(ui.CHROMATRACE_PT_render, context)
+scene.chromatrace.band_plan = "RANGE"
+for kind in ("RGB", "LIBRARY", "CONSTANT", "CSV", "ILLUMINANT", "BLACKBODY", "SAMPLES", "NAMED"):
+    material.chromatrace.reflectance.kind = kind
+    material.chromatrace.emission.kind = kind
+    light.chromatrace.emission.kind = kind
+    material.chromatrace.emissive = True
+    draw(ui.CHROMATRACE_PT_material, context)
+    draw(ui.CHROMATRACE_PT_light, context)
+light.chromatrace.emission.kind = material.chromatrace.emission.kind = "RGB"
+draw(ui.CHROMATRACE_PT_object, context)
+bpy.ops.chromatrace.spectrum_add()
+if len(scene.chromatrace.spectra) != 1:
+    failures.append("spectrum_add added nothing")
+draw(ui.CHROMATRACE_PT_spectra, context)
+bpy.ops.chromatrace.spectrum_remove()
+
+# Choosing a model builds its nodes; the spectral inputs are the ct_ nodes.
+material.chromatrace.emissive = False
+material.chromatrace.reflectance.kind = "LIBRARY"
+material.chromatrace.reflectance.library = "synthetic_reflectances.csv:yellow"
+material.chromatrace.model = "DICHROMATIC"
+nodes = material.node_tree.nodes
+if not all(n in nodes for n in ("ct_reflectance", "ct_diffuse", "ct_glossy", "ct_output")):
+    failures.append(f"dichromatic model built {list(nodes.keys())}")
+material.chromatrace.roughness = 0.4
+if abs(nodes["ct_glossy"].inputs["Roughness"].default_value - 0.4) > 1e-6:
+    failures.append("changing the roughness did not update the nodes")
+with bpy.context.temp_override(material=material):
+    if bpy.ops.chromatrace.build_material() != {"FINISHED"}:
+        failures.append("build_material did not run")
+
+# Import, render (synchronously in background mode) and export through the operators.
+work = tempfile.mkdtemp(prefix="chromatrace-ui-")
+bpy.ops.chromatrace.import_scene(filepath=os.path.join(SOURCE, "scenes", "paper", "box.json"))
+s = scene.chromatrace
+s.samples, s.max_bounces, s.bands_lo, s.bands_hi, s.bands_width = 2, 2, 400, 700, 100
+scene.render.resolution_x = scene.render.resolution_y = 16
+s.output_path = os.path.join(work, "ui.exr")
+s.cache_dir = os.path.join(work, "cache")
+if bpy.ops.chromatrace.render_spectral() != {"FINISHED"} or not os.path.isfile(s.output_path):
+    failures.append("Render Spectral did not write its file")
+if bpy.ops.chromatrace.export_scene(filepath=os.path.join(work, "exported.json")) != {"FINISHED"}:
+    failures.append("export did not finish")
+
+chromatrace.unregister()
+chromatrace.register()
+if not hasattr(bpy.types.Scene, "chromatrace") or not hasattr(bpy.ops.chromatrace, "render_spectral"):
+    failures.append("register after unregister did not restore the add-on")
+
+if failures:
+    for f in failures:
+        print(f"FAIL: {f}", file=sys.stderr)
+    sys.exit(1)
+print("ui: all ok")

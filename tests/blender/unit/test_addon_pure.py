@@ -1,0 +1,234 @@
+"""Plain-Python tests of the add-on's bpy-free modules (python3 -m unittest, no Blender needed)."""
+
+import os
+import sys
+import tempfile
+import unittest
+
+sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "..", "..", "blender_addon"))
+
+from chromatrace import bands, batch_args, cache, camera_math, components, floats, manifest, node_rules, ply, spectra  # noqa: E402
+from chromatrace.errors import BadInput  # noqa: E402
+from chromatrace.journal import Journal  # noqa: E402
+
+
+class Bands(unittest.TestCase):
+    def test_groups_of_three_and_one(self):
+        self.assertEqual(bands.band_groups(7), [[0, 1, 2], [3, 4, 5], [6]])
+        self.assertEqual(bands.band_groups(2, 1), [[0], [1]])
+        with self.assertRaises(ValueError):
+            bands.band_groups(3, 4)
+
+    def test_group_colour_fills_channels_in_order_and_zero_pads(self):
+        values = [0.1, 0.2, 0.3, 0.4]
+        self.assertEqual(bands.group_colour(values, [0, 1, 2]), (0.1, 0.2, 0.3))
+        self.assertEqual(bands.group_colour(values, [3]), (0.4, 0.0, 0.0))
+        self.assertEqual(bands.group_colour(values, [3], replicate=True), (0.4, 0.4, 0.4))
+        self.assertEqual(bands.channel_of([3, 4, 5], 5), "B")
+
+
+class Components(unittest.TestCase):
+    def test_parse(self):
+        self.assertEqual(components.parse_components("all"), {"paths", "lights", "bounces"})
+        self.assertEqual(components.parse_components("paths,none"), {"paths"})
+        with self.assertRaises(components.ComponentError):
+            components.parse_components("paths,colours")
+
+    def test_variants_count_scattering_events_not_cycles_bounces(self):
+        self.assertEqual(components.render_variants(3, False), {"main": 2})
+        self.assertEqual(components.render_variants(3, True), {"k1": 0, "k2": 1, "main": 2})
+        self.assertEqual(components.render_variants(0, True), {"main": 0})
+
+    def test_bounce_terms_telescope_to_the_main_total(self):
+        _total, planned = components.component_plan({"bounces"}, [], 3)
+        by_name = {c["name"]: c["terms"] for c in planned}
+        self.assertEqual(list(by_name), ["bounce.0", "bounce.1", "bounce.2", "bounce.3"])
+        # Sum of all terms, as signed (file, pass) counts, must be main.Combined alone.
+        count = {}
+        for terms in by_name.values():
+            for t in terms:
+                key = (t.get("file", "main"), tuple(t["passes"]))
+                count[key] = count.get(key, 0) + t.get("sign", 1)
+        self.assertEqual({k: v for k, v in count.items() if v}, {("main", ("Combined",)): 1})
+
+    def test_paths_and_lights(self):
+        _total, planned = components.component_plan({"paths", "lights"}, ["ceiling", "lamp_2"], 8)
+        names = [c["name"] for c in planned]
+        self.assertEqual(names, ["emission", "diffuse_direct", "diffuse_indirect", "glossy_direct", "glossy_indirect",
+                                 "light.ceiling", "light.lamp_2"])
+        self.assertEqual(planned[1]["terms"], [{"passes": ["DiffDir", "DiffCol"]}])
+        self.assertIn("Combined_lamp_2", components.passes_needed(planned))
+        _total, with_glass = components.component_plan({"paths"}, [], 8, transmission=True)
+        self.assertEqual(len(with_glass), 7)
+
+
+class Manifest(unittest.TestCase):
+    def test_every_band_filed_under_its_file_and_channel(self):
+        groups = bands.band_groups(4)
+        total, planned = components.component_plan({"paths"}, [], 2)
+        m = manifest.build_manifest([400, 450, 500, 550, 600], groups, ["main"], "ViewLayer", total, planned,
+                                    object_names={2: "b", 1: "a"}, attributes={"chromatrace.samples": "4"})
+        self.assertEqual(m["format"], "chromatrace-assemble/1")
+        self.assertEqual([b["channel"] for b in m["bands"]], ["R", "G", "B", "R"])
+        self.assertEqual(m["bands"][3]["files"], {"main": "g001_main.exr"})
+        self.assertEqual(m["object_names"], {"1": "a", "2": "b"})
+        self.assertEqual(m["object_ids"]["channel"], "ViewLayer.IndexOB.X")
+        replicated = manifest.build_manifest([400, 450, 500], bands.band_groups(2, 1), ["main"], "V", total, planned,
+                                             replicate=True)
+        self.assertEqual([b["channel"] for b in replicated["bands"]], ["R", "R"])
+
+    def test_missing_renders(self):
+        with tempfile.TemporaryDirectory() as d:
+            groups = bands.band_groups(6)
+            open(os.path.join(d, manifest.render_file_name(0, "main")), "w").close()
+            self.assertEqual(manifest.missing_renders(d, groups, ["main"]), [(1, "main")])
+
+
+class JournalTest(unittest.TestCase):
+    def test_restores_first_values_newest_first_even_after_a_failure(self):
+        class Thing:
+            pass
+        a, b = Thing(), Thing()
+        a.x, a.colour, b.y = 1, [0.1, 0.2], "keep"
+        journal = Journal()
+        removed = []
+        journal.set(a, "x", 2)
+        journal.set(a, "x", 3)
+        journal.set(a, "colour", (1.0, 1.0))
+        journal.call_on_restore(lambda: removed.append("group"))
+        journal.call_on_restore(lambda: 1 / 0)  # a failing undo must not stop the others
+        journal.set(b, "y", "changed")
+        with self.assertRaises(ZeroDivisionError):
+            journal.restore()
+        self.assertEqual((a.x, tuple(a.colour), b.y, removed), (1, (0.1, 0.2), "keep", ["group"]))
+        journal.restore()  # nothing left: harmless
+        self.assertEqual(len(journal), 0)
+
+
+class BatchArgs(unittest.TestCase):
+    def setUp(self):
+        self.dir = tempfile.TemporaryDirectory()
+        self.scene = os.path.join(self.dir.name, "s.json")
+        open(self.scene, "w").close()
+        self.out = os.path.join(self.dir.name, "out.exr")
+
+    def tearDown(self):
+        self.dir.cleanup()
+
+    def test_good(self):
+        a = batch_args.parse_batch_args(["--scene", self.scene, "--out", self.out, "--samples", "4", "--resolution",
+                                         "64x32", "--components", "paths,bounces", "--max-bounces", "0"])
+        self.assertEqual((a.samples, a.resolution, a.components, a.max_bounces), (4, (64, 32), {"paths", "bounces"}, 0))
+
+    def test_bad_input_is_one_line_naming_the_option(self):
+        cases = [
+            (["--out", self.out], "--scene"),
+            (["--scene", self.scene], "--out"),
+            (["--scene", self.scene + "x", "--out", self.out], "--scene"),
+            (["--scene", self.scene, "--blend", self.scene, "--out", self.out], "--blend"),
+            (["--scene", self.scene, "--out", "/no/such/dir/o.exr"], "--out"),
+            (["--scene", self.scene, "--out", self.out, "--samples", "0"], "--samples"),
+            (["--scene", self.scene, "--out", self.out, "--samples", "many"], "--samples"),
+            (["--scene", self.scene, "--out", self.out, "--max-bounces", "-1"], "--max-bounces"),
+            (["--scene", self.scene, "--out", self.out, "--resolution", "64"], "--resolution"),
+            (["--scene", self.scene, "--out", self.out, "--components", "all,glow"], "--components"),
+            (["--scene", self.scene, "--out", self.out, "--bands", "1:2:1", "--bands-file", self.scene], "--bands-file"),
+            (["--scene", self.scene, "--out", self.out, "--bands-per-render", "4"], "--bands-per-render"),
+            (["--scene", self.scene, "--out", self.out, "--frobnicate"], "--frobnicate"),
+        ]
+        for argv, option in cases:
+            with self.assertRaises(BadInput, msg=argv) as caught:
+                batch_args.parse_batch_args(argv)
+            self.assertIn(option, str(caught.exception))
+            self.assertNotIn("\n", str(caught.exception))
+
+
+class Ply(unittest.TestCase):
+    def test_round_trip_binary_and_ascii(self):
+        mesh = ply.Mesh([(0, 0, 0), (1, 0, 0), (1, 1, 0.5), (0, 1, 0)], [(0, 0, 1)] * 4, [(0, 1, 2), (0, 2, 3)])
+        back = ply.parse_ply(ply.format_ply(mesh))
+        self.assertEqual((back.positions, back.normals, back.triangles),
+                         ([tuple(map(float, p)) for p in mesh.positions], [(0.0, 0.0, 1.0)] * 4, mesh.triangles))
+        text = b"ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n" \
+               b"element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n4 0 1 2 3\n"
+        quad = ply.parse_ply(text)
+        self.assertEqual(quad.triangles, [(0, 1, 2), (0, 2, 3)])  # a fan from the first vertex, as core splits
+        self.assertEqual(quad.normals, [])
+
+
+class NodeRules(unittest.TestCase):
+    def test_mixing_nodes_allow_the_fallback_and_non_spectral_ones_do_not(self):
+        nodes = [
+            {"name": "Principled BSDF", "type": "ShaderNodeBsdfPrincipled", "props": {"distribution": "GGX"},
+             "inputs": {"Specular": 0.5, "Specular Tint": 0.5, "Sheen": 0.0, "Sheen Tint": 0.5, "Subsurface": 0.0}},
+            {"name": "Glossy", "type": "ShaderNodeBsdfGlossy", "props": {"distribution": "MULTI_GGX"}},
+            {"name": "Ramp", "type": "ShaderNodeValToRGB"},
+            {"name": "Mix", "type": "ShaderNodeMixRGB", "props": {"blend_type": "HUE"}},
+            {"name": "Mix ok", "type": "ShaderNodeMixRGB", "props": {"blend_type": "MULTIPLY"}},
+            {"name": "Gamma", "type": "ShaderNodeGamma"},
+            {"name": "Image", "type": "ShaderNodeTexImage", "colour_output_linked": True},
+            {"name": "Noise fac only", "type": "ShaderNodeTexNoise", "colour_output_linked": False},
+        ]
+        issues = node_rules.tree_issues("wall", nodes, volume_linked=True)
+        found = {(i["node"], i["fallback"]) for i in issues}
+        self.assertEqual(found, {("Material Output", False), ("Principled BSDF", True), ("Glossy", True),
+                                 ("Ramp", True), ("Mix", True), ("Image", False)})
+        self.assertIn('material "wall", node "Principled BSDF"', node_rules.summarise(issues[1:]))
+        tinted_white = {"name": "P", "type": "ShaderNodeBsdfPrincipled", "inputs": {"Specular Tint": (1, 1, 1, 1)}}
+        self.assertEqual(node_rules.node_issues(tinted_white), [])
+        no_sheen = {"name": "P", "type": "ShaderNodeBsdfPrincipled", "inputs": {"Sheen": 0.0, "Sheen Tint": 0.5}}
+        self.assertEqual(node_rules.node_issues(no_sheen), [])  # Blender 3's default: a tint without a lobe
+
+
+class Spectra(unittest.TestCase):
+    def test_sources_round_trip(self):
+        scene_dir = "/data/scenes/paper"
+        for source in ["lamp", {"constant": 0.5}, {"csv": "../spectra/a.csv", "column": "red"},
+                       {"csv": "../spectra/a.csv", "column": "red", "extend": "clamp"}, {"rgb": [0.5, 0.2, 0.1]},
+                       {"illuminant": "D65"}, {"illuminant": "D", "cct_k": 5000}, {"blackbody_k": 3200},
+                       {"samples": [[400, 0.1], [700, 0.9]], "extend": "clamp"}]:
+            kind, values = spectra.source_values(source, scene_dir)
+            full = {"name": "", "library": "", "constant": 0, "csv_path": "", "csv_column": "", "extend": "zero",
+                    "rgb": (0, 0, 0), "use_current_colour": False, "illuminant": "D65", "cct_k": 6504,
+                    "blackbody_k": 0, "samples": []}
+            full.update(values)
+            self.assertEqual(spectra.source_json(kind, full, base_dir=scene_dir), source)
+
+    def test_current_colour_and_emission_normalisation(self):
+        values = {"rgb": (0.1, 0.1, 0.1), "use_current_colour": True}
+        self.assertEqual(spectra.source_json("RGB", values, current_rgb=(0.5, 0.25, 0.0)), {"rgb": [0.5, 0.25, 0.0]})
+        self.assertEqual(spectra.rgb_for_upsampling((4.0, 2.0, 1.0)), ([1.0, 0.5, 0.25], 4.0))
+
+    def test_library_lists_the_projects_spectra(self):
+        entries = spectra.library_entries()
+        self.assertIn("cornell_box.csv:red", entries)
+        self.assertIn("synthetic_reflectances.csv:yellow", entries)
+
+
+class Floats(unittest.TestCase):
+    def test_single_precision_values_come_back_as_typed(self):
+        import struct
+        as32 = lambda x: struct.unpack("<f", struct.pack("<f", x))[0]  # noqa: E731
+        for typed in (0.1, 0.78, 0.08, 0.35, 6504, 1e-30, 2.5e-5):
+            self.assertEqual(floats.short_float(as32(typed)), typed)
+        self.assertIsInstance(floats.short_float(as32(380.0)), int)
+        self.assertEqual(floats.short_float(1e300), 1e300)
+
+
+class Cache(unittest.TestCase):
+    def test_key_depends_on_content_only(self):
+        self.assertEqual(cache.cache_key({"a": 1, "b": [1, 2]}), cache.cache_key({"b": [1, 2], "a": 1}))
+        self.assertNotEqual(cache.cache_key({"a": 1}), cache.cache_key({"a": 2}))
+
+
+class CameraMath(unittest.TestCase):
+    def test_basis_looks_down_minus_z(self):
+        rows = camera_math.camera_basis([0, -3.5, 1], [0, 0, 1], [0, 0, 1])
+        columns = [[rows[i][j] for i in range(3)] for j in range(3)]
+        self.assertEqual([round(c, 12) for c in columns[0]], [1, 0, 0])   # right
+        self.assertEqual([round(c, 12) for c in columns[1]], [0, 0, 1])   # image up
+        self.assertEqual([round(c, 12) for c in columns[2]], [0, -1, 0])  # back
+
+
+if __name__ == "__main__":
+    unittest.main()
