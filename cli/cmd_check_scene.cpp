@@ -150,10 +150,10 @@ int check(const Options& options) {
     const Series series = load_series(options.file, options.threads);
     // Each variant's sensor settings, merged along "extends", must be valid for the sensor simulator.
     for (std::size_t i = 0; i < series.variants.size(); ++i)
-      sensor::resolve_config({sensor::config_patch(
-          series.variants[i].sensor,
-          fmt::format("{}: variants[{}] \"{}\" sensor", options.file, i, series.variants[i].name),
-          std::filesystem::path(options.file).parent_path())});
+      sensor::resolve_config(
+          {sensor::config_patch(series.variants[i].sensor,
+                                fmt::format("{}: variants[{}] \"{}\" sensor", options.file, i, series.variants[i].name),
+                                std::filesystem::path(options.file).parent_path())});
     Json variants = Json::array();
     for (const SeriesVariant& v : series.variants)
       variants.push_back({{"name", v.name},

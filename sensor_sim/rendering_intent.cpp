@@ -9,6 +9,21 @@
 #include "core/error.h"
 
 namespace ct::sensor {
+namespace {
+
+// f(n): the response curve, odd-symmetric so that negative signals (read noise below black) keep their sign.
+double response_curve(const RenderingIntent& intent, double n) {
+  const double magnitude = std::abs(n);
+  double v = magnitude;
+  switch (intent.curve) {
+    case ResponseCurve::Linear: break;
+    case ResponseCurve::Gamma: v = intent.k * std::pow(magnitude, intent.gamma); break;
+    case ResponseCurve::Srgb: v = srgb_encode(magnitude); break;
+  }
+  return std::copysign(v, n);
+}
+
+}  // namespace
 
 Eigen::Vector3d white_balance_gains(const std::array<std::vector<double>, 3>& weights, const Bands& bands,
                                     const PiecewiseLinearSpectrum& illuminant) {
@@ -36,17 +51,6 @@ RenderingIntent rendering_intent(const SensorConfig& config, const Eigen::Vector
   intent.clip = r.clip;
   intent.output_bits = r.output_bits;
   return intent;
-}
-
-double response_curve(const RenderingIntent& intent, double n) {
-  const double magnitude = std::abs(n);
-  double v = magnitude;
-  switch (intent.curve) {
-    case ResponseCurve::Linear: break;
-    case ResponseCurve::Gamma: v = intent.k * std::pow(magnitude, intent.gamma); break;
-    case ResponseCurve::Srgb: v = srgb_encode(magnitude); break;
-  }
-  return std::copysign(v, n);
 }
 
 Eigen::Vector3d render(const RenderingIntent& intent, const Eigen::Vector3d& signal) {

@@ -39,9 +39,6 @@ Eigen::Vector3d white_balance_gains(const std::array<std::vector<double>, 3>& we
 // The intent of a configuration; `gains` are rendering.white_balance, or the illuminant's gains when it names one.
 RenderingIntent rendering_intent(const SensorConfig& config, const Eigen::Vector3d& gains);
 
-// The response curve alone, f(n) above.
-double response_curve(const RenderingIntent& intent, double n);
-
 // One pixel's encoded value from its signal.
 Eigen::Vector3d render(const RenderingIntent& intent, const Eigen::Vector3d& signal);
 

@@ -115,7 +115,7 @@ TEST(SceneBands, BadInputGetsExitTwoAndOneLineNamingTheField) {
 
 TEST(ExportMeshes, WritesTheTracersTrianglesForEveryObjectAndLight) {
   test::TempDir dir;
-  const auto r = run_chromatrace({"export-meshes", kBox, (dir.path() / "meshes").string(), "--json"});
+  const auto r = run_chromatrace({"export-meshes", kBox, (dir.path() / "meshes").string() + "/", "--json"});
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const json index = json::parse(r.out);
   ASSERT_EQ(index["objects"].size(), 7u);
@@ -297,6 +297,8 @@ TEST_F(Assemble, BadManifestGetsExitTwoAndOneLineNamingTheField) {
           {{"assemble", with("k.json", [](json& m) { m["total"][0]["file"] = "k1"; }), "-o", out.string()},
            "total[0].file"},
           {{"assemble", with("u.json", [](json& m) { m["extra"] = 1; }), "-o", out.string()}, "u.json: extra"},
+          {{"assemble", with("n.json", [](json& m) { m["bands"][1]["files"] = {{"k1", "g0.exr"}}; }), "-o", out.string()},
+           "total[0]: bands[1].files has no \"main\""},
           {{"assemble", ok, "-o", (dir_.path() / "no/dir/out.exr").string()}, "does not exist"},
           {{"assemble", (dir_.path() / "missing.json").string(), "-o", out.string()}, "missing.json"},
       },
