@@ -17,6 +17,7 @@ import argparse
 import os
 import re
 import resource
+import shutil
 import subprocess
 import sys
 import tempfile
@@ -105,6 +106,7 @@ def main():
           f"{sum(groups_cpu) / plain_render_cpu:.1f}x CPU "
           f"(one band group / plain RGB: {sum(groups_cpu) / len(groups_cpu) / plain_render_cpu:.2f}x CPU)")
     print("whole run: Blender start, import, renders (and for the spectral run, chromatrace assemble)")
+    shutil.rmtree(work, ignore_errors=True)
 
 if __name__ == "__main__":
     main()

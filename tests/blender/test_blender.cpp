@@ -35,9 +35,11 @@ class Blender : public ::testing::Test {
  protected:
   void SetUp() override {
     setenv("CHROMATRACE_EXE", CHROMATRACE_EXE, 1);
+    setenv("TMPDIR", dir_.path().c_str(), 1);  // what a killed Blender leaves behind goes with dir_
     unsetenv("CHROMATRACE_TEST_FAIL_AT_RENDER");
     unsetenv("CHROMATRACE_TEST_KILL_AT_RENDER");
   }
+  void TearDown() override { unsetenv("TMPDIR"); }
 
   // blender --background --factory-startup --python blender_addon/batch.py -- ARGS --cache-dir <temp>/cache
   CommandResult batch(std::vector<std::string> args, const std::string& cache = "cache") {

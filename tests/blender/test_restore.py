@@ -7,6 +7,7 @@ Run: CHROMATRACE_EXE=... CHROMATRACE_SOURCE_DIR=... blender -b --factory-startup
 
 import hashlib
 import os
+import shutil
 import subprocess
 import sys
 import tempfile
@@ -180,6 +181,7 @@ check_same(with_hue, "after a one-band-per-render fallback")
 if digest(blend) != blend_digest or os.path.exists(blend + "1"):
     failures.append("the .blend on disk was written")
 
+shutil.rmtree(work, ignore_errors=True)
 if failures:
     for f in failures:
         print(f"FAIL: {f}", file=sys.stderr)

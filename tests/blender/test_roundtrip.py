@@ -15,6 +15,7 @@ Run: CHROMATRACE_EXE=... CHROMATRACE_SOURCE_DIR=... blender -b --factory-startup
 
 import json
 import os
+import shutil
 import sys
 import tempfile
 
@@ -81,8 +82,11 @@ def meshes_of(scene_file, directory):
     return [ply.read_ply(os.path.join(directory, e["file"])) for e in index["objects"] + index["lights"]]
 
 
+WORK = tempfile.mkdtemp(prefix="chromatrace-roundtrip-")
+
+
 def round_trip(original):
-    work = tempfile.mkdtemp(prefix="chromatrace-roundtrip-")
+    work = tempfile.mkdtemp(dir=WORK)
     name = os.path.basename(original)
     scene = fresh_scene()
     scene_import.import_scene(original, scene, TOOL, print)
@@ -134,6 +138,7 @@ expect(shift < 1e-6, f"moved sphere: vertices off by {shift}")
 expect(len(after.normals) == len(after.positions), "moved sphere: smooth shading (vertex normals) lost")
 expect(document["objects"][0]["shape"]["type"] == "quad", "an unmoved quad was not written as a quad")
 
+shutil.rmtree(WORK, ignore_errors=True)
 if failures:
     for f in failures:
         print(f"FAIL: {f}", file=sys.stderr)

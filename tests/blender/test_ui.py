@@ -7,6 +7,7 @@ unregisters and registers again cleanly.
 """
 
 import os
+import shutil
 import sys
 import tempfile
 
@@ -126,6 +127,7 @@ chromatrace.register()
 if not hasattr(bpy.types.Scene, "chromatrace") or not hasattr(bpy.ops.chromatrace, "render_spectral"):
     failures.append("register after unregister did not restore the add-on")
 
+shutil.rmtree(work, ignore_errors=True)
 if failures:
     for f in failures:
         print(f"FAIL: {f}", file=sys.stderr)
