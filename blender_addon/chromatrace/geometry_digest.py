@@ -5,16 +5,20 @@ import hashlib
 from array import array
 
 
-def object_digest(ob):
-    digest = hashlib.sha256()
-    digest.update(repr([list(row) for row in ob.matrix_world]).encode())
-    mesh = ob.data
+def update_with_mesh(digest, mesh):
+    """Feeds a mesh's vertex positions and face corners (its triangles) into a hashlib digest."""
     co = array("f", [0.0]) * (len(mesh.vertices) * 3)
     mesh.vertices.foreach_get("co", co)
     loops = array("i", [0]) * len(mesh.loops)
     mesh.loops.foreach_get("vertex_index", loops)
     digest.update(co.tobytes())
     digest.update(loops.tobytes())
+
+
+def object_digest(ob):
+    digest = hashlib.sha256()
+    digest.update(repr([list(row) for row in ob.matrix_world]).encode())
+    update_with_mesh(digest, ob.data)
     digest.update(repr([(m.name, m.type) for m in ob.modifiers]).encode())  # a modifier changes the mesh
     return digest.hexdigest()
 

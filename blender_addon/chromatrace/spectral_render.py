@@ -21,13 +21,13 @@ import shutil
 import sys
 import tempfile
 import time
-from array import array
 
 import bpy
 
 from . import VERSION, cache, components, cycles_setup, manifest, materials, node_rules
 from .bands import band_groups, describe_band_range, group_colour
 from .errors import BadInput
+from .geometry_digest import update_with_mesh
 from .journal import Journal
 from .spectra import SourceError, rgb_for_upsampling
 
@@ -278,12 +278,7 @@ class SpectralRender:
                 evaluated = ob.evaluated_get(depsgraph)
                 mesh = evaluated.to_mesh()
                 if mesh is not None:
-                    co = array("f", [0.0]) * (len(mesh.vertices) * 3)
-                    mesh.vertices.foreach_get("co", co)
-                    loops = array("i", [0]) * len(mesh.loops)
-                    mesh.loops.foreach_get("vertex_index", loops)
-                    digest.update(co.tobytes())
-                    digest.update(loops.tobytes())
+                    update_with_mesh(digest, mesh)
                     digest.update(repr([p.use_smooth for p in mesh.polygons]).encode())
                     evaluated.to_mesh_clear()
                 digest.update(repr([s.material.name if s.material else None for s in ob.material_slots]).encode())
