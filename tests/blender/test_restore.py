@@ -14,15 +14,10 @@ import tempfile
 
 import bpy
 
-SOURCE = os.environ["CHROMATRACE_SOURCE_DIR"]
-sys.path.insert(0, os.path.join(SOURCE, "blender_addon"))
-import chromatrace  # noqa: E402
-from chromatrace import scene_import, spectral_render, tool  # noqa: E402
+sys.path.insert(0, os.path.join(os.environ["CHROMATRACE_SOURCE_DIR"], "tests", "blender"))
+from harness import SOURCE, TOOL, chromatrace, expect, failures, finish  # noqa: E402,F401
+from chromatrace import scene_import, spectral_render  # noqa: E402
 from chromatrace.errors import BadInput  # noqa: E402
-
-chromatrace.register()
-TOOL = tool.Tool(tool.find_executable())
-failures = []
 
 
 def plain(value):
@@ -182,8 +177,4 @@ if digest(blend) != blend_digest or os.path.exists(blend + "1"):
     failures.append("the .blend on disk was written")
 
 shutil.rmtree(work, ignore_errors=True)
-if failures:
-    for f in failures:
-        print(f"FAIL: {f}", file=sys.stderr)
-    sys.exit(1)
-print("restore: all ok")
+finish("restore")

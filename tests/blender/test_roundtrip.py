@@ -21,19 +21,9 @@ import tempfile
 
 import bpy
 
-SOURCE = os.environ["CHROMATRACE_SOURCE_DIR"]
-sys.path.insert(0, os.path.join(SOURCE, "blender_addon"))
-import chromatrace  # noqa: E402
-from chromatrace import ply, scene_export, scene_import, tool  # noqa: E402
-
-chromatrace.register()
-TOOL = tool.Tool(tool.find_executable())
-failures = []
-
-
-def expect(condition, message):
-    if not condition:
-        failures.append(message)
+sys.path.insert(0, os.path.join(os.environ["CHROMATRACE_SOURCE_DIR"], "tests", "blender"))
+from harness import SOURCE, TOOL, chromatrace, expect, failures, finish  # noqa: E402,F401
+from chromatrace import ply, scene_export, scene_import  # noqa: E402
 
 
 def fresh_scene():
@@ -139,8 +129,4 @@ expect(len(after.normals) == len(after.positions), "moved sphere: smooth shading
 expect(document["objects"][0]["shape"]["type"] == "quad", "an unmoved quad was not written as a quad")
 
 shutil.rmtree(WORK, ignore_errors=True)
-if failures:
-    for f in failures:
-        print(f"FAIL: {f}", file=sys.stderr)
-    sys.exit(1)
-print("round trip: all ok")
+finish("round trip")

@@ -13,13 +13,9 @@ import tempfile
 
 import bpy
 
-SOURCE = os.environ["CHROMATRACE_SOURCE_DIR"]
-sys.path.insert(0, os.path.join(SOURCE, "blender_addon"))
-import chromatrace  # noqa: E402
+sys.path.insert(0, os.path.join(os.environ["CHROMATRACE_SOURCE_DIR"], "tests", "blender"))
+from harness import SOURCE, TOOL, chromatrace, expect, failures, finish  # noqa: E402,F401
 from chromatrace import ui  # noqa: E402
-
-chromatrace.register()
-failures = []
 
 
 class Layout:
@@ -128,8 +124,4 @@ if not hasattr(bpy.types.Scene, "chromatrace") or not hasattr(bpy.ops.chromatrac
     failures.append("register after unregister did not restore the add-on")
 
 shutil.rmtree(work, ignore_errors=True)
-if failures:
-    for f in failures:
-        print(f"FAIL: {f}", file=sys.stderr)
-    sys.exit(1)
-print("ui: all ok")
+finish("ui")
