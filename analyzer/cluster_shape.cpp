@@ -62,24 +62,6 @@ TwoLines two_lines(const LineSearch& body, const LineSearch& highlight, std::siz
 
 }  // namespace
 
-std::string_view class_name(ShapeClass shape) {
-  switch (shape) {
-    case ShapeClass::None: return "none";
-    case ShapeClass::Clipped: return "clipped";
-    case ShapeClass::Point: return "point";
-    case ShapeClass::Linear: return "linear";
-    case ShapeClass::L: return "L";
-    case ShapeClass::SkewedT: return "skewed-T";
-    case ShapeClass::Gamma: return "gamma";
-    case ShapeClass::Curved: return "curved";
-    case ShapeClass::Thickened: return "thickened";
-    case ShapeClass::Volume: return "volume";
-    case ShapeClass::P: return "P";
-    case ShapeClass::Planar: return "planar";
-  }
-  return "none";
-}
-
 Plane plane_through_black(const std::vector<Vec3>& points) {
   Plane p;
   if (points.empty()) return p;

@@ -28,6 +28,7 @@
 #include <vector>
 
 #include "analyzer/clipping.h"
+#include "core/structures.h"
 #include "analyzer/gamma_fit.h"
 #include "analyzer/line_fit.h"
 #include "analyzer/moments.h"
@@ -35,8 +36,9 @@
 
 namespace ct::analyzer {
 
-enum class ShapeClass { None, Clipped, Point, Linear, L, SkewedT, Gamma, Curved, Thickened, Volume, P, Planar };
-std::string_view class_name(ShapeClass shape);  // "none", "clipped", "point", "linear", "L", "skewed-T", …
+// The classes are the project's one vocabulary of structures (core/structures.h).
+using ShapeClass = Structure;
+inline std::string_view class_name(ShapeClass shape) { return structure_word(shape); }
 
 struct ShapeCriteria {
   std::size_t min_samples = 10;

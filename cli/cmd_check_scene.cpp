@@ -10,6 +10,8 @@
 #include <fmt/format.h>
 
 #include "cli/command.h"
+#include "core/error.h"
+#include "core/file_io.h"
 #include "core/geometry.h"
 #include "core/json_input.h"
 #include "core/scene.h"
@@ -19,7 +21,7 @@ namespace ct::cli {
 namespace {
 
 struct Options {
-  std::string file;
+  std::string file, variant, emit, emit_sensor;
   bool json = false;
   bool quiet = false;
   int threads = 0;
@@ -132,15 +134,47 @@ void print_scene(const Json& s) {
       r["tessellation"]["rings"].get<int>());
 }
 
+Json expect_json(const std::vector<Expectation>& expect) {
+  Json out = Json::object();
+  for (const Expectation& e : expect) out[e.target] = e.any_of;
+  return out;
+}
+
 // One line per variant: what sets it apart and what it should show.
 void print_variant(const Json& v) {
   const Json& s = v["scene"];
   const std::string extends = v["extends"].get<std::string>();
-  fmt::print("  {}: from {}; materials {}, {} light(s), max {} bounces, {} pixels; sensor {}; expects {}\n",
-             v["name"].get<std::string>(), extends.empty() ? "the base" : extends, materials_text(s["materials"]),
-             s["lights"].get<int>(), s["render"]["max_bounces"].get<int>(),
-             s["render"]["pixel_filter"].get<std::string>(), v["sensor"].dump(),
-             fmt::join(v["expect"].get<std::vector<std::string>>(), ", "));
+  std::vector<std::string> expects;
+  for (const auto& [target, words] : v["expect"].items())
+    expects.push_back(fmt::format("{} {}", target, fmt::join(words.get<std::vector<std::string>>(), "|")));
+  const auto figure = v["figure"].get<std::vector<std::string>>();
+  fmt::print("  {}{}: from {}; materials {}, {} light(s), max {} bounces, {} pixels; sensor {}; expects {}\n",
+             v["name"].get<std::string>(), figure.empty() ? "" : fmt::format(" (figure {})", fmt::join(figure, ", ")),
+             extends.empty() ? "the base" : extends, materials_text(s["materials"]), s["lights"].get<int>(),
+             s["render"]["max_bounces"].get<int>(), s["render"]["pixel_filter"].get<std::string>(), v["sensor"].dump(),
+             expects.empty() ? "nothing" : fmt::format("{}", fmt::join(expects, ", ")));
+}
+
+// --emit / --emit-sensor: the variant's resolved scene (paths relative to where it is written) and its sensor
+// settings as a chromatrace-sensor/1 file, so it can be rendered with `render` or the Blender batch by hand.
+void emit_variant(const Options& options, const Series& series) {
+  const SeriesVariant* variant = series.find_variant(options.variant);
+  if (!variant) {
+    std::vector<std::string> names;
+    for (const SeriesVariant& v : series.variants) names.push_back(v.name);
+    throw InputError(fmt::format("--variant: {} has no variant \"{}\" (variants: {})", options.file, options.variant,
+                                 fmt::join(names, ", ")));
+  }
+  if (!options.emit.empty()) {
+    const std::filesystem::path out = std::filesystem::absolute(options.emit);
+    const Json scene = rebase_scene_paths(variant->scene.json, {}, out.parent_path());
+    write_file_atomically(out, scene.dump(2) + "\n");
+  }
+  if (!options.emit_sensor.empty()) {
+    const std::filesystem::path series_dir = std::filesystem::path(series.source).parent_path();
+    Json sensor = sensor::config_patch(variant->sensor, options.file, series_dir).patch;
+    write_file_atomically(options.emit_sensor, sensor.dump(2) + "\n");
+  }
 }
 
 int check(const Options& options) {
@@ -154,16 +188,20 @@ int check(const Options& options) {
           {sensor::config_patch(series.variants[i].sensor,
                                 fmt::format("{}: variants[{}] \"{}\" sensor", options.file, i, series.variants[i].name),
                                 std::filesystem::path(options.file).parent_path())});
+    if (!options.variant.empty()) emit_variant(options, series);
     Json variants = Json::array();
     for (const SeriesVariant& v : series.variants)
       variants.push_back({{"name", v.name},
                           {"extends", v.extends},
-                          {"expect", v.expect},
+                          {"figure", v.figure},
+                          {"expect", expect_json(v.expect)},
                           {"sensor", v.sensor},
                           {"scene", scene_summary(v.scene)}});
     report = {{"file", options.file}, {"format", kSeriesFormat}, {"valid", true},
               {"name", series.name},  {"base", series.base},     {"variants", variants}};
   } else {
+    if (!options.variant.empty() || !options.emit.empty() || !options.emit_sensor.empty())
+      throw InputError(fmt::format("--variant: {} is a scene, not a series", options.file));
     report = {{"file", options.file},
               {"format", kSceneFormat},
               {"valid", true},
@@ -196,6 +234,12 @@ Action add_check_scene(CLI::App& app) {
   command->add_option("file", options->file, "scene or series JSON file")->required();
   command->add_flag("--json", options->json, "print the summary as JSON");
   command->add_flag("-q,--quiet", options->quiet, "print nothing when the file is valid (errors still go to stderr)");
+  command->add_option("--variant", options->variant, "a series' variant to write out with --emit / --emit-sensor");
+  command->add_option("--emit", options->emit, "write the variant's resolved scene (chromatrace-scene/1) to this file")
+      ->needs("--variant");
+  command->add_option("--emit-sensor", options->emit_sensor,
+                      "write the variant's sensor settings (chromatrace-sensor/1) to this file")
+      ->needs("--variant");
   command->add_option("--threads", options->threads, "threads for checking series variants (0: all)")
       ->check(CLI::NonNegativeNumber);
   return [options] { return check(*options); };

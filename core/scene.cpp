@@ -16,6 +16,7 @@
 #include "core/parallel.h"
 #include "core/ply.h"
 #include "core/rgb_to_spectrum.h"
+#include "core/structures.h"
 
 namespace ct {
 namespace {
@@ -564,81 +565,169 @@ std::string document_format(const Json& document) {
   return format != document.end() && format->is_string() ? format->get<std::string>() : "";
 }
 
-const std::vector<std::string>& histogram_structures() {
-  static const std::vector<std::string> names = {
-      "linear",        // matte surface under one light: a line along the body colour (LD)
-      "planar",        // body plus interface reflection: a plane spanned by LD and LS
-      "L",             // sharp highlight: the plane's points veer sharply towards the light colour
-      "P",             // broad highlight
-      "T",             // highlight leaving the body line part-way (skewed T)
-      "superposed",    // several luminaires of different spectra: their structures add
-      "thickened",     // interreflection (or noise): clusters gain volume off their line or plane
-      "fork",          // two surfaces dominate the indirect light on one object
-      "banana",        // highlights meeting interreflection: curved clusters
-      "interpolated",  // pixel area integration / demosaicing: colours between clusters
-      "bent",          // gamma: clusters curve (lines through the origin stay lines)
-      "clipped",       // saturation: clusters flattened onto faces of the RGB cube
-      "shifted",       // dark current and black level: clusters move off the origin
-  };
-  return names;
+namespace {
+
+// Rewrites every relative `csv` path and every `file` of a shape, wherever it appears in a scene document.
+void rebase_paths_in(Json& node, std::string_view key, const std::filesystem::path& from,
+                     const std::filesystem::path& to) {
+  if (node.is_array()) {
+    for (Json& element : node) rebase_paths_in(element, "", from, to);
+    return;
+  }
+  if (!node.is_object()) return;
+  for (auto& [k, child] : node.items()) {
+    const bool path_key = k == "csv" || (k == "file" && key == "shape");
+    if (path_key && child.is_string()) {
+      std::filesystem::path path = child.get<std::string>();
+      if (path.is_relative()) path = std::filesystem::absolute(from / path).lexically_normal();
+      if (!to.empty()) path = path.lexically_relative(std::filesystem::absolute(to).lexically_normal());
+      child = path.generic_string();
+    } else {
+      rebase_paths_in(child, k, from, to);
+    }
+  }
 }
+
+// `extends` names an earlier variant. Naming itself or a later one would make a cycle or a forward reference;
+// the message says which, following the chain through the variants not yet read.
+[[noreturn]] void fail_extends(const JsonNode& extends, const JsonNode& variants, const std::string& name) {
+  std::map<std::string, std::string> parent;
+  for (const JsonNode& v : variants.elements())
+    if (v.json().is_object() && v.json().contains("name") && v.json()["name"].is_string())
+      parent[v.json()["name"].get<std::string>()] =
+          v.json().contains("extends") && v.json()["extends"].is_string() ? v.json()["extends"].get<std::string>() : "";
+  const std::string target = extends.string();
+  if (!parent.count(target))
+    extends.fail(fmt::format("\"{}\" is not the name of a variant", target));
+  std::vector<std::string> chain = {name, target};
+  for (std::string at = target; !parent[at].empty() && chain.size() <= parent.size() + 1;) {
+    at = parent[at];
+    chain.push_back(at);
+    if (at == name)
+      extends.fail(fmt::format("a cycle of extends: {}", fmt::join(chain, " → ")));
+  }
+  extends.fail(fmt::format("\"{}\" is not an earlier variant (a variant extends one listed before it)", target));
+}
+
+Expectation read_expectation(const std::string& target, const JsonNode& node, const Scene& scene,
+                             const std::vector<std::pair<std::string, std::vector<std::string>>>& groups) {
+  Expectation e;
+  e.target = target;
+  if (target != "image") {
+    const auto group = std::find_if(groups.begin(), groups.end(), [&](const auto& g) { return g.first == target; });
+    if (group != groups.end()) {
+      e.objects = group->second;
+    } else if (std::any_of(scene.objects.begin(), scene.objects.end(), [&](const Object& o) { return o.name == target; })) {
+      e.objects = {target};
+    } else {
+      std::vector<std::string> names;
+      for (const auto& g : groups) names.push_back(g.first);
+      names.push_back("image");
+      node.fail(fmt::format("\"{}\" is neither an object of the scene ({}) nor a group ({})", target,
+                            names_of(scene.objects), fmt::join(names, ", ")));
+    }
+  }
+  const auto add_word = [&](const JsonNode& word_node) {
+    const std::string word = word_node.non_empty_string();
+    if (!structure_from_word(word)) {
+      std::vector<std::string_view> words;
+      for (const StructureWord& w : kStructureWords) words.push_back(w.word);
+      word_node.fail(fmt::format("unknown structure \"{}\" (the analyzer's classes: {})", word, fmt::join(words, ", ")));
+    }
+    e.any_of.push_back(word);
+  };
+  if (node.json().is_string()) {
+    add_word(node);
+  } else {
+    for (const JsonNode& word : node.elements()) add_word(word);
+    if (e.any_of.empty()) node.fail("expects at least one structure");
+  }
+  return e;
+}
+
+}  // namespace
+
+Json rebase_scene_paths(Json document, const std::filesystem::path& from, const std::filesystem::path& to) {
+  rebase_paths_in(document, "", from, to);
+  return document;
+}
+
+const SeriesVariant* Series::find_variant(std::string_view name) const { return find_by_name(variants, name); }
 
 Series load_series(const std::filesystem::path& file, int threads) {
   const Json document = read_json(file);
   const JsonNode root(document, file.string());
   const std::string format = root["format"].string();
   if (format != kSeriesFormat) root["format"].fail(fmt::format("must be \"{}\", got \"{}\"", kSeriesFormat, format));
-  root.expect_object({"format", "name", "description", "base", "variants"});
+  root.expect_object({"format", "name", "description", "base", "groups", "variants"});
 
   Series series;
   series.source = file.string();
   series.name = root.find("name") ? root["name"].non_empty_string() : file.stem().string();
   if (const auto description = root.find("description")) series.description = description->string();
   series.base = root["base"].non_empty_string();
+  const std::filesystem::path series_dir = file.parent_path();
+  const std::filesystem::path base_file = (series_dir / series.base).lexically_normal();
+  if (!std::filesystem::is_regular_file(base_file))
+    root["base"].fail(fmt::format("{}: no such scene file", base_file.string()));
   try {
-    series.base_scene = load_scene((file.parent_path() / series.base).lexically_normal());
+    series.base_scene = load_scene(base_file);
   } catch (const InputError& e) {
     root["base"].fail(e.what());
   }
+  if (const auto groups = root.find("groups")) {
+    for (const auto& [name, members] : groups->members()) {
+      std::vector<std::string> objects;
+      for (const JsonNode& member : members.elements()) {
+        const std::string object = member.non_empty_string();
+        if (!find_by_name(series.base_scene.objects, object))
+          member.fail(fmt::format("\"{}\" is not an object of {} ({})", object, series.base,
+                                  names_of(series.base_scene.objects)));
+        objects.push_back(object);
+      }
+      if (objects.empty()) members.fail("a group needs at least one object");
+      if (name == "image") members.fail("\"image\" names the whole image and cannot be a group");
+      series.groups.emplace_back(name, std::move(objects));
+    }
+  }
 
-  // Merge in order (a variant may extend an earlier one), then validate the merged scenes in parallel.
+  // Merge in order (a variant may extend an earlier one), then validate the merged scenes in parallel. Paths
+  // are made absolute first: the base scene's relative to its file, a patch's relative to the series file.
+  const Json base_json = rebase_scene_paths(series.base_scene.json, series.base_scene.directory, {});
   const JsonNode variants = root["variants"];
   std::vector<Json> merged;  // merged[i]: variant i's scene document
+  std::vector<std::optional<JsonNode>> expects;
   for (const JsonNode& node : variants.elements()) {
-    node.expect_object({"name", "description", "extends", "patch", "sensor", "expect"});
+    node.expect_object({"name", "description", "extends", "patch", "sensor", "figure", "expect"});
     SeriesVariant variant;
     variant.name = node["name"].non_empty_string();
     if (find_by_name(series.variants, variant.name))
       node["name"].fail(fmt::format("\"{}\" is already the name of an earlier variant", variant.name));
     if (const auto description = node.find("description")) variant.description = description->string();
 
-    Json scene_json = series.base_scene.json;
+    Json scene_json = base_json;
     variant.sensor = Json::object();
     if (const auto extends = node.find("extends")) {
       variant.extends = extends->string();
       const SeriesVariant* earlier = find_by_name(series.variants, variant.extends);
-      if (!earlier) extends->fail(fmt::format("\"{}\" is not the name of an earlier variant", variant.extends));
+      if (!earlier) fail_extends(*extends, variants, variant.name);
       scene_json = merged[static_cast<std::size_t>(earlier - series.variants.data())];
       variant.sensor = earlier->sensor;
     }
-    auto merge_patch_at = [&](const char* key, Json& target) {
+    auto merge_patch_at = [&](const char* key, Json& target, bool scene) {
       const auto patch = node.find(key);
       if (!patch) return Json::object();
       if (!patch->json().is_object())
         patch->fail(fmt::format("must be an object (a JSON Merge Patch), got {}", describe_json(patch->json())));
-      target.merge_patch(patch->json());
+      target.merge_patch(scene ? rebase_scene_paths(patch->json(), series_dir, {}) : patch->json());
       return patch->json();
     };
-    variant.patch = merge_patch_at("patch", scene_json);
-    merge_patch_at("sensor", variant.sensor);
-
-    for (const JsonNode& structure : node["expect"].elements()) {
-      const std::string name = structure.string();
-      const std::vector<std::string>& known = histogram_structures();
-      if (std::find(known.begin(), known.end(), name) == known.end())
-        structure.fail(fmt::format("unknown structure \"{}\" (known: {})", name, fmt::join(known, ", ")));
-      variant.expect.push_back(name);
+    variant.patch = merge_patch_at("patch", scene_json, true);
+    merge_patch_at("sensor", variant.sensor, false);
+    if (const auto figure = node.find("figure")) {
+      for (const JsonNode& panel : figure->elements()) variant.figure.push_back(panel.non_empty_string());
     }
+    expects.push_back(node.find("expect"));
     merged.push_back(std::move(scene_json));
     series.variants.push_back(std::move(variant));
   }
@@ -649,8 +738,12 @@ Series load_series(const std::filesystem::path& file, int threads) {
     try {
       SeriesVariant& variant = series.variants[i];
       const std::string source = fmt::format("{}: variants[{}] \"{}\"", file.string(), i, variant.name);
-      variant.scene = parse_scene(merged[i], source, series.base_scene.directory);
+      variant.scene = parse_scene(merged[i], source, series_dir);
       if (variant.scene.name.empty()) variant.scene.name = series.base_scene.name;
+      if (expects[i]) {
+        for (const auto& [target, words] : expects[i]->members())
+          variant.expect.push_back(read_expectation(target, words, variant.scene, series.groups));
+      }
     } catch (...) {
       errors[i] = std::current_exception();
     }

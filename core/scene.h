@@ -13,6 +13,7 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <variant>
 #include <vector>
 
@@ -184,17 +185,23 @@ std::vector<TriangleMesh> scene_meshes(const Scene& scene);
 
 // ---- Experiment series ---------------------------------------------------------------------------------
 
-// The colour-histogram structures a variant can be expected to show (paper-summary.md).
-const std::vector<std::string>& histogram_structures();
+// What a variant expects of one object, a group of objects or the whole image: the class the analyzer
+// gives it (each object of a group on its own) is one of `any_of`, words of core/structures.h.
+struct Expectation {
+  std::string target;                // as written: an object's name, a group's name, or "image"
+  std::vector<std::string> objects;  // the objects it covers, in scene order; empty for "image"
+  std::vector<std::string> any_of;
+};
 
 struct SeriesVariant {
   std::string name;
   std::string description;
   std::string extends;  // an earlier variant whose merged scene and sensor this one patches; empty: the base
   Json patch;           // JSON Merge Patch (RFC 7386) as given
-  Json sensor;          // sensor settings (free-form), merged along `extends`; an empty object if none
-  std::vector<std::string> expect;  // from histogram_structures()
-  Scene scene;                      // the patched scene, validated
+  Json sensor;          // sensor settings (a chromatrace-sensor/1 patch), merged along `extends`; {} if none
+  std::vector<std::string> figure;  // the paper's panels it reproduces, e.g. {"3b", "4a"}
+  std::vector<Expectation> expect;
+  Scene scene;  // the patched scene, validated; scene.json has every path absolute
 };
 
 struct Series {
@@ -203,12 +210,19 @@ struct Series {
   std::string description;
   std::string base;  // the base scene's path as written, relative to the series file
   Scene base_scene;
+  std::vector<std::pair<std::string, std::vector<std::string>>> groups;  // name → object names
   std::vector<SeriesVariant> variants;
+
+  const SeriesVariant* find_variant(std::string_view name) const;
 };
 
 // Loads a series: the base scene must be valid on its own, and each variant's merged scene is validated,
 // on up to `threads` threads (0: all); the error reported is that of the first invalid variant in file order.
 Series load_series(const std::filesystem::path& file, int threads = 0);
+
+// A scene document whose relative paths (`csv`, a shape's `file`) are made relative to `to` (absolute when
+// `to` is empty), from their meaning relative to `from`; so a scene can be written to another folder.
+Json rebase_scene_paths(Json document, const std::filesystem::path& from, const std::filesystem::path& to);
 
 // The "format" of a scene or series document, so tools can accept either; "" if there is none.
 std::string document_format(const Json& document);

@@ -42,6 +42,13 @@ inline const std::vector<BadScene>& bad_scenes() {
       {"no_light.json", "lights: a scene needs at least one light"},
       {"duplicate_name.json", "lights[0].name: \"floor\" is already the name of objects[0]"},
       {"series_bad_variant.json", "variants[1] \"rough\": materials.plastic.roughness: must be in [0, 1], got 1.5"},
+      {"series_cycle.json", "variants[0].extends: a cycle of extends: a → c → b → a"},
+      {"series_missing_base.json", "base: {scenes}/no_such_scene.json: no such scene file"},
+      {"series_unknown_structure.json",
+       "variants[0].expect.image[1]: unknown structure \"banana\" (the analyzer's classes: none, clipped, "
+       "point, linear, L, skewed-T, gamma, curved, thickened, volume, P, planar)"},
+      {"series_unknown_target.json",
+       "variants[0].expect.wals: \"wals\" is neither an object of the scene (floor, ball) nor a group (walls, image)"},
   };
   return cases;
 }
@@ -53,6 +60,9 @@ inline std::string expected_message(const BadScene& bad) {
   std::string message = bad.message;
   const std::string token = "{dir}";
   if (const auto at = message.find(token); at != std::string::npos) message.replace(at, token.size(), bad_scenes_dir());
+  const std::string scenes = "{scenes}";  // the folder above bad/
+  if (const auto at = message.find(scenes); at != std::string::npos)
+    message.replace(at, scenes.size(), std::string(CHROMATRACE_TEST_DATA) + "/scenes");
   return bad_scenes_dir() + "/" + bad.file + ": " + message;
 }
 

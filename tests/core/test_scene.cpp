@@ -11,10 +11,12 @@
 #include "core/error.h"
 #include "core/rgb_to_spectrum.h"
 #include "core/scene.h"
+#include "core/structures.h"
 #include "tests/core/bad_scenes.h"
 
 namespace ct {
 namespace {
+namespace fs = std::filesystem;
 
 const std::filesystem::path kScenes = std::filesystem::path(CHROMATRACE_SOURCE_DIR) / "scenes";
 const std::filesystem::path kTestScenes = std::filesystem::path(CHROMATRACE_TEST_DATA) / "scenes";
@@ -391,7 +393,11 @@ TEST(Series, PaperSeriesValidatesEveryStep) {
   const SeriesVariant& first = variant("1-lambert-direct");
   EXPECT_EQ(first.scene.render.max_bounces, 1);
   for (const Material& m : first.scene.materials) EXPECT_STREQ(material_type_name(m), "lambert") << m.name;
-  EXPECT_EQ(first.expect, std::vector<std::string>{"linear"});
+  ASSERT_EQ(first.expect.size(), 3u);
+  EXPECT_EQ(first.expect[0].target, "walls");
+  EXPECT_EQ(first.expect[0].objects, (std::vector<std::string>{"floor", "ceiling", "back_wall", "left_wall", "right_wall"}));
+  EXPECT_EQ(first.expect[0].any_of, std::vector<std::string>{"linear"});
+  EXPECT_EQ(first.expect[1].objects, std::vector<std::string>{"sphere"});
 
   EXPECT_EQ(variant("2-object-spectra").scene.find_spectrum("grey"), nullptr);  // deleted with null
   EXPECT_STREQ(material_type_name(*variant("3-specular").scene.find_material("sphere")), "dichromatic");
@@ -410,10 +416,43 @@ TEST(Series, PaperSeriesValidatesEveryStep) {
   EXPECT_EQ(sensor["rendering"]["curve"], "linear");
   EXPECT_EQ(sensor["adc"]["bits"], 8);
 
-  for (const SeriesVariant& v : series.variants)
-    for (const std::string& s : v.expect)
-      EXPECT_NE(std::find(histogram_structures().begin(), histogram_structures().end(), s),
-                histogram_structures().end());
+  // The eight panels of the paper's Figures 3 and 4, each reproduced by one variant.
+  std::vector<std::string> panels;
+  for (const SeriesVariant& v : series.variants) panels.insert(panels.end(), v.figure.begin(), v.figure.end());
+  std::sort(panels.begin(), panels.end());
+  EXPECT_EQ(panels, (std::vector<std::string>{"3a", "3b", "3c", "3d", "4a", "4b", "4c", "4d"}));
+
+  // Paths come out absolute, so the resolved scene can be written anywhere.
+  const std::string csv = first.scene.json["spectra"]["beige"]["csv"];
+  EXPECT_TRUE(std::filesystem::path(csv).is_absolute()) << csv;
+  EXPECT_TRUE(std::filesystem::exists(csv)) << csv;
+}
+
+TEST(Series, RebasedScenePathsResolveFromTheirNewFolder) {
+  const Series series = load_series(kScenes / "paper/series.json");
+  const fs::path folder = fs::temp_directory_path() / "chromatrace_rebase";
+  fs::create_directories(folder / "sub");
+  const Json moved = rebase_scene_paths(series.variants[2].scene.json, {}, folder / "sub");
+  const std::string csv = moved["spectra"]["beige"]["csv"];
+  EXPECT_TRUE(fs::path(csv).is_relative()) << csv;
+  EXPECT_TRUE(fs::exists(folder / "sub" / csv)) << csv;
+  // The moved scene parses from its new folder to the same spectra.
+  const Scene again = parse_scene(moved, "moved", folder / "sub");
+  EXPECT_EQ(again.find_spectrum("beige")->spectrum.values(), series.variants[2].scene.find_spectrum("beige")->spectrum.values());
+  fs::remove_all(folder);
+}
+
+TEST(Series, ExpectationsUseTheAnalyzersWords) {
+  // Every word in a shipped series is a structure of core/structures.h, and each names itself back.
+  for (const SeriesVariant& v : load_series(kScenes / "paper/series.json").variants)
+    for (const Expectation& e : v.expect)
+      for (const std::string& word : e.any_of) {
+        const auto s = structure_from_word(word);
+        ASSERT_TRUE(s) << v.name << ": " << word;
+        EXPECT_EQ(structure_word(*s), word);
+      }
+  EXPECT_FALSE(structure_from_word("banana"));  // the paper's word; the analyzer's class is "curved"
+  EXPECT_FALSE(structure_from_word("l"));
 }
 
 TEST(Series, JsonMergePatchSemantics) {
