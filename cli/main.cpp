@@ -25,6 +25,8 @@ int main(int argc, char** argv) {
   add(ct::cli::add_render(app));
   add(ct::cli::add_analyze(app));
   add(ct::cli::add_sensor(app));
+  add(ct::cli::add_series(app));
+  add(ct::cli::add_paper(app));
   add(ct::cli::add_scene_bands(app));
   add(ct::cli::add_export_meshes(app));
   add(ct::cli::add_assemble(app));

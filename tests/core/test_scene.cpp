@@ -393,9 +393,9 @@ TEST(Series, PaperSeriesValidatesEveryStep) {
   const SeriesVariant& first = variant("1-lambert-direct");
   EXPECT_EQ(first.scene.render.max_bounces, 1);
   for (const Material& m : first.scene.materials) EXPECT_STREQ(material_type_name(m), "lambert") << m.name;
-  ASSERT_EQ(first.expect.size(), 3u);
+  ASSERT_EQ(first.expect.size(), 4u);
   EXPECT_EQ(first.expect[0].target, "walls");
-  EXPECT_EQ(first.expect[0].objects, (std::vector<std::string>{"floor", "ceiling", "back_wall", "left_wall", "right_wall"}));
+  EXPECT_EQ(first.expect[0].objects, (std::vector<std::string>{"floor", "back_wall", "left_wall", "right_wall"}));
   EXPECT_EQ(first.expect[0].any_of, std::vector<std::string>{"linear"});
   EXPECT_EQ(first.expect[1].objects, std::vector<std::string>{"sphere"});
 

@@ -1,0 +1,160 @@
+// chromatrace series SERIES.json -o DIR and chromatrace paper -o DIR: experiment series end to end
+// (docs/series.md).
+#include <unistd.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <fmt/core.h>
+#include <fmt/format.h>
+
+#include "cli/command.h"
+#include "core/error.h"
+#include "core/scene.h"
+#include "series/figure.h"
+#include "series/runner.h"
+
+namespace ct::cli {
+namespace {
+namespace fs = std::filesystem;
+
+struct Options {
+  std::string series, output, renderer = "tracer", resolution, components = "paths,lights";
+  std::vector<std::string> variants;
+  std::optional<int> spp;
+  std::optional<std::uint64_t> seed;
+  int threads = 0;
+  bool quiet = false;
+};
+
+fs::path own_executable() {
+  std::error_code error;
+  const fs::path exe = fs::read_symlink("/proc/self/exe", error);
+  return error ? fs::path("chromatrace") : exe;
+}
+
+// A file shipped with chromatrace: installed beside the executable (../share/chromatrace/...), else in the
+// source tree it was built from.
+fs::path shipped_file(const fs::path& relative) {
+  const fs::path installed = own_executable().parent_path().parent_path() / "share" / "chromatrace" / relative;
+  if (fs::exists(installed)) return installed;
+  return fs::path(CHROMATRACE_SOURCE_DIR) / relative;
+}
+
+void add_common(CLI::App* cmd, Options& o) {
+  cmd->add_option("-o,--output", o.output, "Output directory (created; its parent must exist)")->required();
+  cmd->add_option("--variant", o.variants, "Run only this variant (repeatable)");
+  cmd->add_option("--renderer", o.renderer, "tracer (the reference path tracer) or cycles (Blender's Cycles, "
+                                             "through the add-on)")
+      ->capture_default_str();
+  cmd->add_option("--resolution", o.resolution, "Image size WxH for every variant (default: the scenes')");
+  cmd->add_option("--spp", o.spp, "Paths per pixel (default: the scenes' render.samples)");
+  cmd->add_option("--seed", o.seed, "Random seed of the renders (default: the scenes' render.seed)");
+  cmd->add_option("--components", o.components, "Component families rendered: paths, lights, bounces, all")
+      ->capture_default_str();
+  cmd->add_option("--threads", o.threads, "Worker threads (0: all cores)")->check(CLI::NonNegativeNumber);
+  cmd->add_flag("-q,--quiet", o.quiet, "No progress output (the summary table is still printed)");
+}
+
+series::RunOptions run_options(const Options& o) {
+  series::RunOptions r;
+  if (o.renderer == "tracer") r.renderer = series::Renderer::Tracer;
+  else if (o.renderer == "cycles") r.renderer = series::Renderer::Cycles;
+  else throw InputError(fmt::format("--renderer: must be tracer or cycles, got \"{}\"", o.renderer));
+  if (!o.resolution.empty()) {
+    int w = 0, h = 0;
+    char x = 0, extra = 0;
+    if (std::sscanf(o.resolution.c_str(), "%d%c%d%c", &w, &x, &h, &extra) != 3 || x != 'x' || w < 1 || h < 1)
+      throw InputError(fmt::format("--resolution: expected WxH with positive integers, got \"{}\"", o.resolution));
+    r.width = w;
+    r.height = h;
+  }
+  if (o.spp && *o.spp < 1) throw InputError(fmt::format("--spp: must be >= 1, got {}", *o.spp));
+  r.spp = o.spp;
+  r.seed = o.seed;
+  r.components = o.components;
+  r.variants = o.variants;
+  r.threads = o.threads;
+  r.progress = !o.quiet;
+  r.executable = own_executable();
+  const char* addon = std::getenv("CHROMATRACE_BLENDER_ADDON");
+  r.batch_script = (addon && *addon) ? fs::path(addon) / "batch.py" : shipped_file("blender_addon/batch.py");
+  return r;
+}
+
+// One row per expectation: variant, target, expected, found (per object where a group differs), ✔/✗.
+void print_summary(const series::SeriesResult& result, const fs::path& dir) {
+  int met = 0, total = 0;
+  fmt::print("{:<24} {:<7} {:<10} {:<16} {}\n", "variant", "figure", "target", "expected", "found");
+  for (const series::VariantResult& v : result.variants) {
+    const std::string figure = v.figure.empty() ? "" : fmt::format("{}", fmt::join(v.figure, ","));
+    if (!v.ok) {
+      fmt::print("{:<24} {:<7} failed: {}\n", v.name, figure, v.error);
+      continue;
+    }
+    bool first = true;
+    for (const series::ExpectationResult& e : v.expectations) {
+      std::vector<std::string> found;
+      for (const series::Finding& f : e.findings)
+        found.push_back(e.findings.size() == 1 ? f.found : fmt::format("{} {}", f.object, f.found));
+      fmt::print("{:<24} {:<7} {:<10} {:<16} {} {}\n", first ? v.name : "", first ? figure : "", e.expected.target,
+                 fmt::format("{}", fmt::join(e.expected.any_of, "|")), e.ok ? "✔" : "✗",
+                 fmt::join(found, ", "));
+      first = false;
+      met += e.ok ? 1 : 0;
+      ++total;
+    }
+  }
+  fmt::print("{} of {} expectations met; {}\n", met, total, (dir / "index.html").string());
+}
+
+int run(const Options& o, const fs::path& series_file) {
+  series::RunOptions options = run_options(o);
+  if (o.output.empty()) throw InputError("--output: no directory given");
+  const fs::path parent = fs::absolute(o.output).parent_path();
+  if (!fs::is_directory(parent))
+    throw InputError(fmt::format("{}: directory {} does not exist", o.output, parent.string()));
+  if (fs::exists(o.output) && !fs::is_directory(o.output))
+    throw InputError(fmt::format("{}: exists and is not a directory", o.output));
+  series::check_renderer(options);
+  const Series series = load_series(series_file, o.threads);
+  series::select_variants(series, o.variants);  // an unknown variant fails before any work
+
+  const series::SeriesResult result = series::run_series(series, o.output, options);
+  series::write_figure_page(o.output, series::result_json(result));
+  print_summary(result, o.output);
+  for (const series::VariantResult& v : result.variants)
+    if (!v.ok) return 1;
+  return 0;
+}
+
+}  // namespace
+
+Action add_series(CLI::App& app) {
+  auto* cmd = app.add_subcommand("series", "Run an experiment series end to end: render, camera and analysis per "
+                                            "variant, found vs expected structures, a figure page");
+  auto o = std::make_shared<Options>();
+  cmd->add_option("series", o->series, "Series file (chromatrace-series/1)")->required();
+  add_common(cmd, *o);
+  return [o] { return run(*o, o->series); };
+}
+
+Action add_paper(CLI::App& app) {
+  auto* cmd = app.add_subcommand("paper", "Reproduce the paper's Figures 3 and 4: its experiment series, shipped "
+                                           "with chromatrace, at 128x128 and 64 paths per pixel unless told otherwise");
+  auto o = std::make_shared<Options>();
+  add_common(cmd, *o);
+  return [o] {
+    Options options = *o;
+    if (options.resolution.empty()) options.resolution = "128x128";
+    if (!options.spp) options.spp = 64;
+    return run(options, shipped_file("scenes/paper/series.json"));
+  };
+}
+
+}  // namespace ct::cli

@@ -1,0 +1,87 @@
+#include "series/preview.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <vector>
+
+#include <fmt/core.h>
+#include <opencv2/imgcodecs.hpp>
+
+#include "core/colour.h"
+#include "core/file_io.h"
+
+namespace ct::series {
+namespace {
+
+const analyzer::RgbImage* find_layer(const analyzer::AnalysisImage& input, std::string_view name) {
+  for (const analyzer::ComponentLayer& c : input.components)
+    if (c.name == name) return &c.image;
+  return nullptr;
+}
+
+// The q-quantile of `values` (0 ≤ q ≤ 1); 0 for none.
+double quantile(std::vector<float> values, double q) {
+  if (values.empty()) return 0;
+  const auto k = static_cast<std::ptrdiff_t>(std::clamp(q, 0.0, 1.0) * static_cast<double>(values.size() - 1));
+  std::nth_element(values.begin(), values.begin() + k, values.end());
+  return values[static_cast<std::size_t>(k)];
+}
+
+cv::Mat encode(const analyzer::RgbImage& image, const float gains[3], bool srgb) {
+  cv::Mat out(image.height, image.width, CV_8UC3);
+  for (int y = 0; y < image.height; ++y)
+    for (int x = 0; x < image.width; ++x) {
+      const std::size_t i = 3 * (static_cast<std::size_t>(y) * image.width + x);
+      auto& px = out.at<cv::Vec3b>(y, x);
+      for (int c = 0; c < 3; ++c) {
+        double v = std::isfinite(image.rgb[i + c]) ? std::clamp(image.rgb[i + c] * gains[c], 0.0f, 1.0f) : 0.0;
+        if (srgb) v = srgb_encode(v);
+        px[2 - c] = static_cast<unsigned char>(std::lround(255 * v));
+      }
+    }
+  return out;
+}
+
+}  // namespace
+
+cv::Mat preview_image(const analyzer::AnalysisImage& input) {
+  if (const analyzer::RgbImage* display = find_layer(input, "display")) {
+    const float ones[3] = {1, 1, 1};
+    return encode(*display, ones, false);
+  }
+  const analyzer::RgbImage& image = input.linear ? *input.linear : input.image;
+  const analyzer::RgbImage* emission = input.linear ? find_layer(input, "emission") : nullptr;
+  const auto sum = [](const analyzer::RgbImage& im, std::size_t p) { return im.rgb[3 * p] + im.rgb[3 * p + 1] + im.rgb[3 * p + 2]; };
+  // Surfaces only: a lamp seen directly would set the exposure and the white otherwise.
+  std::vector<std::size_t> surfaces;
+  for (std::size_t p = 0; p < image.pixel_count(); ++p)
+    if (!emission || sum(*emission, p) <= 0.5f * sum(image, p)) surfaces.push_back(p);
+  // White balance on the brightest 2 % of the surface pixels (by channel sum), skipping the brightest 0.5 %.
+  std::vector<float> sums;
+  for (const std::size_t p : surfaces) sums.push_back(sum(image, p));
+  const double lo = quantile(sums, 0.975), hi = quantile(sums, 0.995);
+  double mean[3] = {0, 0, 0};
+  for (const std::size_t p : surfaces)
+    if (sum(image, p) >= lo && sum(image, p) <= hi)
+      for (int c = 0; c < 3; ++c) mean[c] += image.rgb[3 * p + c];
+  float gains[3] = {1, 1, 1};
+  if (mean[0] > 0 && mean[1] > 0 && mean[2] > 0)
+    for (int c = 0; c < 3; ++c) gains[c] = static_cast<float>(mean[1] / mean[c]);
+  std::vector<float> brightest;
+  for (const std::size_t p : surfaces)
+    brightest.push_back(std::max({image.rgb[3 * p] * gains[0], image.rgb[3 * p + 1] * gains[1], image.rgb[3 * p + 2] * gains[2]}));
+  const double level = quantile(brightest, 0.99);
+  if (level > 0)
+    for (float& g : gains) g = static_cast<float>(g * 0.9 / level);
+  return encode(image, gains, true);
+}
+
+void write_preview_png(const std::filesystem::path& file, const analyzer::AnalysisImage& input) {
+  std::vector<unsigned char> bytes;
+  if (!cv::imencode(".png", preview_image(input), bytes))
+    throw std::runtime_error(fmt::format("{}: PNG encoding failed", file.string()));
+  write_file_atomically(file, std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()));
+}
+
+}  // namespace ct::series

@@ -1,0 +1,397 @@
+#include "series/runner.h"
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <map>
+
+#include <fmt/core.h>
+#include <fmt/format.h>
+
+#include "analyzer/analysis.h"
+#include "analyzer/output.h"
+#include "core/error.h"
+#include "core/file_io.h"
+#include "core/parallel.h"
+#include "core/spectral_exr.h"
+#include "reference_tracer/render.h"
+#include "sensor_sim/config.h"
+#include "sensor_sim/pipeline.h"
+#include "series/preview.h"
+
+namespace ct::series {
+namespace fs = std::filesystem;
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
+
+// ---- The render cache key -------------------------------------------------------------------------------
+
+// FNV-1a, 64 bits: a cache key, not a cryptographic hash.
+std::uint64_t fnv1a(std::string_view bytes, std::uint64_t h = 0xcbf29ce484222325ull) {
+  for (const unsigned char c : bytes) {
+    h ^= c;
+    h *= 0x100000001b3ull;
+  }
+  return h;
+}
+
+// The scene with every file it names replaced by a hash of the file's bytes: a changed spectrum or mesh
+// changes the key, a moved folder does not.
+void hash_named_files(Json& node, std::string_view key) {
+  if (node.is_array()) {
+    for (Json& element : node) hash_named_files(element, "");
+    return;
+  }
+  if (!node.is_object()) return;
+  for (auto& [k, child] : node.items()) {
+    if ((k == "csv" || (k == "file" && key == "shape")) && child.is_string())
+      child = fmt::format("fnv1a:{:016x}", fnv1a(read_file(child.get<std::string>())));
+    else
+      hash_named_files(child, k);
+  }
+}
+
+// What a render depends on. The scene's name and description do not change a pixel and are left out.
+Json render_inputs(const Scene& scene, const RunOptions& options) {
+  Json document = scene.json;
+  document.erase("name");
+  document.erase("description");
+  hash_named_files(document, "");
+  return {{"renderer", renderer_name(options.renderer)},
+          {"scene", document},
+          {"width", options.width.value_or(scene.camera.width)},
+          {"height", options.height.value_or(scene.camera.height)},
+          {"samples", options.spp.value_or(scene.render.samples)},
+          {"seed", options.seed.value_or(scene.render.seed)},
+          {"components", options.components}};
+}
+
+std::string render_key(const Json& inputs) { return fmt::format("{:016x}", fnv1a(inputs.dump())); }
+
+// ---- Renderers ------------------------------------------------------------------------------------------
+
+void render_with_tracer(Scene scene, const fs::path& out, const RunOptions& options) {
+  if (options.width) scene.camera.width = *options.width;
+  if (options.height) scene.camera.height = *options.height;
+  rt::RenderOptions render;
+  render.samples = options.spp;
+  render.seed = options.seed;
+  render.components = rt::ComponentSelection::parse(options.components);
+  render.threads = options.threads;
+  render.progress = options.progress;
+  rt::write_render(out, scene, rt::render(scene, render));
+}
+
+// Runs a program and waits; its stderr goes to ours (the batch's progress lines), its stdout to `log`.
+int run_program(const std::vector<std::string>& argv, const std::vector<std::pair<std::string, std::string>>& env,
+                const fs::path& log) {
+  const pid_t pid = fork();
+  if (pid < 0) throw std::runtime_error("cannot start a process (fork failed)");
+  if (pid == 0) {
+    for (const auto& [name, value] : env) setenv(name.c_str(), value.c_str(), 1);
+    if (std::FILE* f = std::fopen(log.c_str(), "w")) dup2(fileno(f), STDOUT_FILENO);
+    std::vector<char*> args;
+    for (const std::string& a : argv) args.push_back(const_cast<char*>(a.c_str()));
+    args.push_back(nullptr);
+    execvp(args[0], args.data());
+    _exit(127);
+  }
+  int status = 0;
+  while (waitpid(pid, &status, 0) < 0)
+    if (errno != EINTR) throw std::runtime_error("waiting for a process failed");
+  return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+}
+
+void render_with_cycles(const Scene& scene, const fs::path& scene_file, const fs::path& out, const fs::path& dir,
+                        const RunOptions& options) {
+  std::vector<std::string> argv = {options.blender.string(), "--background", "--factory-startup", "--python",
+                                   options.batch_script.string(), "--",
+                                   "--scene", scene_file.string(), "--out", out.string(),
+                                   "--samples", std::to_string(options.spp.value_or(scene.render.samples)),
+                                   "--seed", std::to_string(options.seed.value_or(scene.render.seed)),
+                                   "--components", options.components,
+                                   "--cache-dir", (dir / "renders" / "cycles-cache").string()};
+  if (options.width || options.height)
+    for (const std::string& a : {std::string("--resolution"),
+                                 fmt::format("{}x{}", options.width.value_or(scene.camera.width),
+                                             options.height.value_or(scene.camera.height))})
+      argv.push_back(a);
+  if (!options.progress) argv.push_back("--quiet");
+  const fs::path log = dir / "renders" / "blender.log";
+  const int status = run_program(argv, {{"CHROMATRACE_EXE", options.executable.string()}}, log);
+  if (status != 0 || !fs::exists(out))
+    throw std::runtime_error(fmt::format("Blender's batch exited with status {} (its output: {})", status, log.string()));
+}
+
+// ---- Expectations ---------------------------------------------------------------------------------------
+
+// Which light paths built a region's cluster, in one line: the path types that carry most of its energy,
+// and how much of its spread off the direct light's structure the indirect light explains.
+std::string explain(const std::optional<analyzer::Explanation>& explanation) {
+  if (!explanation) return "";
+  std::vector<std::string> parts;
+  for (const analyzer::FamilyShares& family : explanation->families) {
+    if (family.family != ComponentFamily::PathType && family.family != ComponentFamily::LightGroup) continue;
+    std::vector<analyzer::ComponentShare> shares = family.components;
+    std::sort(shares.begin(), shares.end(), [](const auto& a, const auto& b) { return a.energy_share > b.energy_share; });
+    std::vector<std::string> named;
+    for (const analyzer::ComponentShare& s : shares)
+      if (s.energy_share >= 0.02 && named.size() < 3) named.push_back(fmt::format("{} {:.0f} %", s.name, 100 * s.energy_share));
+    if (family.family == ComponentFamily::LightGroup && shares.size() < 2) continue;  // one light: nothing to say
+    if (!named.empty()) parts.push_back(fmt::format("{}", fmt::join(named, ", ")));
+  }
+  if (const auto& off = explanation->off_structure;
+      off && off->rms_total > 0 && explanation->indirect_share.value_or(0) >= 0.01)
+    parts.push_back(fmt::format("indirect light makes {:.0f} % of the spread off the {}", 100 * off->indirect_share,
+                                off->structure));
+  return fmt::format("{}", fmt::join(parts, "; "));
+}
+
+std::vector<ExpectationResult> judge(const SeriesVariant& variant, const analyzer::ImageAnalysis& analysis) {
+  // Object id → region index (label regions carry the id as their label).
+  std::map<std::int64_t, int> region_of_id;
+  for (std::size_t r = 0; r < analysis.regions.size(); ++r)
+    if (analysis.regions[r].source == "labels") region_of_id[analysis.regions[r].label] = static_cast<int>(r);
+
+  std::vector<ExpectationResult> results;
+  for (const Expectation& e : variant.expect) {
+    ExpectationResult result{e, {}, true};
+    auto add = [&](const std::string& object, int region) {
+      Finding f{object, region, "absent", false, ""};
+      if (region >= 0) {
+        const auto& shape = analysis.results[static_cast<std::size_t>(region)].shape;
+        f.found = std::string(analyzer::class_name(shape.shape));
+        f.ok = std::find(e.any_of.begin(), e.any_of.end(), f.found) != e.any_of.end();
+        if (static_cast<std::size_t>(region) < analysis.explanations.size())
+          f.explanation = explain(analysis.explanations[static_cast<std::size_t>(region)]);
+      }
+      result.ok = result.ok && f.ok;
+      result.findings.push_back(std::move(f));
+    };
+    if (e.objects.empty()) add("image", 0);
+    for (const std::string& name : e.objects) {
+      const auto object = std::find_if(variant.scene.objects.begin(), variant.scene.objects.end(),
+                                       [&](const Object& o) { return o.name == name; });
+      const auto region = region_of_id.find(object->id);
+      add(name, region == region_of_id.end() ? -1 : region->second);
+    }
+    results.push_back(std::move(result));
+  }
+  return results;
+}
+
+// ---- One variant ----------------------------------------------------------------------------------------
+
+class Stage {
+ public:
+  Stage(const RunOptions& options, std::size_t k, std::size_t n, const std::string& variant)
+      : options_(options), prefix_(fmt::format("[{}/{}] {}", k, n, variant)) {}
+  void operator()(std::string_view what) const {
+    if (options_.progress) fmt::print(stderr, "{}: {}\n", prefix_, what);
+  }
+
+ private:
+  const RunOptions& options_;
+  std::string prefix_;
+};
+
+VariantResult run_variant(const Series& series, const SeriesVariant& variant, const fs::path& dir,
+                          const RunOptions& options, const Stage& stage) {
+  VariantResult result;
+  result.name = variant.name;
+  result.description = variant.description;
+  result.figure = variant.figure;
+  const fs::path out = variant_dir(dir, variant.name);
+  fs::create_directories(out);
+  const fs::path series_dir = fs::path(series.source).parent_path();
+
+  const fs::path scene_file = out / "scene.json";
+  write_file_atomically(scene_file, rebase_scene_paths(variant.scene.json, {}, fs::absolute(out)).dump(2) + "\n");
+  const sensor::ConfigPatch sensor_patch = sensor::config_patch(
+      variant.sensor, fmt::format("{}: variant \"{}\" sensor", series.source, variant.name), series_dir);
+  write_file_atomically(out / "sensor.json", sensor_patch.patch.dump(2) + "\n");
+
+  // Render, or take it from the cache.
+  const Json inputs = render_inputs(variant.scene, options);
+  result.render_key = render_key(inputs);
+  const fs::path render = dir / "renders" / (result.render_key + ".exr");
+  result.render_reused = fs::exists(render);
+  if (result.render_reused) {
+    stage(fmt::format("render {} from the cache", render.filename().string()));
+  } else {
+    stage(fmt::format("rendering with {}", renderer_name(options.renderer)));
+    const auto start = Clock::now();
+    write_file_atomically(dir / "renders" / (result.render_key + ".json"), inputs.dump(2) + "\n");
+    if (options.renderer == Renderer::Tracer)
+      render_with_tracer(variant.scene, render, options);
+    else
+      render_with_cycles(variant.scene, fs::absolute(scene_file), fs::absolute(render), fs::absolute(dir), options);
+    result.render_s = seconds_since(start);
+  }
+
+  stage("camera");
+  auto start = Clock::now();
+  const sensor::SensorConfig config = sensor::resolve_config({sensor_patch});
+  sensor::RunOptions sensor_options;
+  sensor_options.threads = options.threads;
+  sensor::simulate_sensor(render, out / "camera.exr", config, sensor_options);
+  result.sensor_s = seconds_since(start);
+
+  stage("analysis");
+  start = Clock::now();
+  const analyzer::AnalysisImage input = analyzer::read_analysis_image(out / "camera.exr");
+  const analyzer::RgbImage& layer = analyzer::select_layer(input, "final");
+  analyzer::AnalyzeOptions analyze_options;
+  analyze_options.threads = options.threads;
+  const analyzer::ImageAnalysis analysis = analyzer::analyse_image(
+      input, "final", analyzer::select_regions(input, layer, {}), analyze_options, std::nullopt, false);
+  analyzer::write_analysis(out / "analysis", input, analysis, {});
+  write_preview_png(out / "camera.png", input);
+  result.analyze_s = seconds_since(start);
+  result.width = input.image.width;
+  result.height = input.image.height;
+
+  result.expectations = judge(variant, analysis);
+  result.ok = true;
+  return result;
+}
+
+Json finding_json(const Finding& f) {
+  Json j = {{"object", f.object}, {"found", f.found}, {"ok", f.ok}};
+  if (f.region >= 0) j["region"] = f.region;
+  if (!f.explanation.empty()) j["explanation"] = f.explanation;
+  return j;
+}
+
+}  // namespace
+
+std::string_view renderer_name(Renderer renderer) { return renderer == Renderer::Tracer ? "tracer" : "cycles"; }
+
+fs::path variant_dir(const fs::path& dir, const std::string& variant) { return dir / variant; }
+
+void check_renderer(RunOptions& options) {
+  if (options.renderer != Renderer::Cycles) return;
+  if (options.blender.empty()) {
+    const char* env = std::getenv("CHROMATRACE_BLENDER");
+    std::string found;
+    if (env && *env) {
+      found = env;
+    } else if (const char* path = std::getenv("PATH")) {
+      for (std::string_view rest = path; found.empty() && !rest.empty();) {
+        const std::size_t colon = std::min(rest.find(':'), rest.size());
+        const fs::path candidate = fs::path(rest.substr(0, colon)) / "blender";
+        if (colon > 0 && access(candidate.c_str(), X_OK) == 0) found = candidate.string();
+        rest.remove_prefix(std::min(colon + 1, rest.size()));
+      }
+    }
+    if (found.empty())
+      throw InputError("--renderer cycles: Blender is not installed (no blender on PATH; set CHROMATRACE_BLENDER to its "
+                       "executable)");
+    options.blender = found;
+  }
+  if (access(options.blender.c_str(), X_OK) != 0)
+    throw InputError(fmt::format("--renderer cycles: {} is not an executable (CHROMATRACE_BLENDER)", options.blender.string()));
+  if (options.batch_script.empty() || !fs::is_regular_file(options.batch_script))
+    throw InputError(fmt::format("--renderer cycles: the Blender add-on's batch.py is not at {} (set CHROMATRACE_BLENDER_ADDON "
+                                 "to the folder holding batch.py)",
+                                 options.batch_script.string()));
+}
+
+std::vector<const SeriesVariant*> select_variants(const Series& series, const std::vector<std::string>& names) {
+  std::vector<const SeriesVariant*> selected;
+  for (const std::string& name : names)
+    if (!series.find_variant(name)) {
+      std::vector<std::string> all;
+      for (const SeriesVariant& v : series.variants) all.push_back(v.name);
+      throw InputError(fmt::format("--variant: {} has no variant \"{}\" (variants: {})", series.source, name, fmt::join(all, ", ")));
+    }
+  for (const SeriesVariant& v : series.variants)
+    if (names.empty() || std::find(names.begin(), names.end(), v.name) != names.end()) selected.push_back(&v);
+  return selected;
+}
+
+SeriesResult run_series(const Series& series, const fs::path& dir, const RunOptions& options) {
+  const auto start = Clock::now();
+  const std::vector<const SeriesVariant*> selected = select_variants(series, options.variants);
+  // Every variant's sensor settings are checked before any work.
+  const fs::path series_dir = fs::path(series.source).parent_path();
+  for (const SeriesVariant* v : selected)
+    sensor::resolve_config({sensor::config_patch(v->sensor, fmt::format("{}: variant \"{}\" sensor", series.source, v->name),
+                                                 series_dir)});
+  fs::create_directories(dir / "renders");
+  set_exr_threads(thread_count(options.threads));
+
+  SeriesResult result{series.name, series.description, series.source, options, {}, 0};
+  for (std::size_t k = 0; k < selected.size(); ++k) {
+    const SeriesVariant& variant = *selected[k];
+    const Stage stage(options, k + 1, selected.size(), variant.name);
+    try {
+      result.variants.push_back(run_variant(series, variant, dir, options, stage));
+    } catch (const std::exception& e) {
+      VariantResult failed;
+      failed.name = variant.name;
+      failed.description = variant.description;
+      failed.figure = variant.figure;
+      failed.error = e.what();
+      stage(fmt::format("failed: {}", failed.error));
+      result.variants.push_back(std::move(failed));
+    }
+  }
+  result.seconds = seconds_since(start);
+  write_file_atomically(dir / "series.json", result_json(result).dump(2) + "\n");
+  return result;
+}
+
+Json result_json(const SeriesResult& result) {
+  Json variants = Json::array();
+  for (const VariantResult& v : result.variants) {
+    const std::string folder = v.name;
+    Json expect = Json::array();
+    int met = 0;
+    for (const ExpectationResult& e : v.expectations) {
+      Json findings = Json::array();
+      for (const Finding& f : e.findings) findings.push_back(finding_json(f));
+      expect.push_back({{"target", e.expected.target}, {"any_of", e.expected.any_of}, {"ok", e.ok}, {"objects", findings}});
+      met += e.ok ? 1 : 0;
+    }
+    Json j = {{"name", v.name}, {"description", v.description}, {"figure", v.figure}, {"ok", v.ok}};
+    if (!v.ok) {
+      j["error"] = v.error;
+    } else {
+      j["size"] = {v.width, v.height};
+      j["render"] = {{"file", "renders/" + v.render_key + ".exr"}, {"key", v.render_key}, {"reused", v.render_reused},
+                     {"seconds", v.render_s}};
+      j["scene"] = folder + "/scene.json";
+      j["sensor"] = {{"settings", folder + "/sensor.json"}, {"file", folder + "/camera.exr"}, {"seconds", v.sensor_s}};
+      j["preview"] = folder + "/camera.png";
+      j["analysis"] = {{"file", folder + "/analysis/analysis.json"},
+                       {"report", folder + "/analysis/report.html"},
+                       {"seconds", v.analyze_s}};
+      j["expect"] = expect;
+      j["expectations_met"] = met;
+      j["expectations"] = v.expectations.size();
+    }
+    variants.push_back(std::move(j));
+  }
+  const RunOptions& o = result.options;
+  Json options = {{"renderer", renderer_name(o.renderer)}, {"components", o.components}};
+  if (o.width) options["resolution"] = {*o.width, *o.height};
+  if (o.spp) options["spp"] = *o.spp;
+  if (o.seed) options["seed"] = *o.seed;
+  return {{"format", "chromatrace-series-result/1"},
+          {"series", result.name},
+          {"description", result.description},
+          {"source", result.source},
+          {"options", options},
+          {"seconds", result.seconds},
+          {"variants", variants}};
+}
+
+}  // namespace ct::series

@@ -1,0 +1,100 @@
+#pragma once
+// An experiment series end to end (docs/series.md): for each variant, the resolved scene is rendered (by the
+// reference tracer or by Cycles through the Blender add-on's headless batch), seen by the variant's camera,
+// analysed, and its classes compared with the variant's `expect`.
+//
+// Output directory layout:
+//   renders/<key>.exr       one spectral render per distinct (scene, renderer, settings): the cache
+//   renders/<key>.json      what the key was made of, for a person
+//   <variant>/scene.json    the resolved scene (paths relative to it): `chromatrace render` takes it
+//   <variant>/sensor.json   the variant's sensor settings (chromatrace-sensor/1 patch)
+//   <variant>/camera.exr    the simulated camera image with its layers
+//   <variant>/camera.png    the same as a person would see it
+//   <variant>/analysis/     `chromatrace analyze` of camera.exr (analysis.json, report.html, plots)
+//   series.json             per variant: files, timings, found vs expected (written last)
+//
+// A render is reused when renders/<key>.exr exists: the key hashes everything the render depends on (the
+// resolved scene with the bytes of every file it names, the renderer, resolution, samples, seed, components),
+// so a killed run resumes where it stopped and a changed scene or option renders anew.
+
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/json_input.h"
+#include "core/scene.h"
+
+namespace ct::series {
+
+enum class Renderer { Tracer, Cycles };
+std::string_view renderer_name(Renderer renderer);  // "tracer", "cycles"
+
+struct RunOptions {
+  Renderer renderer = Renderer::Tracer;
+  std::vector<std::string> variants;  // empty: every variant
+  std::optional<int> width, height;   // override the scenes' camera resolution
+  std::optional<int> spp;
+  std::optional<std::uint64_t> seed;
+  std::string components = "paths,lights";
+  int threads = 0;
+  bool progress = true;
+  std::filesystem::path executable;  // the running chromatrace, handed to the Blender batch
+  std::filesystem::path blender;     // the Blender executable (Cycles); resolved by check_renderer
+  std::filesystem::path batch_script;  // blender_addon/batch.py (Cycles)
+};
+
+// Finds what the renderer needs (Blender and the add-on's batch.py for Cycles) and fills it into `options`;
+// InputError naming what is missing.
+void check_renderer(RunOptions& options);
+
+// One object (or the whole image) judged against one expectation.
+struct Finding {
+  std::string object;  // an object's name, or "image"
+  int region = -1;     // index into the analysis' regions; −1 when the object is not in view
+  std::string found;   // the analyzer's class; "absent" when not in view
+  bool ok = false;
+  std::string explanation;  // which light paths built it, in one line; empty without component layers
+};
+
+struct ExpectationResult {
+  Expectation expected;
+  std::vector<Finding> findings;  // one per object it covers
+  bool ok = false;                // every finding ok
+};
+
+struct VariantResult {
+  std::string name;
+  std::string description;
+  std::vector<std::string> figure;
+  bool ok = false;      // every step ran
+  std::string error;    // the failure, when a step failed
+  std::string render_key;
+  bool render_reused = false;  // the render was in the cache (from an earlier run or an earlier variant)
+  double render_s = 0, sensor_s = 0, analyze_s = 0;
+  std::vector<ExpectationResult> expectations;
+  int width = 0, height = 0;
+};
+
+struct SeriesResult {
+  std::string name, description, source;
+  RunOptions options;
+  std::vector<VariantResult> variants;
+  double seconds = 0;
+};
+
+// The variants `names` asks for, in series order (all when empty); InputError naming an unknown one.
+std::vector<const SeriesVariant*> select_variants(const Series& series, const std::vector<std::string>& names);
+
+// Runs the selected variants into `dir` (created; its parent must exist) and writes series.json. A failed
+// step fails its variant, not the series: the others still run.
+SeriesResult run_series(const Series& series, const std::filesystem::path& dir, const RunOptions& options);
+
+// series.json (format chromatrace-series-result/1).
+Json result_json(const SeriesResult& result);
+
+// The directory of variant files inside the output directory.
+std::filesystem::path variant_dir(const std::filesystem::path& dir, const std::string& variant);
+
+}  // namespace ct::series
