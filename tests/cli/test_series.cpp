@@ -1,0 +1,245 @@
+// End to end: `chromatrace paper` and `chromatrace series` — every variant rendered, seen by its camera,
+// analysed and judged; renders cached and reused; bad series refused before any work.
+#include <sys/stat.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <set>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "core/json_input.h"
+#include "core/scene.h"
+#include "tests/cli/run_command.h"
+#include "tests/core/bad_scenes.h"
+
+namespace ct {
+namespace {
+namespace fs = std::filesystem;
+using test::run_chromatrace;
+
+const std::string kSeries = std::string(CHROMATRACE_SOURCE_DIR) + "/scenes/paper/series.json";
+
+class SeriesCommand : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() /
+           ("chromatrace-series-" + std::to_string(::getpid()) + "-" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  fs::path dir_;
+};
+
+int line_count(const std::string& text) { return static_cast<int>(std::count(text.begin(), text.end(), '\n')); }
+
+Json read_result(const fs::path& dir) { return read_json(dir / "series.json"); }
+
+// A render file's identity: a rewrite (even of the same bytes) gives a new inode or modification time.
+std::pair<ino_t, std::int64_t> identity(const fs::path& file) {
+  struct stat st {};
+  EXPECT_EQ(::stat(file.c_str(), &st), 0) << file;
+  return {st.st_ino, static_cast<std::int64_t>(st.st_mtim.tv_sec) * 1000000000 + st.st_mtim.tv_nsec};
+}
+
+std::set<std::string> render_files(const fs::path& dir) {
+  std::set<std::string> files;
+  for (const auto& entry : fs::directory_iterator(dir / "renders"))
+    if (entry.path().extension() == ".exr") files.insert(entry.path().filename().string());
+  return files;
+}
+
+TEST_F(SeriesCommand, PaperRunsEveryVariantAndASecondRunReusesEveryRender) {
+  const fs::path out = dir_ / "paper";
+  const std::vector<std::string> args = {"paper", "-o", out.string(), "--resolution", "24x24", "--spp", "4", "--quiet"};
+  const auto first = run_chromatrace(args);
+  ASSERT_EQ(first.exit_code, 0) << first.err;
+
+  const Json result = read_result(out);
+  const Series series = load_series(kSeries);
+  ASSERT_EQ(result["variants"].size(), series.variants.size());
+  std::set<std::string> keys;
+  for (std::size_t i = 0; i < series.variants.size(); ++i) {
+    const Json& v = result["variants"][i];
+    SCOPED_TRACE(v["name"].get<std::string>());
+    EXPECT_EQ(v["name"], series.variants[i].name);
+    ASSERT_TRUE(v["ok"].get<bool>()) << v.dump();
+    EXPECT_EQ(v["size"], Json::array({24, 24}));
+    EXPECT_TRUE(fs::is_regular_file(out / v["render"]["file"].get<std::string>()));
+    EXPECT_TRUE(fs::is_regular_file(out / v["sensor"]["file"].get<std::string>()));
+    EXPECT_TRUE(fs::is_regular_file(out / v["preview"].get<std::string>()));
+    EXPECT_TRUE(fs::is_regular_file(out / v["analysis"]["file"].get<std::string>()));
+    EXPECT_TRUE(fs::is_regular_file(out / v["analysis"]["report"].get<std::string>()));
+    keys.insert(v["render"]["key"].get<std::string>());
+    // A row of found vs expected for every expectation, a class found for every object it covers.
+    ASSERT_EQ(v["expect"].size(), series.variants[i].expect.size());
+    for (std::size_t e = 0; e < v["expect"].size(); ++e) {
+      const Json& row = v["expect"][e];
+      EXPECT_EQ(row["target"], series.variants[i].expect[e].target);
+      const std::size_t covered = std::max<std::size_t>(1, series.variants[i].expect[e].objects.size());
+      ASSERT_EQ(row["objects"].size(), covered);
+      bool all = true;
+      for (const Json& f : row["objects"]) {
+        EXPECT_FALSE(f["found"].get<std::string>().empty());
+        all = all && f["ok"].get<bool>();
+      }
+      EXPECT_EQ(row["ok"].get<bool>(), all);
+    }
+    // The resolved scene renders on its own.
+    EXPECT_EQ(run_chromatrace({"check-scene", "-q", (out / v["scene"].get<std::string>()).string()}).exit_code, 0);
+  }
+  // Variants that differ only in their camera (3-specular and 7b–7d) share one render.
+  EXPECT_LT(keys.size(), series.variants.size());
+  EXPECT_EQ(render_files(out).size(), keys.size());
+  EXPECT_NE(first.out.find("expectations met"), std::string::npos) << first.out;
+  EXPECT_TRUE(fs::is_regular_file(out / "index.html"));
+
+  std::map<std::string, std::pair<ino_t, std::int64_t>> before;
+  for (const std::string& f : render_files(out)) before[f] = identity(out / "renders" / f);
+  const auto second = run_chromatrace(args);
+  ASSERT_EQ(second.exit_code, 0) << second.err;
+  for (const Json& v : read_result(out)["variants"]) EXPECT_TRUE(v["render"]["reused"].get<bool>()) << v["name"];
+  std::map<std::string, std::pair<ino_t, std::int64_t>> after;
+  for (const std::string& f : render_files(out)) after[f] = identity(out / "renders" / f);
+  EXPECT_EQ(before, after);  // no render written again, none added
+}
+
+TEST_F(SeriesCommand, AChangedOptionOrSceneRendersAnewAndAMissingRenderIsRedone) {
+  const fs::path out = dir_ / "out";
+  auto run = [&](const std::string& spp, const std::string& series) {
+    const auto r = run_chromatrace({"series", series, "-o", out.string(), "--variant", "2-object-spectra", "--resolution",
+                                    "16x16", "--spp", spp, "--quiet"});
+    EXPECT_EQ(r.exit_code, 0) << r.err;
+    return read_result(out)["variants"][0]["render"];
+  };
+  const Json a = run("2", kSeries);
+  EXPECT_FALSE(a["reused"].get<bool>());
+  const Json b = run("3", kSeries);
+  EXPECT_FALSE(b["reused"].get<bool>());
+  EXPECT_NE(a["key"], b["key"]);
+
+  // The same series in another folder with one reflectance changed: a new key.
+  const fs::path copy = dir_ / "copy";
+  fs::create_directories(copy / "paper");
+  fs::copy(fs::path(CHROMATRACE_SOURCE_DIR) / "scenes" / "spectra", copy / "spectra", fs::copy_options::recursive);
+  fs::copy(fs::path(CHROMATRACE_SOURCE_DIR) / "scenes" / "paper", copy / "paper", fs::copy_options::recursive);
+  const Json moved = run("3", (copy / "paper" / "series.json").string());
+  EXPECT_EQ(moved["key"], b["key"]);  // a moved folder is the same scene
+  EXPECT_TRUE(moved["reused"].get<bool>());
+  {
+    std::ofstream csv(copy / "spectra" / "synthetic_reflectances.csv", std::ios::app);
+    csv << "\n";  // same values, different bytes: the key follows the files' bytes
+  }
+  const Json changed = run("3", (copy / "paper" / "series.json").string());
+  EXPECT_NE(changed["key"], b["key"]);
+  EXPECT_FALSE(changed["reused"].get<bool>());
+
+  // A run killed before its render was written leaves no render under the final name: the next run makes it.
+  fs::remove(out / b["file"].get<std::string>());
+  const Json redone = run("3", kSeries);
+  EXPECT_EQ(redone["key"], b["key"]);
+  EXPECT_FALSE(redone["reused"].get<bool>());
+}
+
+TEST_F(SeriesCommand, BadSeriesExit2WithOneLineAndNothingWritten) {
+  const std::string bad = test::bad_scenes_dir();
+  struct Case {
+    std::vector<std::string> args;
+    std::string message;
+  };
+  const std::vector<Case> cases = {
+      {{"series", kSeries, "--variant", "3-specular", "--variant", "9-nothing"},
+       "--variant: " + kSeries + " has no variant \"9-nothing\" (variants: 1-lambert-direct,"},
+      {{"series", bad + "/series_cycle.json"}, "variants[0].extends: a cycle of extends: a → c → b → a"},
+      {{"series", bad + "/series_bad_variant.json"},
+       "variants[1] \"rough\": materials.plastic.roughness: must be in [0, 1], got 1.5"},
+      {{"series", bad + "/series_missing_base.json"}, "base: "},
+      {{"series", kSeries, "--renderer", "povray"}, "--renderer: must be tracer or cycles, got \"povray\""},
+      {{"series", kSeries, "--resolution", "0x4"}, "--resolution: expected WxH with positive integers"},
+  };
+  for (const Case& c : cases) {
+    std::vector<std::string> args = c.args;
+    const fs::path out = dir_ / "out";
+    args.insert(args.end(), {"-o", out.string()});
+    const auto r = run_chromatrace(args);
+    EXPECT_EQ(r.exit_code, 2) << r.err;
+    EXPECT_NE(r.err.find(c.message), std::string::npos) << r.err;
+    EXPECT_EQ(line_count(r.err), 1) << r.err;
+    EXPECT_FALSE(fs::exists(out)) << c.message;
+  }
+}
+
+TEST_F(SeriesCommand, CyclesWithoutBlenderIsBadInputNamingWhatIsMissing) {
+  ::setenv("CHROMATRACE_BLENDER", "/nonexistent/blender", 1);
+  const auto r = run_chromatrace({"paper", "-o", (dir_ / "out").string(), "--renderer", "cycles"});
+  ::unsetenv("CHROMATRACE_BLENDER");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_EQ(r.err, "chromatrace paper: error: --renderer cycles: /nonexistent/blender is not an executable "
+                   "(CHROMATRACE_BLENDER)\n");
+  EXPECT_FALSE(fs::exists(dir_ / "out"));
+
+  ::setenv("CHROMATRACE_BLENDER_ADDON", (dir_ / "no_addon").c_str(), 1);
+  const auto s = run_chromatrace({"paper", "-o", (dir_ / "out").string(), "--renderer", "cycles"});
+  ::unsetenv("CHROMATRACE_BLENDER_ADDON");
+  if (s.err.find("Blender is not installed") == std::string::npos) {  // with Blender: the add-on is what is missing
+    EXPECT_EQ(s.exit_code, 2);
+    EXPECT_NE(s.err.find("the Blender add-on's batch.py is not at " + (dir_ / "no_addon" / "batch.py").string()),
+              std::string::npos)
+        << s.err;
+  }
+  EXPECT_FALSE(fs::exists(dir_ / "out"));
+}
+
+// The same variant through Cycles (the add-on's headless batch, real Blender) and through the tracer: an
+// analysis of the same form, the same objects judged.
+TEST_F(SeriesCommand, CyclesRendersAVariantThroughRealBlender) {
+  if (std::system("command -v blender > /dev/null 2>&1") != 0) GTEST_SKIP() << "Blender is not installed";
+  std::map<std::string, Json> by_renderer;
+  for (const std::string renderer : {"cycles", "tracer"}) {
+    const fs::path out = dir_ / renderer;
+    const auto r = run_chromatrace({"paper", "-o", out.string(), "--renderer", renderer, "--variant", "3-specular",
+                                    "--resolution", "24x24", "--spp", "8", "--quiet"});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const Json v = read_result(out)["variants"][0];
+    ASSERT_TRUE(v["ok"].get<bool>()) << v.dump();
+    EXPECT_EQ(read_json(out / "renders" / (v["render"]["key"].get<std::string>() + ".json"))["renderer"], renderer);
+    by_renderer[renderer] = read_json(out / v["analysis"]["file"].get<std::string>());
+  }
+  const auto names = [](const Json& analysis) {
+    std::vector<std::string> n;
+    for (const Json& r : analysis["regions"]) n.push_back(r["name"].get<std::string>());
+    return n;
+  };
+  EXPECT_EQ(names(by_renderer["cycles"]), names(by_renderer["tracer"]));
+  EXPECT_GE(by_renderer["cycles"]["regions"].size(), 8u);  // the image and every object in view
+}
+
+TEST_F(SeriesCommand, EmitWritesAVariantThatRendersOnItsOwn) {
+  const fs::path scene = dir_ / "sub" / "scene.json";
+  const fs::path sensor = dir_ / "sensor.json";
+  fs::create_directories(scene.parent_path());
+  const auto r = run_chromatrace({"check-scene", kSeries, "--variant", "7c-clipping", "--emit", scene.string(),
+                                  "--emit-sensor", sensor.string(), "-q"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const Series series = load_series(kSeries);
+  const Scene emitted = load_scene(scene);
+  EXPECT_EQ(emitted.render.max_bounces, series.find_variant("7c-clipping")->scene.render.max_bounces);
+  EXPECT_EQ(emitted.materials.size(), series.find_variant("7c-clipping")->scene.materials.size());
+  EXPECT_EQ(read_json(sensor)["exposure"]["scale"], 4.0);
+  const fs::path exr = dir_ / "r.exr";
+  ASSERT_EQ(run_chromatrace({"render", scene.string(), "-o", exr.string(), "--resolution", "8x8", "--spp", "1", "-q"}).exit_code, 0);
+  ASSERT_EQ(run_chromatrace({"sensor", exr.string(), "-o", (dir_ / "c.exr").string(), "--config", sensor.string(), "-q"}).exit_code, 0);
+
+  const auto unknown = run_chromatrace({"check-scene", kSeries, "--variant", "nope", "--emit", (dir_ / "x.json").string()});
+  EXPECT_EQ(unknown.exit_code, 2);
+  EXPECT_NE(unknown.err.find("--variant: " + kSeries + " has no variant \"nope\""), std::string::npos) << unknown.err;
+  EXPECT_FALSE(fs::exists(dir_ / "x.json"));
+}
+
+}  // namespace
+}  // namespace ct
