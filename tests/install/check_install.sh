@@ -16,6 +16,11 @@ fail() { echo "install: $*" >&2; exit 1; }
 "$prefix/bin/chromatrace" --version | grep -q '^chromatrace ' || fail "installed command does not run"
 "$prefix/bin/chromatrace" check-scene --quiet "$prefix/share/chromatrace/scenes/paper/box.json" \
   || fail "installed scene does not validate"
+# `paper` runs the series installed with the command, not one in a source tree.
+"$prefix/bin/chromatrace" paper -o "$prefix/paper" --variant 2-object-spectra --resolution 8x8 --spp 1 --quiet > /dev/null \
+  || fail "installed paper command does not run"
+grep -q "\"source\": \"$prefix/share/chromatrace/scenes/paper/series.json\"" "$prefix/paper/series.json" \
+  || fail "installed paper command does not use the installed series"
 addon="$prefix/share/chromatrace/blender_addon"
 [ -f "$addon/chromatrace/__init__.py" ] && [ -f "$addon/batch.py" ] || fail "Blender add-on missing"
 [ ! -d "$addon/chromatrace/__pycache__" ] || fail "Blender add-on installed with __pycache__"
