@@ -112,7 +112,7 @@ void read_optics(const JsonNode& node, OpticsConfig& o) {
 }
 
 void read_exposure(const JsonNode& node, ExposureConfig& e) {
-  node.expect_object({"time_s", "scale", "auto_percentile", "auto_level"});
+  node.expect_object({"time_s", "scale", "auto_percentile", "auto_level", "auto_exclude_emitters"});
   read_key(node, "time_s", [&](const JsonNode& n) {
     if (n.json().is_string()) {
       if (n.string() != "auto") n.fail(fmt::format("must be a time in seconds or \"auto\", got \"{}\"", n.string()));
@@ -127,6 +127,7 @@ void read_exposure(const JsonNode& node, ExposureConfig& e) {
     if (e.auto_percentile == 0) n.fail("must be > 0");
   });
   read_key(node, "auto_level", [&](const JsonNode& n) { e.auto_level = n.number_above(0); });
+  read_key(node, "auto_exclude_emitters", [&](const JsonNode& n) { e.auto_exclude_emitters = n.boolean(); });
 }
 
 void read_pixel(const JsonNode& node, PixelConfig& p) {
@@ -236,6 +237,29 @@ void read_rendering(const JsonNode& node, RenderingConfig& r) {
   });
 }
 
+void read_display(const JsonNode& node, DisplayConfig& d) {
+  node.expect_object({"enabled", "white_balance", "percentile", "level"});
+  read_key(node, "enabled", [&](const JsonNode& n) { d.enabled = n.boolean(); });
+  read_key(node, "white_balance", [&](const JsonNode& n) {
+    const std::string name = n.string();
+    if (name == "auto") {
+      d.white_balance.reset();
+      return;
+    }
+    try {
+      cie::illuminant(name);
+    } catch (const InputError& e) {
+      n.fail(fmt::format("must be \"auto\" or an illuminant: {}", e.what()));
+    }
+    d.white_balance = name;
+  });
+  read_key(node, "percentile", [&](const JsonNode& n) {
+    d.percentile = n.number_in(0, 100);
+    if (d.percentile == 0) n.fail("must be > 0");
+  });
+  read_key(node, "level", [&](const JsonNode& n) { d.level = n.number_above(0); });
+}
+
 // Settings that are valid one by one but not together. `source_of` names the document that set a path last.
 void check_combination(const SensorConfig& c, const std::function<std::string(std::string_view)>& source_of) {
   const auto fail = [&](std::string_view path, const std::string& message) {
@@ -274,7 +298,7 @@ void rebase(Json& value, const fs::path& directory) {
 // Every key on its own, without the checks of combinations.
 SensorConfig read_settings(const JsonNode& root) {
   root.expect_object({"format", "preset", "description", "notes", "optics", "exposure", "pixel", "spectral_response",
-                      "cfa", "noise", "full_well", "adc", "rendering"});
+                      "cfa", "noise", "full_well", "adc", "rendering", "display"});
   SensorConfig c;
   read_key(root, "format", [&](const JsonNode& n) {
     if (n.string() != kSensorFormat) n.fail(fmt::format("must be \"{}\", got \"{}\"", kSensorFormat, n.string()));
@@ -298,6 +322,7 @@ SensorConfig read_settings(const JsonNode& root) {
   read_key(root, "full_well", [&](const JsonNode& n) { read_full_well(n, c.full_well); });
   read_key(root, "adc", [&](const JsonNode& n) { read_adc(n, c.adc); });
   read_key(root, "rendering", [&](const JsonNode& n) { read_rendering(n, c.rendering); });
+  read_key(root, "display", [&](const JsonNode& n) { read_display(n, c.display); });
   return c;
 }
 
@@ -409,7 +434,8 @@ Json config_json(const SensorConfig& c) {
        {{"time_s", c.exposure.time_s ? Json(*c.exposure.time_s) : Json("auto")},
         {"scale", c.exposure.scale},
         {"auto_percentile", c.exposure.auto_percentile},
-        {"auto_level", c.exposure.auto_level}}},
+        {"auto_level", c.exposure.auto_level},
+        {"auto_exclude_emitters", c.exposure.auto_exclude_emitters}}},
       {"pixel",
        {{"pitch_um", c.pixel.pitch_um}, {"fill_factor", c.pixel.fill_factor}, {"supersample", c.pixel.supersample}}},
       {"spectral_response",
@@ -448,6 +474,11 @@ Json config_json(const SensorConfig& c) {
         {"k", c.rendering.k},
         {"clip", c.rendering.clip},
         {"output_bits", c.rendering.output_bits ? Json(*c.rendering.output_bits) : Json(nullptr)}}},
+      {"display",
+       {{"enabled", c.display.enabled},
+        {"white_balance", c.display.white_balance ? Json(*c.display.white_balance) : Json("auto")},
+        {"percentile", c.display.percentile},
+        {"level", c.display.level}}},
       {"notes", c.notes},
   };
 }

@@ -43,6 +43,9 @@ struct ExposureConfig {
   double scale = 1.0;
   double auto_percentile = 99.0;
   double auto_level = 0.9;
+  // Leave emitters seen directly out of the percentile: pixels whose `emission` component carries more than
+  // half of their signal, or whose object id names a light of the scene (docs/sensor.md).
+  bool auto_exclude_emitters = true;
 };
 
 // Stage 2: pixel area A = pitch² × fill factor; `supersample` k averages k×k rendered pixels into one.
@@ -117,6 +120,18 @@ struct RenderingConfig {
   std::optional<int> output_bits;  // 8 or 16: quantise the encoded value
 };
 
+// The display layer of the EXR output (display.R/G/B, docs/sensor.md): the noise-free linear signal rendered
+// for people — white balance, a camera→sRGB matrix fitted to the camera's curves, exposure normalised on the
+// surfaces, the sRGB curve. It changes nothing else in the output.
+struct DisplayConfig {
+  bool enabled = true;
+  // The illuminant the picture is balanced for: none ("auto") = the brightest emitter seen in the image,
+  // else D65; or a CIE illuminant's name.
+  std::optional<std::string> white_balance;
+  double percentile = 99.0;  // of the surfaces' brightest display channel …
+  double level = 0.9;        // … put at this linear value
+};
+
 struct SensorConfig {
   std::string preset = "ideal";
   std::string description;
@@ -129,6 +144,7 @@ struct SensorConfig {
   FullWellConfig full_well;
   AdcConfig adc;
   RenderingConfig rendering;
+  DisplayConfig display;
   std::vector<std::string> notes;  // decisions taken for an image (written with the output)
 };
 

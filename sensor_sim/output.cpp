@@ -11,6 +11,8 @@
 #include <nlohmann/json.hpp>
 
 #include <ImfChannelList.h>
+#include <ImfDoubleAttribute.h>
+#include <ImfIntAttribute.h>
 #include <ImfFrameBuffer.h>
 #include <ImfHeader.h>
 #include <ImfOutputFile.h>
@@ -85,6 +87,7 @@ SensorImageWriter::SensorImageWriter(const fs::path& path, OutputLayout layout)
     for (const std::string& layer : [&] {
            std::vector<std::string> layers = {"", "linear"};
            layers.insert(layers.end(), layout_.components.begin(), layout_.components.end());
+           if (layout_.display) layers.push_back("display");
            return layers;
          }())
       for (int c = 0; c < 3; ++c) header.channels().insert(layer_channel(layer, c), Imf::Channel(Imf::FLOAT));
@@ -95,6 +98,8 @@ SensorImageWriter::SensorImageWriter(const fs::path& path, OutputLayout layout)
       header.insert("chromatrace.objects", Imf::StringAttribute(names.dump()));
     }
     for (const auto& [key, value] : layout_.attributes) header.insert(key, Imf::StringAttribute(value));
+    for (const auto& [key, value] : layout_.number_attributes) header.insert(key, Imf::DoubleAttribute(value));
+    for (const auto& [key, value] : layout_.integer_attributes) header.insert(key, Imf::IntAttribute(value));
     file->stream.open(temporary, std::ios::binary | std::ios::trunc);
     if (!file->stream) throw std::runtime_error(fmt::format("{}: cannot open {} for writing", name, temporary));
     file->exr_stream = std::make_unique<Imf::StdOFStream>(file->stream, temporary.c_str());
@@ -107,6 +112,16 @@ SensorImageWriter::SensorImageWriter(const fs::path& path, OutputLayout layout)
                          layout_.bits == 8 ? OIIO::TypeDesc::UINT8 : OIIO::TypeDesc::UINT16);
     if (layout_.format == OutputFormat::Tiff) spec.attribute("compression", "zip");
     if (!layout_.colour_space.empty()) spec.attribute("oiio:ColorSpace", layout_.colour_space);
+    nlohmann::json description = nlohmann::json::object();
+    for (const auto& [key, value] : layout_.number_attributes) {
+      spec.attribute(key, OIIO::TypeDesc::DOUBLE, &value);
+      description[key] = value;
+    }
+    for (const auto& [key, value] : layout_.integer_attributes) {
+      spec.attribute(key, value);
+      description[key] = value;
+    }
+    if (!description.empty()) spec.attribute("ImageDescription", description.dump());
     if (!file->image->open(temporary, spec))
       throw std::runtime_error(fmt::format("{}: cannot start writing: {}", name, file->image->geterror()));
   }
@@ -128,13 +143,15 @@ void SensorImageWriter::write_rows(const OutputRows& block) {
     const bool sizes_match =
         block.linear.size() == values && block.components.size() == layout_.components.size() &&
         std::all_of(block.components.begin(), block.components.end(), [&](auto c) { return c.size() == values; }) &&
-        block.object_ids.size() == (layout_.object_ids ? values / 3 : 0);
+        block.object_ids.size() == (layout_.object_ids ? values / 3 : 0) &&
+        block.display.size() == (layout_.display ? values : 0);
     if (!sizes_match) throw std::invalid_argument(fmt::format("{}: row block layers do not match", path_.string()));
     Imf::FrameBuffer frame;
     insert_rgb(frame, "", block.image.data(), layout_.width, y0, block.rows);
     insert_rgb(frame, "linear", block.linear.data(), layout_.width, y0, block.rows);
     for (std::size_t c = 0; c < layout_.components.size(); ++c)
       insert_rgb(frame, layout_.components[c], block.components[c].data(), layout_.width, y0, block.rows);
+    if (layout_.display) insert_rgb(frame, "display", block.display.data(), layout_.width, y0, block.rows);
     if (layout_.object_ids) {
       file_->ids.assign(block.object_ids.begin(), block.object_ids.end());
       const Imath::Box2i window({0, y0}, {layout_.width - 1, y0 + block.rows - 1});

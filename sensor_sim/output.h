@@ -4,8 +4,10 @@
 // removes it, so nothing half-written is ever left.
 //
 // EXR (OpenEXR, FLOAT, ZIP): R, G, B (the final image), linear.R/G/B (noise-free linear signal of the
-// total), <component>.R/G/B per path component, object_id, and string attributes. TIFF and PNG (OpenImageIO,
-// 8 or 16 bits): the final image only.
+// total), <component>.R/G/B per path component, display.R/G/B (the picture for people), object_id, string
+// attributes and numeric ones (the camera's black and white levels …). TIFF and PNG (OpenImageIO, 8 or 16
+// bits): the final image only, with the numeric attributes as OpenImageIO attributes and, since TIFF keeps
+// no attributes of its own, as JSON in ImageDescription.
 
 #include <cstdint>
 #include <filesystem>
@@ -31,10 +33,14 @@ struct OutputLayout {
   bool object_ids = false;
   std::map<std::int32_t, std::string> object_names;  // written as chromatrace.objects
   std::map<std::string, std::string> attributes;     // further string attributes, by full name
+  bool display = false;                              // layer display.R/G/B
   // TIFF and PNG only: each value is stored as the code round(value·code_scale), clamped to [0, 2^bits − 1].
   int bits = 16;
   double code_scale = 65535.0;
   std::string colour_space;  // "sRGB" tags the file as such; empty: untagged
+  // Every format: numeric attributes by full name (EXR: double and int attributes).
+  std::map<std::string, double> number_attributes;
+  std::map<std::string, int> integer_attributes;
 };
 
 // The next rows; every image span holds rows·width·3 floats ([row][x][channel]); components in layout order.
@@ -43,6 +49,7 @@ struct OutputRows {
   std::span<const float> image;
   std::span<const float> linear;                   // EXR only
   std::vector<std::span<const float>> components;  // EXR only
+  std::span<const float> display;                  // EXR with the display layer only
   std::span<const std::int32_t> object_ids;        // EXR with object ids only: rows·width
 };
 

@@ -5,17 +5,20 @@
 #include <future>
 #include <map>
 #include <optional>
+#include <set>
 
 #include <fmt/core.h>
 #include <fmt/format.h>
 
 #include "core/cie.h"
+#include "core/colour.h"
 #include "core/error.h"
 #include "core/parallel.h"
 #include "core/progress.h"
 #include "core/spectral_exr.h"
 #include "sensor_sim/adc.h"
 #include "sensor_sim/cfa.h"
+#include "sensor_sim/display.h"
 #include "sensor_sim/linear_signal.h"
 #include "sensor_sim/noise.h"
 #include "sensor_sim/optics.h"
@@ -174,29 +177,251 @@ int block_rows(const SpectralExrInfo& info, std::size_t layers, int k, int reque
   return std::clamp(rendered / k, 1, height);
 }
 
-// Exposure time that puts the `percentile` of the brightest channel's noise-free signal at `level` of the
-// saturation signal (1 e⁻ for an ideal sensor): one pass over the total with T = 1 s.
-double auto_exposure(SpectralExrReader& reader, const Run& unit_run, const SpectralLayer& total, int rows_per_block,
-                     Progress& progress) {
-  const ExposureConfig& e = unit_run.config.exposure;
-  const int height = unit_run.height(), k = unit_run.model.supersample;
-  std::vector<float> brightest;
-  brightest.reserve(to_size(unit_run.width()) * to_size(height));
-  for (int y0 = 0; y0 < height; y0 += rows_per_block) {
-    const int y1 = std::min(height, y0 + rows_per_block);
-    const std::vector<float> linear = linear_rows(unit_run, read_sensor_rows(reader, total, k, y0, y1), y0, y1);
-    for (std::size_t p = 0; p < linear.size(); p += 3)
-      brightest.push_back(std::max({linear[p], linear[p + 1], linear[p + 2]}));
+// The object ids of the scene's lights: the names of chromatrace.scene's "lights" that chromatrace.objects
+// gives an id. Metadata that is missing or not of that form names no light.
+std::set<std::int32_t> light_object_ids(const SpectralExrInfo& info) {
+  std::set<std::int32_t> ids;
+  const auto it = info.metadata.find("chromatrace.scene");
+  if (it == info.metadata.end() || info.object_names.empty()) return ids;
+  const Json scene = Json::parse(it->second, nullptr, false);
+  if (!scene.is_object() || !scene.contains("lights") || !scene["lights"].is_array()) return ids;
+  for (const Json& light : scene["lights"])
+    if (light.is_object() && light.contains("name") && light["name"].is_string())
+      for (const auto& [id, name] : info.object_names)
+        if (name == light["name"].get<std::string>()) ids.insert(id);
+  return ids;
+}
+
+// Sensor rows the display's exposure statistics sample: every row of small images; of larger ones the rows
+// of every n-th group of 16 rendered rows (one ZIP chunk), n = ⌊groups / 8⌋, so that about 8 groups are read.
+bool display_sample_row(int y, int k, int height) {
+  const int groups = (k * height + kChunkRows - 1) / kChunkRows;
+  const int stride = std::max(1, groups / 8);
+  return (k * y / kChunkRows) % stride == 0;
+}
+
+// Sensor row ranges [first, last) to survey: every row in blocks when the exposure is automatic, else only the
+// rows the display samples.
+std::vector<RowRange> survey_rows(bool all_rows, int k, int height, int rows_per_block) {
+  std::vector<RowRange> ranges;
+  for (int y = 0; y < height;) {
+    if (!all_rows && !display_sample_row(y, k, height)) {
+      ++y;
+      continue;
+    }
+    int end = y + 1;
+    while (end < height && end - y < rows_per_block && (all_rows || display_sample_row(end, k, height))) ++end;
+    ranges.push_back({y, end});
+    y = end;
+  }
+  return ranges;
+}
+
+// What one pass over the image at unit exposure (T = 1 s) finds: the brightest channel of each pixel for the
+// automatic exposure (surfaces and emitters apart), the emitters' spectra, and the camera signal of the
+// surfaces in the display's sample rows.
+struct Survey {
+  std::vector<float> surfaces, emitters;  // brightest channel per pixel, e⁻/s
+  std::map<std::int32_t, std::pair<std::vector<double>, std::size_t>> emitter_spectra;  // by id: Σ bands, pixels
+  std::vector<float> display_samples;                                                  // surfaces, 3 per pixel
+};
+
+Survey survey_image(SpectralExrReader& reader, const Run& unit_run, const SpectralLayer& total,
+                    const SpectralLayer* emission, const std::set<std::int32_t>& lights,
+                    const std::vector<RowRange>& ranges, bool want_display, Progress& progress) {
+  const SpectralExrInfo& info = reader.info();
+  const int k = unit_run.model.supersample, width = unit_run.width(), height = unit_run.height();
+  const std::size_t bands = info.bands.size();
+  const bool ids_needed = info.has_object_ids && (!lights.empty() || want_display);
+  Survey s;
+  for (const RowRange& range : ranges) {
+    const int y0 = range.first, y1 = range.last;
+    const std::vector<float> total_spectra = read_sensor_rows(reader, total, k, y0, y1);
+    const std::vector<float> linear = linear_rows(unit_run, total_spectra, y0, y1);
+    std::vector<float> emission_spectra, emission_linear;
+    if (emission != nullptr) {
+      emission_spectra = read_sensor_rows(reader, *emission, k, y0, y1);
+      emission_linear = linear_rows(unit_run, emission_spectra, y0, y1);
+    }
+    std::vector<std::int32_t> ids;
+    if (ids_needed) {
+      std::vector<std::int32_t> rendered(to_size(k * (y1 - y0)) * to_size(info.width));
+      reader.read_object_ids(k * y0, k * y1, rendered);
+      ids = k == 1 ? rendered : sensor_ids(rendered, info.width, k, width, y1 - y0);
+    }
+    for (int r = 0; r < y1 - y0; ++r) {
+      const bool sampled = want_display && display_sample_row(y0 + r, k, height);
+      for (int x = 0; x < width; ++x) {
+        const std::size_t p = to_size(r) * to_size(width) + to_size(x);
+        const float* c = linear.data() + 3 * p;
+        const double sum = double(c[0]) + c[1] + c[2];
+        bool emitter = false;
+        if (!emission_linear.empty()) {
+          const float* e = emission_linear.data() + 3 * p;
+          emitter = sum > 0 && double(e[0]) + e[1] + e[2] > 0.5 * sum;
+        }
+        const std::int32_t id = ids.empty() ? -1 : ids[p];
+        if (!ids.empty() && lights.contains(id)) emitter = true;
+        (emitter ? s.emitters : s.surfaces).push_back(std::max({c[0], c[1], c[2]}));
+        if (!want_display) continue;
+        if (!emitter) {
+          if (sampled) s.display_samples.insert(s.display_samples.end(), c, c + 3);
+          continue;
+        }
+        // The emitter's spectrum as seen: its emission (or, without that layer, its total) over the k×k
+        // rendered pixels.
+        const std::vector<float>& spectra = emission_spectra.empty() ? total_spectra : emission_spectra;
+        auto& [sum_bands, count] = s.emitter_spectra[id];
+        sum_bands.resize(bands, 0.0);
+        for (int sy = 0; sy < k; ++sy)
+          for (int sx = 0; sx < k; ++sx) {
+            const float* l = spectra.data() +
+                             (to_size(r * k + sy) * to_size(info.width) + to_size(x * k + sx)) * bands;
+            for (std::size_t b = 0; b < bands; ++b) sum_bands[b] += l[b] / double(k * k);
+          }
+        ++count;
+      }
+    }
     progress.advance();
   }
+  return s;
+}
+
+// The value at `percentile` (nearest rank below) of `values`, which it reorders.
+double percentile_of(std::vector<float>& values, double percentile) {
   const std::size_t rank =
-      static_cast<std::size_t>(std::floor(e.auto_percentile / 100.0 * static_cast<double>(brightest.size() - 1)));
-  std::nth_element(brightest.begin(), brightest.begin() + static_cast<std::ptrdiff_t>(rank), brightest.end());
-  const double per_second = brightest[rank];
+      static_cast<std::size_t>(std::floor(percentile / 100.0 * static_cast<double>(values.size() - 1)));
+  std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(rank), values.end());
+  return values[rank];
+}
+
+// Exposure time that puts the `auto_percentile` of the brightest channel's noise-free signal of the surfaces
+// (every pixel unless emitters are excluded, or when nothing else is in view) at `auto_level` of the
+// saturation signal (1 e⁻ for an ideal sensor).
+double auto_exposure(Survey& survey, const SensorConfig& config, const std::string& file,
+                     std::vector<std::string>& notes) {
+  const ExposureConfig& e = config.exposure;
+  std::vector<float>& values = survey.surfaces;
+  std::string what = "of the brightest channel";
+  if (!e.auto_exclude_emitters || survey.surfaces.empty()) {
+    if (e.auto_exclude_emitters && !survey.emitters.empty())
+      notes.push_back("exposure.time_s \"auto\": every pixel is an emitter seen directly; the exposure is keyed on them");
+    values.insert(values.end(), survey.emitters.begin(), survey.emitters.end());
+  } else if (!survey.emitters.empty()) {
+    what = fmt::format("of the brightest channel of the surfaces ({} emitter pixel{} left out)", survey.emitters.size(),
+                       survey.emitters.size() == 1 ? "" : "s");
+  }
+  const double per_second = percentile_of(values, e.auto_percentile);
   if (!(per_second > 0))
-    throw InputError(fmt::format("{}: exposure.time_s \"auto\": the image is black (its {}th percentile is {})",
-                                 reader.info().file, e.auto_percentile, per_second));
-  return e.auto_level * saturation_electrons(unit_run.config).value_or(1.0) / per_second;
+    throw InputError(fmt::format("{}: exposure.time_s \"auto\": the image is black (its {}th percentile is {})", file,
+                                 e.auto_percentile, per_second));
+  const double time = e.auto_level * saturation_electrons(config).value_or(1.0) / per_second;
+  notes.push_back(fmt::format(
+      "exposure.time_s \"auto\": {:.6g} s puts the {:g}th percentile {} at {:g} of {}", time, e.auto_percentile, what,
+      e.auto_level,
+      saturation_electrons(config) ? fmt::format("saturation ({:.6g} e-)", *saturation_electrons(config))
+                                   : std::string("1 e- (the ideal sensor does not saturate)")));
+  return time;
+}
+
+// The display rendering at unit exposure: the white balance's illuminant (display.white_balance, else the
+// brightest emitter the survey saw, else D65), its matrix, and the scale that puts the display.percentile of the
+// surfaces' brightest linear sRGB channel at display.level. `description` says what was chosen, as JSON.
+DisplayRendering display_rendering(const Survey& survey, const LinearModel& unit_model, const SensorConfig& config,
+                                   const SpectralExrInfo& info, Json& description, std::vector<std::string>& notes) {
+  const Bands& bands = info.bands;
+  std::vector<double> light;
+  std::string source;
+  if (config.display.white_balance) {
+    light = band_averages(cie::illuminant(*config.display.white_balance), bands);
+    source = fmt::format("illuminant {} (display.white_balance)", *config.display.white_balance);
+  } else {
+    const std::array<std::vector<double>, 3> xyz = xyz_band_weights(bands);
+    double best = 0;
+    for (const auto& [id, entry] : survey.emitter_spectra) {
+      double y = 0;
+      for (std::size_t b = 0; b < bands.size(); ++b) y += entry.first[b] / double(entry.second) * xyz[1][b];
+      if (y > best) {
+        best = y;
+        light = entry.first;
+        for (double& v : light) v /= double(entry.second);
+        const auto name = info.object_names.find(id);
+        source = id < 0 ? fmt::format("the brightest emitter in view ({} pixels)", entry.second)
+                        : fmt::format("the brightest emitter in view, object {}{} ({} pixels)", id,
+                                      name == info.object_names.end() ? "" : " (" + name->second + ")", entry.second);
+      }
+    }
+  }
+  DisplayRendering d;
+  const auto matrix_for = [&](const std::vector<double>& l) { return display_matrix(unit_model.weights, bands, l); };
+  try {
+    if (light.empty()) throw InputError("no emitter in view");
+    d.matrix = matrix_for(light);
+  } catch (const InputError& e) {
+    if (!light.empty()) notes.push_back(fmt::format("display: white balance on D65: {} ({})", source, e.what()));
+    light = band_averages(cie::illuminant("D65"), bands);
+    source = "illuminant D65 (no emitter in view)";
+    d.matrix = matrix_for(light);
+  }
+  std::vector<float> brightest;
+  for (std::size_t i = 0; i + 2 < survey.display_samples.size(); i += 3) {
+    const Eigen::Vector3d c(survey.display_samples[i], survey.display_samples[i + 1], survey.display_samples[i + 2]);
+    brightest.push_back(static_cast<float>(std::max(0.0, (d.matrix * c).maxCoeff())));
+  }
+  const double p = brightest.empty() ? 0.0 : percentile_of(brightest, config.display.percentile);
+  if (p > 0) {
+    d.scale = config.display.level / p;
+  } else {
+    d.scale = 1.0;
+    notes.push_back("display: the surfaces are black; the display layer's exposure is not normalised");
+  }
+  Json matrix = Json::array();
+  for (int r = 0; r < 3; ++r) matrix.push_back({d.matrix(r, 0), d.matrix(r, 1), d.matrix(r, 2)});
+  const Eigen::Vector3d white = white_response(unit_model.weights, light);
+  description = {{"channels", {"display.R", "display.G", "display.B"}},
+                 {"encoding", "sRGB (IEC 61966-2-1), clamped to [0, 1]"},
+                 {"white_balance", source},
+                 {"white_response", {white[0], white[1], white[2]}},
+                 {"percentile", config.display.percentile},
+                 {"level", config.display.level},
+                 {"samples", brightest.size()}};
+  description["matrix"] = matrix;  // camera e⁻ → linear sRGB, before the scale
+  return d;
+}
+
+// What the camera did, as numeric attributes (docs/sensor.md, "Output"): the black level, the white level at
+// which R, G, B clip, the mean dark signal and the read noise's σ, all in the units of R, G, B; the ADC's bits;
+// and whether noise and the ADC were on.
+void camera_levels(const SensorConfig& c, double exposure_s, OutputLayout& layout) {
+  for (const char* key : {"chromatrace.black_level", "chromatrace.white_level", "chromatrace.dark_signal",
+                          "chromatrace.read_noise", "chromatrace.bits", "chromatrace.noise", "chromatrace.adc"})
+    layout.attributes.erase(key);  // an input's own, passed through as text, would clash
+  auto& number = layout.number_attributes;
+  const double dark_e = c.noise.dark_current_e_per_s * exposure_s;
+  const double read_e = c.noise.enabled ? c.noise.read_e : 0.0;
+  if (c.rendering.enabled) {
+    layout.attributes["chromatrace.signal"] = "normalised";
+    number["chromatrace.black_level"] = 0.0;
+    if (c.rendering.clip || c.rendering.output_bits) number["chromatrace.white_level"] = 1.0;
+  } else if (c.adc.enabled) {
+    const double k = c.adc.gain_dn_per_e;
+    layout.attributes["chromatrace.signal"] = "DN";
+    number["chromatrace.black_level"] = c.adc.black_level_dn;
+    number["chromatrace.white_level"] =
+        c.full_well.enabled ? std::min(c.adc.max_dn(), c.adc.black_level_dn + k * c.full_well.electrons)
+                            : c.adc.max_dn();
+    number["chromatrace.dark_signal"] = k * dark_e;
+    number["chromatrace.read_noise"] = k * read_e;
+  } else {
+    layout.attributes["chromatrace.signal"] = "e-";
+    number["chromatrace.black_level"] = 0.0;
+    if (c.full_well.enabled) number["chromatrace.white_level"] = c.full_well.electrons;
+    number["chromatrace.dark_signal"] = dark_e;
+    number["chromatrace.read_noise"] = read_e;
+  }
+  layout.integer_attributes["chromatrace.bits"] = c.adc.enabled ? c.adc.bits : 0;
+  layout.integer_attributes["chromatrace.noise"] = c.noise.enabled ? 1 : 0;
+  layout.integer_attributes["chromatrace.adc"] = c.adc.enabled ? 1 : 0;
 }
 
 // chromatrace.units: what the numbers of R, G, B and of the linear layers are.
@@ -325,19 +550,32 @@ RunReport simulate_sensor(const fs::path& input, const fs::path& output, SensorC
   const std::size_t layers_per_block = 1 + components.size();
   const int rows_per_block = block_rows(info, layers_per_block, k, options.block_rows, height);
   const std::size_t blocks = to_size((height + rows_per_block - 1) / rows_per_block);
-  Progress progress("sensor", blocks * (config.exposure.time_s ? 1 : 2), options.progress);
+  const bool exr = layout.format == OutputFormat::Exr;
+  const bool auto_time = !config.exposure.time_s;
+  const bool want_display = exr && config.display.enabled;
+  const SpectralLayer* emission = info.find_layer("emission", SpectralQuantity::S0);
+  const std::set<std::int32_t> lights = light_object_ids(info);
+  const std::vector<RowRange> surveyed =
+      auto_time || want_display ? survey_rows(auto_time, k, height, rows_per_block) : std::vector<RowRange>{};
+  Progress progress("sensor", blocks + surveyed.size(), options.progress);
 
-  if (!config.exposure.time_s) {
+  // One pass at unit exposure: the automatic exposure time, the display's white balance and brightness.
+  Survey survey;
+  if (!surveyed.empty()) {
     run.config = config;
-    config.exposure.time_s = auto_exposure(reader, run, *total, rows_per_block, progress);
-    config.notes.push_back(fmt::format(
-        "exposure.time_s \"auto\": {:.6g} s puts the {:g}th percentile of the brightest channel at {:g} of {}",
-        *config.exposure.time_s, config.exposure.auto_percentile, config.exposure.auto_level,
-        saturation_electrons(config) ? fmt::format("saturation ({:.6g} e-)", *saturation_electrons(config))
-                                     : std::string("1 e- (the ideal sensor does not saturate)")));
+    const bool exclude = auto_time && config.exposure.auto_exclude_emitters;
+    survey = survey_image(reader, run, *total, exclude || want_display ? emission : nullptr,
+                          exclude || want_display ? lights : std::set<std::int32_t>{}, surveyed, want_display, progress);
   }
+  if (auto_time) config.exposure.time_s = auto_exposure(survey, config, info.file, config.notes);
+  Json display_description;
+  DisplayRendering display;
+  if (want_display) display = display_rendering(survey, run.model, config, info, display_description, config.notes);
+  survey = Survey{};
   run.exposure_s = *config.exposure.time_s * config.exposure.scale;
   run.model = linear_model(config, run.exposure_s, info.bands, fov, info.width, info.height);
+  // The display's matrix and scale were found at unit exposure; the linear layer scales with the time.
+  display.scale /= run.exposure_s;
 
   Eigen::Vector3d gains = config.rendering.white_balance;
   if (config.rendering.white_balance_illuminant)
@@ -363,10 +601,15 @@ RunReport simulate_sensor(const fs::path& input, const fs::path& output, SensorC
     layout.attributes["chromatrace.units"] = units_json(config, run.intent).dump();
     if (!components.empty())
       layout.attributes["chromatrace.components"] = fmt::format("{}", fmt::join(components, ","));
+    if (want_display) {
+      layout.display = true;
+      display_description["scale"] = display.scale;
+      layout.attributes["chromatrace.display"] = display_description.dump();
+    }
   }
+  camera_levels(config, run.exposure_s, layout);
   SensorImageWriter writer(output, layout);
 
-  const bool exr = layout.format == OutputFormat::Exr;
   const auto read_block = [&](int y0) {
     BlockInput in;
     in.y0 = y0;
@@ -402,8 +645,18 @@ RunReport simulate_sensor(const fs::path& input, const fs::path& output, SensorC
     rows.image = image;
     std::vector<std::vector<float>> component_rows;
     std::vector<std::int32_t> ids;
+    std::vector<float> display_rows;
     if (exr) {
       rows.linear = std::span<const float>(linear_ext).subspan(own, own_size);
+      if (layout.display) {
+        display_rows.resize(own_size);
+        parallel_for(own_size / 3, run.threads, [&](std::size_t p) {
+          const float* c = linear_ext.data() + own + 3 * p;
+          const Eigen::Vector3d v = display_value(display, Eigen::Vector3d(c[0], c[1], c[2]));
+          for (int ch = 0; ch < 3; ++ch) display_rows[3 * p + to_size(ch)] = static_cast<float>(v[ch]);
+        });
+        rows.display = display_rows;
+      }
       for (const std::vector<float>& spectral : in.components)
         component_rows.push_back(linear_rows(run, spectral, y0, y1));
       for (const auto& c : component_rows) rows.components.emplace_back(c);

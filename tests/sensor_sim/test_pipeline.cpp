@@ -19,7 +19,8 @@ namespace {
 namespace fs = std::filesystem;
 
 // The analyzer's contract (docs/sensor.md, "Output"): R, G, B; linear.R/G/B; <component>.R/G/B for each input
-// component; object_id with chromatrace.objects; chromatrace.sensor, .components and .units.
+// component; display.R/G/B; object_id with chromatrace.objects; chromatrace.sensor, .components, .units,
+// .display and the camera's numbers (black and white level, dark signal, read noise, bits, noise, ADC).
 TEST(Pipeline, ExrOutputFollowsTheLayoutContract) {
   test::TempDir dir;
   const test::ComponentImage image = test::make_component_image(9, 7, 3);
@@ -32,7 +33,8 @@ TEST(Pipeline, ExrOutputFollowsTheLayoutContract) {
 
   SpectralExrReader reader(dir.file("out.exr"));
   const SpectralExrInfo& info = reader.info();
-  std::vector<std::string> expected = {"R", "G", "B", "linear.R", "linear.G", "linear.B", "object_id"};
+  std::vector<std::string> expected = {"R",        "G",        "B",         "linear.R",  "linear.G",
+                                       "linear.B", "object_id", "display.R", "display.G", "display.B"};
   for (const std::string& c : image.layout.components)
     for (const char* rgb : {".R", ".G", ".B"}) expected.push_back(c + rgb);
   std::sort(expected.begin(), expected.end());
@@ -61,6 +63,16 @@ TEST(Pipeline, ExrOutputFollowsTheLayoutContract) {
   EXPECT_EQ(units["RGB"]["unit"], "DN");
   EXPECT_EQ(units["linear"]["unit"], "e-");
   EXPECT_EQ(units["RGB"]["channels"], nlohmann::json({"X", "Y", "Z"}));
+  // No full well: the white level is the ADC's top code; K·I_d·T = 0 without dark current; K·σ_read.
+  EXPECT_EQ(info.metadata.at("chromatrace.black_level"), "0");
+  EXPECT_EQ(info.metadata.at("chromatrace.white_level"), "16383");
+  EXPECT_EQ(info.metadata.at("chromatrace.dark_signal"), "0");
+  EXPECT_EQ(info.metadata.at("chromatrace.read_noise"), "0.01");
+  EXPECT_EQ(info.metadata.at("chromatrace.bits"), "14");
+  EXPECT_EQ(info.metadata.at("chromatrace.noise"), "1");
+  EXPECT_EQ(info.metadata.at("chromatrace.adc"), "1");
+  EXPECT_EQ(info.metadata.at("chromatrace.signal"), "DN");
+  EXPECT_TRUE(nlohmann::json::parse(info.metadata.at("chromatrace.display")).contains("white_balance"));
 
   // Stages 1–3 are linear: the path types sum to the total's linear signal (float rounding of ~8 terms).
   const test::RgbLayer linear = test::read_rgb(dir.file("out.exr"), "linear");
@@ -87,7 +99,7 @@ TEST(Pipeline, ThreadsAndBlocksDoNotChangeAnyLayer) {
   test::run_sensor(dir.file("in.exr"), dir.file("a.exr"), config, 1, 100);
   test::run_sensor(dir.file("in.exr"), dir.file("b.exr"), config, 2, 1);
   test::run_sensor(dir.file("in.exr"), dir.file("c.exr"), config, 2, 4);
-  for (const std::string layer : {"", "linear", "glossy_direct"}) {
+  for (const std::string layer : {"", "linear", "glossy_direct", "display"}) {
     const auto a = test::read_rgb(dir.file("a.exr"), layer).values;
     EXPECT_EQ(a, test::read_rgb(dir.file("b.exr"), layer).values) << layer;
     EXPECT_EQ(a, test::read_rgb(dir.file("c.exr"), layer).values) << layer;
