@@ -152,12 +152,8 @@ ClusterShape analyse_shape(std::span<const float> rgb, const ShapeContext& conte
   const double min_tolerance = std::max(k.noise_factor * noise_perp, 1e-6 * s1);
   s.body_only = find_line(points, all_indices(n), tolerance, min_tolerance, context.seed);
   const double body_fraction = s.body_only ? static_cast<double>(s.body_only->inliers.size()) / static_cast<double>(n) : 0.0;
-  if (test("body line fraction >= body_only_fraction", body_fraction, k.body_only_fraction, body_fraction >= k.body_only_fraction)) {
-    s.shape = ShapeClass::Linear;
-    s.line = s.body_only->line;
-    s.reason = fmt::format("one straight line holds {:.1f} % of the pixels", 100 * body_fraction);
-    return s;
-  }
+  const bool body_only = test("body line fraction >= body_only_fraction", body_fraction, k.body_only_fraction,
+                              body_fraction >= k.body_only_fraction);
 
   // Two candidate explanations of a cluster in a plane: two straight lines (dichromatic body and
   // highlight), or one bent curve. Each must pass its own tests; when both do, the one closer to the
@@ -180,15 +176,28 @@ ClusterShape analyse_shape(std::span<const float> rgb, const ShapeContext& conte
       for (const Vec3& p : points) squares += std::pow(std::min(m.body.distance(p), m.highlight.distance(p)), 2);
       two_line_rms = std::sqrt(squares / static_cast<double>(n));
       const double limit = std::max(2 * noise_perp, k.two_line_residual * s.sigma[1]);
+      const double highlight_samples = static_cast<double>(highlight->inliers.size());
+      const double highlight_length = (m.highlight.t_max - m.highlight.t_min) / tolerance;
       two_line_ok = test("two-line rms <= max(2 * noise, two_line_residual * sigma2)", two_line_rms, limit, two_line_rms <= limit) &
+                    test("highlight samples >= min_highlight_samples", highlight_samples,
+                         static_cast<double>(k.min_highlight_samples),
+                         highlight_samples >= static_cast<double>(k.min_highlight_samples)) &
                     test("highlight fraction >= min_highlight_fraction", m.highlight_fraction, k.min_highlight_fraction,
                          m.highlight_fraction >= k.min_highlight_fraction) &
+                    test("highlight length / tolerance >= highlight_length", highlight_length, k.highlight_length,
+                         highlight_length >= k.highlight_length) &
                     test("angle between lines (deg) >= min_line_angle_deg", m.angle_deg, k.min_line_angle_deg, m.angle_deg >= k.min_line_angle_deg) &
                     test("gap between lines <= 2 * tolerance", m.gap, 2 * tolerance, m.gap <= 2 * tolerance) &
                     test("junction on highlight line <= highlight_end", m.junction_on_highlight, k.highlight_end,
-                         m.junction_on_highlight <= k.highlight_end) &
-                    test("junction on body line >= t_junction", m.junction_on_body, k.t_junction, m.junction_on_body >= k.t_junction);
+                         m.junction_on_highlight <= k.highlight_end);
     }
+  }
+  // A line holding nearly every sample is linear unless the few others form a highlight line of their own.
+  if (body_only && !two_line_ok) {
+    s.shape = ShapeClass::Linear;
+    s.line = s.body_only->line;
+    s.reason = fmt::format("one straight line holds {:.1f} % of the pixels", 100 * body_fraction);
+    return s;
   }
   s.curve = fit_principal_curve(points, s.moments);
   const PrincipalCurve& c = *s.curve;
@@ -200,6 +209,12 @@ ClusterShape analyse_shape(std::span<const float> rgb, const ShapeContext& conte
 
   if (two_line_ok && (!curve_ok || two_line_rms <= c.curve_rms)) {
     const TwoLines& m = *s.two_lines;
+    if (!test("junction on body line >= t_junction", m.junction_on_body, k.t_junction, m.junction_on_body >= k.t_junction)) {
+      s.shape = ShapeClass::Fork;
+      s.reason = fmt::format("two lines ({:.0f} % and {:.0f} %) diverging at {:.0f}° from near the dark end: two light colours",
+                             100 * m.body_fraction, 100 * m.highlight_fraction, m.angle_deg);
+      return s;
+    }
     const bool l = test("junction on body line >= l_junction", m.junction_on_body, k.l_junction, m.junction_on_body >= k.l_junction);
     s.shape = l ? ShapeClass::L : ShapeClass::SkewedT;
     s.reason = fmt::format("a body line ({:.0f} %) and a highlight line ({:.0f} %) meeting at {:.0f}° {}", 100 * m.body_fraction,
@@ -233,23 +248,63 @@ ClusterShape analyse_shape(std::span<const float> rgb, const ShapeContext& conte
     return s;
   }
 
-  if (s.body_only && test("body line fraction >= p_body_fraction", body_fraction, k.p_body_fraction, body_fraction >= k.p_body_fraction)) {
-    // In-plane direction perpendicular to the body line.
+  // The share of the samples off the body line that lie on its more populated side, within the principal
+  // plane: a highlight lies on one side of the body line.
+  const auto one_side = [&](const std::vector<std::size_t>& rest) {
     const Line& body = s.body_only->line;
     const Vec3 across = s.moments.axes.col(2).cross(body.direction).normalized();
-    const std::vector<std::size_t> rest = complement(n, s.body_only->inliers);
     std::size_t positive = 0;
+    for (const std::size_t i : rest) positive += (points[i] - body.point).dot(across) > 0;
+    return static_cast<double>(std::max(positive, rest.size() - positive)) / static_cast<double>(std::max<std::size_t>(1, rest.size()));
+  };
+  // How much of the body line's length the samples off it accompany (their 5–95 % range along it, as a share
+  // of the whole cluster's): a highlight sits where the object faces the light, interreflection thickens the
+  // line all along. And interreflected light turns the colour by a few per cent (a reflectance times a form
+  // factor times a difference of colours, a second-order term), where a highlight adds a first-order one:
+  // a thickened line stays thin (thick_line_ratio).
+  const auto coverage = [&](const std::vector<std::size_t>& rest) {
+    const Line& body = s.body_only->line;
+    std::vector<double> along, all;
+    for (const std::size_t i : rest) along.push_back((points[i] - body.point).dot(body.direction));
+    for (const Vec3& p : points) all.push_back((p - body.point).dot(body.direction));
+    if (along.size() < 2) return 0.0;
+    const auto range = [](std::vector<double>& v, double lo, double hi) {
+      const auto at = [&](double q) {
+        const auto k = static_cast<std::ptrdiff_t>(q * static_cast<double>(v.size() - 1));
+        std::nth_element(v.begin(), v.begin() + k, v.end());
+        return v[static_cast<std::size_t>(k)];
+      };
+      return at(hi) - at(lo);
+    };
+    return range(along, 0.05, 0.95) / std::max(1e-300, range(all, 0.0, 1.0));
+  };
+  if (s.body_only) {
+    const double ratio = s.sigma[1] / s1;
+    const std::vector<std::size_t> rest = complement(n, s.body_only->inliers);
+    if (test("sigma2 / sigma1 <= thick_line_ratio", ratio, k.thick_line_ratio, ratio <= k.thick_line_ratio) &&
+        test("off-body samples along the body line >= thick_line_coverage", coverage(rest), k.thick_line_coverage,
+             coverage(rest) >= k.thick_line_coverage)) {
+      s.shape = ShapeClass::ThickenedLine;
+      s.line = s.body_only->line;
+      s.reason = fmt::format("a line thickened all along it: σ2 = {:.3g} is {:.1f} × the noise and {:.1f} % of σ1", s.sigma[1],
+                             s.sigma[1] / std::max(1e-300, s.noise_sigma[1]), 100 * ratio);
+      return s;
+    }
+  }
+
+  if (s.body_only && test("body line fraction >= p_body_fraction", body_fraction, k.p_body_fraction, body_fraction >= k.p_body_fraction)) {
+    const std::vector<std::size_t> rest = complement(n, s.body_only->inliers);
     Vec3 mean = Vec3::Zero();
-    for (const std::size_t i : rest) positive += (points[i] - body.point).dot(across) > 0, mean += points[i];
+    for (const std::size_t i : rest) mean += points[i];
     mean /= static_cast<double>(rest.size());
     Mat3 scatter = Mat3::Zero();
     for (const std::size_t i : rest) scatter += (points[i] - mean) * (points[i] - mean).transpose();
     Vec3 values;
     Mat3 axes;
     principal_axes(scatter, values, axes);
-    const double one_side = static_cast<double>(std::max(positive, rest.size() - positive)) / static_cast<double>(rest.size());
+    const double sided = one_side(rest);
     const double area = values[0] > 0 ? std::sqrt(values[1] / values[0]) : 0.0;
-    if (test("off-body pixels on one side >= p_one_side", one_side, k.p_one_side, one_side >= k.p_one_side) &
+    if (test("off-body pixels on one side >= p_one_side", sided, k.p_one_side, sided >= k.p_one_side) &
         test("off-body sigma2 / sigma1 >= p_area_ratio", area, k.p_area_ratio, area >= k.p_area_ratio)) {
       s.shape = ShapeClass::P;
       s.reason = fmt::format("a body line ({:.0f} %) with a broad highlight filling an area on one side of it", 100 * body_fraction);

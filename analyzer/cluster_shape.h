@@ -10,11 +10,13 @@
 //   point     σ1 not significant
 //   linear    σ2 not significant, or the body line holds body_only_fraction of the samples
 //   L         body + highlight lines leave a small residual (two_line_residual), meet at an angle, the highlight leaving the body
-//   skewed-T  line at its bright end (L) or part-way along it (skewed-T)
+//   skewed-T  line at its bright end (L) or part-way along it (skewed-T) …
+//   fork      … or near its dark end (t_junction): two lines diverging from near black
 //   gamma     a quadratic principal curve explains the off-line spread, and a power curve straightens it
 //   curved    … and no power curve straightens it (the "banana")
 //   thickened σ3 significant but at most thickened_ratio of σ2: a plane with spread off it
 //   volume    σ3 larger than that
+//   thickened-line  σ2 at most thick_line_ratio × σ1, the samples off the body line all along it
 //   P         the body line holds p_body_fraction, the rest fills an area on one side of it
 //   planar    any other cluster in a plane
 // where σk = √(eigenvalue k) of the covariance, and σk is significant when it exceeds both
@@ -48,7 +50,9 @@ struct ShapeCriteria {
   double clipped_fraction = 0.02;
   double body_only_fraction = 0.98;
   double two_line_residual = 0.3;  // the points' rms distance from the nearer line, as a share of σ2
-  double min_highlight_fraction = 0.01;
+  std::size_t min_highlight_samples = 5;  // a line: two samples fix it, three more confirm it …
+  double min_highlight_fraction = 0;      // (off: a small object's highlight holds few of its pixels)
+  double highlight_length = 3;            // … and it is at least this many tolerances τ long
   double min_line_angle_deg = 3;
   double highlight_end = 0.15;      // the junction lies within this share of the highlight line's end
   double l_junction = 0.85;         // junction at or beyond this position along the body line: L
@@ -58,6 +62,8 @@ struct ShapeCriteria {
   double gamma_straightening = 0.02;  // linearised off-line variance within this share of the stored one
   double min_gamma_departure = 0.05;  // |γ − 1| at least this for a gamma diagnosis
   double thickened_ratio = 0.35;
+  double thick_line_ratio = 0.06;     // σ2 / σ1 at most this …
+  double thick_line_coverage = 0.5;  // … and the samples off the body line along this share of it: a thickened line
   double p_body_fraction = 0.3;
   double p_one_side = 0.95;
   double p_area_ratio = 0.15;

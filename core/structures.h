@@ -9,7 +9,10 @@
 
 namespace ct {
 
-enum class Structure { None, Clipped, Point, Linear, L, SkewedT, Gamma, Curved, Thickened, Volume, P, Planar };
+enum class Structure {
+  None, Clipped, Mixed, Point, Linear, ThickenedLine, L, SkewedT, Fork, Gamma, Curved, Thickened, Volume, P,
+  Superposed, Planar
+};
 
 struct StructureWord {
   Structure structure;
@@ -17,18 +20,22 @@ struct StructureWord {
   std::string_view meaning;  // one line, for messages and the figure page
 };
 
-inline constexpr std::array<StructureWord, 12> kStructureWords{{
+inline constexpr std::array<StructureWord, 16> kStructureWords{{
     {Structure::None, "none", "no shape measured: too few samples, or all black"},
     {Structure::Clipped, "clipped", "saturation flattened the cluster onto faces of the RGB cube"},
+    {Structure::Mixed, "mixed", "object-edge pixels mixing two objects' colours (pixel area): between their clusters"},
     {Structure::Point, "point", "a single colour: no spread beyond noise"},
     {Structure::Linear, "linear", "a line along one colour: matte shading (LD)"},
+    {Structure::ThickenedLine, "thickened-line", "a line thickened all along it: interreflection adds other colours"},
     {Structure::L, "L", "a body line with a highlight line leaving its bright end: a sharp highlight"},
     {Structure::SkewedT, "skewed-T", "a highlight line leaving the body line part-way along it"},
+    {Structure::Fork, "fork", "two branches leaving one body line near its dark end: two light colours"},
     {Structure::Gamma, "gamma", "bent by a power-law response; a power curve straightens it"},
     {Structure::Curved, "curved", "bent, and no power curve straightens it: the \"banana\""},
     {Structure::Thickened, "thickened", "a plane with spread off it: interreflection or noise"},
     {Structure::Volume, "volume", "spread in all three directions"},
     {Structure::P, "P", "a body line with a broad highlight filling an area on one side: a broad highlight"},
+    {Structure::Superposed, "superposed", "the structures of several luminaires of different colours, added"},
     {Structure::Planar, "planar", "a cluster in a plane: body and interface reflection (LD and LS)"},
 }};
 

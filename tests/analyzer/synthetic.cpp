@@ -40,6 +40,34 @@ RgbImage l_shape() {
   });
 }
 
+RgbImage small_highlight_l() {
+  // 128 columns; the last column of 82 of 128 rows … simpler: the highlight is the last 0.5 % of u.
+  return make_image(128, 128, [](double u, double v) -> Vec3 {
+    const double s = u + v / 128.0;  // one index over the whole image, in [0, 1 + 1/128]
+    return s < 0.995 ? dichromatic(s / 0.995, 0) : dichromatic(1.0, 0.5 * (s - 0.995) / (1.0 + 1 / 128.0 - 0.995));
+  });
+}
+
+RgbImage fork_shape() {
+  // The object's upper half is lit by the body's light, its lower half by a second light of another colour
+  // (e.g. a coloured wall), shading from near black to full.
+  return make_image(128, 128, [](double u, double v) -> Vec3 {
+    const double m = 0.05 + 0.95 * u;
+    return v < 0.5 ? Vec3(m * kBody) : Vec3(m * 0.8 * kBody.cwiseProduct(kSecondLight).normalized());
+  });
+}
+
+RgbImage thickened_line() {
+  // Each pixel's colour turns by up to ±4 % towards a third colour, smoothly across the object and mostly
+  // near its edges (by (2v − 1)³, as light from two walls of other colours): a fan about the body line, on
+  // both of its sides.
+  const Vec3 perpendicular = kBody.cross(Vec3(0, 0, 1)).normalized();
+  return make_image(128, 128, [perpendicular](double u, double v) -> Vec3 {
+    const double m = 0.05 + 0.95 * u;
+    return m * (kBody + 0.04 * std::pow(2 * v - 1, 3) * perpendicular);
+  });
+}
+
 RgbImage skewed_t() {
   return make_image(128, 128, [](double u, double) -> Vec3 {
     return u < 0.8 ? dichromatic(u / 0.8, 0) : dichromatic(0.5, 0.5 * (u - 0.8) / 0.2);

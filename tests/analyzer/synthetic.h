@@ -43,6 +43,10 @@ RgbImage curved_cluster();  // a bent (parabolic) cluster no power curve straigh
 RgbImage clipped_line();    // a matte line over-exposed so that red clips at 1
 RgbImage gamma_line();      // a line with an ambient offset, encoded with I' = I^(1/2.2)
 RgbImage thickened_plane(); // an L whose pixels are pushed off its plane by a smooth third colour
+RgbImage small_highlight_l(); // an L whose highlight holds 0.5 % of the pixels (a small sphere's highlight)
+RgbImage fork_shape();      // two lines diverging from near black: one object lit by two light colours
+RgbImage thickened_line();  // a matte line whose colour turns a little, both ways, across the object (interreflection)
+inline const Vec3 kSecondLight = Vec3(0.55, 0.95, 0.5).normalized();  // the fork's second light colour
 inline constexpr double kGamma = 1 / 2.2;
 
 // A scene of several dichromatic objects (different body colours, one illuminant), each a block of pixels

@@ -47,6 +47,46 @@ TEST(ClusterShape, NarrowHighlightAtTheBrightEndIsAnL) {
   EXPECT_LT(line_angle_degrees(s.black_plane->normal, normal), kDegrees);
 }
 
+// A small sphere's highlight holds well under 1 % of its pixels; the highlight is judged by its samples and
+// its length, not its share.
+TEST(ClusterShape, SmallHighlightIsStillAnL) {
+  const ClusterShape s = shape_of(small_highlight_l());
+  ASSERT_EQ(s.shape, ShapeClass::L) << describe(s);
+  EXPECT_GE(s.two_lines->body_fraction, 0.98);  // the body line alone holds nearly every pixel
+  EXPECT_LT(line_angle_degrees(s.two_lines->highlight.direction, kIlluminant), kDegrees);
+}
+
+// A handful of stray pixels off a matte line is not a highlight.
+TEST(ClusterShape, StrayPixelsDoNotMakeAnL) {
+  RgbImage image = matte_line();
+  for (int i = 0; i < 5; ++i)
+    for (int c = 0; c < 3; ++c) image.rgb[static_cast<std::size_t>(3 * (64 * 128 + 20 * i) + c)] += static_cast<float>(0.2 * kIlluminant[c]);
+  const ClusterShape s = shape_of(image);
+  EXPECT_EQ(s.shape, ShapeClass::Linear) << describe(s);
+}
+
+// Two light colours on one object: two lines from near black (the paper's fork).
+TEST(ClusterShape, TwoLinesFromNearBlackAreAFork) {
+  const ClusterShape s = shape_of(fork_shape());
+  ASSERT_EQ(s.shape, ShapeClass::Fork) << describe(s);
+  const Vec3 second = kBody.cwiseProduct(kSecondLight).normalized();
+  const bool body_first = line_angle_degrees(s.two_lines->body.direction, kBody) < kDegrees;
+  EXPECT_LT(line_angle_degrees(s.two_lines->body.direction, body_first ? kBody : second), kDegrees);
+  EXPECT_LT(line_angle_degrees(s.two_lines->highlight.direction, body_first ? second : kBody), kDegrees);
+  EXPECT_NEAR(s.two_lines->angle_deg, line_angle_degrees(kBody, second), kDegrees);
+}
+
+// Interreflection turning the colour a little both ways across the object: a thickened line, not a plane.
+TEST(ClusterShape, LineTurnedBothWaysIsAThickenedLine) {
+  const ClusterShape s = shape_of(thickened_line());
+  ASSERT_EQ(s.shape, ShapeClass::ThickenedLine) << describe(s);
+  ASSERT_TRUE(s.line);
+  // The body line is one of the fan's rays: within its half-angle atan(0.04) of the body colour.
+  EXPECT_LT(line_angle_degrees(s.line->direction, kBody), std::atan(0.04) * 180 / 3.14159265358979 + kDegrees);
+  // σ2 / σ1 of a fan of half-angle atan(0.04) about a line: below thick_line_ratio, well above noise.
+  EXPECT_LT(s.sigma[1] / s.sigma[0], 0.15);
+}
+
 TEST(ClusterShape, HighlightLeavingHalfWayIsASkewedT) {
   const ClusterShape s = shape_of(skewed_t());
   ASSERT_EQ(s.shape, ShapeClass::SkewedT) << describe(s);
@@ -95,7 +135,8 @@ TEST(ClusterShape, SpreadOffThePlaneIsThickening) {
 TEST(ClusterShape, SensorNoiseAloneDoesNotThickenALine) {
   const ClusterShape s = shape_of(add_sensor_noise(matte_line(), 20000, 5, 7));
   EXPECT_EQ(s.shape, ShapeClass::Linear) << describe(s);
-  EXPECT_LT(line_angle_degrees(s.line->direction, kBody), 1.0);
+  // The body line is one of the fan's rays: within its half-angle atan(0.04) of the body colour.
+  EXPECT_LT(line_angle_degrees(s.line->direction, kBody), std::atan(0.04) * 180 / 3.14159265358979 + kDegrees);
 }
 
 TEST(ClusterShape, NoisyLStaysAnL) {

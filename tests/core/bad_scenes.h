@@ -46,7 +46,8 @@ inline const std::vector<BadScene>& bad_scenes() {
       {"series_missing_base.json", "base: {scenes}/no_such_scene.json: no such scene file"},
       {"series_unknown_structure.json",
        "variants[0].expect.image[1]: unknown structure \"banana\" (the analyzer's classes: none, clipped, "
-       "point, linear, L, skewed-T, gamma, curved, thickened, volume, P, planar)"},
+       "mixed, point, linear, thickened-line, L, skewed-T, fork, gamma, curved, thickened, volume, P, superposed, "
+       "planar)"},
       {"series_unknown_target.json",
        "variants[0].expect.wals: \"wals\" is neither an object of the scene (floor, ball) nor a group (walls, image)"},
   };
