@@ -1,5 +1,7 @@
 #include "analyzer/analysis_json.h"
 
+#include <cmath>
+
 #include <fmt/core.h>
 
 namespace ct::analyzer {
@@ -61,6 +63,34 @@ json explanation_json(const Explanation& e) {
                                                         {"indirect_share", o.indirect_share}};
                                           })},
           {"notes", e.notes}};
+}
+
+// What the camera did to the analysed numbers (docs/analyze.md, "Input"): its black level and the shift it
+// and the dark current cause, whether the black level was subtracted, its white level.
+json input_json(const ImageAnalysis& a) {
+  const ImageEncoding& e = a.encoding;
+  const auto number = [](const std::optional<double>& v) { return v ? json(*v) : json(nullptr); };
+  const auto triple = [](const std::optional<double>& v) { return v ? json::array({*v, *v, *v}) : json(nullptr); };
+  // Black level and mean dark signal move every pixel by the same vector along the grey axis: the histogram is
+  // shifted, its shape unchanged (the paper: "only a shift").
+  std::optional<double> shift, remaining;
+  if (e.black_level || e.dark_signal) {
+    shift = e.black_level.value_or(0.0) + e.dark_signal.value_or(0.0);
+    remaining = e.dark_signal.value_or(0.0) + (e.black_subtracted ? 0.0 : e.black_level.value_or(0.0));
+  }
+  return {{"metadata", e.metadata.empty() ? json(nullptr) : json(e.metadata)},
+          {"black_level", triple(e.black_level)},
+          {"subtracted", e.black_subtracted},
+          {"dark_signal", triple(e.dark_signal)},
+          {"shift", triple(shift)},
+          {"shift_length", shift ? json(std::sqrt(3.0) * std::abs(*shift)) : json(nullptr)},
+          {"remaining_shift", triple(remaining)},
+          {"white_level", number(e.white_level)},
+          {"clipping_level", number(e.clipping_level())},
+          {"read_noise", number(e.read_noise)},
+          {"bits", e.adc_bits ? json(*e.adc_bits) : json(nullptr)},
+          {"noise", e.noise ? json(*e.noise) : json(nullptr)},
+          {"adc", e.adc ? json(*e.adc) : json(nullptr)}};
 }
 
 }  // namespace
@@ -150,8 +180,10 @@ json analysis_to_json(const ImageAnalysis& a) {
   return {{"format", kAnalysisFormat},
           {"image", {{"file", a.file}, {"width", a.width}, {"height", a.height}, {"layer", a.layer},
                      {"integer", a.encoding.integer}, {"bits", a.encoding.bits}, {"full_scale", a.encoding.full_scale}}},
+          {"input", input_json(a)},
           {"histogram", {{"bins", spec.bins}, {"lo", spec.lo}, {"hi", spec.hi}}},
           {"clipping_levels", a.context.high_levels},
+          {"clipping_levels_source", a.context.high_levels_source},
           {"quantisation_sigma", a.context.quantisation_sigma},
           {"criteria",
            {{"min_samples", k.min_samples},

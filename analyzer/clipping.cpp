@@ -5,17 +5,30 @@
 #include <limits>
 
 namespace ct::analyzer {
+namespace {
+
+thread_local ClippingRules current_rules;
+
+}  // namespace
+
+ClippingRulesScope::ClippingRulesScope(const ClippingRules& rules) : previous_(current_rules) { current_rules = rules; }
+ClippingRulesScope::~ClippingRulesScope() { current_rules = previous_; }
 
 Clipping find_clipping(std::span<const float> rgb, const std::array<double, 3>& high_levels) {
+  return find_clipping(rgb, high_levels, current_rules);
+}
+
+Clipping find_clipping(std::span<const float> rgb, const std::array<double, 3>& high_levels, const ClippingRules& rules) {
   Clipping result;
   const std::size_t n = rgb.size() / 3;
   if (n == 0) return result;
+  const auto& low = rules.low;
   // count[c][0] low face, count[c][1] high face
   std::array<std::array<std::size_t, 2>, 3> count{};
   auto side = [&](std::size_t i, int c) {
     const double v = rgb[i * 3 + static_cast<std::size_t>(c)];
     if (v >= high_levels[c]) return 1;
-    if (v <= 0 && (rgb[i * 3] > 0 || rgb[i * 3 + 1] > 0 || rgb[i * 3 + 2] > 0)) return 0;
+    if (v <= low[c] && (rgb[i * 3] > low[0] || rgb[i * 3 + 1] > low[1] || rgb[i * 3 + 2] > low[2])) return 0;
     return -1;
   };
   // The other two channels' extremes on each face: on a true clipping face they keep changing.
@@ -37,12 +50,15 @@ Clipping find_clipping(std::span<const float> rgb, const std::array<double, 3>& 
     for (int s = 0; s < 2; ++s) {
       const double fraction = static_cast<double>(count[c][s]) / static_cast<double>(n);
       if (count[c][s] < 3 || fraction < kFaceFraction) continue;
-      const double spread = std::max(hi[c][s][0] - lo[c][s][0], hi[c][s][1] - lo[c][s][1]);
-      const double scale = std::max({std::abs(high_levels[c]) < 1e300 ? std::abs(high_levels[c]) : 0.0,
-                                     static_cast<double>(std::abs(hi[c][s][0])), static_cast<double>(std::abs(hi[c][s][1]))});
-      if (spread <= kFaceSpread * scale) continue;
+      if (!(s == 1 && rules.known_high)) {
+        const double spread = std::max(hi[c][s][0] - lo[c][s][0], hi[c][s][1] - lo[c][s][1]);
+        const double scale = std::max({std::abs(high_levels[c]) < 1e300 ? std::abs(high_levels[c] - low[c]) : 0.0,
+                                       static_cast<double>(std::abs(hi[c][s][0] - low[(c + 1) % 3])),
+                                       static_cast<double>(std::abs(hi[c][s][1] - low[(c + 2) % 3]))});
+        if (spread <= kFaceSpread * scale) continue;
+      }
       kept[c][s] = true;
-      result.faces.push_back({c, s == 1, s == 1 ? high_levels[c] : 0.0, count[c][s], fraction});
+      result.faces.push_back({c, s == 1, s == 1 ? high_levels[c] : low[c], count[c][s], fraction});
     }
   result.on_face.assign(n, 0);
   for (std::size_t i = 0; i < n; ++i)

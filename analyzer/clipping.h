@@ -12,7 +12,7 @@ namespace ct::analyzer {
 
 struct ClippedFace {
   int channel = 0;     // 0 R, 1 G, 2 B
-  bool high = true;    // the channel's upper limit (else 0)
+  bool high = true;    // the channel's upper limit (else the lower)
   double level = 0;    // the limit's value
   std::size_t count = 0;
   double fraction = 0;  // of the samples
@@ -28,14 +28,39 @@ struct Clipping {
 // A face counts when at least this share of the samples lies on it: a few pixels exactly at a channel's
 // maximum happen without clipping.
 constexpr double kFaceFraction = 0.005;
-// … and only when the other channels keep changing on it (their range above this share of the level): a
-// flat patch that happens to hold a channel's largest value is not clipped.
+// … and, when the upper levels are only estimated (each channel's largest value in a float image), only when
+// the other channels keep changing on it (their range above this share of the level): a flat patch that
+// happens to hold a channel's largest value is not clipped.
 constexpr double kFaceSpread = 0.01;
 
-// Samples [i][channel] at or above high_levels[c] lie on the high face of c; at or below 0, with another
-// channel above 0, on its low face (a pixel black in all three channels is dark, not clipped).
-// high_levels: the integer format's full scale, or for float images the channel's largest value in the
-// image (a float file clipped by a simulated sensor holds that value in many pixels).
+// Where the faces are. `known_high`: the upper levels are limits the camera or the file format clipped at
+// (the metadata's white level, an integer format's full scale), so every sample at one is clipped, whatever
+// the other channels do — a region clipped in all three channels is wholly clipped. Otherwise they are each
+// channel's largest value, and the spread rule above applies. `low`: the lower limits (0, or −black level
+// once a camera's black level has been subtracted).
+struct ClippingRules {
+  bool known_high = false;
+  std::array<double, 3> low{0, 0, 0};
+};
+
+// Samples [i][channel] at or above high_levels[c] lie on the high face of c; at or below rules.low[c], with
+// another channel above its low limit, on its low face (a pixel black in all three channels is dark, not
+// clipped).
+Clipping find_clipping(std::span<const float> rgb, const std::array<double, 3>& high_levels, const ClippingRules& rules);
+
+// The same with the rules of the calling thread's innermost ClippingRulesScope (the defaults outside any): the
+// shape analysis calls this form, and a region's analysis sets the rules of its layer around it.
 Clipping find_clipping(std::span<const float> rgb, const std::array<double, 3>& high_levels);
+
+class ClippingRulesScope {
+ public:
+  explicit ClippingRulesScope(const ClippingRules& rules);
+  ~ClippingRulesScope();
+  ClippingRulesScope(const ClippingRulesScope&) = delete;
+  ClippingRulesScope& operator=(const ClippingRulesScope&) = delete;
+
+ private:
+  ClippingRules previous_;
+};
 
 }  // namespace ct::analyzer

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <sstream>
 
 #include <OpenImageIO/imageio.h>
@@ -19,7 +20,43 @@ struct RawImage {
   std::vector<float> values;  // [y][x][channel], integer files already scaled to their stored integers
   ImageEncoding encoding;
   std::string objects_attribute, components_attribute;
+  // The camera's numbers (chromatrace.black_level …) as found: attributes, else ImageDescription's JSON.
+  nlohmann::json camera = nlohmann::json::object();
+  std::string camera_source;
 };
+
+constexpr const char* kCameraKeys[] = {"chromatrace.black_level", "chromatrace.white_level", "chromatrace.dark_signal",
+                                       "chromatrace.read_noise",  "chromatrace.bits",        "chromatrace.noise",
+                                       "chromatrace.adc"};
+
+// The camera's numbers: numeric attributes (EXR), numbers spelled as text (PNG keeps attributes as text), or
+// the JSON object a TIFF or PNG holds in ImageDescription.
+void read_camera_metadata(const OIIO::ImageSpec& spec, RawImage& raw) {
+  for (const char* key : kCameraKeys) {
+    const OIIO::ParamValue* p = spec.find_attribute(key);
+    if (p == nullptr) continue;
+    if (p->type().basetype == OIIO::TypeDesc::STRING) {
+      const std::string text = p->get_string();
+      char* end = nullptr;
+      const double v = std::strtod(text.c_str(), &end);
+      if (end == text.c_str() || *end != '\0' || !std::isfinite(v)) continue;
+      raw.camera[key] = v;
+    } else if (p->type() == OIIO::TypeDesc::DOUBLE) {
+      raw.camera[key] = *static_cast<const double*>(p->data());
+    } else if (p->type() == OIIO::TypeDesc::FLOAT || p->type() == OIIO::TypeDesc::INT) {
+      raw.camera[key] = p->type() == OIIO::TypeDesc::INT ? double(p->get_int()) : double(p->get_float());
+    }
+  }
+  if (!raw.camera.empty()) {
+    raw.camera_source = "attributes";
+    return;
+  }
+  const nlohmann::json description = nlohmann::json::parse(spec.get_string_attribute("ImageDescription"), nullptr, false);
+  if (!description.is_object()) return;
+  for (const char* key : kCameraKeys)
+    if (description.contains(key) && description[key].is_number()) raw.camera[key] = description[key];
+  if (!raw.camera.empty()) raw.camera_source = "ImageDescription";
+}
 
 RawImage read_raw(const std::filesystem::path& file) {
   const std::string name = file.string();
@@ -45,6 +82,7 @@ RawImage read_raw(const std::filesystem::path& file) {
   }
   raw.objects_attribute = spec.get_string_attribute("chromatrace.objects");
   raw.components_attribute = spec.get_string_attribute("chromatrace.components");
+  read_camera_metadata(spec, raw);
   if (raw.width < 1 || raw.height < 1) throw InputError(fmt::format("{}: image has no pixels", name));
   raw.values.resize(static_cast<std::size_t>(raw.width) * static_cast<std::size_t>(raw.height) *
                     static_cast<std::size_t>(raw.channels));
@@ -133,9 +171,34 @@ std::vector<std::string> component_names(const RawImage& raw) {
   for (const std::string& c : raw.names) {
     if (c.size() < 3 || c.compare(c.size() - 2, 2, ".R") != 0) continue;
     const std::string prefix = c.substr(0, c.size() - 2);
-    if (prefix != "linear" && extract_rgb(raw, prefix)) names.push_back(prefix);
+    if (prefix != "linear" && prefix != "display" && extract_rgb(raw, prefix)) names.push_back(prefix);
   }
   return names;
+}
+
+std::optional<double> camera_number(const RawImage& raw, const char* key) {
+  if (!raw.camera.contains(key)) return std::nullopt;
+  const double v = raw.camera[key].get<double>();
+  return std::isfinite(v) ? std::optional(v) : std::nullopt;
+}
+
+// Records what the camera did and takes the black level off R, G, B.
+void apply_camera_metadata(const RawImage& raw, AnalysisImage& out) {
+  ImageEncoding& e = out.encoding;
+  if (raw.camera_source.empty()) return;
+  e.metadata = raw.camera_source;
+  e.black_level = camera_number(raw, "chromatrace.black_level");
+  e.white_level = camera_number(raw, "chromatrace.white_level");
+  e.dark_signal = camera_number(raw, "chromatrace.dark_signal");
+  e.read_noise = camera_number(raw, "chromatrace.read_noise");
+  if (const auto bits = camera_number(raw, "chromatrace.bits")) e.adc_bits = static_cast<int>(*bits);
+  if (const auto noise = camera_number(raw, "chromatrace.noise")) e.noise = *noise != 0;
+  if (const auto adc = camera_number(raw, "chromatrace.adc")) e.adc = *adc != 0;
+  if (e.black_level && *e.black_level != 0) {
+    const auto black = static_cast<float>(*e.black_level);
+    for (float& v : out.image.rgb) v -= black;
+  }
+  e.black_subtracted = e.black_level.has_value();
 }
 
 }  // namespace
@@ -159,6 +222,8 @@ AnalysisImage read_analysis_image(const std::filesystem::path& file) {
                                  raw.names.empty() ? std::string("none") : fmt::format("{}", fmt::join(raw.names, ", "))));
   }
   out.linear = extract_rgb(raw, "linear");
+  out.display = extract_rgb(raw, "display");
+  apply_camera_metadata(raw, out);
   // A renderer's spectral EXR names its components too, but holds them as spectra, not as camera RGB:
   // only RGB layers explain a camera image.
   for (const std::string& c : component_names(raw))

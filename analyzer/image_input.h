@@ -29,6 +29,27 @@ struct ImageEncoding {
   bool integer = false;    // stored as unsigned integers
   int bits = 0;            // bits per sample of integer files (8, 16, 32); 0 for float
   double full_scale = 1;   // the value of a full-scale sample: 2^bits − 1, or 1 for float files
+
+  // What the camera did, from the sensor simulator's metadata (chromatrace.black_level …, docs/sensor.md),
+  // in the units of the file's R, G, B; absent without it. Describes the final layer only.
+  std::string metadata = "";          // where it was read: "attributes", "ImageDescription", or "" (none)
+  std::optional<double> black_level = std::nullopt;  // the value that means no light
+  bool black_subtracted = false;      // R, G, B hold the stored value − black_level
+  std::optional<double> white_level = std::nullopt;  // the stored value at which R, G, B clip (black level included)
+  std::optional<double> dark_signal = std::nullopt;  // the mean dark-current signal above black
+  std::optional<double> read_noise = std::nullopt;   // σ of the read noise
+  std::optional<int> adc_bits = std::nullopt;  // the ADC's bits (0: no ADC)
+  std::optional<bool> noise = std::nullopt;  // whether noise was on
+  std::optional<bool> adc = std::nullopt;    // whether the ADC was on
+
+  // The value R, G, B hold for black: −black_level once subtracted, else 0 (the ADC's code 0 lies at
+  // −black_level after subtraction).
+  double lowest_code() const { return black_subtracted && black_level ? -*black_level : 0.0; }
+  // The level at which the analysed R, G, B clip: the white level less the subtracted black level.
+  std::optional<double> clipping_level() const {
+    if (!white_level) return std::nullopt;
+    return *white_level - (black_subtracted && black_level ? *black_level : 0.0);
+  }
 };
 
 // One light-path component layer, <name>.R/G/B, in the units of the linear layer.
@@ -42,14 +63,17 @@ struct AnalysisImage {
   RgbImage image;    // R, G, B: the final image
   ImageEncoding encoding;
   std::optional<RgbImage> linear;          // linear.R/G/B: noise-free linear camera signal of the total
+  std::optional<RgbImage> display;         // display.R/G/B: the picture for people, sRGB-encoded in [0, 1]
   std::vector<ComponentLayer> components;  // in chromatrace.components order when the file names them
   std::vector<std::int32_t> object_ids;    // channel object_id, [y][x]; empty when absent
   std::map<std::int32_t, std::string> object_names;  // attribute chromatrace.objects
 };
 
 // Reads R, G, B (or a grey-free file's first three channels) and whatever extra layers are present.
-// An unreadable file, fewer than three channels or a malformed object_id / chromatrace.objects is an
-// InputError naming the file.
+// When the file says what the camera's black level was (chromatrace.black_level, as an attribute or in the
+// ImageDescription JSON of a TIFF/PNG), it is subtracted from R, G, B, so that black is 0 for every fit
+// through black. An unreadable file, fewer than three channels or a malformed object_id /
+// chromatrace.objects is an InputError naming the file.
 AnalysisImage read_analysis_image(const std::filesystem::path& file);
 
 // The RGB layer the histograms are made of: "" or "final" for R,G,B, "linear", or a component's name.

@@ -24,8 +24,13 @@ struct AnalyzeOptions {
 // What every region of a layer shares.
 struct LayerContext {
   HistogramSpec spec;
-  std::array<double, 3> high_levels{};  // clipping levels: full scale, or each channel's largest value
-  double quantisation_sigma = 0;        // 1/√12 digital numbers for integer files, else 0
+  // Clipping levels: from the camera's white level when the file gives it (less the subtracted black level
+  // and 3σ of the read noise: a saturated pixel reads its white level less the read noise), else an integer
+  // format's full scale, else each channel's largest value.
+  std::array<double, 3> high_levels{};
+  std::string high_levels_source = "";  // "white level", "full scale" or "channel maxima"
+  ClippingRules clipping = {};          // known_high for the first two; the lower limits
+  double quantisation_sigma = 0;   // 1/√12 digital numbers for integer files, else 0
 };
 // `encoding` is the file's for the final image; pass a default (float) encoding for the linear and
 // component layers.

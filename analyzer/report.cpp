@@ -70,32 +70,40 @@ Display display_size(int width, int height) {
   return {std::max(1, static_cast<int>(std::lround(width * scale))), std::max(1, static_cast<int>(std::lround(height * scale))), scale};
 }
 
-// The image as 8-bit sRGB for the page: integer files as stored; float files scaled so that the 99.5th
-// percentile of the brightest channel is white, then sRGB-encoded.
-std::string image_png(const RgbImage& layer, const ImageAnalysis& a, const Display& d) {
-  double white = a.encoding.integer ? a.encoding.full_scale : 0.0;
-  if (!a.encoding.integer) {
+// The image as 8-bit sRGB for the page: the sensor's display layer (display.R/G/B, already sRGB-encoded in
+// [0, 1]) when the file has one and the final image is analysed; else integer files up to their clipping
+// level (the camera's white level less black, or full scale); float files scaled so that the 99.5th percentile
+// of the brightest channel is white, then sRGB-encoded.
+std::string image_png(const AnalysisImage& input, const RgbImage& layer, const ImageAnalysis& a, const Display& d) {
+  const bool display = a.layer == "final" && input.display && input.display->width == layer.width &&
+                       input.display->height == layer.height;
+  const RgbImage& shown_layer = display ? *input.display : layer;
+  double white = 1.0;
+  if (!display && a.encoding.integer) white = a.encoding.clipping_level().value_or(a.encoding.full_scale);
+  if (!display && !a.encoding.integer) {
     std::vector<float> brightest;
     for (std::size_t p = 0; p < layer.pixel_count(); ++p) {
       const float m = std::max({layer.rgb[p * 3], layer.rgb[p * 3 + 1], layer.rgb[p * 3 + 2]});
       if (std::isfinite(m)) brightest.push_back(m);
     }
+    white = 0.0;
     if (!brightest.empty()) {
       const auto k = static_cast<std::ptrdiff_t>(0.995 * static_cast<double>(brightest.size() - 1));
       std::nth_element(brightest.begin(), brightest.begin() + k, brightest.end());
       white = brightest[static_cast<std::size_t>(k)];
     }
-    if (!(white > 0)) white = 1;
   }
-  cv::Mat full(layer.height, layer.width, CV_8UC3);
-  for (int y = 0; y < layer.height; ++y)
-    for (int x = 0; x < layer.width; ++x) {
-      const std::size_t p = static_cast<std::size_t>(y) * static_cast<std::size_t>(layer.width) + static_cast<std::size_t>(x);
+  if (!(white > 0)) white = 1;
+  const bool encode = !display && !a.encoding.integer;
+  cv::Mat full(shown_layer.height, shown_layer.width, CV_8UC3);
+  for (int y = 0; y < shown_layer.height; ++y)
+    for (int x = 0; x < shown_layer.width; ++x) {
+      const std::size_t p = static_cast<std::size_t>(y) * static_cast<std::size_t>(shown_layer.width) + static_cast<std::size_t>(x);
       cv::Vec3b& out = full.at<cv::Vec3b>(y, x);
       for (int c = 0; c < 3; ++c) {
-        double v = layer.rgb[p * 3 + static_cast<std::size_t>(c)] / white;
+        double v = shown_layer.rgb[p * 3 + static_cast<std::size_t>(c)] / white;
         v = std::isfinite(v) ? std::clamp(v, 0.0, 1.0) : 0.0;
-        out[2 - c] = cv::saturate_cast<std::uint8_t>(255.0 * (a.encoding.integer ? v : srgb_encode(v)));
+        out[2 - c] = cv::saturate_cast<std::uint8_t>(255.0 * (encode ? srgb_encode(v) : v));
       }
     }
   cv::Mat shown;
@@ -307,7 +315,7 @@ Colour: <select id="colour-mode"><option value="own">own colour</option><option 
       fmt::arg("title", escape_html(std::filesystem::path(a.file).filename().string())), fmt::arg("style", kStyle),
       fmt::arg("width", a.width), fmt::arg("height", a.height), fmt::arg("layer", escape_html(a.layer)),
       fmt::arg("regions", a.results.size()), fmt::arg("plural", a.results.size() == 1 ? "" : "s"), fmt::arg("notes", notes),
-      fmt::arg("image", image_png(layer, a, d)), fmt::arg("illuminant", illuminant), fmt::arg("legend", legend),
+      fmt::arg("image", image_png(input, layer, a, d)), fmt::arg("illuminant", illuminant), fmt::arg("legend", legend),
       fmt::arg("data", script_safe(data.dump())), fmt::arg("bundle", script_safe(std::string(viewer_bundle()))));
 }
 
