@@ -390,8 +390,8 @@ DisplayRendering display_rendering(const Survey& survey, const LinearModel& unit
 }
 
 // What the camera did, as numeric attributes (docs/sensor.md, "Output"): the black level, the white level at
-// which R, G, B clip, the mean dark signal and the read noise's σ, all in the units of R, G, B; the ADC's bits;
-// and whether noise and the ADC were on.
+// which R, G, B clip, the mean dark signal and the read noise's σ, all in the units of R, G, B as the file
+// stores them (TIFF/PNG codes); the ADC's bits; and whether noise and the ADC were on.
 void camera_levels(const SensorConfig& c, double exposure_s, OutputLayout& layout) {
   for (const char* key : {"chromatrace.black_level", "chromatrace.white_level", "chromatrace.dark_signal",
                           "chromatrace.read_noise", "chromatrace.bits", "chromatrace.noise", "chromatrace.adc"})
@@ -419,6 +419,9 @@ void camera_levels(const SensorConfig& c, double exposure_s, OutputLayout& layou
     number["chromatrace.dark_signal"] = dark_e;
     number["chromatrace.read_noise"] = read_e;
   }
+  // TIFF and PNG store R, G, B as codes round(value · code_scale): the levels are given in codes.
+  if (layout.format != OutputFormat::Exr)
+    for (auto& [key, value] : number) value *= layout.code_scale;
   layout.integer_attributes["chromatrace.bits"] = c.adc.enabled ? c.adc.bits : 0;
   layout.integer_attributes["chromatrace.noise"] = c.noise.enabled ? 1 : 0;
   layout.integer_attributes["chromatrace.adc"] = c.adc.enabled ? 1 : 0;

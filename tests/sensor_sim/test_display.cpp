@@ -195,6 +195,14 @@ TEST(CameraMetadata, ExrAndTiffCarryBlackWhiteBitsNoiseAndAdc) {
     EXPECT_EQ(number("chromatrace.adc"), 1.0) << file;
     EXPECT_NEAR(number("chromatrace.read_noise"), 0.2118 * 33.0, 1e-12) << file;
   }
+  // A rendered 8-bit PNG stores codes: its levels are in codes too, black 0 and white 255.
+  patch["rendering"] = {{"enabled", true}, {"curve", "srgb"}};
+  test::run_sensor(dir.file("in.exr"), dir.file("photo.png"), test::config_of(patch));
+  auto png = OIIO::ImageInput::open(dir.file("photo.png").string());
+  ASSERT_TRUE(png);
+  const nlohmann::json description = nlohmann::json::parse(png->spec().get_string_attribute("ImageDescription"));
+  EXPECT_EQ(description["chromatrace.black_level"], 0.0);
+  EXPECT_EQ(description["chromatrace.white_level"], 255.0);
 }
 
 // ---- The display layer --------------------------------------------------------------------------------------
