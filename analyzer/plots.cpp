@@ -95,7 +95,7 @@ void draw_fits(cv::Mat& img, const Frame& frame, const ClusterShape& s) {
     draw_polyline(img, frame, {m - a - b, m + a - b, m + a + b, m - a + b, m - a - b}, kPlaneColour, 1);
   }
   if (s.line) segment(*s.line, kBodyColour);
-  if (s.two_lines && (s.shape == ShapeClass::L || s.shape == ShapeClass::SkewedT)) {
+  if (s.two_lines && (s.shape == ShapeClass::L || s.shape == ShapeClass::SkewedT || s.shape == ShapeClass::Fork)) {
     segment(s.two_lines->body, kBodyColour);
     segment(s.two_lines->highlight, kHighlightColour);
     for (int p = 0; p < 4; ++p) cv::circle(img, frame.at(s.two_lines->junction, p), 4, kHighlightColour, 1, cv::LINE_AA);

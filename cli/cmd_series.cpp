@@ -146,13 +146,12 @@ Action add_series(CLI::App& app) {
 
 Action add_paper(CLI::App& app) {
   auto* cmd = app.add_subcommand("paper", "Reproduce the paper's Figures 3 and 4: its experiment series, shipped "
-                                           "with chromatrace, at 128x128 and 64 paths per pixel unless told otherwise");
+                                           "with chromatrace, at 128x128 pixels unless told otherwise");
   auto o = std::make_shared<Options>();
   add_common(cmd, *o);
   return [o] {
     Options options = *o;
     if (options.resolution.empty()) options.resolution = "128x128";
-    if (!options.spp) options.spp = 64;
     return run(options, shipped_file("scenes/paper/series.json"));
   };
 }

@@ -10,7 +10,7 @@ images=$root/docs/images
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 "$build/tests/analyzer_synthetic_images" "$tmp"
-for class in linear L skewed-T P curved clipped gamma thickened; do
+for class in linear L skewed-T P curved clipped gamma thickened fork thickened-line; do
   "$build/cli/chromatrace" analyze "$tmp/$class.exr" -o "$tmp/$class" --no-report --quiet
   cp "$tmp/$class/plots/region-00.png" "$images/analyze_$class.png"
 done

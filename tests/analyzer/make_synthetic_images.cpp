@@ -17,7 +17,8 @@ int main(int argc, char** argv) {
   const std::pair<const char*, RgbImage> shapes[] = {
       {"linear", matte_line()},   {"L", l_shape()},           {"skewed-T", skewed_t()},
       {"P", p_shape()},           {"curved", curved_cluster()}, {"clipped", clipped_line()},
-      {"gamma", gamma_line()},    {"thickened", thickened_plane()}};
+      {"gamma", gamma_line()},    {"thickened", thickened_plane()}, {"fork", fork_shape()},
+      {"thickened-line", thickened_line()}};
   for (const auto& [name, image] : shapes) write_sensor_exr(dir / (std::string(name) + ".exr"), {image, image, {}, {}, {}});
   write_sensor_exr(dir / "scene.exr", scene_with_components());
   SensorExr noisy = scene_with_components();
