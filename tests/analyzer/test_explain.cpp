@@ -3,7 +3,10 @@
 // dichromatic plane.
 #include <gtest/gtest.h>
 
+#include "analyzer/analysis.h"
 #include "analyzer/explain.h"
+#include "analyzer/line_fit.h"
+#include "analyzer/superposition.h"
 #include "tests/analyzer/synthetic.h"
 #include "tests/core/spectral_exr_fixtures.h"
 
@@ -74,6 +77,73 @@ TEST(ComponentNames, Directness) {
   EXPECT_EQ(is_direct("bounce.2"), false);
   EXPECT_EQ(is_direct("transmission_indirect"), false);
   EXPECT_FALSE(is_direct("light.key"));
+}
+
+}  // namespace
+}  // namespace ct::test
+
+// ---- Superposed luminaires ------------------------------------------------------------------------------
+
+namespace ct::test {
+namespace {
+
+// A matte object lit by two luminaires: group a's colour is body ∘ warm, group b's body ∘ cool, with their
+// shares varying across the object. Known: the shares, and the angle between the two colours.
+analyzer::AnalysisImage two_lights(double share_b, const Vec3& warm, const Vec3& cool) {
+  analyzer::AnalysisImage input;
+  const RgbImage a = make_image(64, 64, [&](double u, double v) -> Vec3 {
+    return (0.1 + 0.9 * u) * (1 - share_b) * 2 * v * kBody.cwiseProduct(warm);
+  });
+  const RgbImage b = make_image(64, 64, [&](double u, double v) -> Vec3 {
+    return (0.1 + 0.9 * u) * share_b * 2 * (1 - v) * kBody.cwiseProduct(cool);
+  });
+  input.image = a;
+  for (std::size_t i = 0; i < a.rgb.size(); ++i) input.image.rgb[i] = a.rgb[i] + b.rgb[i];
+  input.components = {{"light.warm", a}, {"light.cool", b}};
+  return input;
+}
+
+double energy(const RgbImage& image) { double e = 0; for (float v : image.rgb) e += v; return e; }
+
+TEST(Superposition, TwoLuminairesOfDifferentColoursAreSuperposed) {
+  const Vec3 warm(1.0, 0.8, 0.55), cool(0.8, 0.9, 1.0);
+  const analyzer::AnalysisImage input = two_lights(0.4, warm, cool);
+  const analyzer::Region region = analyzer::whole_image_region(64, 64);
+  const auto s = analyzer::find_superposition(input, region, analyzer::ShapeCriteria{});
+  ASSERT_TRUE(s);
+  ASSERT_EQ(s->groups.size(), 2u);
+  const double e_warm = energy(input.components[0].image), e_cool = energy(input.components[1].image);
+  EXPECT_EQ(s->groups[0].name, e_warm >= e_cool ? "light.warm" : "light.cool");
+  EXPECT_NEAR(s->groups[0].share, std::max(e_warm, e_cool) / (e_warm + e_cool), 1e-6);
+  EXPECT_NEAR(s->angle_deg, analyzer::line_angle_degrees(kBody.cwiseProduct(warm), kBody.cwiseProduct(cool)), 1e-3);
+  EXPECT_TRUE(s->superposed);
+
+  // The cluster itself: a wedge between the two colours; the analysis calls it superposed and says why.
+  analyzer::AnalyzeOptions options;
+  const analyzer::ImageAnalysis a = analyzer::analyse_image(input, "final", {region}, options, std::nullopt, false);
+  EXPECT_EQ(a.results[0].shape.shape, analyzer::ShapeClass::Superposed) << a.results[0].shape.reason;
+  EXPECT_NE(a.results[0].shape.reason.find("light.warm"), std::string::npos);
+  // Analysing one luminaire's own layer is no superposition.
+  const analyzer::ImageAnalysis one = analyzer::analyse_image(input, "light.warm", {region}, options, std::nullopt, false);
+  EXPECT_NE(one.results[0].shape.shape, analyzer::ShapeClass::Superposed);
+}
+
+TEST(Superposition, SameColouredLuminairesOrAWeakSecondOneAreNot) {
+  const Vec3 warm(1.0, 0.8, 0.55);
+  const analyzer::Region region = analyzer::whole_image_region(64, 64);
+  // Two lamps of one colour: their sum is the structure of one lamp.
+  const auto same = analyzer::find_superposition(two_lights(0.5, warm, warm), region, analyzer::ShapeCriteria{});
+  ASSERT_TRUE(same);
+  EXPECT_LT(same->angle_deg, 1e-3);
+  EXPECT_FALSE(same->superposed);
+  // A second lamp carrying 5 % of the light, under superposed_share.
+  const analyzer::AnalysisImage input = two_lights(0.05, warm, Vec3(0.8, 0.9, 1.0));
+  const auto weak = analyzer::find_superposition(input, region, analyzer::ShapeCriteria{});
+  ASSERT_TRUE(weak);
+  const double e_warm = energy(input.components[0].image), e_cool = energy(input.components[1].image);
+  EXPECT_NEAR(weak->groups[1].share, e_cool / (e_warm + e_cool), 1e-6);
+  EXPECT_LT(weak->groups[1].share, analyzer::ShapeCriteria{}.superposed_share);
+  EXPECT_FALSE(weak->superposed);
 }
 
 }  // namespace
