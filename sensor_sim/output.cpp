@@ -10,6 +10,7 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include <half.h>
 #include <ImfChannelList.h>
 #include <ImfDoubleAttribute.h>
 #include <ImfIntAttribute.h>
@@ -68,6 +69,7 @@ struct SensorImageWriter::File {
   std::unique_ptr<Imf::StdOFStream> exr_stream;
   std::unique_ptr<Imf::OutputFile> exr;
   std::vector<float> ids;  // object ids as floats, for the current block
+  std::vector<Imath::half> display;  // the display layer as half, for the current block
   // TIFF / PNG
   std::unique_ptr<OIIO::ImageOutput> image;
 };
@@ -90,7 +92,8 @@ SensorImageWriter::SensorImageWriter(const fs::path& path, OutputLayout layout)
            if (layout_.display) layers.push_back("display");
            return layers;
          }())
-      for (int c = 0; c < 3; ++c) header.channels().insert(layer_channel(layer, c), Imf::Channel(Imf::FLOAT));
+      for (int c = 0; c < 3; ++c)
+        header.channels().insert(layer_channel(layer, c), Imf::Channel(layer == "display" ? Imf::HALF : Imf::FLOAT));
     if (layout_.object_ids) {
       header.channels().insert("object_id", Imf::Channel(Imf::FLOAT));
       nlohmann::json names = nlohmann::json::object();
@@ -151,7 +154,14 @@ void SensorImageWriter::write_rows(const OutputRows& block) {
     insert_rgb(frame, "linear", block.linear.data(), layout_.width, y0, block.rows);
     for (std::size_t c = 0; c < layout_.components.size(); ++c)
       insert_rgb(frame, layout_.components[c], block.components[c].data(), layout_.width, y0, block.rows);
-    if (layout_.display) insert_rgb(frame, "display", block.display.data(), layout_.width, y0, block.rows);
+    if (layout_.display) {  // stored as half: 11 bits of an sRGB-encoded value in [0, 1] are 3 more than 8-bit
+      file_->display.assign(block.display.begin(), block.display.end());
+      const Imath::Box2i window({0, y0}, {layout_.width - 1, y0 + block.rows - 1});
+      for (int c = 0; c < 3; ++c)
+        frame.insert(layer_channel("display", c),
+                     Imf::Slice::Make(Imf::HALF, file_->display.data() + c, window, 3 * sizeof(Imath::half),
+                                      3 * sizeof(Imath::half) * width));
+    }
     if (layout_.object_ids) {
       file_->ids.assign(block.object_ids.begin(), block.object_ids.end());
       const Imath::Box2i window({0, y0}, {layout_.width - 1, y0 + block.rows - 1});

@@ -41,7 +41,7 @@ TEST(Pipeline, ExrOutputFollowsTheLayoutContract) {
   std::vector<std::string> channels;
   for (const ExrChannel& c : info.channels) {
     channels.push_back(c.name);
-    EXPECT_EQ(c.type, ExrPixelType::Float) << c.name;
+    EXPECT_EQ(c.type, c.name.starts_with("display.") ? ExrPixelType::Half : ExrPixelType::Float) << c.name;
   }
   EXPECT_EQ(channels, expected);
   EXPECT_EQ(info.metadata.at("chromatrace.components"), fmt::format("{}", fmt::join(image.layout.components, ",")));
