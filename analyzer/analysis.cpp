@@ -1,9 +1,11 @@
 #include "analyzer/analysis.h"
 
 #include <algorithm>
+#include <cmath>
 
 #include <fmt/core.h>
 
+#include "analyzer/edge_mixing.h"
 #include "analyzer/superposition.h"
 #include "core/error.h"
 #include "core/progress.h"
@@ -56,6 +58,14 @@ ImageAnalysis analyse_image(const AnalysisImage& input, const std::string& layer
   Progress bar("analyze", a.regions.size(), progress);
   for (const Region& r : a.regions) {
     a.results.push_back(analyse_region(pixels, a.context, r, options));
+    if (r.source == "labels" && !input.object_ids.empty()) {
+      RegionAnalysis& result = a.results.back();
+      // Mixing turns a colour's direction; the noise that matters is across the cluster's first axis (along it,
+      // neighbouring pixels differ by shading as well as by noise).
+      const double noise = std::hypot(result.shape.noise_sigma[1], result.shape.noise_sigma[2]);
+      const EdgeMixing mixing = find_edge_mixing(pixels, input.object_ids, r, static_cast<std::int32_t>(r.label), noise);
+      apply_edge_mixing(result, mixing, pixels, a.context, r, options, input.object_names);
+    }
     if (!input.components.empty()) a.explanations.push_back(explain_region(input, r));
     // The light-group layers are the linear camera signal of each luminaire's light; the test reads them, not
     // the analysed layer, so it holds whatever curve encoded the final image. A layer that is one component

@@ -67,7 +67,8 @@ struct ShapeCriteria {
   double p_body_fraction = 0.3;
   double p_one_side = 0.95;
   double p_area_ratio = 0.15;
-  double superposed_share = 0.1;  // two light groups each carrying this share of a region's light: superposed
+  double superposed_share = 0.1;
+  std::size_t min_mixed_samples = 5;  // mixed edge pixels that can make a structure (as min_highlight_samples)  // two light groups each carrying this share of a region's light: superposed
 };
 
 // A plane n·x = offset with the rms distance of the samples from it.

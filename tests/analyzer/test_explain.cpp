@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include "analyzer/analysis.h"
+#include "analyzer/edge_mixing.h"
 #include "analyzer/explain.h"
 #include "analyzer/line_fit.h"
 #include "analyzer/superposition.h"
@@ -144,6 +145,65 @@ TEST(Superposition, SameColouredLuminairesOrAWeakSecondOneAreNot) {
   EXPECT_NEAR(weak->groups[1].share, e_cool / (e_warm + e_cool), 1e-6);
   EXPECT_LT(weak->groups[1].share, analyzer::ShapeCriteria{}.superposed_share);
   EXPECT_FALSE(weak->superposed);
+}
+
+}  // namespace
+}  // namespace ct::test
+
+// ---- Mixed edge pixels ------------------------------------------------------------------------------------
+
+namespace ct::test {
+namespace {
+
+// Two matte objects side by side, each shaded top to bottom: ids 1 (left, x < 32) and 2. With pixel-area
+// integration the column on each side of the edge records a mix of the two colours (the edge runs a
+// quarter of the way into column 31: 75 % object 1, 25 % object 2; column 32 is pure object 2 but its
+// neighbour two steps over is object 2 too).
+analyzer::AnalysisImage two_objects(bool box_filter) {
+  const Vec3 other = kBody.cwiseProduct(kSecondLight).normalized();
+  analyzer::AnalysisImage input;
+  input.image = make_image(64, 64, [&](double u, double v) -> Vec3 {
+    const double m = 0.1 + 0.9 * v;
+    const int x = static_cast<int>(std::lround(u * 63));
+    if (box_filter && x == 31) return m * (0.75 * kBody + 0.25 * other);
+    return m * (x < 32 ? kBody : other);
+  });
+  for (int y = 0; y < 64; ++y)
+    for (int x = 0; x < 64; ++x) input.object_ids.push_back(x < 32 ? 1 : 2);
+  input.object_names = {{1, "left"}, {2, "right"}};
+  return input;
+}
+
+TEST(EdgeMixing, MixedEdgePixelsOfPixelAreaAreFoundAndNamed) {
+  const analyzer::AnalysisImage input = two_objects(true);
+  const analyzer::Region left = analyzer::label_regions(input.object_ids, "object", input.object_names, {0})[0];
+  const analyzer::EdgeMixing m = analyzer::find_edge_mixing(input.image, input.object_ids, left, 1, 0.0);
+  EXPECT_EQ(m.edge_pixels, 64u);  // column 31
+  EXPECT_EQ(m.mixed.size(), 64u);
+  EXPECT_EQ(m.with.at(2), 64u);
+
+  analyzer::AnalyzeOptions options;
+  const analyzer::ImageAnalysis a = analyzer::analyse_image(
+      input, "final", analyzer::select_regions(input, input.image, {}), options, std::nullopt, false);
+  ASSERT_EQ(a.results.size(), 3u);
+  const analyzer::ClusterShape& s = a.results[1].shape;
+  EXPECT_EQ(s.shape, analyzer::ShapeClass::Mixed) << s.reason;
+  EXPECT_NE(s.reason.find("without them linear"), std::string::npos) << s.reason;
+  // The dimmest rows, where the two colours differ by less than 3 × the measured noise, are not judged.
+  EXPECT_NE(s.reason.find("with its neighbours' (right ("), std::string::npos) << s.reason;
+  EXPECT_EQ(a.results[2].shape.shape, analyzer::ShapeClass::Linear) << a.results[2].shape.reason;  // pure on its side
+}
+
+TEST(EdgeMixing, PointSampledEdgesAreNotMixed) {
+  const analyzer::AnalysisImage input = two_objects(false);
+  const analyzer::Region left = analyzer::label_regions(input.object_ids, "object", input.object_names, {0})[0];
+  const analyzer::EdgeMixing m = analyzer::find_edge_mixing(input.image, input.object_ids, left, 1, 0.0);
+  EXPECT_EQ(m.edge_pixels, 64u);
+  EXPECT_TRUE(m.mixed.empty());
+  analyzer::AnalyzeOptions options;
+  const analyzer::ImageAnalysis a = analyzer::analyse_image(
+      input, "final", analyzer::select_regions(input, input.image, {}), options, std::nullopt, false);
+  EXPECT_EQ(a.results[1].shape.shape, analyzer::ShapeClass::Linear) << a.results[1].shape.reason;
 }
 
 }  // namespace
