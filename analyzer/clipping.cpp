@@ -5,19 +5,6 @@
 #include <limits>
 
 namespace ct::analyzer {
-namespace {
-
-thread_local ClippingRules current_rules;
-
-}  // namespace
-
-ClippingRulesScope::ClippingRulesScope(const ClippingRules& rules) : previous_(current_rules) { current_rules = rules; }
-ClippingRulesScope::~ClippingRulesScope() { current_rules = previous_; }
-
-Clipping find_clipping(std::span<const float> rgb, const std::array<double, 3>& high_levels) {
-  return find_clipping(rgb, high_levels, current_rules);
-}
-
 Clipping find_clipping(std::span<const float> rgb, const std::array<double, 3>& high_levels, const ClippingRules& rules) {
   Clipping result;
   const std::size_t n = rgb.size() / 3;

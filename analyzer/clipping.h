@@ -48,19 +48,5 @@ struct ClippingRules {
 // clipped).
 Clipping find_clipping(std::span<const float> rgb, const std::array<double, 3>& high_levels, const ClippingRules& rules);
 
-// The same with the rules of the calling thread's innermost ClippingRulesScope (the defaults outside any): the
-// shape analysis calls this form, and a region's analysis sets the rules of its layer around it.
-Clipping find_clipping(std::span<const float> rgb, const std::array<double, 3>& high_levels);
-
-class ClippingRulesScope {
- public:
-  explicit ClippingRulesScope(const ClippingRules& rules);
-  ~ClippingRulesScope();
-  ClippingRulesScope(const ClippingRulesScope&) = delete;
-  ClippingRulesScope& operator=(const ClippingRulesScope&) = delete;
-
- private:
-  ClippingRules previous_;
-};
 
 }  // namespace ct::analyzer

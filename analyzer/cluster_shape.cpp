@@ -100,7 +100,7 @@ ClusterShape analyse_shape(std::span<const float> rgb, const ShapeContext& conte
     return s;
   }
 
-  s.clipping = find_clipping(rgb, context.high_levels);
+  s.clipping = find_clipping(rgb, context.high_levels, context.clipping);
   if (test("clipped fraction >= clipped_fraction", s.clipping.fraction, k.clipped_fraction, s.clipping.fraction >= k.clipped_fraction)) {
     s.shape = ShapeClass::Clipped;
     s.reason = fmt::format("{:.1f} % of the pixels lie on {} face{} of the RGB cube", 100 * s.clipping.fraction,

@@ -125,6 +125,7 @@ struct ShapeContext {
   std::span<const float> differences;
   double quantisation_sigma = 0;  // step / √12 for integer images
   std::array<double, 3> high_levels{};  // clipping levels (analyzer/clipping.h)
+  ClippingRules clipping;               // whether they are known, and the lower limits
   std::uint64_t seed = 1;
   int threads = 0;
   ShapeCriteria criteria;

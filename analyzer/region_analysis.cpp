@@ -53,11 +53,9 @@ RegionAnalysis analyse_region(const RgbImage& layer, const LayerContext& context
   a.non_finite = samples.non_finite;
   a.histogram = histogram_3d(samples.rgb, context.spec, options.threads);
   const std::vector<float> differences = neighbour_differences(layer, samples, options.max_noise_pairs);
-  ShapeContext shape{differences, context.quantisation_sigma, context.high_levels, options.seed, options.threads, options.criteria};
-  {
-    const ClippingRulesScope rules(context.clipping);  // the layer's clipping rules for the shape analysis
-    a.shape = analyse_shape(samples.rgb, shape);
-  }
+  ShapeContext shape{differences, context.quantisation_sigma, context.high_levels, context.clipping, options.seed, options.threads,
+                     options.criteria};
+  a.shape = analyse_shape(samples.rgb, shape);
   if (a.pixels == 0) a.shape.reason = "the region is empty: no shape measured";
   else if (samples.size() == 0) a.shape.reason = "every pixel of the region is NaN or infinite: no shape measured";
   return a;

@@ -12,6 +12,7 @@
 #include "analyzer/analysis.h"
 #include "analyzer/analysis_json.h"
 #include "analyzer/clipping.h"
+#include "analyzer/cluster_shape.h"
 #include "analyzer/report.h"
 #include "core/file_io.h"
 #include "tests/analyzer/synthetic.h"
@@ -139,11 +140,14 @@ TEST(CameraLevels, KnownLevelsCountEverySampleOnThem) {
   const std::vector<float> flat(300, 5.0f);
   EXPECT_EQ(find_clipping(flat, {5, 5, 5}, ClippingRules{true, {0, 0, 0}}).fraction, 1.0);
   EXPECT_EQ(find_clipping(flat, {5, 5, 5}, ClippingRules{false, {0, 0, 0}}).fraction, 0.0);
-  {
-    const ClippingRulesScope scope(ClippingRules{true, {0, 0, 0}});
-    EXPECT_EQ(find_clipping(flat, {5, 5, 5}).fraction, 1.0);
-  }
-  EXPECT_EQ(find_clipping(flat, {5, 5, 5}).fraction, 0.0);  // the scope ended
+  // The shape analysis applies the rules its context carries.
+  ShapeContext known;
+  known.high_levels = {5, 5, 5};
+  known.clipping = ClippingRules{true, {0, 0, 0}};
+  EXPECT_EQ(analyse_shape(flat, known).clipping.fraction, 1.0);
+  ShapeContext estimated = known;
+  estimated.clipping.known_high = false;
+  EXPECT_EQ(analyse_shape(flat, estimated).clipping.fraction, 0.0);
   // Below black after subtraction is noise, not clipping: the low face is the ADC's code 0, at −black.
   std::vector<float> dark;
   for (int i = 0; i < 100; ++i) dark.insert(dark.end(), {float(i % 7) - 3.0f, 100.0f + 20.0f * i, 50.0f + 10.0f * i});
