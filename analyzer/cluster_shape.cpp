@@ -166,9 +166,18 @@ ClusterShape analyse_shape(std::span<const float> rgb, const ShapeContext& conte
     std::vector<std::size_t> rest;
     for (const std::size_t i : complement(n, s.body_only->inliers))
       if (s.body_only->line.distance(points[i]) > 2 * tolerance) rest.push_back(i);
-    const auto highlight = rest.size() >= std::max<std::size_t>(3, static_cast<std::size_t>(k.min_highlight_fraction * static_cast<double>(n)))
-                               ? find_line(points, rest, tolerance, min_tolerance, context.seed + 1)
-                               : std::nullopt;
+    // A line parallel to the body line among them is the body's own spread (shading beside the line, the
+    // tail of a glossy lobe), not a highlight, which leaves the body line at an angle: set its samples
+    // aside and look again, a few times.
+    std::optional<LineSearch> highlight;
+    for (int attempt = 0; attempt < 3 && rest.size() >= std::max<std::size_t>(3, k.min_highlight_samples); ++attempt) {
+      highlight = find_line(points, rest, tolerance, min_tolerance, context.seed + 1 + static_cast<std::uint64_t>(attempt));
+      if (!highlight || line_angle_degrees(highlight->line.direction, s.body_only->line.direction) >= k.min_line_angle_deg) break;
+      std::vector<std::size_t> others;
+      std::set_difference(rest.begin(), rest.end(), highlight->inliers.begin(), highlight->inliers.end(), std::back_inserter(others));
+      rest = std::move(others);
+      highlight.reset();
+    }
     if (highlight) {
       const TwoLines m = two_lines(*s.body_only, *highlight, n);
       s.two_lines = m;

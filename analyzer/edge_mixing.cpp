@@ -50,7 +50,8 @@ EdgeMixing find_edge_mixing(const RgbImage& layer, const std::vector<std::int32_
       const double from_b = std::acos(std::clamp(ub.dot(uc), -1.0, 1.0));
       const double off = std::abs(uc.dot(ua.cross(ub).normalized()));
       const double t = from_a / apart;  // 0 at A's colour, 1 at B's
-      if (t >= 0.05 && from_b < apart && off <= std::max(noise_angle, 0.1 * apart)) {
+      // Turned towards B beyond the noise, and by at least 5 % of the way: a mix, not a noisy pixel of A.
+      if (t >= 0.05 && from_a > noise_angle && from_b < apart && off <= std::max(noise_angle, 0.1 * apart)) {
         mixed = true;
         towards = other;
         break;

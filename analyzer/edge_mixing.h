@@ -26,7 +26,8 @@ struct EdgeMixing {
 
 // `labels` per pixel ([y][x]); `region` holds the pixels of id `label`; `noise` is the colour noise σ the
 // comparisons allow for. Colours are compared by direction (shading changes a colour's length, a mix its
-// direction): a mixed pixel's direction lies between A's and B's, at least 5 % of the way, and within 3σ/|c| or 10 %
+// direction): a mixed pixel's direction lies between A's and B's, at least 5 % of the way and more than 3σ/|c|
+// from A's, and within 3σ/|c| or 10 %
 // of their angle of the plane they span.
 EdgeMixing find_edge_mixing(const RgbImage& layer, const std::vector<std::int32_t>& labels, const Region& region,
                             std::int32_t label, double noise);
