@@ -12,6 +12,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "core/json_input.h"
+#include "series/preview.h"
 
 namespace ct::series {
 namespace {
@@ -24,20 +25,6 @@ const cv::Scalar kWhite(255, 255, 255), kInk(40, 40, 40), kSoftInk(95, 95, 95), 
 const cv::Scalar kChannel[3] = {cv::Scalar(40, 40, 200), cv::Scalar(40, 150, 40), cv::Scalar(200, 70, 40)};
 constexpr int kFont = cv::FONT_HERSHEY_SIMPLEX;
 constexpr double kTick = 0.42, kLabel = 0.45, kTitle = 0.5;
-
-const analyzer::RgbImage* find_layer(const analyzer::AnalysisImage& input, std::string_view name) {
-  for (const analyzer::ComponentLayer& c : input.components)
-    if (c.name == name) return &c.image;
-  return nullptr;
-}
-
-// The q-quantile of `values` (0 ≤ q ≤ 1); 0 for none.
-double quantile(std::vector<float> values, double q) {
-  if (values.empty()) return 0;
-  const auto k = static_cast<std::ptrdiff_t>(std::clamp(q, 0.0, 1.0) * static_cast<double>(values.size() - 1));
-  std::nth_element(values.begin(), values.begin() + k, values.end());
-  return values[static_cast<std::size_t>(k)];
-}
 
 cv::Point rounded(const cv::Point2d& p) { return {static_cast<int>(std::lround(p.x)), static_cast<int>(std::lround(p.y))}; }
 

@@ -14,20 +14,6 @@
 namespace ct::series {
 namespace {
 
-const analyzer::RgbImage* find_layer(const analyzer::AnalysisImage& input, std::string_view name) {
-  for (const analyzer::ComponentLayer& c : input.components)
-    if (c.name == name) return &c.image;
-  return nullptr;
-}
-
-// The q-quantile of `values` (0 ≤ q ≤ 1); 0 for none.
-double quantile(std::vector<float> values, double q) {
-  if (values.empty()) return 0;
-  const auto k = static_cast<std::ptrdiff_t>(std::clamp(q, 0.0, 1.0) * static_cast<double>(values.size() - 1));
-  std::nth_element(values.begin(), values.begin() + k, values.end());
-  return values[static_cast<std::size_t>(k)];
-}
-
 cv::Mat encode(const analyzer::RgbImage& image, const float gains[3], bool srgb) {
   cv::Mat out(image.height, image.width, CV_8UC3);
   for (int y = 0; y < image.height; ++y)
@@ -44,6 +30,19 @@ cv::Mat encode(const analyzer::RgbImage& image, const float gains[3], bool srgb)
 }
 
 }  // namespace
+
+const analyzer::RgbImage* find_layer(const analyzer::AnalysisImage& input, std::string_view name) {
+  for (const analyzer::ComponentLayer& c : input.components)
+    if (c.name == name) return &c.image;
+  return nullptr;
+}
+
+double quantile(std::vector<float> values, double q) {
+  if (values.empty()) return 0;
+  const auto k = static_cast<std::ptrdiff_t>(std::clamp(q, 0.0, 1.0) * static_cast<double>(values.size() - 1));
+  std::nth_element(values.begin(), values.begin() + k, values.end());
+  return values[static_cast<std::size_t>(k)];
+}
 
 cv::Mat preview_image(const analyzer::AnalysisImage& input) {
   if (const analyzer::RgbImage* display = find_layer(input, "display")) {

@@ -6,12 +6,20 @@
 // directly, set neither), and sRGB-encoded.
 
 #include <filesystem>
+#include <string_view>
+#include <vector>
 
 #include <opencv2/core.hpp>
 
 #include "analyzer/image_input.h"
 
 namespace ct::series {
+
+// A component layer of the file by name (`display`, `emission` …); nullptr when it has none.
+const analyzer::RgbImage* find_layer(const analyzer::AnalysisImage& input, std::string_view name);
+
+// The q-quantile of `values` (0 ≤ q ≤ 1, the nearest rank below); 0 for none.
+double quantile(std::vector<float> values, double q);
 
 // 8-bit BGR (OpenCV's order).
 cv::Mat preview_image(const analyzer::AnalysisImage& input);

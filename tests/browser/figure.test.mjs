@@ -16,7 +16,7 @@ import fs from 'node:fs';
 import os from 'node:os';
 import path from 'node:path';
 import { fileURLToPath } from 'node:url';
-import { chromium } from 'playwright-core';
+import { openOffline } from './offline_page.mjs';
 
 const work = fs.mkdtempSync(path.join(os.tmpdir(), 'chromatrace-figure-'));
 const out = path.join(work, 'paper');
@@ -33,23 +33,9 @@ before(async () => {
   } catch (e) {
     if (e.status !== 1) throw e;
   }
-  context = await chromium.launchPersistentContext(path.join(work, 'profile'), {
-    executablePath: '/usr/bin/chromium',
-    headless: true,
-    viewport: { width: 1900, height: 1200 },
-    args: ['--headless', '--no-sandbox', '--disable-gpu', '--disable-quic', '--no-first-run', '--disable-background-networking',
-      '--disable-component-update', '--disable-sync'],
-  });
-  page = await context.newPage();
-  page.on('console', (m) => m.type() === 'error' && problems.push(m.text()));
-  page.on('pageerror', (e) => problems.push(e.message));
+  ({ context, page } = await openOffline(work, { width: 1900, height: 1200 }, problems));
   const index = 'file://' + path.join(out, 'index.html');
   page.on('request', (r) => r.url() !== index && !r.url().startsWith('data:') && requests.push(r.url()));
-  // Offline means offline: any request other than the file itself is a fault.
-  await page.route(/^(?!file:|data:)/, (route) => {
-    problems.push(`network request: ${route.request().url()}`);
-    route.abort();
-  });
   await page.goto(index);
   await page.waitForLoadState('load');
 });

@@ -12,7 +12,7 @@ import { execFileSync } from 'node:child_process';
 import fs from 'node:fs';
 import os from 'node:os';
 import path from 'node:path';
-import { chromium } from 'playwright-core';
+import { openOffline } from './offline_page.mjs';
 
 const work = fs.mkdtempSync(path.join(os.tmpdir(), 'chromatrace-report-'));
 let context;
@@ -22,21 +22,7 @@ const problems = []; // console errors and uncaught exceptions
 before(async () => {
   execFileSync(process.env.CHROMATRACE_SYNTHETIC_IMAGES, [work]);
   execFileSync(process.env.CHROMATRACE_EXE, ['analyze', path.join(work, 'scene.exr'), '-o', path.join(work, 'out'), '--quiet']);
-  context = await chromium.launchPersistentContext(path.join(work, 'profile'), {
-    executablePath: '/usr/bin/chromium',
-    headless: true,
-    viewport: { width: 1280, height: 900 },
-    args: ['--headless', '--no-sandbox', '--disable-gpu', '--disable-quic', '--no-first-run', '--disable-background-networking',
-      '--disable-component-update', '--disable-sync'],
-  });
-  page = await context.newPage();
-  page.on('console', (m) => m.type() === 'error' && problems.push(m.text()));
-  page.on('pageerror', (e) => problems.push(e.message));
-  // Offline means offline: any request other than the file itself is a fault.
-  await page.route(/^(?!file:|data:)/, (route) => {
-    problems.push(`network request: ${route.request().url()}`);
-    route.abort();
-  });
+  ({ context, page } = await openOffline(work, { width: 1280, height: 900 }, problems));
   await page.goto('file://' + path.join(work, 'out', 'report.html'));
   await page.waitForFunction(() => document.body.dataset.ready === '1', null, { timeout: 30000 });
 });
