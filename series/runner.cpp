@@ -1,12 +1,16 @@
 #include "series/runner.h"
 
+#include <fcntl.h>
+#include <spawn.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <map>
 
 #include <fmt/core.h>
@@ -89,20 +93,32 @@ void render_with_tracer(Scene scene, const fs::path& out, const RunOptions& opti
   rt::write_render(out, scene, rt::render(scene, render));
 }
 
-// Runs a program and waits; its stderr goes to ours (the batch's progress lines), its stdout to `log`.
+// Runs a program and waits; its stderr goes to ours (the batch's progress lines), its stdout to `log`, and
+// its environment is ours with `env` set. posix_spawn: no code of ours runs between fork and exec.
 int run_program(const std::vector<std::string>& argv, const std::vector<std::pair<std::string, std::string>>& env,
                 const fs::path& log) {
-  const pid_t pid = fork();
-  if (pid < 0) throw std::runtime_error("cannot start a process (fork failed)");
-  if (pid == 0) {
-    for (const auto& [name, value] : env) setenv(name.c_str(), value.c_str(), 1);
-    if (std::FILE* f = std::fopen(log.c_str(), "w")) dup2(fileno(f), STDOUT_FILENO);
-    std::vector<char*> args;
-    for (const std::string& a : argv) args.push_back(const_cast<char*>(a.c_str()));
-    args.push_back(nullptr);
-    execvp(args[0], args.data());
-    _exit(127);
+  std::vector<std::string> environment;
+  for (char** e = environ; *e; ++e) {
+    const std::string_view entry(*e);
+    const bool replaced = std::any_of(env.begin(), env.end(), [&](const auto& kv) { return entry.starts_with(kv.first + "="); });
+    if (!replaced) environment.emplace_back(entry);
   }
+  for (const auto& [name, value] : env) environment.push_back(name + "=" + value);
+  const auto pointers = [](std::vector<std::string>& strings) {
+    std::vector<char*> p;
+    for (std::string& s : strings) p.push_back(s.data());
+    p.push_back(nullptr);
+    return p;
+  };
+  std::vector<std::string> args = argv;
+  std::vector<char*> arg_pointers = pointers(args), env_pointers = pointers(environment);
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  pid_t pid = 0;
+  const int error = posix_spawnp(&pid, arg_pointers[0], &actions, nullptr, arg_pointers.data(), env_pointers.data());
+  posix_spawn_file_actions_destroy(&actions);
+  if (error != 0) throw std::runtime_error(fmt::format("cannot start {}: {}", argv[0], std::strerror(error)));
   int status = 0;
   while (waitpid(pid, &status, 0) < 0)
     if (errno != EINTR) throw std::runtime_error("waiting for a process failed");
@@ -118,11 +134,10 @@ void render_with_cycles(const Scene& scene, const fs::path& scene_file, const fs
                                    "--seed", std::to_string(options.seed.value_or(scene.render.seed)),
                                    "--components", options.components,
                                    "--cache-dir", (dir / "renders" / "cycles-cache").string()};
-  if (options.width || options.height)
-    for (const std::string& a : {std::string("--resolution"),
-                                 fmt::format("{}x{}", options.width.value_or(scene.camera.width),
-                                             options.height.value_or(scene.camera.height))})
-      argv.push_back(a);
+  if (options.width || options.height) {
+    argv.push_back("--resolution");
+    argv.push_back(fmt::format("{}x{}", options.width.value_or(scene.camera.width), options.height.value_or(scene.camera.height)));
+  }
   if (!options.progress) argv.push_back("--quiet");
   const fs::path log = dir / "renders" / "blender.log";
   const int status = run_program(argv, {{"CHROMATRACE_EXE", options.executable.string()}}, log);
