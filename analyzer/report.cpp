@@ -12,46 +12,16 @@
 #include "analyzer/plots.h"
 #include "analyzer/viewer_bundle.h"
 #include "core/colour.h"
+#include "core/html_text.h"
 
 namespace ct::analyzer {
 namespace {
 
 using nlohmann::json;
 
-std::string base64(std::string_view bytes) {
-  static constexpr char table[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-  std::string out;
-  out.reserve((bytes.size() + 2) / 3 * 4);
-  for (std::size_t i = 0; i < bytes.size(); i += 3) {
-    const std::uint32_t b0 = static_cast<std::uint8_t>(bytes[i]);
-    const std::uint32_t b1 = i + 1 < bytes.size() ? static_cast<std::uint8_t>(bytes[i + 1]) : 0;
-    const std::uint32_t b2 = i + 2 < bytes.size() ? static_cast<std::uint8_t>(bytes[i + 2]) : 0;
-    const std::uint32_t v = (b0 << 16) | (b1 << 8) | b2;
-    out += table[(v >> 18) & 63];
-    out += table[(v >> 12) & 63];
-    out += i + 1 < bytes.size() ? table[(v >> 6) & 63] : '=';
-    out += i + 2 < bytes.size() ? table[v & 63] : '=';
-  }
-  return out;
-}
-
 template <class T>
 std::string base64_of(const std::vector<T>& values) {  // little-endian, as typed arrays read them on x86 and ARM
   return base64(std::string_view(reinterpret_cast<const char*>(values.data()), values.size() * sizeof(T)));
-}
-
-std::string escape_html(std::string_view text) {
-  std::string out;
-  for (const char c : text) {
-    switch (c) {
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '&': out += "&amp;"; break;
-      case '"': out += "&quot;"; break;
-      default: out += c;
-    }
-  }
-  return out;
 }
 
 // Inside <script>, "</" would end the element early; "<\/" means the same to JSON and JavaScript.

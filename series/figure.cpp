@@ -10,6 +10,7 @@
 #include <fmt/format.h>
 
 #include "core/file_io.h"
+#include "core/html_text.h"
 #include "series/figure_data.h"
 #include "series/figure_raster.h"
 
@@ -20,48 +21,12 @@ namespace {
 // Points per histogram plot at most (a deterministic subsample beyond).
 constexpr std::size_t kMaxPoints = 40000;
 
-std::string escape(std::string_view text) {
-  std::string out;
-  out.reserve(text.size());
-  for (const char c : text) {
-    switch (c) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      case '\'': out += "&#39;"; break;
-      default: out += c;
-    }
-  }
-  return out;
-}
-
 // A relative link: each path segment percent-encoded where it must be.
 std::string href(std::string_view path) {
   std::string out;
   for (const unsigned char c : path) {
     if (std::isalnum(c) || c == '/' || c == '-' || c == '_' || c == '.' || c == '~') out += static_cast<char>(c);
     else out += fmt::format("%{:02X}", c);
-  }
-  return out;
-}
-
-std::string base64(std::string_view bytes) {
-  static constexpr char table[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-  std::string out;
-  out.reserve((bytes.size() + 2) / 3 * 4);
-  std::size_t i = 0;
-  for (; i + 2 < bytes.size(); i += 3) {
-    const unsigned v = static_cast<unsigned char>(bytes[i]) << 16 | static_cast<unsigned char>(bytes[i + 1]) << 8 |
-                       static_cast<unsigned char>(bytes[i + 2]);
-    out += {table[v >> 18], table[(v >> 12) & 63], table[(v >> 6) & 63], table[v & 63]};
-  }
-  if (i + 1 == bytes.size()) {
-    const unsigned v = static_cast<unsigned char>(bytes[i]) << 16;
-    out += {table[v >> 18], table[(v >> 12) & 63], '=', '='};
-  } else if (i + 2 == bytes.size()) {
-    const unsigned v = static_cast<unsigned char>(bytes[i]) << 16 | static_cast<unsigned char>(bytes[i + 1]) << 8;
-    out += {table[v >> 18], table[(v >> 12) & 63], table[(v >> 6) & 63], '='};
   }
   return out;
 }
@@ -135,20 +100,20 @@ std::string findings_table(const VariantView& v) {
   std::string html = R"(<table class="findings"><tr><th>object</th><th>expected</th><th>found</th><th></th></tr>)";
   for (const FindingView& f : v.findings) {
     const std::string object = f.target != f.object && f.target != "image" && !f.target.empty()
-                                   ? fmt::format("{} <span class=\"description\">({})</span>", escape(f.object), escape(f.target))
-                                   : escape(f.object);
+                                   ? fmt::format("{} <span class=\"description\">({})</span>", escape_html(f.object), escape_html(f.target))
+                                   : escape_html(f.object);
     html += fmt::format("<tr class=\"finding\" data-ok=\"{}\"><td>{}</td><td>{}</td><td><b>{}</b></td><td>{}</td></tr>", f.ok ? 1 : 0,
-                        object, escape(fmt::format("{}", fmt::join(f.any_of, " or "))), escape(f.found), mark(f.ok));
+                        object, escape_html(fmt::format("{}", fmt::join(f.any_of, " or "))), escape_html(f.found), mark(f.ok));
     if (!f.explanation.empty())
-      html += fmt::format("<tr><td class=\"paths\" colspan=\"4\">light paths: {}</td></tr>", escape(f.explanation));
+      html += fmt::format("<tr><td class=\"paths\" colspan=\"4\">light paths: {}</td></tr>", escape_html(f.explanation));
   }
   return html + "</table>";
 }
 
 std::string plot_note(const VariantView& v) {
   const HistogramPoints& p = v.points;
-  std::string note = fmt::format("Cube shown: 0 to {} in each channel [{}]. ", tick_label(p.hi, p.step), escape(p.units));
-  if (p.lo != 0) note = fmt::format("Cube shown: {} to {} in each channel [{}]. ", tick_label(p.lo, p.step), tick_label(p.hi, p.step), escape(p.units));
+  std::string note = fmt::format("Cube shown: 0 to {} in each channel [{}]. ", tick_label(p.hi, p.step), escape_html(p.units));
+  if (p.lo != 0) note = fmt::format("Cube shown: {} to {} in each channel [{}]. ", tick_label(p.lo, p.step), tick_label(p.hi, p.step), escape_html(p.units));
   if (p.beyond > 0)
     note += p.lamps_beyond == p.beyond ? fmt::format("{} px of lamps seen directly lie beyond it and are not drawn. ", p.beyond)
                                        : fmt::format("{} px lie beyond it and are not drawn ({} of them lamps seen directly). ", p.beyond,
@@ -163,24 +128,24 @@ std::string panel_html(const std::string& panel, const VariantView* v) {
   const std::string caption = panel.empty() ? "" : panel_caption(panel);
   if (!v)
     return fmt::format(R"(<section class="panel missing" data-missing="{}"><h3 class="caption">{}</h3><p>No variant of this run reproduces this panel.</p></section>)",
-                       escape(panel), escape(caption));
+                       escape_html(panel), escape_html(caption));
   std::string html = panel.empty()
-                         ? fmt::format(R"(<section class="panel" data-variant="{}">)", escape(v->name))
-                         : fmt::format(R"(<section class="panel" data-panel="{}" data-variant="{}">)", escape(panel), escape(v->name));
+                         ? fmt::format(R"(<section class="panel" data-variant="{}">)", escape_html(v->name))
+                         : fmt::format(R"(<section class="panel" data-panel="{}" data-variant="{}">)", escape_html(panel), escape_html(v->name));
   html += R"(<div class="panel-head">)";
-  if (!caption.empty()) html += fmt::format(R"(<h3 class="caption">{}</h3>)", escape(caption));
-  html += fmt::format(R"(<div class="variant-name">{}</div><p class="description">{}</p></div>)", escape(v->name), escape(v->description));
-  if (!v->ok) return html + fmt::format(R"(<p class="error">This variant failed: {}</p></section>)", escape(v->error));
+  if (!caption.empty()) html += fmt::format(R"(<h3 class="caption">{}</h3>)", escape_html(caption));
+  html += fmt::format(R"(<div class="variant-name">{}</div><p class="description">{}</p></div>)", escape_html(v->name), escape_html(v->description));
+  if (!v->ok) return html + fmt::format(R"(<p class="error">This variant failed: {}</p></section>)", escape_html(v->error));
   if (!v->image_error.empty()) {
-    html += fmt::format(R"(<p class="error">Its images cannot be shown: {}</p>)", escape(v->image_error));
+    html += fmt::format(R"(<p class="error">Its images cannot be shown: {}</p>)", escape_html(v->image_error));
   } else {
     const cv::Size shown = display_size(v->camera, 288);
     html += fmt::format(R"(<figure><img class="camera" src="{}" width="{}" height="{}" alt="camera image of {}"><figcaption>camera image as a person sees it (camera.png), {} × {} px</figcaption></figure>)",
-                        data_uri(v->camera_png), shown.width, shown.height, escape(v->name), v->camera.cols, v->camera.rows);
+                        data_uri(v->camera_png), shown.width, shown.height, escape_html(v->name), v->camera.cols, v->camera.rows);
     html += fmt::format(R"(<img class="plot oblique" src="{}" width="{}" height="{}" alt="3D colour histogram of {}, oblique view">)",
-                        data_uri(v->oblique_png), v->oblique.cols, v->oblique.rows, escape(v->name));
+                        data_uri(v->oblique_png), v->oblique.cols, v->oblique.rows, escape_html(v->name));
     html += fmt::format(R"(<img class="plot projection" src="{}" width="{}" height="{}" alt="colour histogram of {} projected on its principal plane">)",
-                        data_uri(v->projection_png), v->projection.cols, v->projection.rows, escape(v->name));
+                        data_uri(v->projection_png), v->projection.cols, v->projection.rows, escape_html(v->name));
     html += fmt::format(R"(<p class="plot-note">{}</p>)", plot_note(*v));
   }
   html += findings_table(*v);
@@ -198,14 +163,14 @@ std::string variants_table(const fs::path& dir, const std::vector<VariantView>& 
   for (const VariantView& v : variants) {
     const std::string thumb = [&] {
       const std::string png = thumbnail_png(dir, v, 64);
-      return png.empty() ? std::string() : fmt::format(R"(<img src="{}" alt="{}">)", data_uri(png), escape(v.name));
+      return png.empty() ? std::string() : fmt::format(R"(<img src="{}" alt="{}">)", data_uri(png), escape_html(v.name));
     }();
-    const std::string figure = escape(fmt::format("{}", fmt::join(v.figure, ", ")));
-    const std::string name = fmt::format(R"(<span class="variant-name">{}</span><br><span class="description">{}</span>)", escape(v.name),
-                                         escape(v.description));
+    const std::string figure = escape_html(fmt::format("{}", fmt::join(v.figure, ", ")));
+    const std::string name = fmt::format(R"(<span class="variant-name">{}</span><br><span class="description">{}</span>)", escape_html(v.name),
+                                         escape_html(v.description));
     if (!v.ok) {
       html += fmt::format(R"(<tr class="first" data-variant="{}"><td>{}</td><td>{}</td><td>{}</td><td colspan="5" class="error">failed: {}</td></tr>)",
-                          escape(v.name), name, figure, thumb, escape(v.error));
+                          escape_html(v.name), name, figure, thumb, escape_html(v.error));
       continue;
     }
     // Group the findings by expectation (target), in order.
@@ -222,7 +187,7 @@ std::string variants_table(const fs::path& dir, const std::vector<VariantView>& 
     const std::string head = fmt::format(R"(<td rowspan="{0}">{1}<br><span class="description">{2} of {3} expectations met</span></td><td rowspan="{0}">{4}</td><td rowspan="{0}">{5}</td>)",
                                          rows, name, v.met, v.expectations, figure, thumb);
     if (groups.empty()) {
-      html += fmt::format(R"(<tr class="first" data-variant="{}">{}<td colspan="4">no expectations</td><td>{}</td></tr>)", escape(v.name), head, files);
+      html += fmt::format(R"(<tr class="first" data-variant="{}">{}<td colspan="4">no expectations</td><td>{}</td></tr>)", escape_html(v.name), head, files);
       continue;
     }
     for (std::size_t g = 0; g < groups.size(); ++g) {
@@ -232,15 +197,15 @@ std::string variants_table(const fs::path& dir, const std::vector<VariantView>& 
       for (const FindingView* f : group) {
         ok = ok && f->ok;
         if (group.size() > 1)
-          found.push_back(fmt::format("{} <b>{}</b>&nbsp;{}", escape(f->object), escape(f->found), mark(f->ok)));
+          found.push_back(fmt::format("{} <b>{}</b>&nbsp;{}", escape_html(f->object), escape_html(f->found), mark(f->ok)));
         else if (f->object == f->target)
-          found.push_back(fmt::format("<b>{}</b>", escape(f->found)));
+          found.push_back(fmt::format("<b>{}</b>", escape_html(f->found)));
         else
-          found.push_back(fmt::format("{} <b>{}</b>", escape(f->object), escape(f->found)));
+          found.push_back(fmt::format("{} <b>{}</b>", escape_html(f->object), escape_html(f->found)));
       }
       html += fmt::format(R"(<tr{} data-variant="{}">{}<td>{}</td><td>{}</td><td>{}</td><td>{}</td>{}</tr>)", g == 0 ? R"( class="first")" : "",
-                          escape(v.name), g == 0 ? head : "", escape(group.front()->target),
-                          escape(fmt::format("{}", fmt::join(group.front()->any_of, " or "))), fmt::join(found, ", "), mark(ok),
+                          escape_html(v.name), g == 0 ? head : "", escape_html(group.front()->target),
+                          escape_html(fmt::format("{}", fmt::join(group.front()->any_of, " or "))), fmt::join(found, ", "), mark(ok),
                           g == 0 ? fmt::format(R"(<td rowspan="{}">{}</td>)", rows, files) : "");
     }
   }
@@ -272,10 +237,10 @@ void write_figure_page(const std::filesystem::path& dir, const Json& result) {
 
   std::string html = "<!doctype html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">"
                      "<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">";
-  html += fmt::format("<title>chromatrace series {}: figures</title><style>{}</style></head><body>", escape(series), kStyle);
-  html += fmt::format(R"(<header><h1>Series “{}”</h1><p>{}</p>)", escape(series), escape(string_of(result, "description")));
+  html += fmt::format("<title>chromatrace series {}: figures</title><style>{}</style></head><body>", escape_html(series), kStyle);
+  html += fmt::format(R"(<header><h1>Series “{}”</h1><p>{}</p>)", escape_html(series), escape_html(string_of(result, "description")));
   html += fmt::format(R"(<p class="run">{}{}{} variants · {} of {} expectations met{} · <a href="series.json">series.json</a></p>)",
-                      escape(options), options.empty() ? "" : " · ", variants.size(), met, total,
+                      escape_html(options), options.empty() ? "" : " · ", variants.size(), met, total,
                       failed > 0 ? fmt::format(" · <span class=\"error\">{} failed</span>", failed) : "");
   html += R"(<p class="about">The figures follow Peng, Lafortune, Greenberg and Sobel, <i>Use of Computer Graphic Simulation to Explain Color Histogram Structure</i>: )"
           R"(each panel is one variant of the series, its camera image and the colour histogram of the <b>whole image</b>. )"
@@ -304,7 +269,7 @@ void write_figure_page(const std::filesystem::path& dir, const Json& result) {
     }
     write_png(raster, figure_raster(figure, panels, subtitle));
     html += fmt::format(R"(<section class="figure" id="figure-{0}"><h2>{1}.</h2><p class="figure-note">From left to right, as in the paper; also as one image: <a href="{2}">{2}</a>.</p><div class="panels">)",
-                        figure, escape(figure_title(figure)), raster_files[figure - 3]);
+                        figure, escape_html(figure_title(figure)), raster_files[figure - 3]);
     for (int k = 0; k < 4; ++k) html += panel_html(names[k], panels[k]);
     html += "</div></section>";
   }

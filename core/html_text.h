@@ -1,0 +1,16 @@
+#pragma once
+// Text for self-contained HTML pages (the analyzer's report, the series' figure page): escaping and the
+// base64 of data: URIs.
+
+#include <string>
+#include <string_view>
+
+namespace ct {
+
+// &, <, >, " and ' as character references: safe in element text and in quoted attributes.
+std::string escape_html(std::string_view text);
+
+// RFC 4648 base64 with padding.
+std::string base64(std::string_view bytes);
+
+}  // namespace ct
