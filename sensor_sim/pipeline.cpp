@@ -457,8 +457,15 @@ Json units_json(const SensorConfig& c, const RenderingIntent& intent) {
              "response (stages 1-3); path components in the same unit"}}}};
 }
 
+// Whether the output is a PNG of the display rendering: a PNG is a picture for people, so without a rendering
+// intent of the user's (rendering.enabled) it shows the display rendering, unless display.enabled is false,
+// which asks for the camera's raw numbers.
+bool display_png(const fs::path& output, const SensorConfig& c) {
+  return output_format(output) == OutputFormat::Png && !c.rendering.enabled && c.display.enabled;
+}
+
 // The file's layout: TIFF/PNG need integer codes, which the final image has only with the rendering intent
-// (values in [0, 1]) or as digital numbers that fit the file.
+// (values in [0, 1]), as the display rendering (PNG), or as digital numbers that fit the file.
 OutputLayout output_layout(const fs::path& output, const SensorConfig& c, int width, int height) {
   OutputLayout layout;
   layout.width = width;
@@ -466,6 +473,12 @@ OutputLayout output_layout(const fs::path& output, const SensorConfig& c, int wi
   layout.format = output_format(output);
   if (layout.format == OutputFormat::Exr) return layout;
   const std::string file = output.string();
+  if (display_png(output, c)) {
+    layout.bits = 8;
+    layout.code_scale = 255.0;
+    layout.colour_space = "sRGB";
+    return layout;
+  }
   if (c.rendering.enabled) {
     layout.bits = c.rendering.output_bits.value_or(layout.format == OutputFormat::Png ? 8 : 16);
     layout.code_scale = std::ldexp(1.0, layout.bits) - 1.0;
@@ -475,7 +488,8 @@ OutputLayout output_layout(const fs::path& output, const SensorConfig& c, int wi
   if (!c.adc.enabled)
     throw InputError(
         fmt::format("{}: a TIFF or PNG holds integer codes, but the image is in electrons; enable "
-                    "rendering (rendering.enabled) or the ADC (adc.enabled), or write an EXR",
+                    "rendering (rendering.enabled) or the ADC (adc.enabled), write an EXR, or (PNG) leave "
+                    "display.enabled on for the picture",
                     file));
   if (c.adc.bits > 16)
     throw InputError(
@@ -555,7 +569,8 @@ RunReport simulate_sensor(const fs::path& input, const fs::path& output, SensorC
   const std::size_t blocks = to_size((height + rows_per_block - 1) / rows_per_block);
   const bool exr = layout.format == OutputFormat::Exr;
   const bool auto_time = !config.exposure.time_s;
-  const bool want_display = exr && config.display.enabled;
+  const bool picture = display_png(output, config);  // the PNG holds the display rendering
+  const bool want_display = (exr && config.display.enabled) || picture;
   const SpectralLayer* emission = info.find_layer("emission", SpectralQuantity::S0);
   const std::set<std::int32_t> lights = light_object_ids(info);
   const std::vector<RowRange> surveyed =
@@ -611,6 +626,10 @@ RunReport simulate_sensor(const fs::path& input, const fs::path& output, SensorC
     }
   }
   camera_levels(config, run.exposure_s, layout);
+  if (picture) {  // the codes are the display rendering's (sRGB, 0…255), not the camera's numbers
+    layout.attributes["chromatrace.signal"] = "display";
+    layout.number_attributes = {{"chromatrace.black_level", 0.0}, {"chromatrace.white_level", 255.0}};
+  }
   SensorImageWriter writer(output, layout);
 
   const auto read_block = [&](int y0) {
@@ -642,6 +661,12 @@ RunReport simulate_sensor(const fs::path& input, const fs::path& output, SensorC
     image.erase(image.begin() + static_cast<std::ptrdiff_t>(own + own_size), image.end());
     image.erase(image.begin(), image.begin() + static_cast<std::ptrdiff_t>(own));
     if (config.rendering.enabled) render_rows(run, image);
+    if (picture)  // the picture for people in place of the raw numbers
+      parallel_for(image.size() / 3, run.threads, [&](std::size_t p) {
+        const float* c = linear_ext.data() + own + 3 * p;
+        const Eigen::Vector3d v = display_value(display, Eigen::Vector3d(c[0], c[1], c[2]));
+        for (int ch = 0; ch < 3; ++ch) image[3 * p + to_size(ch)] = static_cast<float>(v[ch]);
+      });
 
     OutputRows rows;
     rows.rows = y1 - y0;

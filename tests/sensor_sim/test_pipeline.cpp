@@ -173,7 +173,8 @@ std::vector<unsigned char> bytes_of(const fs::path& file) {
   return {std::istreambuf_iterator<char>(in), {}};
 }
 
-// PNG and TIFF hold the final image only: 16-bit digital numbers unchanged, or rendered values in 8/16 bits.
+// PNG and TIFF hold the final image only: 16-bit digital numbers unchanged, or rendered values in 8/16 bits; a
+// PNG without a rendering intent holds the display rendering.
 TEST(Pipeline, TiffAndPngHoldTheFinalImage) {
   test::TempDir dir;
   test::write_radiance(dir.file("in.exr"), Bands::uniform(400, 700, 100), 6, 4, [](int x, int y, std::size_t b) {
@@ -202,9 +203,24 @@ TEST(Pipeline, TiffAndPngHoldTheFinalImage) {
   test::run_sensor(dir.file("in.exr"), dir.file("out16.png"), test::config_of(rendered));
   EXPECT_EQ(bytes_of(dir.file("out16.png"))[24], 16);
 
-  // In electrons there are no codes to store: an error naming the file, and no file.
+  // Without a rendering intent of the user's, a PNG is the picture for people: the display rendering, as the
+  // EXR's display layer holds it (there as half floats, so a code may differ by one where half rounding meets
+  // a code's edge).
+  test::run_sensor(dir.file("in.exr"), dir.file("picture.png"), test::config_of(raw));
+  auto picture = OIIO::ImageInput::open(dir.file("picture.png").string());
+  ASSERT_TRUE(picture);
+  EXPECT_EQ(picture->spec().format, OIIO::TypeDesc::UINT8);
+  std::vector<std::uint8_t> shown(dn.values.size());
+  ASSERT_TRUE(picture->read_image(0, 0, 0, 3, OIIO::TypeDesc::UINT8, shown.data()));
+  const test::RgbLayer display = test::read_rgb(dir.file("raw.exr"), "display");
+  ASSERT_EQ(display.values.size(), shown.size());
+  for (std::size_t i = 0; i < shown.size(); ++i)
+    EXPECT_LE(std::abs(int(shown[i]) - int(std::lround(255 * display.values[i]))), 1) << i;
+
+  // In electrons with the display rendering off there are no codes to store: an error naming the file, and no
+  // file.
   try {
-    test::run_sensor(dir.file("in.exr"), dir.file("e.png"), test::config_of(Json::object()));
+    test::run_sensor(dir.file("in.exr"), dir.file("e.png"), test::config_of({{"display", {{"enabled", false}}}}));
     FAIL();
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("e.png: a TIFF or PNG holds integer codes"), std::string::npos) << e.what();
