@@ -14,6 +14,10 @@ for class in linear L skewed-T P curved clipped gamma thickened fork thickened-l
   "$build/cli/chromatrace" analyze "$tmp/$class.exr" -o "$tmp/$class" --no-report --quiet
   cp "$tmp/$class/plots/region-00.png" "$images/analyze_$class.png"
 done
+for class in superposed mixed; do  # object 1 of a file with light-group layers, or with object ids
+  "$build/cli/chromatrace" analyze "$tmp/$class.exr" -o "$tmp/$class" --no-report --quiet
+  cp "$tmp/$class/plots/region-01.png" "$images/analyze_$class.png"
+done
 "$build/cli/chromatrace" analyze "$tmp/scene.exr" -o "$tmp/scene" --no-report --quiet
 cp "$tmp/scene/plots/region-01-components.png" "$images/analyze_scene_components.png"
 cp "$tmp/scene/plots/region-04-density.png" "$images/analyze_scene_density.png"

@@ -21,6 +21,8 @@ int main(int argc, char** argv) {
       {"thickened-line", thickened_line()}};
   for (const auto& [name, image] : shapes) write_sensor_exr(dir / (std::string(name) + ".exr"), {image, image, {}, {}, {}});
   write_sensor_exr(dir / "scene.exr", scene_with_components());
+  write_sensor_exr(dir / "superposed.exr", two_luminaires(0.4, Vec3(1.0, 0.8, 0.55), Vec3(0.8, 0.9, 1.0)));
+  write_sensor_exr(dir / "mixed.exr", two_objects_edge(true));
   SensorExr noisy = scene_with_components();
   noisy.final_image = add_sensor_noise(noisy.final_image, 20000, 10, 42);
   write_sensor_exr(dir / "scene_noisy.exr", noisy);

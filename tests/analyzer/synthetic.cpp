@@ -173,6 +173,42 @@ RgbImage add_sensor_noise(const RgbImage& image, double full_well, double read_n
   return out;
 }
 
+analyzer::AnalysisImage analysis_image(const SensorExr& exr) {
+  analyzer::AnalysisImage input;
+  input.image = exr.final_image;
+  input.linear = exr.linear;
+  for (const auto& [name, layer] : exr.components) input.components.push_back({name, layer});
+  input.object_ids = exr.ids;
+  input.object_names = exr.names;
+  return input;
+}
+
+SensorExr two_luminaires(double share_b, const Vec3& warm, const Vec3& cool) {
+  const RgbImage a = make_image(64, 64, [&](double u, double v) -> Vec3 {
+    return (0.1 + 0.9 * u) * (1 - share_b) * 2 * v * kBody.cwiseProduct(warm);
+  });
+  const RgbImage b = make_image(64, 64, [&](double u, double v) -> Vec3 {
+    return (0.1 + 0.9 * u) * share_b * 2 * (1 - v) * kBody.cwiseProduct(cool);
+  });
+  RgbImage total = a;
+  for (std::size_t i = 0; i < a.rgb.size(); ++i) total.rgb[i] = a.rgb[i] + b.rgb[i];
+  return {total, total, {{"light.warm", a}, {"light.cool", b}}, std::vector<std::int32_t>(64 * 64, 1), {{1, "wall"}}};
+}
+
+SensorExr two_objects_edge(bool box_filter) {
+  const Vec3 other = kBody.cwiseProduct(kSecondLight).normalized();
+  const RgbImage image = make_image(64, 64, [&](double u, double v) -> Vec3 {
+    const double m = 0.1 + 0.9 * v;
+    const int x = static_cast<int>(std::lround(u * 63));
+    if (box_filter && x == 31) return m * (0.75 * kBody + 0.25 * other);
+    return m * (x < 32 ? kBody : other);
+  });
+  std::vector<std::int32_t> ids;
+  for (int y = 0; y < 64; ++y)
+    for (int x = 0; x < 64; ++x) ids.push_back(x < 32 ? 1 : 2);
+  return {image, image, {}, ids, {{1, "left"}, {2, "right"}}};
+}
+
 void write_sensor_exr(const std::filesystem::path& file, const SensorExr& exr) {
   const int w = exr.final_image.width, h = exr.final_image.height;
   std::vector<std::string> channels{"R", "G", "B", "linear.R", "linear.G", "linear.B"};

@@ -72,6 +72,15 @@ struct SensorExr {
   std::map<std::int32_t, std::string> names;
 };
 void write_sensor_exr(const std::filesystem::path& file, const SensorExr& exr);
+// The same as the analyzer reads it from such a file.
+analyzer::AnalysisImage analysis_image(const SensorExr& exr);
+
+// A matte object (id 1, "wall"), 64 × 64, lit by two luminaires: light.warm's colour is body ∘ warm, light.cool's
+// body ∘ cool, their shares varying across it (share_b of the light is cool's on average).
+SensorExr two_luminaires(double share_b, const Vec3& warm, const Vec3& cool);
+// Two matte objects side by side, 64 × 64, each shaded top to bottom: ids 1 ("left", x < 32) and 2 ("right").
+// With pixel-area integration (box_filter) column 31 records a mix: 75 % object 1, 25 % object 2.
+SensorExr two_objects_edge(bool box_filter);
 // A plain 8- or 16-bit RGB file (PNG/TIFF by extension), values in [0, 1] scaled to full scale.
 void write_rgb(const std::filesystem::path& file, const RgbImage& image, int bits);
 

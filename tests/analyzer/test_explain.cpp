@@ -88,20 +88,8 @@ TEST(ComponentNames, Directness) {
 namespace ct::test {
 namespace {
 
-// A matte object lit by two luminaires: group a's colour is body ∘ warm, group b's body ∘ cool, with their
-// shares varying across the object. Known: the shares, and the angle between the two colours.
 analyzer::AnalysisImage two_lights(double share_b, const Vec3& warm, const Vec3& cool) {
-  analyzer::AnalysisImage input;
-  const RgbImage a = make_image(64, 64, [&](double u, double v) -> Vec3 {
-    return (0.1 + 0.9 * u) * (1 - share_b) * 2 * v * kBody.cwiseProduct(warm);
-  });
-  const RgbImage b = make_image(64, 64, [&](double u, double v) -> Vec3 {
-    return (0.1 + 0.9 * u) * share_b * 2 * (1 - v) * kBody.cwiseProduct(cool);
-  });
-  input.image = a;
-  for (std::size_t i = 0; i < a.rgb.size(); ++i) input.image.rgb[i] = a.rgb[i] + b.rgb[i];
-  input.components = {{"light.warm", a}, {"light.cool", b}};
-  return input;
+  return analysis_image(two_luminaires(share_b, warm, cool));
 }
 
 double energy(const RgbImage& image) { double e = 0; for (float v : image.rgb) e += v; return e; }
@@ -155,24 +143,7 @@ TEST(Superposition, SameColouredLuminairesOrAWeakSecondOneAreNot) {
 namespace ct::test {
 namespace {
 
-// Two matte objects side by side, each shaded top to bottom: ids 1 (left, x < 32) and 2. With pixel-area
-// integration the column on each side of the edge records a mix of the two colours (the edge runs a
-// quarter of the way into column 31: 75 % object 1, 25 % object 2; column 32 is pure object 2 but its
-// neighbour two steps over is object 2 too).
-analyzer::AnalysisImage two_objects(bool box_filter) {
-  const Vec3 other = kBody.cwiseProduct(kSecondLight).normalized();
-  analyzer::AnalysisImage input;
-  input.image = make_image(64, 64, [&](double u, double v) -> Vec3 {
-    const double m = 0.1 + 0.9 * v;
-    const int x = static_cast<int>(std::lround(u * 63));
-    if (box_filter && x == 31) return m * (0.75 * kBody + 0.25 * other);
-    return m * (x < 32 ? kBody : other);
-  });
-  for (int y = 0; y < 64; ++y)
-    for (int x = 0; x < 64; ++x) input.object_ids.push_back(x < 32 ? 1 : 2);
-  input.object_names = {{1, "left"}, {2, "right"}};
-  return input;
-}
+analyzer::AnalysisImage two_objects(bool box_filter) { return analysis_image(two_objects_edge(box_filter)); }
 
 TEST(EdgeMixing, MixedEdgePixelsOfPixelAreaAreFoundAndNamed) {
   const analyzer::AnalysisImage input = two_objects(true);
