@@ -2,7 +2,7 @@
 // The `chromatrace` command: each subcommand lives in its own cmd_<name>.cpp and registers itself here.
 //
 // A subcommand's add function creates its CLI11 subcommand on `app` and returns the action to run when the
-// user chose it. Actions return the exit code (0 success, 3 reserved for `compare` disagreements) and
+// user chose it. Actions return the exit code (0 success, also for `compare` whether or not the renders agree) and
 // throw ct::InputError for bad input (exit 2, one line) or anything else for runtime failures (exit 1).
 
 #include <functional>
@@ -24,5 +24,6 @@ Action add_paper(CLI::App& app);
 Action add_scene_bands(CLI::App& app);
 Action add_export_meshes(CLI::App& app);
 Action add_assemble(CLI::App& app);
+Action add_compare(CLI::App& app);
 
 }  // namespace ct::cli

@@ -30,6 +30,7 @@ int main(int argc, char** argv) {
   add(ct::cli::add_scene_bands(app));
   add(ct::cli::add_export_meshes(app));
   add(ct::cli::add_assemble(app));
+  add(ct::cli::add_compare(app));
 
   try {
     app.parse(argc, argv);

@@ -1,0 +1,509 @@
+// Cross-validation of two spectral renders (compare.h, docs/compare.md).
+#include "compare/compare.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numeric>
+#include <set>
+
+#include <fmt/core.h>
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "core/cie.h"
+#include "core/colour.h"
+#include "core/error.h"
+#include "core/spectral_exr.h"
+#include "sensor_sim/spectral_response.h"
+
+namespace ct::cmp {
+namespace {
+
+using nlohmann::json;
+
+struct Render {
+  std::string file;
+  SpectralExrInfo info;
+  std::map<std::string, std::vector<float>> layers;  // "total" and components, [y][x][band] on the file's bands
+  std::vector<std::int32_t> ids;
+};
+
+std::vector<std::string> component_names(const SpectralExrInfo& info) {
+  std::vector<std::string> names;
+  for (const SpectralLayer& l : info.layers)
+    if (!l.component.empty() && l.quantity == SpectralQuantity::S0) names.push_back(l.component);
+  return names;
+}
+
+Render load(const std::string& file) {
+  SpectralExrReader reader(file);
+  Render r;
+  r.file = file;
+  r.info = reader.info();
+  if (!r.info.emissive)
+    throw InputError(fmt::format("{}: not a spectral emissive render (kind: {}); compare needs S0.<λ>nm channels", file,
+                                 r.info.kind()));
+  r.layers["total"] = reader.read_layer(r.info.layer("", SpectralQuantity::S0));
+  for (const std::string& c : component_names(r.info))
+    r.layers[c] = reader.read_layer(r.info.layer(c, SpectralQuantity::S0));
+  if (r.info.has_object_ids) {
+    r.ids.resize(static_cast<std::size_t>(r.info.width) * r.info.height);
+    reader.read_object_ids(0, r.info.height, r.ids);
+  }
+  for (const auto& [name, values] : r.layers)
+    for (std::size_t i = 0; i < values.size(); ++i)
+      if (!std::isfinite(values[i]))
+        throw InputError(fmt::format("{}: layer {}: NaN or infinite value at pixel ({}, {})", file,
+                                     name == "total" ? "S0" : name, i / r.info.bands.size() % r.info.width,
+                                     i / r.info.bands.size() / r.info.width));
+  return r;
+}
+
+std::string meta(const SpectralExrInfo& info, const std::string& key) {
+  auto it = info.metadata.find(key);
+  return it == info.metadata.end() ? std::string() : it->second;
+}
+
+json parse_meta(const SpectralExrInfo& info, const std::string& key) {
+  const std::string text = meta(info, key);
+  if (text.empty()) return json();
+  json j = json::parse(text, nullptr, false);
+  return j.is_discarded() ? json() : j;
+}
+
+bool same_edges(const Bands& a, const Bands& b) {
+  if (a.size() != b.size()) return false;
+  for (std::size_t i = 0; i < a.edges().size(); ++i)
+    if (std::abs(a.edges()[i] - b.edges()[i]) > 1e-4) return false;
+  return true;
+}
+
+// For each band of `coarse`, the bands of `fine` that tile it and their width fractions; nullopt when the
+// plans do not nest (an edge of the coarse plan that is not an edge of the fine one, or a gap).
+using Rebin = std::vector<std::vector<std::pair<std::size_t, double>>>;
+std::optional<Rebin> nest(const Bands& coarse, const Bands& fine) {
+  constexpr double eps = 1e-4;
+  Rebin rebin(coarse.size());
+  for (std::size_t j = 0; j < coarse.size(); ++j) {
+    double at = coarse.lo(j);
+    for (std::size_t i = 0; i < fine.size(); ++i) {
+      if (fine.hi(i) <= coarse.lo(j) + eps || fine.lo(i) >= coarse.hi(j) - eps) continue;
+      if (std::abs(fine.lo(i) - at) > eps || fine.hi(i) > coarse.hi(j) + eps) return std::nullopt;
+      rebin[j].emplace_back(i, fine.width(i) / coarse.width(j));
+      at = fine.hi(i);
+    }
+    if (std::abs(at - coarse.hi(j)) > eps) return std::nullopt;
+  }
+  return rebin;
+}
+
+std::vector<float> rebinned(const std::vector<float>& values, std::size_t in_bands, const Rebin& rebin) {
+  const std::size_t pixels = values.size() / in_bands;
+  std::vector<float> out(pixels * rebin.size());
+  for (std::size_t p = 0; p < pixels; ++p)
+    for (std::size_t j = 0; j < rebin.size(); ++j) {
+      double s = 0;
+      for (const auto& [i, w] : rebin[j]) s += w * values[p * in_bands + i];
+      out[p * rebin.size() + j] = static_cast<float>(s);
+    }
+  return out;
+}
+
+std::string describe_bands(const Bands& b) {
+  return fmt::format("{:g}-{:g} nm ({} bands)", b.min_wavelength(), b.max_wavelength(), b.size());
+}
+
+// Every render of a side must be of the same kind as its first.
+void check_side(const std::vector<Render>& side) {
+  const Render& first = side.front();
+  for (std::size_t i = 1; i < side.size(); ++i) {
+    const Render& r = side[i];
+    if (r.info.width != first.info.width || r.info.height != first.info.height)
+      throw InputError(fmt::format("{}: image is {}x{} but {} is {}x{}", r.file, r.info.width, r.info.height,
+                                   first.file, first.info.width, first.info.height));
+    if (!same_edges(r.info.bands, first.info.bands))
+      throw InputError(fmt::format("{}: bands {} differ from {}'s {} (renders of one side need the same plan)", r.file,
+                                   describe_bands(r.info.bands), first.file, describe_bands(first.info.bands)));
+    if (component_names(r.info) != component_names(first.info))
+      throw InputError(fmt::format("{}: components differ from {}'s", r.file, first.file));
+  }
+}
+
+std::array<double, 3> vec(const json& j) {
+  if (!j.is_array() || j.size() != 3) return {0, 0, 0};
+  return {j[0].get<double>(), j[1].get<double>(), j[2].get<double>()};
+}
+std::array<double, 3> normalised(std::array<double, 3> v) {
+  const double n = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+  if (n > 0)
+    for (double& x : v) x /= n;
+  return v;
+}
+
+// Different scenes, cameras or sizes are incomparable: an InputError naming B's file and what differs.
+void check_comparable(const Render& a, const Render& b) {
+  if (a.info.width != b.info.width || a.info.height != b.info.height)
+    throw InputError(fmt::format("{}: image is {}x{} but {} is {}x{} (incomparable: different sizes)", b.file,
+                                 b.info.width, b.info.height, a.file, a.info.width, a.info.height));
+  const json sa = parse_meta(a.info, "chromatrace.scene"), sb = parse_meta(b.info, "chromatrace.scene");
+  if (sa.is_object() && sb.is_object() && sa.contains("name") && sb.contains("name") && sa["name"] != sb["name"])
+    throw InputError(fmt::format("{}: attribute chromatrace.scene: scene {} but {} renders {} (incomparable: "
+                                 "different scenes)",
+                                 b.file, sb["name"].dump(), a.file, sa["name"].dump()));
+  if (!a.info.object_names.empty() && !b.info.object_names.empty() && a.info.object_names != b.info.object_names) {
+    for (const auto& [id, name] : a.info.object_names) {
+      auto it = b.info.object_names.find(id);
+      const std::string other = it == b.info.object_names.end() ? "no object" : "\"" + it->second + "\"";
+      if (other != "\"" + name + "\"")
+        throw InputError(fmt::format("{}: attribute chromatrace.objects: id {} is {} but \"{}\" in {} (incomparable: "
+                                     "different scenes)",
+                                     b.file, id, other, name, a.file));
+    }
+    throw InputError(fmt::format("{}: attribute chromatrace.objects: more objects than in {} (incomparable: "
+                                 "different scenes)",
+                                 b.file, a.file));
+  }
+  const json ca = parse_meta(a.info, "chromatrace.camera"), cb = parse_meta(b.info, "chromatrace.camera");
+  if (ca.is_object() && cb.is_object()) {
+    auto differ = [&](const std::string& what, double x, double y, double tol) {
+      if (std::abs(x - y) > tol)
+        throw InputError(fmt::format("{}: attribute chromatrace.camera: {} is {:.6g} but {:.6g} in {} (incomparable: "
+                                     "different cameras)",
+                                     b.file, what, y, x, a.file));
+    };
+    const auto pa = vec(ca.value("position", json())), pb = vec(cb.value("position", json()));
+    const auto la = vec(ca.value("look_at", json())), lb = vec(cb.value("look_at", json()));
+    const auto da = normalised({la[0] - pa[0], la[1] - pa[1], la[2] - pa[2]});
+    const auto db = normalised({lb[0] - pb[0], lb[1] - pb[1], lb[2] - pb[2]});
+    auto ortho_up = [](std::array<double, 3> up, const std::array<double, 3>& d) {
+      const double k = up[0] * d[0] + up[1] * d[1] + up[2] * d[2];
+      for (int i = 0; i < 3; ++i) up[i] -= k * d[i];
+      return normalised(up);
+    };
+    const auto ua = ortho_up(vec(ca.value("up", json())), da), ub = ortho_up(vec(cb.value("up", json())), db);
+    static const char* axis = "xyz";
+    for (int i = 0; i < 3; ++i) {
+      differ(fmt::format("position.{}", axis[i]), pa[i], pb[i], 1e-4 * (1 + std::abs(pa[i])));
+      differ(fmt::format("direction.{}", axis[i]), da[i], db[i], 1e-5);
+      differ(fmt::format("up.{}", axis[i]), ua[i], ub[i], 1e-5);
+    }
+    for (const char* key : {"horizontal_fov_deg", "vertical_fov_deg"})
+      if (ca.contains(key) && cb.contains(key)) differ(key, ca[key].get<double>(), cb[key].get<double>(), 1e-3);
+  }
+}
+
+// The scene's BRDF type of each object name ("lambert", "dichromatic", …, "emitter" for lights).
+std::map<std::string, std::string> brdf_types(const json& scene) {
+  std::map<std::string, std::string> types;
+  if (!scene.is_object()) return types;
+  const json materials = scene.value("materials", json::object());
+  for (const json& o : scene.value("objects", json::array())) {
+    if (!o.is_object() || !o.contains("name")) continue;
+    std::string type = "unknown";
+    const json m = o.value("material", json());
+    if (m.is_string() && materials.contains(m.get<std::string>()))
+      type = materials[m.get<std::string>()].value("type", "unknown");
+    else if (m.is_object())
+      type = m.value("type", "unknown");
+    types[o["name"].get<std::string>()] = type;
+  }
+  for (const json& l : scene.value("lights", json::array()))
+    if (l.is_object() && l.contains("name")) types[l["name"].get<std::string>()] = "emitter";
+  return types;
+}
+
+double default_tolerance(const std::string& brdf) { return brdf == "lambert" || brdf == "emitter" ? 0.01 : 0.02; }
+
+struct Region {
+  std::int32_t id = 0;
+  std::string name, brdf;
+  std::vector<std::size_t> pixels;
+  std::vector<std::pair<std::size_t, std::size_t>> pairs;  // neighbouring pixels both in the region
+};
+
+// Mean and standard error of one side's renders over a region, for one layer and band.
+std::pair<double, double> side_stats(const std::vector<const std::vector<float>*>& layers, std::size_t bands,
+                                     std::size_t band, const Region& region) {
+  std::vector<double> means;
+  for (const auto* values : layers) {
+    double s = 0;
+    for (std::size_t p : region.pixels) s += (*values)[p * bands + band];
+    means.push_back(s / static_cast<double>(region.pixels.size()));
+  }
+  const double k = static_cast<double>(means.size());
+  const double mean = std::accumulate(means.begin(), means.end(), 0.0) / k;
+  if (means.size() >= 2) {
+    double ss = 0;
+    for (double m : means) ss += (m - mean) * (m - mean);
+    return {mean, std::sqrt(ss / (k - 1) / k)};
+  }
+  const std::vector<float>& v = *layers.front();
+  double variance = 0;
+  if (!region.pairs.empty()) {
+    double ss = 0;
+    for (const auto& [p, q] : region.pairs) {
+      const double d = double(v[p * bands + band]) - v[q * bands + band];
+      ss += d * d;
+    }
+    variance = ss / (2.0 * static_cast<double>(region.pairs.size()));
+  } else if (region.pixels.size() >= 2) {
+    double ss = 0;
+    for (std::size_t p : region.pixels) ss += (v[p * bands + band] - mean) * (v[p * bands + band] - mean);
+    variance = ss / static_cast<double>(region.pixels.size() - 1);
+  } else {
+    return {mean, std::abs(mean)};  // one pixel: no noise estimate; as uncertain as the value itself
+  }
+  return {mean, std::sqrt(variance / static_cast<double>(region.pixels.size()))};
+}
+
+double percentile(std::vector<double> v, double q) {
+  if (v.empty()) return 0;
+  const std::size_t k = std::min(v.size() - 1, static_cast<std::size_t>(q * static_cast<double>(v.size() - 1) + 0.5));
+  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(k), v.end());
+  return v[k];
+}
+
+SideSummary summary(const std::vector<Render>& side) {
+  SideSummary s;
+  std::vector<std::string> seeds;
+  for (const Render& r : side) {
+    s.files.push_back(r.file);
+    seeds.push_back(meta(r.info, "chromatrace.seed"));
+  }
+  s.renderer = meta(side.front().info, "chromatrace.renderer");
+  s.samples = meta(side.front().info, "chromatrace.samples");
+  s.seeds = fmt::format("{}", fmt::join(seeds, ","));
+  return s;
+}
+
+}  // namespace
+
+Comparison compare(const CompareOptions& options) {
+  if (options.a.empty() || options.b.empty()) throw InputError("compare: needs two renders, A and B");
+  if (options.pixels != "matched" && options.pixels != "interior")
+    throw InputError(fmt::format("--pixels: must be matched or interior, got \"{}\"", options.pixels));
+  if (options.tolerance && !(*options.tolerance >= 0 && *options.tolerance < 1))
+    throw InputError(fmt::format("--tolerance: must be in [0, 100) %, got {:g} %", *options.tolerance * 100));
+  if (!(options.sigmas >= 0)) throw InputError(fmt::format("--sigmas: must be >= 0, got {:g}", options.sigmas));
+  const sensor::CameraCurves curves = sensor::camera_curves(options.camera, {"r", "g", "b"}, "--camera");
+
+  std::vector<Render> A, B;
+  for (const std::string& f : options.a) A.push_back(load(f));
+  for (const std::string& f : options.b) B.push_back(load(f));
+  check_side(A);
+  check_side(B);
+  check_comparable(A.front(), B.front());
+
+  Comparison c;
+  c.a = summary(A);
+  c.b = summary(B);
+  c.sigmas = options.sigmas;
+  c.camera = curves.name;
+  c.pixels_mode = options.pixels;
+  c.tolerance_mode = options.tolerance ? fmt::format("fixed {:g} %", *options.tolerance * 100)
+                                       : std::string("by BRDF type (Lambert and emitters 1 %, glossy 2 %)");
+  c.width = A.front().info.width;
+  c.height = A.front().info.height;
+  const json scene = parse_meta(A.front().info, "chromatrace.scene");
+  c.scene_name = scene.is_object() ? scene.value("name", "") : "";
+
+  // The common band plan: the coarser of the two, the finer averaged into it.
+  const Bands &ba = A.front().info.bands, &bb = B.front().info.bands;
+  if (same_edges(ba, bb)) {
+    c.bands = ba;
+  } else {
+    const bool a_coarse = ba.size() <= bb.size();
+    const Bands& coarse = a_coarse ? ba : bb;
+    const Bands& fine = a_coarse ? bb : ba;
+    const auto rebin = nest(coarse, fine);
+    if (!rebin)
+      throw InputError(fmt::format("{}: bands {} do not nest with {}'s {} (every edge of the coarser plan must be an "
+                                   "edge of the finer)",
+                                   B.front().file, describe_bands(bb), A.front().file, describe_bands(ba)));
+    c.bands = coarse;
+    for (Render& r : a_coarse ? B : A)
+      for (auto& [name, values] : r.layers) values = rebinned(values, fine.size(), *rebin);
+  }
+  const std::size_t nb = c.bands.size();
+
+  // Components both sides have.
+  const auto ca = component_names(A.front().info), cb = component_names(B.front().info);
+  c.components.push_back("total");
+  for (const std::string& n : ca)
+    if (std::find(cb.begin(), cb.end(), n) != cb.end()) c.components.push_back(n);
+    else c.only_a.push_back(n);
+  for (const std::string& n : cb)
+    if (std::find(ca.begin(), ca.end(), n) == ca.end()) c.only_b.push_back(n);
+
+  // Regions: each object's pixels (ids equal in both renders), and the whole image.
+  const std::size_t W = static_cast<std::size_t>(c.width), H = static_cast<std::size_t>(c.height), N = W * H;
+  const auto types = brdf_types(scene);
+  std::vector<Region> regions;
+  {
+    Region image;
+    image.id = -1;
+    image.name = "(image)";
+    image.brdf = "image";
+    for (std::size_t p = 0; p < N; ++p) image.pixels.push_back(p);
+    regions.push_back(std::move(image));
+  }
+  const std::vector<std::int32_t>& ida = A.front().ids;
+  const std::vector<std::int32_t>& idb = B.front().ids;
+  if (!ida.empty() && !idb.empty()) {
+    std::vector<std::int32_t> label(N, -1);  // the object of each pixel used, or -1
+    for (std::size_t p = 0; p < N; ++p) {
+      if (ida[p] != idb[p]) {
+        ++c.id_mismatch_pixels;
+        continue;
+      }
+      if (ida[p] == 0) continue;
+      bool keep = true;
+      if (options.pixels == "interior") {
+        const std::size_t x = p % W, y = p / W;
+        for (int dy = -1; dy <= 1 && keep; ++dy)
+          for (int dx = -1; dx <= 1 && keep; ++dx) {
+            const long xx = long(x) + dx, yy = long(y) + dy;
+            if (xx < 0 || yy < 0 || xx >= long(W) || yy >= long(H)) continue;
+            const std::size_t q = std::size_t(yy) * W + std::size_t(xx);
+            keep = ida[q] == ida[p] && idb[q] == ida[p];
+          }
+      }
+      if (keep) label[p] = ida[p];
+    }
+    std::map<std::int32_t, Region> by_id;
+    for (std::size_t p = 0; p < N; ++p)
+      if (label[p] >= 0) by_id[label[p]].pixels.push_back(p);
+    for (auto& [id, region] : by_id) {
+      region.id = id;
+      auto it = A.front().info.object_names.find(id);
+      region.name = it != A.front().info.object_names.end() ? it->second : fmt::format("id {}", id);
+      auto t = types.find(region.name);
+      region.brdf = t != types.end() ? t->second : "unknown";
+      for (std::size_t p : region.pixels) {
+        const std::size_t x = p % W, y = p / W;
+        if (x + 1 < W && label[p + 1] == id) region.pairs.emplace_back(p, p + 1);
+        if (y + 1 < H && label[p + W] == id) region.pairs.emplace_back(p, p + W);
+      }
+      regions.push_back(std::move(region));
+    }
+  }
+  for (Region& r : regions)
+    if (r.id == -1)
+      for (std::size_t p = 0; p < N; ++p) {
+        if ((p % W) + 1 < W) r.pairs.emplace_back(p, p + 1);
+        if (p + W < N) r.pairs.emplace_back(p, p + W);
+      }
+  double max_tolerance = 0.01;
+  for (const Region& r : regions)
+    if (r.id >= 0) max_tolerance = std::max(max_tolerance, default_tolerance(r.brdf));
+
+  // Cells.
+  for (const Region& region : regions) {
+    if (region.pixels.empty()) continue;
+    const double tol = options.tolerance ? *options.tolerance
+                       : region.id == -1 ? max_tolerance
+                                         : default_tolerance(region.brdf);
+    for (const std::string& component : c.components) {
+      std::vector<const std::vector<float>*> la, lb;
+      for (const Render& r : A) la.push_back(&r.layers.at(component));
+      for (const Render& r : B) lb.push_back(&r.layers.at(component));
+      for (std::size_t band = 0; band < nb; ++band) {
+        Cell cell;
+        cell.object_id = region.id;
+        cell.object = region.name;
+        cell.brdf = region.brdf;
+        cell.component = component;
+        cell.band = band;
+        cell.lo_nm = c.bands.lo(band);
+        cell.hi_nm = c.bands.hi(band);
+        cell.pixels = region.pixels.size();
+        std::tie(cell.mean_a, cell.se_a) = side_stats(la, nb, band, region);
+        std::tie(cell.mean_b, cell.se_b) = side_stats(lb, nb, band, region);
+        const double diff = cell.mean_a - cell.mean_b;
+        const double se = std::hypot(cell.se_a, cell.se_b);
+        const double scale = std::max(std::abs(cell.mean_a), std::abs(cell.mean_b));
+        // Exact values on both sides (a lamp seen directly): a difference within float rounding is z = 0.
+        cell.z = se > 0                            ? diff / se
+                 : std::abs(diff) <= 1e-6 * scale ? 0.0
+                                                  : std::copysign(std::numeric_limits<double>::infinity(), diff);
+        if (cell.mean_b != 0) {
+          const double r = cell.mean_a / cell.mean_b;
+          cell.ratio = r;
+          cell.se_ratio = cell.mean_a != 0 ? std::abs(r) * std::hypot(cell.se_a / cell.mean_a, cell.se_b / cell.mean_b)
+                                           : cell.se_a / std::abs(cell.mean_b);
+        }
+        cell.tolerance = tol;
+        // Float rounding of the stored values (2^-24 relative) is never a disagreement.
+        cell.pass = std::abs(diff) <= tol * std::abs(cell.mean_b) + options.sigmas * se + 1e-6 * scale;
+        if (!cell.pass) ++c.failed;
+        c.cells.push_back(std::move(cell));
+      }
+    }
+  }
+
+  // Image level: ΔE00 through the camera, between the sides' average images.
+  auto average = [&](const std::vector<Render>& side) {
+    std::vector<double> out(N * nb, 0.0);
+    for (const Render& r : side) {
+      const auto& v = r.layers.at("total");
+      for (std::size_t i = 0; i < out.size(); ++i) out[i] += v[i];
+    }
+    for (double& v : out) v /= static_cast<double>(side.size());
+    return out;
+  };
+  const auto q = sensor::photon_response(c.bands, curves, sensor::ResponseBasis::Energy, 1.0,
+                                         PiecewiseLinearSpectrum::constant(1.0));
+  auto responses = [&](const std::vector<double>& img) {
+    std::vector<Vec3d> out(N);
+    for (std::size_t p = 0; p < N; ++p)
+      for (int k = 0; k < 3; ++k) {
+        double s = 0;
+        for (std::size_t b = 0; b < nb; ++b) s += q[k][b] * img[p * nb + b];
+        out[p][k] = s;
+      }
+    return out;
+  };
+  const auto xa = responses(average(A)), xb = responses(average(B));
+  // White: the camera's response to D65, scaled to the 99th percentile of A's second channel over pixels not
+  // on an emitter (emitters would set it otherwise).
+  std::set<std::int32_t> emitters;
+  for (const Region& r : regions)
+    if (r.brdf == "emitter") emitters.insert(r.id);
+  std::vector<double> ys;
+  for (std::size_t p = 0; p < N; ++p)
+    if (ida.empty() || !emitters.count(ida[p])) ys.push_back(xa[p][1]);
+  double yw = percentile(ys, 0.99);
+  if (!(yw > 0)) {
+    yw = 0;
+    for (const auto& v : xa) yw = std::max(yw, v[1]);
+  }
+  if (!(yw > 0)) yw = 1;
+  const std::vector<double> d65 = band_averages(cie::illuminant("D65"), c.bands);
+  Vec3d white{};
+  for (int k = 0; k < 3; ++k)
+    for (std::size_t b = 0; b < nb; ++b) white[k] += q[k][b] * d65[b];
+  const double wscale = white[1] > 0 ? yw / white[1] : 1.0;
+  for (double& v : white) v = std::max(v * wscale, 1e-300);
+  c.delta_e.resize(N);
+  c.rgb_a.resize(N * 3);
+  c.rgb_b.resize(N * 3);
+  const bool cie = curves.name == "cie1931";
+  for (std::size_t p = 0; p < N; ++p) {
+    c.delta_e[p] = delta_e_2000(xyz_to_lab(xa[p], white), xyz_to_lab(xb[p], white));
+    for (int side = 0; side < 2; ++side) {
+      const Vec3d& x = side == 0 ? xa[p] : xb[p];
+      Vec3d rgb;
+      if (cie) rgb = xyz_to_linear_srgb({x[0] / yw, x[1] / yw, x[2] / yw});
+      else rgb = {x[0] / white[0], x[1] / white[1], x[2] / white[2]};  // white-balanced camera RGB
+      auto& out = side == 0 ? c.rgb_a : c.rgb_b;
+      for (int k = 0; k < 3; ++k) out[p * 3 + k] = static_cast<float>(rgb[k]);
+    }
+  }
+  c.delta_e_mean = std::accumulate(c.delta_e.begin(), c.delta_e.end(), 0.0) / static_cast<double>(N);
+  c.delta_e_p95 = percentile(c.delta_e, 0.95);
+  c.delta_e_max = *std::max_element(c.delta_e.begin(), c.delta_e.end());
+  return c;
+}
+
+}  // namespace ct::cmp

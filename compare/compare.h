@@ -1,0 +1,87 @@
+#pragma once
+// Cross-validation of two spectral renders of one scene (docs/compare.md): per object × band × component
+// the two means, their ratio with its Monte Carlo standard error, the z-score and a pass/fail against a
+// tolerance; image-level ΔE00 through a camera; compare.json, compare.png and compare.html.
+//
+// Either side may be several renders with independent seeds (A1.exr,A2.exr): the side's mean is the
+// average of the renders' object means and its standard error their spread / √k. A single render's standard
+// error comes from the per-pixel noise within the object, estimated from differences of neighbouring pixels
+// of the object (half their mean square is the per-pixel variance; smooth shading cancels out).
+//
+// Bad or incomparable input (different scenes, cameras, sizes, band plans that do not nest) is an
+// InputError naming the file and what differs.
+
+#include <cstdint>
+#include <filesystem>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/spectrum.h"
+
+namespace ct::cmp {
+
+struct CompareOptions {
+  std::vector<std::string> a;  // renders of side A (one, or several with independent seeds)
+  std::vector<std::string> b;
+  // Relative tolerance for every cell; unset: by BRDF type (Lambert and emitters 1 %, anything glossy 2 %).
+  std::optional<double> tolerance;
+  double sigmas = 4.0;  // a cell passes when |mean_a − mean_b| ≤ tolerance·|mean_b| + sigmas·se
+  // Pixels of an object: "matched" (the id is the same in both renders) or "interior" (also every
+  // 8-neighbour has that id in both).
+  std::string pixels = "matched";
+  std::string camera = "cie1931";  // for ΔE00: the CIE observer, or a camera the sensor simulator ships
+};
+
+struct Cell {
+  std::int32_t object_id = 0;  // -1: the whole image
+  std::string object;
+  std::string brdf;  // lambert, dichromatic, mirror, ggx, phong, emitter, image
+  std::string component;  // "total", "diffuse_direct", "light.ceiling", …
+  std::size_t band = 0;
+  double lo_nm = 0, hi_nm = 0;
+  std::size_t pixels = 0;
+  double mean_a = 0, mean_b = 0, se_a = 0, se_b = 0;
+  std::optional<double> ratio, se_ratio;  // unset when mean_b is 0
+  double z = 0;                           // (mean_a − mean_b) / √(se_a² + se_b²); 0 when both are exact
+  double tolerance = 0;
+  bool pass = true;
+};
+
+struct SideSummary {
+  std::vector<std::string> files;
+  std::string renderer, samples, seeds;
+};
+
+struct Comparison {
+  SideSummary a, b;
+  std::string scene_name;
+  int width = 0, height = 0;
+  Bands bands;  // the common (coarser) plan
+  std::vector<std::string> components;  // compared: "total" and the components both have
+  std::vector<std::string> only_a, only_b;
+  std::size_t id_mismatch_pixels = 0;  // pixels whose object id differs between A and B
+  std::vector<Cell> cells;
+  std::size_t failed = 0;
+  double sigmas = 4.0;
+  std::string tolerance_mode;  // "by BRDF type" or "fixed 1%"
+  std::string pixels_mode;
+  // Image level.
+  std::string camera;
+  std::vector<double> delta_e;  // per pixel, [y][x]
+  double delta_e_mean = 0, delta_e_p95 = 0, delta_e_max = 0;
+  // Linear sRGB previews of A, B (row-major RGB), scaled so the reference white is 1.
+  std::vector<float> rgb_a, rgb_b;
+};
+
+Comparison compare(const CompareOptions& options);
+
+// compare.json, compare.png (A | B | difference | ΔE00), compare.html in `dir` (created if missing; its
+// parent must exist); each written atomically.
+void write_outputs(const Comparison& c, const std::filesystem::path& dir);
+
+// The one-screen verdict for stderr.
+std::string verdict(const Comparison& c, std::size_t max_lines = 12);
+
+}  // namespace ct::cmp
