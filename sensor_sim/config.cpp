@@ -97,7 +97,8 @@ PiecewiseLinearSpectrum transmittance(const JsonNode& node) {
 }
 
 void read_optics(const JsonNode& node, OpticsConfig& o) {
-  node.expect_object({"enabled", "f_number", "cos4", "fov_deg", "transmittance"});
+  node.expect_object({"enabled", "f_number", "cos4", "fov_deg", "transmittance", "flare"});
+  read_key(node, "flare", [&](const JsonNode& n) { o.flare = n.number_in(0, 1); });
   read_key(node, "enabled", [&](const JsonNode& n) { o.enabled = n.boolean(); });
   read_key(node, "f_number", [&](const JsonNode& n) { o.f_number = n.number_above(0); });
   read_key(node, "cos4", [&](const JsonNode& n) { o.cos4 = n.boolean(); });
@@ -429,7 +430,8 @@ Json config_json(const SensorConfig& c) {
         {"f_number", c.optics.f_number},
         {"cos4", c.optics.cos4},
         {"fov_deg", optional(c.optics.fov_deg)},
-        {"transmittance", c.optics.transmittance ? c.optics.transmittance_spec : Json(nullptr)}}},
+        {"transmittance", c.optics.transmittance ? c.optics.transmittance_spec : Json(nullptr)},
+        {"flare", c.optics.flare}}},
       {"exposure",
        {{"time_s", c.exposure.time_s ? Json(*c.exposure.time_s) : Json("auto")},
         {"scale", c.exposure.scale},

@@ -34,6 +34,9 @@ struct OpticsConfig {
   // Lens transmittance τ(λ); none: 1. `transmittance_spec` is the JSON it came from (for the record).
   std::optional<PiecewiseLinearSpectrum> transmittance;
   Json transmittance_spec;
+  // Veiling glare: light scattered inside the lens spreads over the whole sensor. Modelled as a uniform
+  // irradiance of `flare` × the image's mean (the veiling glare index of ISO 9358; 0.5–3 % for real lenses).
+  double flare = 0.0;
 };
 
 // Stage 2: exposure time T. Auto: the time that puts the `auto_percentile` of the brightest channel's

@@ -224,6 +224,8 @@ struct Survey {
   std::vector<float> surfaces, emitters;  // brightest channel per pixel, e⁻/s
   std::map<std::int32_t, std::pair<std::vector<double>, std::size_t>> emitter_spectra;  // by id: Σ bands, pixels
   std::vector<float> display_samples;                                                  // surfaces, 3 per pixel
+  std::array<double, 3> signal_sum{};  // Σ linear signal over every surveyed pixel, emitters included (veiling glare)
+  std::size_t pixels = 0;
 };
 
 Survey survey_image(SpectralExrReader& reader, const Run& unit_run, const SpectralLayer& total,
@@ -255,6 +257,8 @@ Survey survey_image(SpectralExrReader& reader, const Run& unit_run, const Spectr
         const std::size_t p = to_size(r) * to_size(width) + to_size(x);
         const float* c = linear.data() + 3 * p;
         const double sum = double(c[0]) + c[1] + c[2];
+        for (int ch = 0; ch < 3; ++ch) s.signal_sum[to_size(ch)] += c[ch];
+        ++s.pixels;
         bool emitter = false;
         if (!emission_linear.empty()) {
           const float* e = emission_linear.data() + 3 * p;
@@ -574,7 +578,8 @@ RunReport simulate_sensor(const fs::path& input, const fs::path& output, SensorC
   const SpectralLayer* emission = info.find_layer("emission", SpectralQuantity::S0);
   const std::set<std::int32_t> lights = light_object_ids(info);
   const std::vector<RowRange> surveyed =
-      auto_time || want_display ? survey_rows(auto_time, k, height, rows_per_block) : std::vector<RowRange>{};
+      auto_time || want_display || config.optics.flare > 0 ? survey_rows(auto_time, k, height, rows_per_block)
+                                                            : std::vector<RowRange>{};
   Progress progress("sensor", blocks + surveyed.size(), options.progress);
 
   // One pass at unit exposure: the automatic exposure time, the display's white balance and brightness.
@@ -589,8 +594,13 @@ RunReport simulate_sensor(const fs::path& input, const fs::path& output, SensorC
   Json display_description;
   DisplayRendering display;
   if (want_display) display = display_rendering(survey, run.model, config, info, display_description, config.notes);
+  // Veiling glare at unit exposure: flare × the image's mean signal, per channel.
+  std::array<double, 3> glare{};
+  if (config.optics.flare > 0 && survey.pixels > 0)
+    for (std::size_t c = 0; c < 3; ++c) glare[c] = config.optics.flare * survey.signal_sum[c] / double(survey.pixels);
   survey = Survey{};
   run.exposure_s = *config.exposure.time_s * config.exposure.scale;
+  for (double& g : glare) g *= run.exposure_s;
   run.model = linear_model(config, run.exposure_s, info.bands, fov, info.width, info.height);
   // The display's matrix and scale were found at unit exposure; the linear layer scales with the time.
   display.scale /= run.exposure_s;
@@ -655,7 +665,9 @@ RunReport simulate_sensor(const fs::path& input, const fs::path& output, SensorC
     const BlockInput in = next.get();
     if (in.y1 < height) next = std::async(std::launch::async, read_block, in.y1);
     const int y0 = in.y0, y1 = in.y1, e0 = in.context.first, e1 = in.context.last;
-    const std::vector<float> linear_ext = linear_rows(run, in.total, e0, e1);
+    std::vector<float> linear_ext = linear_rows(run, in.total, e0, e1);
+    if (config.optics.flare > 0)  // the glare lands on every pixel: it is light, so the linear layer has it too
+      for (std::size_t i = 0; i < linear_ext.size(); ++i) linear_ext[i] += static_cast<float>(glare[i % 3]);
     std::vector<float> image = read_out_rows(run, linear_ext, e0, e1);
     const std::size_t own = to_size(y0 - e0) * row_values, own_size = to_size(y1 - y0) * row_values;
     image.erase(image.begin() + static_cast<std::ptrdiff_t>(own + own_size), image.end());

@@ -77,6 +77,28 @@ TEST(Optics, ApertureAndTransmittanceScaleTheIrradiance) {
   EXPECT_DOUBLE_EQ(sensor::aperture_factor(2.0), std::numbers::pi / 16.0);
 }
 
+// Veiling glare adds flare × the image's mean signal to every pixel, per channel, whatever the pixel; the path
+// components are the scene's light and stay as they were.
+TEST(Optics, VeilingGlareAddsAFractionOfTheMeanSignalEverywhere) {
+  test::TempDir dir;
+  test::write_radiance(dir.file("ramp.exr"), kBands, 8, 6, [](int x, int y, std::size_t b) {
+    return static_cast<float>(0.2 + 0.3 * x + 0.1 * y * (b + 1));
+  });
+  const auto linear = [&](double flare, const std::string& name) {
+    test::run_sensor(dir.file("ramp.exr"), dir.file(name), test::config_of({{"optics", {{"flare", flare}}}}));
+    return test::read_rgb(dir.file(name), "linear");
+  };
+  const test::RgbLayer clean = linear(0.0, "clean.exr"), glared = linear(0.02, "glare.exr");
+  const std::size_t pixels = clean.values.size() / 3;
+  for (std::size_t c = 0; c < 3; ++c) {
+    double mean = 0;
+    for (std::size_t p = 0; p < pixels; ++p) mean += clean.values[3 * p + c] / double(pixels);
+    for (std::size_t p = 0; p < pixels; ++p)
+      EXPECT_NEAR(glared.values[3 * p + c] - clean.values[3 * p + c], 0.02 * mean, 1e-5 * mean) << "channel " << c;
+  }
+  EXPECT_THROW(test::config_of({{"optics", {{"flare", 1.5}}}}), InputError);  // a fraction in [0, 1]
+}
+
 TEST(Optics, MalformedCameraAttributeNamesIt) {
   test::TempDir dir;
   test::write_radiance(dir.file("bad.exr"), kBands, 2, 2, [](int, int, std::size_t) { return 1.0f; },
