@@ -4,9 +4,13 @@
 // tolerance; image-level ΔE00 through a camera; compare.json, compare.png and compare.html.
 //
 // Either side may be several renders with independent seeds (A1.exr,A2.exr): the side's mean is the
-// average of the renders' object means and its standard error their spread / √k. A single render's standard
-// error comes from the per-pixel noise within the object, estimated from differences of neighbouring pixels
-// of the object (half their mean square is the per-pixel variance; smooth shading cancels out).
+// average of the renders' object means. The standard error of the difference of the two means, which the
+// z-score and the test use, is from the seeds when both sides have several renders (their spread / √k, each
+// side), else from the per-pixel variance within the object of the difference image A − B (its standard
+// deviation / √n): both renderers render the same image, so its structure cancels and what remains is the
+// two renders' per-pixel noise, independent from pixel to pixel. se_a and se_b are reported per side: from
+// the seeds, or, for a single render, from differences of neighbouring pixels of the object (an upper bound:
+// shading gradients add to it).
 //
 // Bad or incomparable input (different scenes, cameras, sizes, band plans that do not nest) is an
 // InputError naming the file and what differs.
@@ -43,6 +47,7 @@ struct Cell {
   double lo_nm = 0, hi_nm = 0;
   std::size_t pixels = 0;
   double mean_a = 0, mean_b = 0, se_a = 0, se_b = 0;
+  double se = 0;  // standard error of mean_a − mean_b, which z and the test use (see se_method)
   std::optional<double> ratio, se_ratio;  // unset when mean_b is 0
   double z = 0;                           // (mean_a − mean_b) / √(se_a² + se_b²); 0 when both are exact
   double tolerance = 0;
@@ -67,6 +72,9 @@ struct Comparison {
   double sigmas = 4.0;
   std::string tolerance_mode;  // "by BRDF type" or "fixed 1%"
   std::string pixels_mode;
+  // "seeds" (both sides several renders: the spread of their means) or "paired pixels" (the spread of the
+  // per-pixel differences A − B within the object, which removes the image's own structure).
+  std::string se_method;
   // Image level.
   std::string camera;
   std::vector<double> delta_e;  // per pixel, [y][x]

@@ -63,6 +63,7 @@ json to_json(const Comparison& c) {
                      {"mean_b", cell.mean_b},
                      {"se_a", cell.se_a},
                      {"se_b", cell.se_b},
+                     {"se", cell.se},
                      {"ratio", cell.ratio ? number(*cell.ratio) : json(nullptr)},
                      {"se_ratio", cell.se_ratio ? number(*cell.se_ratio) : json(nullptr)},
                      {"z", number(cell.z)},
@@ -104,6 +105,7 @@ json to_json(const Comparison& c) {
           {"object_id_mismatch_pixels", c.id_mismatch_pixels},
           {"tolerance", c.tolerance_mode},
           {"sigmas", c.sigmas},
+          {"standard_error", c.se_method},
           {"image", {{"camera", c.camera},
                      {"delta_e00", {{"mean", c.delta_e_mean}, {"p95", c.delta_e_p95}, {"max", c.delta_e_max}}}}},
           {"verdict", {{"cells", c.cells.size()}, {"failed", c.failed}, {"agree", c.failed == 0}}},
@@ -229,6 +231,7 @@ std::string verdict(const Comparison& c, std::size_t max_lines) {
   out += fmt::format("  {}×{}, {} bands {:g}-{:g} nm, {} components, pixels {} ({} with different ids left out)\n",
                      c.width, c.height, c.bands.size(), c.bands.min_wavelength(), c.bands.max_wavelength(),
                      c.components.size(), c.pixels_mode, c.id_mismatch_pixels);
+  out += fmt::format("  standard errors from {}\n", c.se_method);
   out += fmt::format("  ΔE00 ({}): mean {:.3f}, 95th percentile {:.3f}, max {:.3f}\n", c.camera, c.delta_e_mean,
                      c.delta_e_p95, c.delta_e_max);
   const auto cells = worst_cells(c);

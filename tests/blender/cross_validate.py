@@ -1,0 +1,138 @@
+"""Cycles (through the add-on, real Blender) held to the reference tracer with `chromatrace compare`.
+
+    python3 cross_validate.py agree SCENE.json        # every object × band × component must agree
+    python3 cross_validate.py filter-glossy SCENE.json  # Cycles' default Filter Glossy and Clamp Indirect left on: must fail
+    python3 cross_validate.py reflectance SCENE.json OBJECT  # OBJECT's reflectance changed for Cycles: must fail there
+
+Environment: CHROMATRACE_EXE, BLENDER (the executable), and optionally CROSS_SIZE (32x32), CROSS_BANDS
+(380:780:40), CROSS_SPP (tracer and Cycles samples per pixel), CROSS_KEEP (a folder to keep the files in).
+Exit 0 when the assertion holds, 1 otherwise, with the compare verdict on stderr.
+"""
+import json
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+
+EXE = os.environ["CHROMATRACE_EXE"]
+BLENDER = os.environ.get("BLENDER", "blender")
+SOURCE = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+SIZE = os.environ.get("CROSS_SIZE", "32x32")
+BANDS = os.environ.get("CROSS_BANDS", "380:780:40")
+SPP = os.environ.get("CROSS_SPP", "2048")
+
+
+def run(args, env=None):
+    start = time.monotonic()
+    result = subprocess.run(args, capture_output=True, text=True, env=env)
+    if result.returncode != 0:
+        sys.exit(f"failed ({result.returncode}): {' '.join(args)}\n{result.stderr}")
+    return result, time.monotonic() - start
+
+
+def render_tracer(scene, out, seed=1):
+    _, seconds = run([EXE, "render", scene, "-o", out, "--spp", SPP, "--resolution", SIZE, "--bands", BANDS,
+                      "--seed", str(seed), "--components", "paths,lights", "-q"])
+    return seconds
+
+
+def render_cycles(scene, out, work, env_extra=None):
+    env = dict(os.environ, CHROMATRACE_EXE=EXE)
+    env.update(env_extra or {})
+    _, seconds = run([BLENDER, "--background", "--factory-startup", "--python",
+                      os.path.join(SOURCE, "blender_addon", "batch.py"), "--", "--scene", scene, "--out", out,
+                      "--samples", SPP, "--resolution", SIZE, "--bands", BANDS, "--components", "paths,lights",
+                      "--seed", "7", "--cache-dir", os.path.join(work, "cache"), "-q"], env)
+    return seconds
+
+
+def compare(a, b, out):
+    # Interior pixels: Cycles takes an object's id from the first sample in the pixel, the tracer from its
+    # centre, so edge pixels are not the same set in both (docs/blender.md).
+    result, _ = run([EXE, "compare", a, b, "-o", out, "--pixels", "interior"])
+    sys.stderr.write(result.stderr)
+    with open(os.path.join(out, "compare.json")) as f:
+        return json.load(f)
+
+
+def scene_groups(scene):
+    with open(scene) as f:
+        return sorted({light["group"] for light in json.load(f)["lights"]})
+
+
+def check(condition, message):
+    if not condition:
+        sys.exit("FAIL: " + message)
+
+
+def main():
+    case, scene = sys.argv[1], os.path.abspath(sys.argv[2])
+    work = tempfile.mkdtemp(prefix="cross_validate_")
+    try:
+        tracer, cycles = os.path.join(work, "tracer.exr"), os.path.join(work, "cycles.exr")
+        t_seconds = render_tracer(scene, tracer)
+        if case == "agree":
+            c_seconds = render_cycles(scene, cycles, work)
+            doc = compare(cycles, tracer, os.path.join(work, "compare"))
+            # Every component family the issue names is compared.
+            expected = {"total", "emission", "diffuse_direct", "diffuse_indirect", "glossy_direct", "glossy_indirect"}
+            expected |= {f"light.{g}" for g in scene_groups(scene)}
+            check(expected <= set(doc["components"]), f"components compared {doc['components']}, expected {sorted(expected)}")
+            # The test has power: on every object of at least 60 interior pixels, the standard error of the
+            # total's difference in the brightest band is below the object's tolerance (1 % or 2 %), so a
+            # bias of a few per cent would be caught.
+            for o in doc["objects"]:
+                if o["object_id"] < 0 or o["pixels"] < 60:
+                    continue
+                cells = [c for c in doc["cells"] if c["object_id"] == o["object_id"] and c["component"] == "total"]
+                best = max(cells, key=lambda c: c["mean_b"])
+                se = best["se"] / best["mean_b"]
+                check(se < o["tolerance"], f"{o['object']}: relative standard error {se:.4f} of the total is too large to test")
+            failed = [c for c in doc["cells"] if not c["pass"]]
+            check(not failed, f"{len(failed)} cells disagree, e.g. {failed[:3]}")
+            print(f"agree: {len(doc['cells'])} cells, ΔE00 mean {doc['image']['delta_e00']['mean']:.3f}, "
+                  f"tracer {t_seconds:.1f} s, Cycles {c_seconds:.1f} s")
+        elif case == "filter-glossy":
+            render_cycles(scene, cycles, work, {"CHROMATRACE_TEST_CYCLES_SETTINGS": "blur_glossy=1,sample_clamp_indirect=10"})
+            doc = compare(cycles, tracer, os.path.join(work, "compare"))
+            failed = [c for c in doc["cells"] if not c["pass"]]
+            check(failed, "Cycles with Filter Glossy and Clamp Indirect on must disagree, but every cell passed")
+            # Clamping indirect light and blurring glossy bounces change indirect and glossy light only: the
+            # offending cells are there, never in emission or direct diffuse light.
+            biased = [c for c in failed if c["component"].endswith("_indirect") or c["component"].startswith("glossy_")]
+            check(biased, f"the offending cells must include indirect or glossy components: {failed[:5]}")
+            wrong = [c for c in failed if c["component"] in ("emission", "diffuse_direct")]
+            check(not wrong, f"emission and direct diffuse light must still agree: {wrong[:3]}")
+            print(f"disagree as expected: {len(failed)} cells, e.g. "
+                  + ", ".join(f"{c['object']} {c['component']} z={c['z']:.1f}" for c in biased[:3]))
+        elif case == "reflectance":
+            target = sys.argv[3]
+            with open(scene) as f:
+                document = json.load(f)
+            material = next(o["material"] for o in document["objects"] if o["name"] == target)
+            document["materials"][material] = {"type": "lambert", "reflectance": {"constant": 0.5}}
+            for key, spectrum in document["spectra"].items():  # keep relative paths valid from the copy
+                if "csv" in spectrum:
+                    spectrum["csv"] = os.path.join(os.path.dirname(scene), spectrum["csv"])
+            changed = os.path.join(work, "changed.json")
+            with open(changed, "w") as f:
+                json.dump(document, f)
+            render_cycles(changed, cycles, work)
+            doc = compare(cycles, tracer, os.path.join(work, "compare"))
+            failed = [c for c in doc["cells"] if not c["pass"]]
+            on_target = [c for c in failed if c["object"] == target and c["component"] == "total"]
+            check(len(on_target) >= len({c["band"] for c in doc["cells"]}) // 2,
+                  f"{target}'s total must fail in most bands; failed cells: {[(c['object'], c['component'], c['band']) for c in failed[:8]]}")
+            print(f"disagree as expected: {len(on_target)} bands of {target}'s total, {len(failed)} cells in all")
+        else:
+            sys.exit(f"unknown case {case}")
+    finally:
+        keep = os.environ.get("CROSS_KEEP")
+        if keep:
+            shutil.copytree(work, keep, dirs_exist_ok=True)
+        shutil.rmtree(work, ignore_errors=True)
+
+
+main()
