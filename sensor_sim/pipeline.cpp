@@ -602,8 +602,10 @@ RunReport simulate_sensor(const fs::path& input, const fs::path& output, SensorC
   run.exposure_s = *config.exposure.time_s * config.exposure.scale;
   for (double& g : glare) g *= run.exposure_s;
   run.model = linear_model(config, run.exposure_s, info.bands, fov, info.width, info.height);
-  // The display's matrix and scale were found at unit exposure; the linear layer scales with the time.
-  display.scale /= run.exposure_s;
+  // The display's matrix and scale were found at unit exposure; the linear layer scales with the time. The
+  // display is exposed like the camera's own picture: the time (chosen or automatic) is normalised away, an
+  // over-exposure asked for with exposure.scale shows, clipped, as it would in the camera's JPEG.
+  display.scale /= *config.exposure.time_s;
 
   Eigen::Vector3d gains = config.rendering.white_balance;
   if (config.rendering.white_balance_illuminant)

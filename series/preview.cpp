@@ -45,9 +45,9 @@ double quantile(std::vector<float> values, double q) {
 }
 
 cv::Mat preview_image(const analyzer::AnalysisImage& input) {
-  if (const analyzer::RgbImage* display = find_layer(input, "display")) {
+  if (input.display) {
     const float ones[3] = {1, 1, 1};
-    return encode(*display, ones, false);
+    return encode(*input.display, ones, false);
   }
   const analyzer::RgbImage& image = input.linear ? *input.linear : input.image;
   const analyzer::RgbImage* emission = input.linear ? find_layer(input, "emission") : nullptr;

@@ -15,7 +15,7 @@
 
 namespace ct::series {
 
-// A component layer of the file by name (`display`, `emission` …); nullptr when it has none.
+// A component layer of the file by name (`emission`, `light.key` …); nullptr when it has none.
 const analyzer::RgbImage* find_layer(const analyzer::AnalysisImage& input, std::string_view name);
 
 // The q-quantile of `values` (0 ≤ q ≤ 1, the nearest rank below); 0 for none.

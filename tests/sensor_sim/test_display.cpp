@@ -301,6 +301,37 @@ TEST(Display, LeavesTheRawImageAlone) {
   for (const ExrChannel& c : reader.info().channels) EXPECT_FALSE(c.name.starts_with("display.")) << c.name;
 }
 
+// The display is the camera's picture: exposure.scale over-exposes it as it over-exposes the raw numbers (4× the
+// linear display value where nothing clips, and white where it does), while the exposure time itself is
+// normalised away.
+TEST(Display, ShowsTheOverExposureAskedFor) {
+  test::TempDir dir;
+  write_display_scene(dir.file("in.exr"), lit_by("D65", Bands::uniform(380, 780, 10)), true);
+  Json patch = {{"preset", "ideal"}, {"exposure", {{"time_s", 0.01}}}};
+  test::run_sensor(dir.file("in.exr"), dir.file("one.exr"), test::config_of(patch));
+  patch["exposure"]["time_s"] = 0.04;
+  test::run_sensor(dir.file("in.exr"), dir.file("longer.exr"), test::config_of(patch));
+  patch["exposure"] = {{"time_s", 0.01}, {"scale", 4.0}};
+  test::run_sensor(dir.file("in.exr"), dir.file("four.exr"), test::config_of(patch));
+  const test::RgbLayer one = test::read_rgb(dir.file("one.exr"), "display");
+  const test::RgbLayer longer = test::read_rgb(dir.file("longer.exr"), "display");
+  const test::RgbLayer four = test::read_rgb(dir.file("four.exr"), "display");
+  std::size_t compared = 0, clipped = 0;
+  for (std::size_t i = 0; i < one.values.size(); ++i) {
+    EXPECT_NEAR(longer.values[i], one.values[i], 1e-3) << i;  // a longer time alone: the same picture
+    const double a = srgb_decode(one.values[i]), b = srgb_decode(four.values[i]);
+    if (4 * a < 0.95 && a > 0.02) {  // half storage: ~2.4e-4 of the encoded value, well under 1 % of these
+      EXPECT_NEAR(b / a, 4.0, 0.04) << i;
+      ++compared;
+    } else if (4 * a > 1.05) {
+      EXPECT_NEAR(four.values[i], 1.0, 1e-3) << i;
+      ++clipped;
+    }
+  }
+  EXPECT_GT(compared, 0u);
+  EXPECT_GT(clipped, 0u);
+}
+
 // For the CIE camera the fitted matrix is exact: the display reproduces a reflectance's sRGB colour under D65.
 // Errors: 1 nm bands integrate the CIE functions against band averages (~1e-6); the matrix keeps sRGB white
 // (the chromaticity-defined D65 white) while the targets are relative to the tabulated D65 white, ~1e-4 apart;
