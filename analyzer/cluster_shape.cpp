@@ -220,7 +220,8 @@ ClusterShape analyse_shape(std::span<const float> rgb, const ShapeContext& conte
     const TwoLines& m = *s.two_lines;
     if (!test("junction on body line >= t_junction", m.junction_on_body, k.t_junction, m.junction_on_body >= k.t_junction)) {
       s.shape = ShapeClass::Fork;
-      s.reason = fmt::format("two lines ({:.0f} % and {:.0f} %) diverging at {:.0f}° from near the dark end: two light colours",
+      s.reason = fmt::format("two lines ({:.0f} % and {:.0f} %) diverging at {:.0f}° from near the dark end: two light "
+                             "colours on one surface, or two surfaces in one region",
                              100 * m.body_fraction, 100 * m.highlight_fraction, m.angle_deg);
       return s;
     }

@@ -158,13 +158,7 @@ void print_variant(const Json& v) {
 // --emit / --emit-sensor: the variant's resolved scene (paths relative to where it is written) and its sensor
 // settings as a chromatrace-sensor/1 file, so it can be rendered with `render` or the Blender batch by hand.
 void emit_variant(const Options& options, const Series& series) {
-  const SeriesVariant* variant = series.find_variant(options.variant);
-  if (!variant) {
-    std::vector<std::string> names;
-    for (const SeriesVariant& v : series.variants) names.push_back(v.name);
-    throw InputError(fmt::format("--variant: {} has no variant \"{}\" (variants: {})", options.file, options.variant,
-                                 fmt::join(names, ", ")));
-  }
+  const SeriesVariant* variant = &series.variant(options.variant, "--variant");
   if (!options.emit.empty()) {
     const std::filesystem::path out = std::filesystem::absolute(options.emit);
     const Json scene = rebase_scene_paths(variant->scene.json, {}, out.parent_path());

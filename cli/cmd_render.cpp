@@ -1,11 +1,12 @@
 // chromatrace render SCENE.json -o OUT.exr: the reference path tracer.
-#include <cstdio>
 #include <filesystem>
 #include <optional>
+#include <tuple>
 
 #include <fmt/core.h>
 
 #include "cli/command.h"
+#include "cli/options.h"
 #include "core/error.h"
 #include "core/parallel.h"
 #include "core/scene.h"
@@ -42,14 +43,8 @@ Action add_render(CLI::App& app) {
 
   return [o] {
     Scene scene = load_scene(o->scene);
-    if (!o->resolution.empty()) {
-      int w = 0, h = 0;
-      char x = 0, extra = 0;
-      if (std::sscanf(o->resolution.c_str(), "%d%c%d%c", &w, &x, &h, &extra) != 3 || x != 'x' || w < 1 || h < 1)
-        throw InputError(fmt::format("--resolution: expected WxH with positive integers, got \"{}\"", o->resolution));
-      scene.camera.width = w;
-      scene.camera.height = h;
-    }
+    if (!o->resolution.empty())
+      std::tie(scene.camera.width, scene.camera.height) = parse_resolution(o->resolution);
     rt::RenderOptions options;
     options.samples = o->spp;
     options.max_bounces = o->max_bounces;

@@ -2,18 +2,19 @@
 // (docs/series.md).
 #include <unistd.h>
 
-#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <memory>
 #include <optional>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include <fmt/core.h>
 #include <fmt/format.h>
 
 #include "cli/command.h"
+#include "cli/options.h"
 #include "core/error.h"
 #include "core/scene.h"
 #include "series/figure.h"
@@ -66,14 +67,7 @@ series::RunOptions run_options(const Options& o) {
   if (o.renderer == "tracer") r.renderer = series::Renderer::Tracer;
   else if (o.renderer == "cycles") r.renderer = series::Renderer::Cycles;
   else throw InputError(fmt::format("--renderer: must be tracer or cycles, got \"{}\"", o.renderer));
-  if (!o.resolution.empty()) {
-    int w = 0, h = 0;
-    char x = 0, extra = 0;
-    if (std::sscanf(o.resolution.c_str(), "%d%c%d%c", &w, &x, &h, &extra) != 3 || x != 'x' || w < 1 || h < 1)
-      throw InputError(fmt::format("--resolution: expected WxH with positive integers, got \"{}\"", o.resolution));
-    r.width = w;
-    r.height = h;
-  }
+  if (!o.resolution.empty()) std::tie(r.width, r.height) = parse_resolution(o.resolution);
   if (o.spp && *o.spp < 1) throw InputError(fmt::format("--spp: must be >= 1, got {}", *o.spp));
   r.spp = o.spp;
   r.seed = o.seed;
@@ -123,8 +117,7 @@ int run(const Options& o, const fs::path& series_file) {
     throw InputError(fmt::format("{}: exists and is not a directory", o.output));
   series::check_renderer(options);
   const Series series = load_series(series_file, o.threads);
-  series::select_variants(series, o.variants);  // an unknown variant fails before any work
-
+  // run_series checks the variants and their sensor settings before it writes anything.
   const series::SeriesResult result = series::run_series(series, o.output, options);
   series::write_figure_page(o.output, series::result_json(result));
   print_summary(result, o.output);

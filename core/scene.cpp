@@ -567,24 +567,17 @@ std::string document_format(const Json& document) {
 
 namespace {
 
-// Rewrites every relative `csv` path and every `file` of a shape, wherever it appears in a scene document.
-void rebase_paths_in(Json& node, std::string_view key, const std::filesystem::path& from,
-                     const std::filesystem::path& to) {
+void visit_paths(Json& node, std::string_view key, const std::function<void(Json&)>& visit) {
   if (node.is_array()) {
-    for (Json& element : node) rebase_paths_in(element, "", from, to);
+    for (Json& element : node) visit_paths(element, "", visit);
     return;
   }
   if (!node.is_object()) return;
   for (auto& [k, child] : node.items()) {
-    const bool path_key = k == "csv" || (k == "file" && key == "shape");
-    if (path_key && child.is_string()) {
-      std::filesystem::path path = child.get<std::string>();
-      if (path.is_relative()) path = std::filesystem::absolute(from / path).lexically_normal();
-      if (!to.empty()) path = path.lexically_relative(std::filesystem::absolute(to).lexically_normal());
-      child = path.generic_string();
-    } else {
-      rebase_paths_in(child, k, from, to);
-    }
+    if ((k == "csv" || (k == "file" && key == "shape")) && child.is_string())
+      visit(child);
+    else
+      visit_paths(child, k, visit);
   }
 }
 
@@ -647,12 +640,24 @@ Expectation read_expectation(const std::string& target, const JsonNode& node, co
 
 }  // namespace
 
+void for_each_scene_path(Json& document, const std::function<void(Json& path)>& visit) { visit_paths(document, "", visit); }
+
 Json rebase_scene_paths(Json document, const std::filesystem::path& from, const std::filesystem::path& to) {
-  rebase_paths_in(document, "", from, to);
+  for_each_scene_path(document, [&](Json& value) {
+    std::filesystem::path path = value.get<std::string>();
+    if (path.is_relative()) path = std::filesystem::absolute(from / path).lexically_normal();
+    if (!to.empty()) path = path.lexically_relative(std::filesystem::absolute(to).lexically_normal());
+    value = path.generic_string();
+  });
   return document;
 }
 
 const SeriesVariant* Series::find_variant(std::string_view name) const { return find_by_name(variants, name); }
+
+const SeriesVariant& Series::variant(std::string_view name, std::string_view what) const {
+  if (const SeriesVariant* v = find_variant(name)) return *v;
+  throw InputError(fmt::format("{}: {} has no variant \"{}\" (variants: {})", what, source, name, names_of(variants)));
+}
 
 Series load_series(const std::filesystem::path& file, int threads) {
   const Json document = read_json(file);

@@ -10,6 +10,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -214,14 +215,20 @@ struct Series {
   std::vector<SeriesVariant> variants;
 
   const SeriesVariant* find_variant(std::string_view name) const;
+  // The variant named `name`; InputError "<what>: <source> has no variant "x" (variants: …)" otherwise.
+  const SeriesVariant& variant(std::string_view name, std::string_view what) const;
 };
 
 // Loads a series: the base scene must be valid on its own, and each variant's merged scene is validated,
 // on up to `threads` threads (0: all); the error reported is that of the first invalid variant in file order.
 Series load_series(const std::filesystem::path& file, int threads = 0);
 
-// A scene document whose relative paths (`csv`, a shape's `file`) are made relative to `to` (absolute when
-// `to` is empty), from their meaning relative to `from`; so a scene can be written to another folder.
+// Calls `visit` on every file path a scene document holds (a spectrum's `csv`, a shape's `file`), wherever it
+// stands, so that it can read or rewrite it.
+void for_each_scene_path(Json& document, const std::function<void(Json& path)>& visit);
+
+// A scene document whose relative paths are made relative to `to` (absolute when `to` is empty), from their
+// meaning relative to `from`; so a scene can be written to another folder.
 Json rebase_scene_paths(Json document, const std::filesystem::path& from, const std::filesystem::path& to);
 
 // The "format" of a scene or series document, so tools can accept either; "" if there is none.

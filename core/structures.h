@@ -29,7 +29,7 @@ inline constexpr std::array<StructureWord, 16> kStructureWords{{
     {Structure::ThickenedLine, "thickened-line", "a line thickened all along it: interreflection adds other colours"},
     {Structure::L, "L", "a body line with a highlight line leaving its bright end: a sharp highlight"},
     {Structure::SkewedT, "skewed-T", "a highlight line leaving the body line part-way along it"},
-    {Structure::Fork, "fork", "two branches leaving one body line near its dark end: two light colours"},
+    {Structure::Fork, "fork", "two lines diverging from near black: two light colours on one surface (or two surfaces)"},
     {Structure::Gamma, "gamma", "bent by a power-law response; a power curve straightens it"},
     {Structure::Curved, "curved", "bent, and no power curve straightens it: the \"banana\""},
     {Structure::Thickened, "thickened", "a plane with spread off it: interreflection or noise"},

@@ -48,18 +48,10 @@ std::uint64_t fnv1a(std::string_view bytes, std::uint64_t h = 0xcbf29ce484222325
 
 // The scene with every file it names replaced by a hash of the file's bytes: a changed spectrum or mesh
 // changes the key, a moved folder does not.
-void hash_named_files(Json& node, std::string_view key) {
-  if (node.is_array()) {
-    for (Json& element : node) hash_named_files(element, "");
-    return;
-  }
-  if (!node.is_object()) return;
-  for (auto& [k, child] : node.items()) {
-    if ((k == "csv" || (k == "file" && key == "shape")) && child.is_string())
-      child = fmt::format("fnv1a:{:016x}", fnv1a(read_file(child.get<std::string>())));
-    else
-      hash_named_files(child, k);
-  }
+void hash_named_files(Json& document) {
+  for_each_scene_path(document, [](Json& path) {
+    path = fmt::format("fnv1a:{:016x}", fnv1a(read_file(path.get<std::string>())));
+  });
 }
 
 // What a render depends on. The scene's name and description do not change a pixel and are left out.
@@ -67,7 +59,7 @@ Json render_inputs(const Scene& scene, const RunOptions& options) {
   Json document = scene.json;
   document.erase("name");
   document.erase("description");
-  hash_named_files(document, "");
+  hash_named_files(document);
   return {{"renderer", renderer_name(options.renderer)},
           {"scene", document},
           {"width", options.width.value_or(scene.camera.width)},
@@ -321,12 +313,7 @@ void check_renderer(RunOptions& options) {
 
 std::vector<const SeriesVariant*> select_variants(const Series& series, const std::vector<std::string>& names) {
   std::vector<const SeriesVariant*> selected;
-  for (const std::string& name : names)
-    if (!series.find_variant(name)) {
-      std::vector<std::string> all;
-      for (const SeriesVariant& v : series.variants) all.push_back(v.name);
-      throw InputError(fmt::format("--variant: {} has no variant \"{}\" (variants: {})", series.source, name, fmt::join(all, ", ")));
-    }
+  for (const std::string& name : names) series.variant(name, "--variant");
   for (const SeriesVariant& v : series.variants)
     if (names.empty() || std::find(names.begin(), names.end(), v.name) != names.end()) selected.push_back(&v);
   return selected;

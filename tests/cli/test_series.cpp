@@ -14,6 +14,7 @@
 #include "core/json_input.h"
 #include "core/scene.h"
 #include "tests/cli/run_command.h"
+#include "tests/core/spectral_exr_fixtures.h"
 #include "tests/core/bad_scenes.h"
 
 namespace ct {
@@ -25,15 +26,8 @@ const std::string kSeries = std::string(CHROMATRACE_SOURCE_DIR) + "/scenes/paper
 
 class SeriesCommand : public ::testing::Test {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("chromatrace-series-" + std::to_string(::getpid()) + "-" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-  fs::path dir_;
+  test::TempDir temp_;
+  const fs::path dir_ = temp_.path();
 };
 
 int line_count(const std::string& text) { return static_cast<int>(std::count(text.begin(), text.end(), '\n')); }
