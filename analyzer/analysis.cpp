@@ -63,8 +63,12 @@ ImageAnalysis analyse_image(const AnalysisImage& input, const std::string& layer
       // Mixing turns a colour's direction; the noise that matters is across the cluster's first axis (along it,
       // neighbouring pixels differ by shading as well as by noise).
       const double noise = std::hypot(result.shape.noise_sigma[1], result.shape.noise_sigma[2]);
-      const EdgeMixing mixing = find_edge_mixing(pixels, input.object_ids, r, static_cast<std::int32_t>(r.label), noise);
-      apply_edge_mixing(result, mixing, pixels, a.context, r, options, input.object_names);
+      if (input.encoding.pixel_area.value_or(true)) {
+        const EdgeMixing mixing = find_edge_mixing(pixels, input.object_ids, r, static_cast<std::int32_t>(r.label), noise);
+        apply_edge_mixing(result, mixing, pixels, a.context, r, options, input.object_names);
+      } else {  // point-sampled pixels hold one surface's colour each: nothing mixes at an edge
+        result.shape.decisions.push_back({"pixels integrate an area (chromatrace.pixel_area)", 0.0, 1.0, false});
+      }
     }
     if (!input.components.empty()) a.explanations.push_back(explain_region(input, r));
     // The light-group layers are the linear camera signal of each luminaire's light; the test reads them, not

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numbers>
 
 #include <fmt/core.h>
 
@@ -37,6 +38,16 @@ std::vector<std::size_t> complement(std::size_t n, const std::vector<std::size_t
 }
 
 // The two-line model of the dichromatic reflection model: body line, highlight line and their junction.
+// The distance between the lo and hi quantiles of v (which it reorders); v holds at least one value.
+double quantile_range(std::vector<double>& v, double lo, double hi) {
+  const auto at = [&](double q) {
+    const auto k = static_cast<std::ptrdiff_t>(q * static_cast<double>(v.size() - 1));
+    std::nth_element(v.begin(), v.begin() + k, v.end());
+    return v[static_cast<std::size_t>(k)];
+  };
+  return at(hi) - at(lo);
+}
+
 TwoLines two_lines(const LineSearch& body, const LineSearch& highlight, std::size_t n) {
   TwoLines m;
   m.body = body.line;
@@ -138,6 +149,9 @@ ClusterShape analyse_shape(std::span<const float> rgb, const ShapeContext& conte
     s.reason = "the cluster is no larger than the noise: a single colour";
     return s;
   }
+  const double noise_perp = std::hypot(s.noise_sigma[1], s.noise_sigma[2]);
+  const double tolerance = std::max(k.noise_factor * noise_perp, k.relative_floor * s1);
+  s.line_tolerance = tolerance;
   const bool sigma2_significant = significant(1), sigma3_significant = significant(2);
   s.significant_axes = 1 + sigma2_significant + sigma3_significant;
   if (!sigma2_significant) {
@@ -147,8 +161,6 @@ ClusterShape analyse_shape(std::span<const float> rgb, const ShapeContext& conte
     return s;
   }
 
-  const double noise_perp = std::hypot(s.noise_sigma[1], s.noise_sigma[2]);
-  const double tolerance = std::max(k.noise_factor * noise_perp, k.relative_floor * s1);
   const double min_tolerance = std::max(k.noise_factor * noise_perp, 1e-6 * s1);
   s.body_only = find_line(points, all_indices(n), tolerance, min_tolerance, context.seed);
   const double body_fraction = s.body_only ? static_cast<double>(s.body_only->inliers.size()) / static_cast<double>(n) : 0.0;
@@ -216,6 +228,59 @@ ClusterShape analyse_shape(std::span<const float> rgb, const ShapeContext& conte
       test("bend (sagitta / chord) > max_bend_for_straight", c.bend, k.max_bend_for_straight, c.bend > k.max_bend_for_straight);
   if (two_line_ok && curve_ok) test("two-line rms <= curve rms", two_line_rms, c.curve_rms, two_line_rms <= c.curve_rms);
 
+  // The share of the samples off the body line that lie on its more populated side, within the principal
+  // plane: a highlight lies on one side of the body line.
+  const auto one_side = [&](const std::vector<std::size_t>& rest) {
+    const Line& body = s.body_only->line;
+    const Vec3 across = s.moments.axes.col(2).cross(body.direction).normalized();
+    std::size_t positive = 0;
+    for (const std::size_t i : rest) positive += (points[i] - body.point).dot(across) > 0;
+    return static_cast<double>(std::max(positive, rest.size() - positive)) / static_cast<double>(std::max<std::size_t>(1, rest.size()));
+  };
+  // A P: a broad highlight. Its samples lie on one side of the body line and leave it from a stretch of it,
+  // not from one point: in the dichromatic frame x − junction = a · body + b · highlight (the body colour and
+  // the highlight's direction, found above even when the two-line model fails), a spreads as well as b,
+  // where an L or a T keeps a ≈ 0: a P may pass the two-line model too (its scans across the highlight lie
+  // near the two lines), and is told from an L or a T by this spread. The samples judged are those clearly off the body line (farther than
+  // 2τ, as in the highlight search): nearer ones are the body's own spread, on both sides of it.
+  const auto broad_highlight = [&] {
+    if (!test("body line fraction >= p_body_fraction", body_fraction, k.p_body_fraction, body_fraction >= k.p_body_fraction))
+      return false;
+    const TwoLines& m = *s.two_lines;
+    std::vector<std::size_t> rest;
+    for (const std::size_t i : complement(n, s.body_only->inliers))
+      if (s.body_only->line.distance(points[i]) > 2 * tolerance) rest.push_back(i);
+    Eigen::Matrix<double, 3, 2> frame;
+    frame << m.body.direction, m.highlight.direction;
+    const Eigen::ColPivHouseholderQR<Eigen::Matrix<double, 3, 2>> solve(frame);
+    std::vector<double> along_body, along_highlight;
+    for (const std::size_t i : rest) {
+      const Eigen::Vector2d ab = solve.solve(points[i] - m.junction);
+      along_body.push_back(ab[0]);
+      along_highlight.push_back(ab[1]);
+    }
+    // A highlight adds light: from where it leaves the body line it leads away from black. A branch that
+    // leads towards black is a bent or offset dark end (a tone curve over an offset), not a highlight.
+    const double brightening = (m.junction + m.highlight.direction).norm() - m.junction.norm();
+    const double sided = one_side(rest);
+    const double highlight_spread = along_highlight.size() < 2 ? 0.0 : quantile_range(along_highlight, 0.05, 0.95);
+    // Noise across the body line scatters a by noise / sin(angle) (the oblique frame magnifies it): the
+    // 5–95 % range of a Gaussian is 3.29 σ, and only the spread beyond it is the highlight's.
+    const double sine = std::sin(m.angle_deg * std::numbers::pi / 180);
+    const double noise_spread = 3.29 * noise_perp / std::max(1e-300, sine);
+    const double body_spread = along_body.size() < 2 ? 0.0 : quantile_range(along_body, 0.05, 0.95);
+    const double spread = std::sqrt(std::max(0.0, body_spread * body_spread - noise_spread * noise_spread));
+    const double area = highlight_spread > 0 ? spread / highlight_spread : 0.0;
+    if (test("highlight leads away from black (|junction + direction| - |junction|) > 0", brightening, 0.0, brightening > 0) &
+        test("off-body pixels on one side >= p_one_side", sided, k.p_one_side, sided >= k.p_one_side) &
+        test("off-body spread along body (beyond the noise) / along highlight >= p_area_ratio", area, k.p_area_ratio, area >= k.p_area_ratio)) {
+      s.shape = ShapeClass::P;
+      s.reason = fmt::format("a body line ({:.0f} %) with a broad highlight leaving it along a stretch of it and filling an area on one side",
+                             100 * body_fraction);
+      return true;
+    }
+    return false;
+  };
   if (two_line_ok && (!curve_ok || two_line_rms <= c.curve_rms)) {
     const TwoLines& m = *s.two_lines;
     if (!test("junction on body line >= t_junction", m.junction_on_body, k.t_junction, m.junction_on_body >= k.t_junction)) {
@@ -225,6 +290,7 @@ ClusterShape analyse_shape(std::span<const float> rgb, const ShapeContext& conte
                              100 * m.body_fraction, 100 * m.highlight_fraction, m.angle_deg);
       return s;
     }
+    if (broad_highlight()) return s;
     const bool l = test("junction on body line >= l_junction", m.junction_on_body, k.l_junction, m.junction_on_body >= k.l_junction);
     s.shape = l ? ShapeClass::L : ShapeClass::SkewedT;
     s.reason = fmt::format("a body line ({:.0f} %) and a highlight line ({:.0f} %) meeting at {:.0f}° {}", 100 * m.body_fraction,
@@ -258,15 +324,6 @@ ClusterShape analyse_shape(std::span<const float> rgb, const ShapeContext& conte
     return s;
   }
 
-  // The share of the samples off the body line that lie on its more populated side, within the principal
-  // plane: a highlight lies on one side of the body line.
-  const auto one_side = [&](const std::vector<std::size_t>& rest) {
-    const Line& body = s.body_only->line;
-    const Vec3 across = s.moments.axes.col(2).cross(body.direction).normalized();
-    std::size_t positive = 0;
-    for (const std::size_t i : rest) positive += (points[i] - body.point).dot(across) > 0;
-    return static_cast<double>(std::max(positive, rest.size() - positive)) / static_cast<double>(std::max<std::size_t>(1, rest.size()));
-  };
   // How much of the body line's length the samples off it accompany (their 5–95 % range along it, as a share
   // of the whole cluster's): a highlight sits where the object faces the light, interreflection thickens the
   // line all along. And interreflected light turns the colour by a few per cent (a reflectance times a form
@@ -278,15 +335,7 @@ ClusterShape analyse_shape(std::span<const float> rgb, const ShapeContext& conte
     for (const std::size_t i : rest) along.push_back((points[i] - body.point).dot(body.direction));
     for (const Vec3& p : points) all.push_back((p - body.point).dot(body.direction));
     if (along.size() < 2) return 0.0;
-    const auto range = [](std::vector<double>& v, double lo, double hi) {
-      const auto at = [&](double q) {
-        const auto k = static_cast<std::ptrdiff_t>(q * static_cast<double>(v.size() - 1));
-        std::nth_element(v.begin(), v.begin() + k, v.end());
-        return v[static_cast<std::size_t>(k)];
-      };
-      return at(hi) - at(lo);
-    };
-    return range(along, 0.05, 0.95) / std::max(1e-300, range(all, 0.0, 1.0));
+    return quantile_range(along, 0.05, 0.95) / std::max(1e-300, quantile_range(all, 0.0, 1.0));
   };
   if (s.body_only) {
     const double ratio = s.sigma[1] / s1;
@@ -302,25 +351,7 @@ ClusterShape analyse_shape(std::span<const float> rgb, const ShapeContext& conte
     }
   }
 
-  if (s.body_only && test("body line fraction >= p_body_fraction", body_fraction, k.p_body_fraction, body_fraction >= k.p_body_fraction)) {
-    const std::vector<std::size_t> rest = complement(n, s.body_only->inliers);
-    Vec3 mean = Vec3::Zero();
-    for (const std::size_t i : rest) mean += points[i];
-    mean /= static_cast<double>(rest.size());
-    Mat3 scatter = Mat3::Zero();
-    for (const std::size_t i : rest) scatter += (points[i] - mean) * (points[i] - mean).transpose();
-    Vec3 values;
-    Mat3 axes;
-    principal_axes(scatter, values, axes);
-    const double sided = one_side(rest);
-    const double area = values[0] > 0 ? std::sqrt(values[1] / values[0]) : 0.0;
-    if (test("off-body pixels on one side >= p_one_side", sided, k.p_one_side, sided >= k.p_one_side) &
-        test("off-body sigma2 / sigma1 >= p_area_ratio", area, k.p_area_ratio, area >= k.p_area_ratio)) {
-      s.shape = ShapeClass::P;
-      s.reason = fmt::format("a body line ({:.0f} %) with a broad highlight filling an area on one side of it", 100 * body_fraction);
-      return s;
-    }
-  }
+  if (s.body_only && s.two_lines && broad_highlight()) return s;
   s.shape = ShapeClass::Planar;
   s.reason = "a planar cluster that is neither two lines, a curve nor a P";
   return s;

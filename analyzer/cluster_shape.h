@@ -111,6 +111,7 @@ struct ClusterShape {
   Clipping clipping;
   std::optional<Line> line;            // the principal line (linear clusters)
   std::optional<LineSearch> body_only;  // the robust body line before the two-line model
+  double line_tolerance = 0;            // τ: a sample within it of a line lies on the line
   std::optional<TwoLines> two_lines;
   std::optional<Plane> plane;          // principal plane through the mean (normal = third axis)
   std::optional<Plane> black_plane;    // best plane through black: the dichromatic plane

@@ -35,7 +35,13 @@ EdgeMixing find_edge_mixing(const RgbImage& layer, const std::vector<std::int32_
       if (!inside(x - dx, y - dy) || id(x - dx, y - dy) != label) continue;
       const std::int32_t other = id(x + dx, y + dy);
       const bool far = inside(x + 2 * dx, y + 2 * dy) && id(x + 2 * dx, y + 2 * dy) == other;
-      const Vec3 a = colour(layer, static_cast<std::size_t>(y - dy) * w + (x - dx));
+      // A's colour at the edge pixel: extrapolated from the two pixels behind it, since shading, shadows and
+      // an offset (flare, black level) under a tone curve turn a colour smoothly across an object, while a
+      // mix turns it at the edge pixel alone. Where the object is not three pixels deep along the step, the
+      // step cannot tell the two apart and is not judged.
+      if (!inside(x - 2 * dx, y - 2 * dy) || id(x - 2 * dx, y - 2 * dy) != label) continue;
+      const Vec3 a = 2 * colour(layer, static_cast<std::size_t>(y - dy) * w + (x - dx)) -
+                     colour(layer, static_cast<std::size_t>(y - 2 * dy) * w + (x - 2 * dx));
       const Vec3 b = colour(layer, far ? static_cast<std::size_t>(y + 2 * dy) * w + (x + 2 * dx)
                                        : static_cast<std::size_t>(y + dy) * w + (x + dx));
       const Vec3 c = colour(layer, p);
@@ -82,16 +88,40 @@ void apply_edge_mixing(RegionAnalysis& analysed, const EdgeMixing& mixing, const
   const RegionAnalysis unmixed = analyse_region(layer, context, rest, options);
   const bool changed = unmixed.shape.shape != shape.shape;
   shape.decisions.push_back({"class without the mixed pixels differs", changed ? 1.0 : 0.0, 1.0, changed});
-  if (!changed) return;
+  // A line keeps its class when a few per cent of its pixels leave it, yet those pixels can be a structure
+  // of their own in the histogram: a tail from the line towards a neighbour's cluster. That is the mixing's
+  // when the samples clearly off the line of the rest (beyond 2τ, as a highlight is searched for) are
+  // mostly mixed edge pixels; interreflection near an edge turns the colours beside it too.
+  std::size_t off_line = 0, mixed_off_line = 0;
+  const bool line_class = unmixed.shape.shape == ShapeClass::Linear || unmixed.shape.shape == ShapeClass::ThickenedLine;
+  if (!changed && line_class && unmixed.shape.line) {
+    const Line& line = *unmixed.shape.line;
+    const auto off = [&](std::uint32_t p) {
+      const Vec3 c(layer.rgb[3 * std::size_t{p}], layer.rgb[3 * std::size_t{p} + 1], layer.rgb[3 * std::size_t{p} + 2]);
+      return c.allFinite() && line.distance(c) > 2 * unmixed.shape.line_tolerance;
+    };
+    for (const std::uint32_t p : region.pixels) off_line += off(p);
+    for (const std::uint32_t p : mixing.mixed) mixed_off_line += off(p);
+    const double share = static_cast<double>(mixed_off_line) / static_cast<double>(std::max<std::size_t>(1, off_line));
+    shape.decisions.push_back({"mixed pixels off the line of the rest >= min_mixed_samples", static_cast<double>(mixed_off_line),
+                               static_cast<double>(min_mixed), mixed_off_line >= min_mixed});
+    shape.decisions.push_back({"mixed share of the samples off that line >= 0.5", share, 0.5, share >= 0.5});
+  }
+  const bool tail = mixed_off_line >= min_mixed && 2 * mixed_off_line >= off_line;
+  if (!changed && !tail) return;
   std::vector<std::string> with;
   for (const auto& [id, n] : mixing.with) {
     const auto name = names.find(id);
     with.push_back(fmt::format("{} ({})", name != names.end() ? name->second : fmt::format("id {}", id), n));
   }
-  shape.reason = fmt::format("{} of its {} edge pixels mix its colour with its neighbours' ({}): with them the cluster is {}, "
-                             "without them {}",
-                             mixing.mixed.size(), mixing.edge_pixels, fmt::join(with, ", "), class_name(shape.shape),
-                             class_name(unmixed.shape.shape));
+  shape.reason =
+      changed ? fmt::format("{} of its {} edge pixels mix its colour with its neighbours' ({}): with them the cluster is {}, "
+                            "without them {}",
+                            mixing.mixed.size(), mixing.edge_pixels, fmt::join(with, ", "), class_name(shape.shape),
+                            class_name(unmixed.shape.shape))
+              : fmt::format("{} of its {} edge pixels mix its colour with its neighbours' ({}), {} of them off its {} cluster: "
+                            "a tail towards its neighbours' clusters",
+                            mixing.mixed.size(), mixing.edge_pixels, fmt::join(with, ", "), mixed_off_line, class_name(unmixed.shape.shape));
   shape.shape = ShapeClass::Mixed;
 }
 

@@ -2,10 +2,11 @@
 // Pixel area integration at object edges (the paper's interpolated structures, Figure 4b): a pixel that
 // straddles the edge between two objects records a mix of their colours, which lies between their clusters.
 // With an id per pixel (object_id, or a label image), an edge pixel of region A next to region B (one of its
-// eight neighbours) is mixed
-// when its colour lies on the segment between A's colour just inside the edge and B's just beyond it.
-// When leaving the mixed pixels out changes the region's class, the class seen was made by the mixing:
-// the region is `mixed`, and its reason names the class of the rest.
+// eight neighbours) is mixed when its colour lies on the segment between A's colour at the edge
+// (extrapolated from the two pixels behind it) and B's just beyond it.
+// When leaving the mixed pixels out changes the region's class, or the rest is a line and the mixed pixels
+// make most of the samples off it (a tail towards a neighbour's cluster), the class seen was made by the
+// mixing: the region is `mixed`, and its reason names the class of the rest.
 
 #include <cstdint>
 #include <map>
@@ -32,8 +33,9 @@ struct EdgeMixing {
 EdgeMixing find_edge_mixing(const RgbImage& layer, const std::vector<std::int32_t>& labels, const Region& region,
                             std::int32_t label, double noise);
 
-// Analyses the region without its mixed pixels; when that changes the class (and at least min_mixed_samples
-// pixels are mixed), `analysed` becomes `mixed`. Its decisions record the test either way.
+// Analyses the region without its mixed pixels; when that changes the class, or the mixed pixels are the tail
+// off the rest's line (and at least min_mixed_samples pixels are mixed), `analysed` becomes `mixed`. Its
+// decisions record the tests either way.
 void apply_edge_mixing(RegionAnalysis& analysed, const EdgeMixing& mixing, const RgbImage& layer, const LayerContext& context,
                        const Region& region, const AnalyzeOptions& options, const std::map<std::int32_t, std::string>& names);
 

@@ -51,7 +51,8 @@ IlluminantAnalysis estimate_illuminant(const std::vector<RegionAnalysis>& region
   for (const RegionAnalysis& r : regions) {
     if (parts && r.source == "image") continue;
     const ClusterShape& s = r.shape;
-    if ((s.shape == ShapeClass::L || s.shape == ShapeClass::SkewedT) && s.two_lines) {
+    // A P too: its highlight line is the line the two-line search found through the broad highlight.
+    if ((s.shape == ShapeClass::L || s.shape == ShapeClass::SkewedT || s.shape == ShapeClass::P) && s.two_lines) {
       highlight_sum += positive(s.two_lines->highlight.direction) * static_cast<double>(s.two_lines->highlight.inliers);
       highlights.regions.push_back(r.name);
     }

@@ -27,7 +27,7 @@ struct RawImage {
 
 constexpr const char* kCameraKeys[] = {"chromatrace.black_level", "chromatrace.white_level", "chromatrace.dark_signal",
                                        "chromatrace.read_noise",  "chromatrace.bits",        "chromatrace.noise",
-                                       "chromatrace.adc"};
+                                       "chromatrace.adc",         "chromatrace.pixel_area"};
 
 // The camera's numbers: numeric attributes (EXR), numbers spelled as text (PNG keeps attributes as text), or
 // the JSON object a TIFF or PNG holds in ImageDescription.
@@ -194,6 +194,7 @@ void apply_camera_metadata(const RawImage& raw, AnalysisImage& out) {
   if (const auto bits = camera_number(raw, "chromatrace.bits")) e.adc_bits = static_cast<int>(*bits);
   if (const auto noise = camera_number(raw, "chromatrace.noise")) e.noise = *noise != 0;
   if (const auto adc = camera_number(raw, "chromatrace.adc")) e.adc = *adc != 0;
+  if (const auto area = camera_number(raw, "chromatrace.pixel_area")) e.pixel_area = *area != 0;
   if (e.black_level && *e.black_level != 0) {
     const auto black = static_cast<float>(*e.black_level);
     for (float& v : out.image.rgb) v -= black;

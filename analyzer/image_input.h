@@ -41,6 +41,7 @@ struct ImageEncoding {
   std::optional<int> adc_bits = std::nullopt;  // the ADC's bits (0: no ADC)
   std::optional<bool> noise = std::nullopt;  // whether noise was on
   std::optional<bool> adc = std::nullopt;    // whether the ADC was on
+  std::optional<bool> pixel_area = std::nullopt;  // whether pixels integrate an area (false: point samples)
 
   // The value R, G, B hold for black: −black_level once subtracted, else 0 (the ADC's code 0 lies at
   // −black_level after subtraction).

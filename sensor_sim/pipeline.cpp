@@ -192,6 +192,22 @@ std::set<std::int32_t> light_object_ids(const SpectralExrInfo& info) {
   return ids;
 }
 
+// Whether each pixel integrates light over an area (1) or samples it at a point (0): a point only when the
+// reference tracer rendered with pixel_filter "point" (chromatrace.scene, chromatrace.renderer) and the sensor
+// does not supersample. Only area pixels can mix two objects' colours at an edge (docs/analyze.md, mixed).
+int pixel_area(const SpectralExrInfo& info, const SensorConfig& config) {
+  if (config.pixel.supersample > 1) return 1;
+  const auto scene = info.metadata.find("chromatrace.scene");
+  const auto renderer = info.metadata.find("chromatrace.renderer");
+  if (scene == info.metadata.end() || renderer == info.metadata.end() ||
+      !renderer->second.starts_with("chromatrace reference tracer"))
+    return 1;
+  const Json j = Json::parse(scene->second, nullptr, false);
+  const bool point = j.is_object() && j.contains("render") && j["render"].is_object() && j["render"].contains("pixel_filter") &&
+                     j["render"]["pixel_filter"] == "point";
+  return point ? 0 : 1;
+}
+
 // Sensor rows the display's exposure statistics sample: every row of small images; of larger ones the rows
 // of every n-th group of 16 rendered rows (one ZIP chunk), n = ⌊groups / 8⌋, so that about 8 groups are read.
 bool display_sample_row(int y, int k, int height) {
@@ -398,7 +414,8 @@ DisplayRendering display_rendering(const Survey& survey, const LinearModel& unit
 // stores them (TIFF/PNG codes); the ADC's bits; and whether noise and the ADC were on.
 void camera_levels(const SensorConfig& c, double exposure_s, OutputLayout& layout) {
   for (const char* key : {"chromatrace.black_level", "chromatrace.white_level", "chromatrace.dark_signal",
-                          "chromatrace.read_noise", "chromatrace.bits", "chromatrace.noise", "chromatrace.adc"})
+                          "chromatrace.read_noise", "chromatrace.bits", "chromatrace.noise", "chromatrace.adc",
+                          "chromatrace.pixel_area"})
     layout.attributes.erase(key);  // an input's own, passed through as text, would clash
   auto& number = layout.number_attributes;
   const double dark_e = c.noise.dark_current_e_per_s * exposure_s;
@@ -638,6 +655,7 @@ RunReport simulate_sensor(const fs::path& input, const fs::path& output, SensorC
     }
   }
   camera_levels(config, run.exposure_s, layout);
+  layout.integer_attributes["chromatrace.pixel_area"] = pixel_area(info, config);
   if (picture) {  // the codes are the display rendering's (sRGB, 0…255), not the camera's numbers
     layout.attributes["chromatrace.signal"] = "display";
     layout.number_attributes = {{"chromatrace.black_level", 0.0}, {"chromatrace.white_level", 255.0}};

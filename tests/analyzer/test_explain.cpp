@@ -177,5 +177,71 @@ TEST(EdgeMixing, PointSampledEdgesAreNotMixed) {
   EXPECT_EQ(a.results[1].shape.shape, analyzer::ShapeClass::Linear) << a.results[1].shape.reason;
 }
 
+// Two objects side by side, `width` columns each; `left(x, m)` gives the left object's colour in column x at
+// shading m, the right object is the second light's body colour; `mixed_column` (if ≥ 0) records the left
+// colour mixed with a share of the right one that changes from row to row between 5 % and 45 %, as the pixels
+// along a slightly slanted edge are covered by the right object.
+template <class F>
+analyzer::AnalysisImage side_by_side(int width, F left, int mixed_column) {
+  const Vec3 other = kBody.cwiseProduct(kSecondLight).normalized();
+  const RgbImage image = make_image(2 * width, 64, [&](double u, double v) -> Vec3 {
+    const double m = 0.1 + 0.9 * v;
+    const int x = static_cast<int>(std::lround(u * (2 * width - 1)));
+    const double share = 0.05 + 0.4 * ((static_cast<int>(std::lround(v * 63)) * 7) % 16) / 15.0;
+    if (x == mixed_column) return (1 - share) * left(x, m) + share * m * other;
+    return x < width ? left(x, m) : Vec3(m * other);
+  });
+  std::vector<std::int32_t> ids;
+  for (int y = 0; y < 64; ++y)
+    for (int x = 0; x < 2 * width; ++x) ids.push_back(x < width ? 1 : 2);
+  return analysis_image({image, image, {}, ids, {{1, "left"}, {2, "right"}}});
+}
+
+analyzer::ClusterShape left_shape(const analyzer::AnalysisImage& input) {
+  const analyzer::ImageAnalysis a = analyzer::analyse_image(input, "final", analyzer::select_regions(input, input.image, {}), {},
+                                                            std::nullopt, false);
+  return a.results.at(1).shape;
+}
+
+// A wide matte object with one mixed column: 64 of its 8 192 pixels leave its line (99.2 % stay on it, so
+// the class is linear with them or without them), and they are the tail from its line towards the neighbour.
+// (Mixed in one proportion all along the edge, they would make a second line through black: a fork.)
+TEST(EdgeMixing, AFewMixedPixelsOffALineAreItsTail) {
+  const auto input = side_by_side(128, [](int, double m) { return Vec3(m * kBody); }, 127);
+  const analyzer::ClusterShape s = left_shape(input);
+  EXPECT_EQ(s.shape, analyzer::ShapeClass::Mixed) << s.reason;
+  // The four rows mixed at 5 % are not beyond "at least 5 % of the way" (an angle, a little under the share).
+  EXPECT_NE(s.reason.find("60 of its 64 edge pixels"), std::string::npos) << s.reason;
+  EXPECT_NE(s.reason.find("of them off its linear cluster"), std::string::npos) << s.reason;
+}
+
+// A colour that turns smoothly across the object towards the neighbour's (shading, an offset under a tone
+// curve) is not a mix: here 60 % of the way at the edge, as (x/127)^8, 14 % of it in the last column alone,
+// so that the last column turns 3.7 % of the way beyond the one behind it, but continues the turn of the two
+// behind it to within 0.3 %.
+TEST(EdgeMixing, ASmoothTurnTowardsTheEdgeIsNoMix) {
+  const Vec3 other = kBody.cwiseProduct(kSecondLight).normalized();
+  const auto turned = [&](int x, double m) {
+    const double s = 0.6 * std::pow(x / 127.0, 8);
+    return Vec3(m * ((1 - s) * kBody + s * other));
+  };
+  const auto input = side_by_side(128, turned, -1);
+  const analyzer::Region left = analyzer::label_regions(input.object_ids, "object", input.object_names, {0})[0];
+  EXPECT_TRUE(analyzer::find_edge_mixing(input.image, input.object_ids, left, 1, 0.0).mixed.empty());
+}
+
+// Point-sampled pixels (chromatrace.pixel_area 0) hold one surface each: the mixed column is then not looked at
+// as a mix, and the record says why.
+TEST(EdgeMixing, PointSampledFilesAreNotSearchedForMixing) {
+  auto input = side_by_side(32, [](int, double m) { return Vec3(m * kBody); }, 31);
+  input.encoding.pixel_area = false;
+  const analyzer::ClusterShape s = left_shape(input);
+  EXPECT_NE(s.shape, analyzer::ShapeClass::Mixed) << s.reason;
+  ASSERT_FALSE(s.decisions.empty());
+  EXPECT_EQ(s.decisions.back().test, "pixels integrate an area (chromatrace.pixel_area)");
+  input.encoding.pixel_area = true;
+  EXPECT_EQ(left_shape(input).shape, analyzer::ShapeClass::Mixed);
+}
+
 }  // namespace
 }  // namespace ct::test
