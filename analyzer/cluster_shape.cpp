@@ -244,9 +244,14 @@ ClusterShape analyse_shape(std::span<const float> rgb, const ShapeContext& conte
   // near the two lines), and is told from an L or a T by this spread. The samples judged are those clearly off the body line (farther than
   // 2τ, as in the highlight search): nearer ones are the body's own spread, on both sides of it.
   const auto broad_highlight = [&] {
-    if (!test("body line fraction >= p_body_fraction", body_fraction, k.p_body_fraction, body_fraction >= k.p_body_fraction))
-      return false;
     const TwoLines& m = *s.two_lines;
+    // The highlight leaves the body line: their junction lies on the body line, away from its dark end (two
+    // lines from black are a fork). It need not lie at the highlight line's own end: the bowl's scans bridge
+    // the gap between the body line and the straight far part of a broad highlight.
+    if (!(test("body line fraction >= p_body_fraction", body_fraction, k.p_body_fraction, body_fraction >= k.p_body_fraction) &
+          test("junction on body line in [t_junction, 1]", m.junction_on_body, k.t_junction,
+               m.junction_on_body >= k.t_junction && m.junction_on_body <= 1)))
+      return false;
     std::vector<std::size_t> rest;
     for (const std::size_t i : complement(n, s.body_only->inliers))
       if (s.body_only->line.distance(points[i]) > 2 * tolerance) rest.push_back(i);
