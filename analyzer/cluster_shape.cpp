@@ -37,7 +37,6 @@ std::vector<std::size_t> complement(std::size_t n, const std::vector<std::size_t
   return rest;
 }
 
-// The two-line model of the dichromatic reflection model: body line, highlight line and their junction.
 // The distance between the lo and hi quantiles of v (which it reorders); v holds at least one value.
 double quantile_range(std::vector<double>& v, double lo, double hi) {
   const auto at = [&](double q) {
@@ -48,6 +47,7 @@ double quantile_range(std::vector<double>& v, double lo, double hi) {
   return at(hi) - at(lo);
 }
 
+// The two-line model of the dichromatic reflection model: body line, highlight line and their junction.
 TwoLines two_lines(const LineSearch& body, const LineSearch& highlight, std::size_t n) {
   TwoLines m;
   m.body = body.line;
@@ -172,12 +172,18 @@ ClusterShape analyse_shape(std::span<const float> rgb, const ShapeContext& conte
   // points wins (they have about as many parameters: 2 × 4 against 2 × 4).
   bool two_line_ok = false;
   double two_line_rms = std::numeric_limits<double>::infinity();
-  if (s.body_only) {
-    // The highlight is searched among the points clearly off the body line: those just outside its
-    // tolerance (the fringe of a highlight, shading noise) would otherwise pull out a second body line.
-    std::vector<std::size_t> rest;
+  // The samples clearly off the body line (farther than 2τ): those just outside its tolerance are its own
+  // fringe (the edge of a highlight, shading noise, on both sides of it).
+  const auto clearly_off_body = [&] {
+    std::vector<std::size_t> off;
     for (const std::size_t i : complement(n, s.body_only->inliers))
-      if (s.body_only->line.distance(points[i]) > 2 * tolerance) rest.push_back(i);
+      if (s.body_only->line.distance(points[i]) > 2 * tolerance) off.push_back(i);
+    return off;
+  };
+  if (s.body_only) {
+    // The highlight is searched among the samples clearly off the body line: the fringe would otherwise
+    // pull out a second body line.
+    std::vector<std::size_t> rest = clearly_off_body();
     // A line parallel to the body line among them is the body's own spread (shading beside the line, the
     // tail of a glossy lobe), not a highlight, which leaves the body line at an angle: set its samples
     // aside and look again, a few times.
@@ -237,12 +243,11 @@ ClusterShape analyse_shape(std::span<const float> rgb, const ShapeContext& conte
     for (const std::size_t i : rest) positive += (points[i] - body.point).dot(across) > 0;
     return static_cast<double>(std::max(positive, rest.size() - positive)) / static_cast<double>(std::max<std::size_t>(1, rest.size()));
   };
-  // A P: a broad highlight. Its samples lie on one side of the body line and leave it from a stretch of it,
-  // not from one point: in the dichromatic frame x − junction = a · body + b · highlight (the body colour and
-  // the highlight's direction, found above even when the two-line model fails), a spreads as well as b,
-  // where an L or a T keeps a ≈ 0: a P may pass the two-line model too (its scans across the highlight lie
-  // near the two lines), and is told from an L or a T by this spread. The samples judged are those clearly off the body line (farther than
-  // 2τ, as in the highlight search): nearer ones are the body's own spread, on both sides of it.
+  // A P: a broad highlight. The samples clearly off the body line lie on one side of it and leave it from a
+  // stretch of it, not from one point: in the dichromatic frame x − junction = a · body + b · highlight (the
+  // body colour and the highlight's direction, found above even when the two-line model fails), a spreads
+  // as well as b, where an L or a T keeps a ≈ 0. A P may pass the two-line model too (its scans across the
+  // highlight lie near the two lines); this spread tells it from an L or a T.
   const auto broad_highlight = [&] {
     const TwoLines& m = *s.two_lines;
     // The highlight leaves the body line: their junction lies on the body line, away from its dark end (two
@@ -252,9 +257,7 @@ ClusterShape analyse_shape(std::span<const float> rgb, const ShapeContext& conte
           test("junction on body line in [t_junction, 1]", m.junction_on_body, k.t_junction,
                m.junction_on_body >= k.t_junction && m.junction_on_body <= 1)))
       return false;
-    std::vector<std::size_t> rest;
-    for (const std::size_t i : complement(n, s.body_only->inliers))
-      if (s.body_only->line.distance(points[i]) > 2 * tolerance) rest.push_back(i);
+    const std::vector<std::size_t> rest = clearly_off_body();
     Eigen::Matrix<double, 3, 2> frame;
     frame << m.body.direction, m.highlight.direction;
     const Eigen::ColPivHouseholderQR<Eigen::Matrix<double, 3, 2>> solve(frame);
