@@ -71,6 +71,15 @@ def apply(journal, scene, view_layer, samples, seed, point_filter, resolution, p
     _set_if(journal, getattr(view_layer, "cycles", None), "denoising_store_passes", False)
 
 
+def set_id_render(journal, scene, view_layer):
+    """Settings of the object-id render, after apply(): one sample per pixel through a 0.01-pixel box filter
+    (at the pixel's centre, where the reference tracer takes a pixel's id), the Object Index pass on."""
+    journal.set(scene.cycles, "samples", 1)
+    journal.set(scene.cycles, "filter_width", 0.01)
+    journal.set(view_layer, VIEW_LAYER_PASSES["IndexOB"], True)
+    set_bounces(journal, scene, 0)
+
+
 def set_bounces(journal, scene, cycles_max_bounces):
     c = scene.cycles
     for attribute in ("max_bounces", "diffuse_bounces", "glossy_bounces", "transmission_bounces"):

@@ -15,6 +15,11 @@ def render_file_name(group_index, variant):
     return f"g{group_index:03d}_{variant}.exr"
 
 
+# The object-id render: one sample at each pixel's centre (a 0.01-pixel filter), so that a pixel's id is the
+# object at its centre, as in the reference tracer, not the object its first light sample happened to hit.
+IDS_FILE = "ids.exr"
+
+
 def build_manifest(edges_nm, groups, variants, view_layer, total, components, object_names=None,
                    attributes=None, replicate=False, sum_tolerance=1e-4):
     """The manifest dict, with file paths relative to the directory the manifest is written to.
@@ -42,7 +47,7 @@ def build_manifest(edges_nm, groups, variants, view_layer, total, components, ob
         "sum_tolerance": sum_tolerance,
     }
     if object_names is not None:
-        manifest["object_ids"] = {"file": render_file_name(0, "main"), "channel": _join(view_layer, "IndexOB.X")}
+        manifest["object_ids"] = {"file": IDS_FILE, "channel": _join(view_layer, "IndexOB.X")}
         manifest["object_names"] = {str(i): name for i, name in sorted(object_names.items())}
     if attributes:
         manifest["attributes"] = dict(attributes)

@@ -250,8 +250,7 @@ class SpectralRender:
         passes = components.passes_needed(planned)
 
         ids = {}
-        if request.object_ids:
-            passes.add("IndexOB")
+        if request.object_ids:  # written by their own render (manifest.IDS_FILE), not by the band renders
             geometry = [ob for ob in objects if ob.type in _GEOMETRY_TYPES]
             indices = [ob.pass_index for ob in geometry]
             if all(i > 0 for i in indices) and len(set(indices)) == len(indices):
@@ -356,7 +355,7 @@ class SpectralRender:
             plan = self._prepare(work_dir)
             self.cache_dir = cache.cache_directory(request.cache_root, plan["key"])
             groups, variants = plan["groups"], plan["variants"]
-            total = len(groups) * len(variants)
+            total = len(groups) * len(variants) + (1 if request.object_ids else 0)
             request.log(f"{len(plan['edges']) - 1} bands in {len(groups)} renders of {plan['per_render']} band(s)"
                         f"{' x ' + str(len(variants)) + ' bounce limits' if len(variants) > 1 else ''}; "
                         f"cache {self.cache_dir}")
@@ -396,6 +395,21 @@ class SpectralRender:
                                f"{time.monotonic() - start:.2f} s, {time.process_time() - start_cpu:.2f} s CPU")
                     request.log(message)
                     yield done, total, message
+            if request.object_ids:
+                ids_file = os.path.join(self.cache_dir, manifest.IDS_FILE)
+                if os.path.isfile(ids_file):
+                    self.cached += 1
+                    done += 1
+                    request.log(f"render {done}/{total} (object ids): already in the cache")
+                    yield done, total, "cached"
+                else:
+                    if not applied:
+                        self._apply_settings(journal, plan)
+                        applied = True
+                    message = self._render_ids(journal, plan, ids_file)
+                    done += 1
+                    request.log(f"render {done}/{total} (object ids): {message}")
+                    yield done, total, message
             journal.restore()
             self._assemble(plan)
             if not request.keep_cache:
@@ -403,6 +417,19 @@ class SpectralRender:
         finally:
             journal.restore()
             shutil.rmtree(work_dir, ignore_errors=True)
+
+    def _render_ids(self, journal, plan, final):
+        """The object-id render: one sample per pixel through a 0.01-pixel filter, i.e. at the pixel's centre."""
+        cycles_setup.set_id_render(journal, self.scene, plan["view_layer"])
+        temporary = final + ".partial"
+        journal.set(self.scene.render, "filepath", temporary)
+        start = time.monotonic()
+        bpy.ops.render.render(write_still=True, scene=self.scene.name)
+        if not os.path.isfile(temporary):
+            raise RuntimeError(f"Cycles wrote no file for the object-id render ({temporary})")
+        cache.commit(temporary, final)
+        self.rendered += 1
+        return f"{time.monotonic() - start:.2f} s"
 
     def _assemble(self, plan):
         request = self.request

@@ -284,8 +284,8 @@ TEST_F(Blender, MaxBouncesZeroShowsEmittersOnly) {
   EXPECT_GT(*std::max_element(total.begin(), total.end()), 1.0f);  // the lamp is in view
 }
 
-// A run killed after two of four renders leaves them in the cache; running again renders only the other two
-// and writes the same file as a run that was never interrupted.
+// A run killed after two of five renders (four band groups and the object ids) leaves them in the cache;
+// running again renders only the other three and writes the same file as a run that was never interrupted.
 TEST_F(Blender, KilledRunResumesWithOnlyTheRemainingRenders) {
   const fs::path out = dir_.file("resumed.exr"), reference = dir_.file("reference.exr");
   const std::vector<std::string> common = {"--scene", kBox, "--resolution", "24x24", "--samples", "4",
@@ -303,12 +303,13 @@ TEST_F(Blender, KilledRunResumesWithOnlyTheRemainingRenders) {
   const CommandResult resumed = batch(args);
   ASSERT_EQ(resumed.exit_code, 0) << resumed.err;
   const auto renders = lines_starting(resumed.err, "chromatrace: render ");
-  ASSERT_EQ(renders.size(), 4u) << resumed.err;
+  ASSERT_EQ(renders.size(), 5u) << resumed.err;
   EXPECT_NE(renders[0].find("already in the cache"), std::string::npos) << renders[0];
   EXPECT_NE(renders[1].find("already in the cache"), std::string::npos) << renders[1];
   EXPECT_EQ(renders[2].find("already in the cache"), std::string::npos) << renders[2];
   EXPECT_EQ(renders[3].find("already in the cache"), std::string::npos) << renders[3];
-  EXPECT_NE(resumed.err.find("(2 renders made, 2 from the cache)"), std::string::npos) << resumed.err;
+  EXPECT_NE(renders[4].find("(object ids)"), std::string::npos) << renders[4];
+  EXPECT_NE(resumed.err.find("(3 renders made, 2 from the cache)"), std::string::npos) << resumed.err;
 
   std::vector<std::string> fresh = common;
   fresh.insert(fresh.end(), {"--out", reference.string()});

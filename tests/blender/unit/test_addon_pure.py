@@ -73,6 +73,7 @@ class Manifest(unittest.TestCase):
         self.assertEqual(m["bands"][3]["files"], {"main": "g001_main.exr"})
         self.assertEqual(m["object_names"], {"1": "a", "2": "b"})
         self.assertEqual(m["object_ids"]["channel"], "ViewLayer.IndexOB.X")
+        self.assertEqual(m["object_ids"]["file"], manifest.IDS_FILE)  # the centre-sampled id render
         replicated = manifest.build_manifest([400, 450, 500], bands.band_groups(2, 1), ["main"], "V", total, planned,
                                              replicate=True)
         self.assertEqual([b["channel"] for b in replicated["bands"]], ["R", "R"])
