@@ -193,15 +193,13 @@ std::set<std::int32_t> light_object_ids(const SpectralExrInfo& info) {
 }
 
 // Whether each pixel integrates light over an area (1) or samples it at a point (0): a point only when the
-// reference tracer rendered with pixel_filter "point" (chromatrace.scene, chromatrace.renderer) and the sensor
-// does not supersample. Only area pixels can mix two objects' colours at an edge (docs/analyze.md, mixed).
+// scene was rendered with pixel_filter "point" (chromatrace.scene; the tracer and the add-on both honour it)
+// and the sensor does not supersample. Only area pixels can mix two objects' colours at an edge
+// (docs/analyze.md, mixed).
 int pixel_area(const SpectralExrInfo& info, const SensorConfig& config) {
   if (config.pixel.supersample > 1) return 1;
   const auto scene = info.metadata.find("chromatrace.scene");
-  const auto renderer = info.metadata.find("chromatrace.renderer");
-  if (scene == info.metadata.end() || renderer == info.metadata.end() ||
-      !renderer->second.starts_with("chromatrace reference tracer"))
-    return 1;
+  if (scene == info.metadata.end()) return 1;
   const Json j = Json::parse(scene->second, nullptr, false);
   const bool point = j.is_object() && j.contains("render") && j["render"].is_object() && j["render"].contains("pixel_filter") &&
                      j["render"]["pixel_filter"] == "point";

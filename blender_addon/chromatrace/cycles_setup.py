@@ -3,8 +3,8 @@ render is an independent estimate of its band (applied through the journal, so t
 
 Off: clamping (direct and indirect), Filter Glossy, denoising, adaptive sampling, the light threshold,
 path guiding, fast GI, simplify, motion blur, Freestyle, compositing and the sequencer. On: both kinds of
-caustics. Box pixel filter of width 1 (0.01 for the scene format's "point"), Standard view transform with
-look None, exposure 0 and gamma 1, Cycles film exposure 1, 32-bit float multilayer OpenEXR.
+caustics. Box pixel filter of width 1 (for the scene format's "point", a Gaussian 0.01 wide), Standard view
+transform with look None, exposure 0 and gamma 1, Cycles film exposure 1, 32-bit float multilayer OpenEXR.
 """
 
 VIEW_LAYER_PASSES = {
@@ -22,6 +22,14 @@ def _set_if(journal, target, attribute, value):
         journal.set(target, attribute, value)
 
 
+def pixel_filter(point):
+    """Cycles' pixel filter: a box over the pixel, or (point) a Gaussian 0.01 pixels wide, the narrowest Cycles
+    allows: every sample at the pixel's centre. Cycles ignores the width of its Box filter (always one pixel),
+    so a point cannot be a narrow box."""
+    return (("pixel_filter_type", "GAUSSIAN"), ("filter_width", 0.01)) if point else (("pixel_filter_type", "BOX"),
+                                                                                      ("filter_width", 1.0))
+
+
 def apply(journal, scene, view_layer, samples, seed, point_filter, resolution, passes):
     render = scene.render
     journal.set(render, "engine", "CYCLES")
@@ -32,8 +40,7 @@ def apply(journal, scene, view_layer, samples, seed, point_filter, resolution, p
     for attribute, value in (("use_animated_seed", False), ("use_adaptive_sampling", False),
                              ("use_denoising", False), ("sample_clamp_direct", 0.0), ("sample_clamp_indirect", 0.0),
                              ("blur_glossy", 0.0), ("light_sampling_threshold", 0.0), ("caustics_reflective", True),
-                             ("caustics_refractive", True), ("pixel_filter_type", "BOX"),
-                             ("filter_width", 0.01 if point_filter else 1.0), ("use_layer_samples", "IGNORE"),
+                             ("caustics_refractive", True), *pixel_filter(point_filter), ("use_layer_samples", "IGNORE"),
                              ("time_limit", 0.0), ("use_guiding", False), ("use_fast_gi", False),
                              ("film_exposure", 1.0), ("sample_offset", 0), ("volume_bounces", 0)):
         _set_if(journal, c, attribute, value)
@@ -72,10 +79,11 @@ def apply(journal, scene, view_layer, samples, seed, point_filter, resolution, p
 
 
 def set_id_render(journal, scene, view_layer):
-    """Settings of the object-id render, after apply(): one sample per pixel through a 0.01-pixel box filter
-    (at the pixel's centre, where the reference tracer takes a pixel's id), the Object Index pass on."""
+    """Settings of the object-id render, after apply(): one sample per pixel through the point filter (at the
+    pixel's centre, where the reference tracer takes a pixel's id), the Object Index pass on."""
     journal.set(scene.cycles, "samples", 1)
-    journal.set(scene.cycles, "filter_width", 0.01)
+    for attribute, value in pixel_filter(point=True):
+        journal.set(scene.cycles, attribute, value)
     journal.set(view_layer, VIEW_LAYER_PASSES["IndexOB"], True)
     set_bounces(journal, scene, 0)
 

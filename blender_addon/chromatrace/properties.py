@@ -188,7 +188,7 @@ class CHROMATRACE_PG_scene(bpy.types.PropertyGroup):
                              description="Scattering events per path: 0 emitters only, 1 direct light, >= 2 global")
     seed: IntProperty(name="Seed", min=0, default=1)
     pixel_filter: EnumProperty(name="Pixel filter", items=[("box", "Box", "Integrate over the pixel"),
-                                                           ("point", "Point", "The pixel centre (nearly: width 0.01)")],
+                                                           ("point", "Point", "The pixel centre (nearly: a Gaussian 0.01 pixel wide)")],
                                default="box")
     spectral_mode: StringProperty(default="bands", description="Kept for export: Cycles always renders bands")
     tessellation_segments: IntProperty(name="Segments", min=0, default=0, description="0: the format's default")

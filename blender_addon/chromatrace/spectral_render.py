@@ -419,7 +419,7 @@ class SpectralRender:
             shutil.rmtree(work_dir, ignore_errors=True)
 
     def _render_ids(self, journal, plan, final):
-        """The object-id render: one sample per pixel through a 0.01-pixel filter, i.e. at the pixel's centre."""
+        """The object-id render: one sample per pixel, at the pixel's centre."""
         cycles_setup.set_id_render(journal, self.scene, plan["view_layer"])
         temporary = final + ".partial"
         journal.set(self.scene.render, "filepath", temporary)

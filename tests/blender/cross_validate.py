@@ -1,6 +1,7 @@
 """Cycles (through the add-on, real Blender) held to the reference tracer with `chromatrace compare`.
 
     python3 cross_validate.py agree SCENE.json        # every object × band × component must agree
+    python3 cross_validate.py agree-point SCENE.json  # the same with the scene's pixels point samples
     python3 cross_validate.py filter-glossy SCENE.json  # Cycles' default Filter Glossy and Clamp Indirect left on: must fail
     python3 cross_validate.py reflectance SCENE.json OBJECT  # OBJECT's reflectance changed for Cycles: must fail there
 
@@ -58,6 +59,20 @@ def compare(a, b, out, pixels="interior"):
         return json.load(f)
 
 
+def scene_copy(scene, work, change):
+    """A copy of the scene file with change(document) applied, its relative paths kept valid."""
+    with open(scene) as f:
+        document = json.load(f)
+    change(document)
+    for spectrum in document["spectra"].values():
+        if "csv" in spectrum:
+            spectrum["csv"] = os.path.join(os.path.dirname(scene), spectrum["csv"])
+    changed = os.path.join(work, "changed.json")
+    with open(changed, "w") as f:
+        json.dump(document, f)
+    return changed
+
+
 def scene_groups(scene):
     with open(scene) as f:
         return sorted({light["group"] for light in json.load(f)["lights"]})
@@ -73,6 +88,10 @@ def main():
     work = tempfile.mkdtemp(prefix="cross_validate_")
     try:
         tracer, cycles = os.path.join(work, "tracer.exr"), os.path.join(work, "cycles.exr")
+        point = case == "agree-point"
+        if point:  # point pixels: Cycles' narrow Gaussian against the tracer's pixel centres
+            scene = scene_copy(scene, work, lambda d: d.setdefault("render", {}).update(pixel_filter="point"))
+            case = "agree"
         t_seconds = render_tracer(scene, tracer)
         if case == "agree":
             c_seconds = render_cycles(scene, cycles, work)
@@ -97,6 +116,20 @@ def main():
             matched = compare(cycles, tracer, os.path.join(work, "compare-matched"), "matched")
             failed = [c for c in matched["cells"] if not c["pass"]]
             check(not failed, f"with the edge pixels, {len(failed)} cells disagree, e.g. {failed[:3]}")
+            if point:
+                # A point sample sees an emitter only where the pixel's centre lies on it, so no other object's
+                # pixels hold emission: none in the tracer's (exact centres); in Cycles', whose point is a
+                # Gaussian 0.01 pixel wide, at most that width's share of an emitter along its edge, under 1 %
+                # of the emitter's radiance over an object larger than the edge. A pixel-wide filter gives the
+                # pixels around a lamp a share of it several times that.
+                emitter = {}
+                for c in matched["cells"]:
+                    if c["component"] == "emission" and c["brdf"] == "emitter":
+                        emitter[c["band"]] = max(emitter.get(c["band"], 0.0), c["mean_b"])
+                lit = [(c["object"], c["band"], c["mean_a"], c["mean_b"]) for c in matched["cells"]
+                       if c["component"] == "emission" and c["brdf"] not in ("emitter", "image")
+                       and (c["mean_b"] != 0 or c["mean_a"] > 0.01 * emitter.get(c["band"], 0.0))]
+                check(not lit, f"emission on pixels of objects that emit none (object, band, Cycles, tracer): {lit[:4]}")
             print(f"agree: {len(doc['cells'])} cells, ΔE00 mean {doc['image']['delta_e00']['mean']:.3f}, "
                   f"tracer {t_seconds:.1f} s, Cycles {c_seconds:.1f} s")
         elif case == "filter-glossy":
@@ -114,17 +147,12 @@ def main():
                   + ", ".join(f"{c['object']} {c['component']} z={c['z']:.1f}" for c in biased[:3]))
         elif case == "reflectance":
             target = sys.argv[3]
-            with open(scene) as f:
-                document = json.load(f)
-            material = next(o["material"] for o in document["objects"] if o["name"] == target)
-            document["materials"][material] = {"type": "lambert", "reflectance": {"constant": 0.5}}
-            for key, spectrum in document["spectra"].items():  # keep relative paths valid from the copy
-                if "csv" in spectrum:
-                    spectrum["csv"] = os.path.join(os.path.dirname(scene), spectrum["csv"])
-            changed = os.path.join(work, "changed.json")
-            with open(changed, "w") as f:
-                json.dump(document, f)
-            render_cycles(changed, cycles, work)
+
+            def grey(document):
+                material = next(o["material"] for o in document["objects"] if o["name"] == target)
+                document["materials"][material] = {"type": "lambert", "reflectance": {"constant": 0.5}}
+
+            render_cycles(scene_copy(scene, work, grey), cycles, work)
             doc = compare(cycles, tracer, os.path.join(work, "compare"))
             failed = [c for c in doc["cells"] if not c["pass"]]
             on_target = [c for c in failed if c["object"] == target and c["component"] == "total"]
