@@ -76,6 +76,10 @@ def row(name, scene, work):
     cells = doc["cells"]
     worst = max(cells, key=lambda c: abs(c["z"]) if isinstance(c["z"], (int, float)) else 0.0)
     de = doc["image"]["delta_e00"]
+    # The objects' totals: their ratios Cycles / tracer and the ratios' standard errors (median and largest).
+    totals = [c for c in cells if c["component"] == "total" and c["object_id"] >= 0 and c["ratio"] and c["se_ratio"]]
+    deviation = max(abs(c["ratio"] - 1) for c in totals)
+    se_median, se_max = statistics.median(c["se_ratio"] for c in totals), max(c["se_ratio"] for c in totals)
     # Cycles' noise against the tracer's at equal samples: the median over the cells of the ratio of their
     # variances, and the time Cycles takes for the tracer's noise (its samples scaled by that ratio, variance
     # falling as 1 / samples; the fixed cost unscaled).
@@ -86,15 +90,17 @@ def row(name, scene, work):
     tracer_time, cycles_time = statistics.mean(t), statistics.mean(c)
     cycles_equal = c0 + (cycles_time - c0) * variance_ratio
     return (f"| {name} | {len(cells)} | {sum(not c['pass'] for c in cells)} | {abs(worst['z']):.1f} "
-            f"({worst['object']} {worst['component']}, {worst['band_nm'][0]:g}–{worst['band_nm'][1]:g} nm) | {de['mean']:.2f} / {de['p95']:.2f} "
+            f"({worst['object']} {worst['component']}, {worst['band_nm'][0]:g}–{worst['band_nm'][1]:g} nm) "
+            f"| {100 * deviation:.2f} % | {100 * se_median:.2f} % / {100 * se_max:.2f} % | {de['mean']:.2f} / {de['p95']:.2f} "
             f"| {tracer_time:.1f} s ({t0:.1f} s fixed) | {cycles_time:.1f} s ({c0:.1f} s fixed) "
             f"| {variance_ratio:.2f} ({len(ratios)} cells) | {tracer_time:.1f} s / {cycles_equal:.1f} s |")
 
 
 def main():
-    lines = ["| scene | cells | failed | largest \\|z\\| | ΔE00 mean / 95th pct. | tracer | Cycles | variance Cycles / tracer "
-             "(same samples) | time for the tracer's noise: tracer / Cycles |",
-             "|---|---|---|---|---|---|---|---|---|"]
+    lines = ["| scene | cells | failed | largest \\|z\\| | objects' totals: largest \\|ratio − 1\\| | their standard error: "
+             "median / largest | ΔE00 mean / 95th pct. | tracer | Cycles | variance Cycles / tracer (same samples) "
+             "| time for the tracer's noise: tracer / Cycles |",
+             "|---|---|---|---|---|---|---|---|---|---|---|"]
     for name, scene in SCENES:
         with tempfile.TemporaryDirectory(prefix="validation_") as work:
             lines.append(row(name, os.path.join(ROOT, scene), work))
