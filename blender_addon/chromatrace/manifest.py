@@ -15,8 +15,9 @@ def render_file_name(group_index, variant):
     return f"g{group_index:03d}_{variant}.exr"
 
 
-# The object-id render: one sample at each pixel's centre (cycles_setup.pixel_filter(point=True)), so that a pixel's id is the
-# object at its centre, as in the reference tracer, not the object its first light sample happened to hit.
+# The object-id render: one sample at each pixel's centre (cycles_setup.pixel_filter(point=True)), so that a
+# pixel's id is the object at its centre, as in the reference tracer, whichever sample Cycles takes data passes
+# from in the band renders.
 IDS_FILE = "ids.exr"
 
 

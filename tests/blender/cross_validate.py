@@ -100,7 +100,7 @@ def main():
             expected = {"total", "emission", "diffuse_direct", "diffuse_indirect", "glossy_direct", "glossy_indirect"}
             expected |= {f"light.{g}" for g in scene_groups(scene)}
             check(expected <= set(doc["components"]), f"components compared {doc['components']}, expected {sorted(expected)}")
-            # The test has power: on every object of at least 60 pixels, the standard error of the
+            # The test has power: on every object of at least 60 interior pixels, the standard error of the
             # total's difference in the brightest band is below the object's tolerance (1 % or 2 %), so a
             # bias of a few per cent would be caught.
             for o in doc["objects"]:
