@@ -83,19 +83,32 @@ std::optional<MaterialSample> sample_material(const TracerMaterial& m, const Vec
 }  // namespace
 
 ComponentSelection ComponentSelection::parse(const std::string& list, const std::string& what) {
+  // The grammar and its cases: tests/data/component_grammar.json, shared with the Blender add-on's parser.
+  constexpr const char* kKnown = "(known: paths, lights, bounces, all, none)";
   ComponentSelection c{false, false, false};
+  bool none = false, family = false;
   std::stringstream in(list);
   std::string item;
+  std::size_t items = 0;
   while (std::getline(in, item, ',')) {
+    ++items;
+    const auto first = item.find_first_not_of(' '), last = item.find_last_not_of(' ');
+    item = first == std::string::npos ? "" : item.substr(first, last - first + 1);
+    if (item.empty()) throw InputError(fmt::format("{}: an empty item {}", what, kKnown));
+    if (item == "none") {
+      none = true;
+      continue;
+    }
+    family = true;
     if (item == "paths") c.paths = true;
     else if (item == "lights") c.lights = true;
     else if (item == "bounces") c.bounces = true;
     else if (item == "all") c = {true, true, true};
-    else if (item == "none") c = {false, false, false};
-    else
-      throw InputError(fmt::format("{}: unknown component family \"{}\" (known: paths, lights, bounces, all, none)",
-                                   what, item));
+    else throw InputError(fmt::format("{}: unknown component family \"{}\" {}", what, item, kKnown));
   }
+  if (items == 0 || list.back() == ',')  // getline yields no item for "" nor for the empty one after a last comma
+    throw InputError(fmt::format("{}: an empty item {}", what, kKnown));
+  if (none && family) throw InputError(fmt::format("{}: \"none\" cannot be combined with other families", what));
   return c;
 }
 

@@ -23,7 +23,8 @@ struct ComponentSelection {
   bool paths = true;    // emission, diffuse_direct, diffuse_indirect, glossy_direct, glossy_indirect
   bool lights = true;   // light.<group>
   bool bounces = false; // bounce.0 .. bounce.<max_bounces>
-  // Parses a comma-separated list of "paths", "lights", "bounces", "all", "none"; errors name `what`.
+  // Parses a comma-separated list of "paths", "lights", "bounces", "all" (spaces around items ignored), or
+  // "none" alone; errors name `what`. Cases: tests/data/component_grammar.json.
   static ComponentSelection parse(const std::string& list, const std::string& what = "--components");
 };
 

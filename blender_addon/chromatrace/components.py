@@ -40,17 +40,26 @@ class ComponentError(ValueError):
 
 
 def parse_components(text, what="--components"):
-    """'paths,lights' -> {'paths', 'lights'}; also 'all' and 'none' (as `chromatrace render --components`)."""
-    selected = set()
-    for item in (part.strip() for part in text.split(",")):
+    """'paths,lights' -> {'paths', 'lights'}; 'all' is every family, 'none' (alone) no family; spaces around items
+    are ignored. The grammar and its cases: tests/data/component_grammar.json, shared with the tracer's parser
+    (reference_tracer/integrator.cpp)."""
+    known = "(known: paths, lights, bounces, all, none)"
+    selected, none, family = set(), False, False
+    for item in (part.strip(" ") for part in text.split(",")):
+        if not item:
+            raise ComponentError(f"{what}: an empty item {known}")
+        if item == "none":
+            none = True
+            continue
+        family = True
         if item == "all":
             selected.update(FAMILIES)
-        elif item == "none":
-            continue
         elif item in FAMILIES:
             selected.add(item)
         else:
-            raise ComponentError(f"{what}: unknown component family \"{item}\" (paths, lights, bounces, all, none)")
+            raise ComponentError(f"{what}: unknown component family \"{item}\" {known}")
+    if none and family:
+        raise ComponentError(f"{what}: \"none\" cannot be combined with other families")
     return selected
 
 

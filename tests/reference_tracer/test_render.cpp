@@ -16,6 +16,7 @@
 #include <fmt/core.h>
 #include <nlohmann/json.hpp>
 
+#include "core/error.h"
 #include "core/scene.h"
 #include "core/spectral_exr.h"
 #include "reference_tracer/render.h"
@@ -263,6 +264,31 @@ TEST(Render, BandsAndContinuousAgreeWhenSpectraAreConstantWithinBands) {
     }
     const double mean = sum / n, se = std::sqrt((sum2 / n - mean * mean) / (n - 1));
     EXPECT_LT(std::abs(mean), 4.0 * se) << "band " << b << ": mean difference " << mean << ", se " << se;
+  }
+}
+
+// The --components grammar from the table the Blender add-on's parser is tested against too.
+TEST(ComponentGrammar, EveryCaseOfTheSharedTable) {
+  std::ifstream file(std::string(CHROMATRACE_TEST_DATA) + "/component_grammar.json");
+  const nlohmann::json table = nlohmann::json::parse(file);
+  ASSERT_GE(table["cases"].size(), 10u);
+  for (const nlohmann::json& c : table["cases"]) {
+    const std::string input = c["input"].get<std::string>();
+    if (c.contains("error")) {
+      try {
+        ComponentSelection::parse(input, "--components");
+        ADD_FAILURE() << "\"" << input << "\" parsed; expected: " << c["error"];
+      } catch (const InputError& e) {
+        EXPECT_EQ(std::string(e.what()), "--components: " + c["error"].get<std::string>()) << input;
+      }
+      continue;
+    }
+    const ComponentSelection s = ComponentSelection::parse(input, "--components");
+    std::vector<std::string> families;
+    if (s.bounces) families.push_back("bounces");
+    if (s.lights) families.push_back("lights");
+    if (s.paths) families.push_back("paths");
+    EXPECT_EQ(nlohmann::json(families), c["families"]) << "\"" << input << "\"";
   }
 }
 

@@ -1,5 +1,6 @@
 """Plain-Python tests of the add-on's bpy-free modules (python3 -m unittest, no Blender needed)."""
 
+import json
 import os
 import sys
 import tempfile
@@ -28,11 +29,19 @@ class Bands(unittest.TestCase):
 
 
 class Components(unittest.TestCase):
-    def test_parse(self):
-        self.assertEqual(components.parse_components("all"), {"paths", "lights", "bounces"})
-        self.assertEqual(components.parse_components("paths,none"), {"paths"})
-        with self.assertRaises(components.ComponentError):
-            components.parse_components("paths,colours")
+    def test_parse_every_case_of_the_shared_table(self):
+        """The --components grammar from the table the tracer's parser is tested against too."""
+        with open(os.path.join(os.path.dirname(__file__), "..", "..", "data", "component_grammar.json")) as f:
+            table = json.load(f)
+        self.assertGreaterEqual(len(table["cases"]), 10)
+        for case in table["cases"]:
+            with self.subTest(input=case["input"]):
+                if "error" in case:
+                    with self.assertRaises(components.ComponentError) as raised:
+                        components.parse_components(case["input"])
+                    self.assertEqual(str(raised.exception), "--components: " + case["error"])
+                else:
+                    self.assertEqual(sorted(components.parse_components(case["input"])), case["families"])
 
     def test_variants_count_scattering_events_not_cycles_bounces(self):
         self.assertEqual(components.render_variants(3, False), {"main": 2})
