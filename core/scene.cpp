@@ -372,17 +372,25 @@ Material SceneReader::material(const std::string& name, const JsonNode& node) {
     return {name, MirrorMaterial{reflectance(node["reflectance"])}};
   }
 
-  node.expect_object({"type", "diffuse", "specular", "lobe", "roughness", "exponent"});
+  node.expect_object({"type", "diffuse", "specular", "lobe", "roughness", "masking", "exponent"});
   DichromaticMaterial dichromatic;
   dichromatic.diffuse = reflectance(node["diffuse"]);
   dichromatic.specular = node["specular"].number_in(0.0, 1.0);
   const bool ggx = !node.has("lobe") || node["lobe"].choice({"ggx", "phong"}) == "ggx";
-  if (const auto other = node.find(ggx ? "exponent" : "roughness"))
-    other->fail(fmt::format("applies only to \"lobe\": \"{}\"", ggx ? "phong" : "ggx"));
-  if (ggx)
-    dichromatic.lobe = DichromaticMaterial::Ggx{node["roughness"].number_in(0.0, 1.0)};
-  else
+  const std::vector<const char*> other_lobes_keys = ggx ? std::vector<const char*>{"exponent"}
+                                                       : std::vector<const char*>{"roughness", "masking"};
+  for (const char* key : other_lobes_keys)
+    if (const auto other = node.find(key))
+      other->fail(fmt::format("applies only to \"lobe\": \"{}\"", ggx ? "phong" : "ggx"));
+  if (ggx) {
+    const auto masking = node.find("masking");
+    const bool correlated = masking && masking->choice({"separable", "height-correlated"}) == "height-correlated";
+    dichromatic.lobe = DichromaticMaterial::Ggx{node["roughness"].number_in(0.0, 1.0),
+                                                correlated ? DichromaticMaterial::Masking::HeightCorrelated
+                                                           : DichromaticMaterial::Masking::Separable};
+  } else {
     dichromatic.lobe = DichromaticMaterial::Phong{node["exponent"].number_at_least(0.0)};
+  }
   // Neither lobe reflects more than k_s, so this bound keeps the material from creating energy.
   const double body = extreme_sample(dichromatic.diffuse.spectrum, true).value;
   if (body + dichromatic.specular > 1.0)

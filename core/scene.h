@@ -49,10 +49,14 @@ struct LambertMaterial {
 // f = ρ_d(λ) / π + k_s · f_lobe: a Lambertian body term plus a spectrally flat interface lobe (the
 // reference tracer's reference_tracer/bsdf.h evaluates the lobes). Validation guarantees max ρ_d + k_s <= 1.
 struct DichromaticMaterial {
-  // GGX microfacet lobe, alpha = roughness² (Blender's convention), separable Smith masking, no Fresnel
-  // factor; roughness 0 is a perfect mirror lobe.
+  // GGX microfacet lobe, alpha = roughness² (Blender's convention), no Fresnel factor; roughness 0 is a
+  // perfect mirror lobe. The Smith masking-shadowing term as Cycles has it: separable G1(wo)·G1(wi) up to
+  // Blender 3.x (the default, the Debian 12 Blender the add-on runs), height-correlated
+  // 1 / (1 + Λ(wo) + Λ(wi)) from Blender 4.0.
+  enum class Masking { Separable, HeightCorrelated };
   struct Ggx {
     double roughness;
+    Masking masking;  // no default here: a nested aggregate's initialiser would leave the variant unconstructible
     double alpha() const { return roughness * roughness; }
   };
   // Normalised modified Phong lobe (n + 2) / (2π) · cos^n of the angle to the mirror direction.

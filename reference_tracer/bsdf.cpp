@@ -67,17 +67,23 @@ double GgxLobe::D(const Vec3& h) const {
   return a2 / (kPi * denom * denom);
 }
 
-double GgxLobe::G1(const Vec3& w) const {
+double GgxLobe::Lambda(const Vec3& w) const {
   const double c2 = w.z() * w.z();
-  if (c2 <= 0.0) return 0.0;
+  if (w.z() <= 0.0) return std::numeric_limits<double>::infinity();
   const double tan2 = std::max(0.0, 1.0 - c2) / c2;
-  return 2.0 / (1.0 + std::sqrt(1.0 + alpha * alpha * tan2));
+  return 0.5 * (std::sqrt(1.0 + alpha * alpha * tan2) - 1.0);
+}
+
+double GgxLobe::G1(const Vec3& w) const { return 1.0 / (1.0 + Lambda(w)); }
+
+double GgxLobe::G2(const Vec3& wo, const Vec3& wi) const {
+  return height_correlated ? 1.0 / (1.0 + Lambda(wo) + Lambda(wi)) : G1(wo) * G1(wi);
 }
 
 double GgxLobe::eval(const Vec3& wo, const Vec3& wi) const {
   if (!same_hemisphere_above(wo, wi)) return 0.0;
   const Vec3 h = (wo + wi).normalized();
-  return D(h) * G1(wo) * G1(wi) / (4.0 * wo.z());
+  return D(h) * G2(wo, wi) / (4.0 * wo.z());
 }
 
 double GgxLobe::pdf(const Vec3& wo, const Vec3& wi) const {
@@ -103,9 +109,10 @@ std::optional<LobeSample> GgxLobe::sample(const Vec3& wo, const Vec2& u) const {
   const Vec3 h = Vec3(alpha * nh.x(), alpha * nh.y(), std::max(1e-12, nh.z())).normalized();
   const Vec3 wi = 2.0 * wo.dot(h) * h - wo;
   if (wi.z() <= 0.0) return std::nullopt;
-  const double p = G1(wo) * D(h) / (4.0 * wo.z());
-  // eval / pdf reduces to G1(wi).
-  return LobeSample{wi, G1(wi), p};
+  const double g1 = G1(wo);
+  const double p = g1 * D(h) / (4.0 * wo.z());
+  // eval / pdf reduces to G2(wo, wi) / G1(wo): G1(wi) for separable masking.
+  return LobeSample{wi, G2(wo, wi) / g1, p};
 }
 
 // ---- Phong ----

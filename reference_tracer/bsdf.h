@@ -32,12 +32,17 @@ struct LambertLobe {
 };
 
 // GGX (Trowbridge–Reitz) microfacet reflection as Cycles' Glossy BSDF evaluates it: alpha = roughness²,
-// f = D(h)·G1(wo)·G1(wi) / (4 cos θo cos θi) with the separable Smith masking G1, no Fresnel. Sampled
+// f = D(h)·G2(wo, wi) / (4 cos θo cos θi), no Fresnel, with the Smith masking-shadowing G2 of the Cycles
+// version held to: separable G1(wo)·G1(wi) (Blender 3.x) or height-correlated 1 / (1 + Λ(wo) + Λ(wi))
+// (Blender 4.0 on; Heitz 2014, "Understanding the Masking-Shadowing Function"), G1 = 1 / (1 + Λ). Sampled
 // from the distribution of visible normals (Heitz 2018), pdf = G1(wo)·D(h) / (4 cos θo).
 struct GgxLobe {
   double alpha;
+  bool height_correlated = false;
   double D(const Vec3& h) const;
+  double Lambda(const Vec3& w) const;  // Smith's Λ; +∞ at or below the horizon
   double G1(const Vec3& w) const;
+  double G2(const Vec3& wo, const Vec3& wi) const;
   double eval(const Vec3& wo, const Vec3& wi) const;
   double pdf(const Vec3& wo, const Vec3& wi) const;
   std::optional<LobeSample> sample(const Vec3& wo, const Vec2& u) const;

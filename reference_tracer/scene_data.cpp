@@ -21,7 +21,8 @@ TracerMaterial make_material(const Material& material) {
     m.specular_weight = dichromatic->specular;
     if (const auto* ggx = std::get_if<DichromaticMaterial::Ggx>(&dichromatic->lobe)) {
       // Roughness 0 is a perfect mirror lobe (the scene format's convention, as in Cycles).
-      if (ggx->roughness > 0.0) m.glossy = rt::GgxLobe{ggx->alpha()};
+      if (ggx->roughness > 0.0)
+        m.glossy = rt::GgxLobe{ggx->alpha(), ggx->masking == DichromaticMaterial::Masking::HeightCorrelated};
       else m.glossy = MirrorLobe{};
     } else {
       m.glossy = rt::PhongLobe{std::get<DichromaticMaterial::Phong>(dichromatic->lobe).exponent};

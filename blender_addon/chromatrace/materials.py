@@ -42,6 +42,12 @@ def _new(nodes, kind, name, location):
     return node
 
 
+def cycles_ggx_masking():
+    """The Smith masking of the running Cycles' GGX (the scene format's "masking"): separable up to Blender 3.x,
+    height-correlated from 4.0."""
+    return "height-correlated" if bpy.app.version >= (4, 0, 0) else "separable"
+
+
 def build_material_nodes(material):
     """Replaces the material's nodes with those of its chromatrace model: RGB nodes named ct_reflectance and
     ct_emission hold the colours the spectral render sets; a one-sided emitter's strength is 0 on back faces."""

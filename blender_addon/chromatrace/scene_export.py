@@ -11,7 +11,7 @@ import os
 
 import bpy
 
-from . import ply
+from . import materials, ply
 from .errors import BadInput
 from .floats import short_float
 from .geometry_digest import camera_digest, object_digest
@@ -32,6 +32,8 @@ def _material_entry(material, out_dir, log):
     if s.model == "DICHROMATIC":
         entry = {"type": "dichromatic", "diffuse": reflectance, "specular": short_float(s.specular), "lobe": s.lobe}
         entry["roughness" if s.lobe == "ggx" else "exponent"] = short_float(s.roughness if s.lobe == "ggx" else s.exponent)
+        if s.lobe == "ggx" and materials.cycles_ggx_masking() != "separable":  # the format's default
+            entry["masking"] = materials.cycles_ggx_masking()
         return entry
     if s.model == "MIRROR":
         return {"type": "mirror", "reflectance": reflectance}

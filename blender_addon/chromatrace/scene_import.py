@@ -17,6 +17,7 @@ import bpy
 from mathutils import Matrix
 
 from . import camera_math, materials, ply
+from .errors import BadInput
 from .geometry_digest import camera_digest, object_digest
 
 
@@ -35,6 +36,10 @@ def _material(name, entry, scene_dir):
         s.lobe = entry.get("lobe", "ggx")
         if s.lobe == "ggx":
             s.roughness = entry["roughness"]
+            masking, cycles = entry.get("masking", "separable"), materials.cycles_ggx_masking()
+            if masking != cycles:
+                raise BadInput(f"materials.{name}.masking: \"{masking}\", but the GGX of Cycles in Blender "
+                               f"{bpy.app.version_string} has {cycles} masking: Cycles would render another material")
         else:
             s.exponent = entry["exponent"]
     else:

@@ -29,6 +29,8 @@ inline const std::vector<BadScene>& bad_scenes() {
        "line 3, column 56: syntax error while parsing object - unexpected string literal; expected '}'"},
       {"unknown_spectrum.json", "materials.wall.reflectance: unknown spectrum \"whte\" (spectra: white)"},
       {"roughness_out_of_range.json", "materials.red_plastic.roughness: must be in [0, 1], got 1.5"},
+      {"unknown_masking.json",
+       "materials.red_plastic.masking: must be one of \"separable\", \"height-correlated\", got \"smith\""},
       {"duplicate_key.json", "materials.wall.reflectance: key appears twice in one object"},
       {"reflectance_above_one.json",
        "materials.wall.reflectance: spectrum \"glow\" reaches 1.2 at 650 nm, but a reflectance must be in [0, 1]"},

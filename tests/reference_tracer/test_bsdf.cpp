@@ -154,7 +154,10 @@ void expect_weights_match_eval(const Lobe& lobe, const std::string& name) {
 
 TEST(Lobes, SampleWeightsAreEvalOverPdf) {
   expect_weights_match_eval(LambertLobe{}, "lambert");
-  for (double a : {0.05, 0.3, 1.0}) expect_weights_match_eval(GgxLobe{a}, "ggx");
+  for (double a : {0.05, 0.3, 1.0}) {
+    expect_weights_match_eval(GgxLobe{a}, "ggx");
+    expect_weights_match_eval(GgxLobe{a, true}, "ggx, height-correlated");
+  }
   for (double n : {1.0, 30.0, 500.0}) expect_weights_match_eval(PhongLobe{n}, "phong");
 }
 
@@ -164,8 +167,8 @@ TEST(Lobes, AreReciprocal) {
   for (int i = 0; i < 200; ++i) {
     const Vec3 a = direction_with_cos(uni(rng), 6 * uni(rng)), b = direction_with_cos(uni(rng), 6 * uni(rng));
     // eval includes cos θi, so f(a, b) = eval(a, b) / cos θb.
-    const GgxLobe ggx{0.4};
-    EXPECT_NEAR(ggx.eval(a, b) / b.z(), ggx.eval(b, a) / a.z(), 1e-12 * (1 + ggx.eval(a, b) / b.z()));
+    for (const GgxLobe ggx : {GgxLobe{0.4}, GgxLobe{0.4, true}})
+      EXPECT_NEAR(ggx.eval(a, b) / b.z(), ggx.eval(b, a) / a.z(), 1e-12 * (1 + ggx.eval(a, b) / b.z()));
     const PhongLobe phong{15};
     EXPECT_NEAR(phong.eval(a, b) / b.z(), phong.eval(b, a) / a.z(), 1e-12 * (1 + phong.eval(a, b) / b.z()));
   }
@@ -195,8 +198,30 @@ void expect_energy_conserving(const Lobe& lobe, const std::string& name) {
 
 TEST(Lobes, ConserveEnergy) {
   expect_energy_conserving(LambertLobe{}, "lambert");
-  for (double roughness : {0.01, 0.1, 0.3, 0.5, 0.8, 1.0}) expect_energy_conserving(GgxLobe{roughness * roughness}, "ggx");
+  for (double roughness : {0.01, 0.1, 0.3, 0.5, 0.8, 1.0}) {
+    expect_energy_conserving(GgxLobe{roughness * roughness}, "ggx");
+    expect_energy_conserving(GgxLobe{roughness * roughness, true}, "ggx, height-correlated");
+  }
   for (double n : {0.0, 1.0, 10.0, 100.0, 1000.0}) expect_energy_conserving(PhongLobe{n}, "phong");
+}
+
+// Height-correlated masking 1 / (1 + Λo + Λi) never shadows more than the separable G1(wo)·G1(wi) =
+// 1 / (1 + Λo + Λi + Λo·Λi), and equals it where either Λ is 0: at normal incidence, and as alpha → 0.
+TEST(Ggx, HeightCorrelatedMaskingBoundsTheSeparableOneAndMeetsItWhereItMust) {
+  std::mt19937_64 rng(3);
+  std::uniform_real_distribution<double> uni(0.02, 1.0);
+  for (int i = 0; i < 500; ++i) {
+    const Vec3 wo = direction_with_cos(uni(rng), 6 * uni(rng)), wi = direction_with_cos(uni(rng), 6 * uni(rng));
+    const GgxLobe separable{0.6}, correlated{0.6, true};
+    const double lo = separable.Lambda(wo), li = separable.Lambda(wi);
+    EXPECT_NEAR(correlated.G2(wo, wi), 1 / (1 + lo + li), 1e-12);
+    EXPECT_NEAR(separable.G2(wo, wi), 1 / ((1 + lo) * (1 + li)), 1e-12);
+    EXPECT_GE(correlated.G2(wo, wi), separable.G2(wo, wi));
+    const Vec3 normal(0, 0, 1);
+    EXPECT_NEAR(correlated.G2(normal, wi), separable.G2(normal, wi), 1e-15);
+    const GgxLobe smooth_correlated{1e-4, true}, smooth_separable{1e-4};
+    EXPECT_NEAR(smooth_correlated.G2(wo, wi), smooth_separable.G2(wo, wi), 1e-6);
+  }
 }
 
 TEST(Ggx, NormalDistributionIsNormalised) {

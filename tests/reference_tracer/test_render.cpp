@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <fstream>
 #include <numbers>
+#include <random>
 #include <sstream>
 
 #include <unistd.h>
@@ -265,6 +266,63 @@ TEST(Render, BandsAndContinuousAgreeWhenSpectraAreConstantWithinBands) {
     const double mean = sum / n, se = std::sqrt((sum2 / n - mean * mean) / (n - 1));
     EXPECT_LT(std::abs(mean), 4.0 * se) << "band " << b << ": mean difference " << mean << ", se " << se;
   }
+}
+
+// A black-bodied, fully glossy GGX plane inside a closed cube that emits 1 everywhere, direct light only:
+// each pixel sees the lobe's directional albedo ρ(θo) = ∫ f cos θi dωi at the camera's angle, which the lobe's
+// own samples estimate independently. The two maskings must agree at normal incidence (Λ(wo) = 0 there, so
+// both are G1(wi)) and as roughness → 0, and differ at grazing incidence on a rough surface, where the
+// separable product shadows more.
+TEST(GgxMasking, RendersAgreeWhereTheyMustAndDifferWhereTheyMust) {
+  const auto render_plane = [](double roughness, const std::string& masking, double view_deg) {
+    json doc = furnace({{"constant", 0.5}}, 1, "bands");
+    doc["spectra"]["black"] = {{"constant", 0.0}};
+    doc["materials"]["plane"] = {{"type", "dichromatic"}, {"diffuse", "black"}, {"specular", 1.0},
+                                 {"lobe", "ggx"}, {"roughness", roughness}, {"masking", masking}};
+    doc["objects"] = json::array({{{"name", "plane"}, {"material", "plane"},
+                                   {"shape", {{"type", "quad"}, {"corner", {-0.8, -0.8, -0.5}}, {"edge1", {1.6, 0, 0}},
+                                              {"edge2", {0, 1.6, 0}}}}}});
+    const double t = view_deg * kPi / 180;
+    doc["camera"] = {{"position", {0.9 * std::sin(t), 0, -0.5 + 0.9 * std::cos(t)}}, {"look_at", {0, 0, -0.5}},
+                     {"up", {0, 1, 0}}, {"fov_deg", 1}, {"resolution", {4, 4}}};
+    doc["render"] = {{"samples", 4096}, {"max_bounces", 1}, {"bands", "500:600:100"}, {"seed", 7}};
+    RenderOptions options;
+    options.progress = false;
+    options.components = {false, false, false};
+    return band_stats(render(make_scene(doc), options), 0, 0);
+  };
+  // ρ(θo) from the lobe's own samples: E[weight].
+  const auto albedo = [](double roughness, bool correlated, double view_deg) {
+    const GgxLobe lobe{roughness * roughness, correlated};
+    const double t = view_deg * kPi / 180;
+    const Vec3 wo(std::sin(t), 0, std::cos(t));
+    std::mt19937_64 rng(19);
+    std::uniform_real_distribution<double> uni(0.0, 1.0);
+    constexpr int kN = 400000;
+    double sum = 0, sum2 = 0;
+    for (int i = 0; i < kN; ++i) {
+      const auto s = lobe.sample(wo, Vec2(uni(rng), uni(rng)));
+      const double w = s ? s->weight : 0.0;
+      sum += w;
+      sum2 += w * w;
+    }
+    const double mean = sum / kN;
+    return Stats{mean, std::sqrt(std::max(0.0, sum2 / kN - mean * mean) / kN)};
+  };
+  const auto near = [](const Stats& a, const Stats& b) { return std::abs(a.mean - b.mean) <= 4 * std::hypot(a.se, b.se); };
+
+  const Stats normal_separable = render_plane(1.0, "separable", 0), normal_correlated = render_plane(1.0, "height-correlated", 0);
+  EXPECT_TRUE(near(normal_separable, normal_correlated)) << normal_separable.mean << " vs " << normal_correlated.mean;
+  const Stats smooth_separable = render_plane(0.05, "separable", 80), smooth_correlated = render_plane(0.05, "height-correlated", 80);
+  EXPECT_TRUE(near(smooth_separable, smooth_correlated)) << smooth_separable.mean << " vs " << smooth_correlated.mean;
+
+  const Stats grazing_separable = render_plane(1.0, "separable", 80), grazing_correlated = render_plane(1.0, "height-correlated", 80);
+  EXPECT_GT(grazing_correlated.mean - grazing_separable.mean, 4 * std::hypot(grazing_correlated.se, grazing_separable.se))
+      << grazing_separable.mean << " vs " << grazing_correlated.mean;
+  // Each render holds its lobe's albedo (the camera's 1° field of view changes θo by ±0.5°).
+  EXPECT_NEAR(normal_separable.mean, albedo(1.0, false, 0).mean, 0.01 * normal_separable.mean + 4 * normal_separable.se);
+  EXPECT_NEAR(grazing_separable.mean, albedo(1.0, false, 80).mean, 0.01 * grazing_separable.mean + 4 * grazing_separable.se);
+  EXPECT_NEAR(grazing_correlated.mean, albedo(1.0, true, 80).mean, 0.01 * grazing_correlated.mean + 4 * grazing_correlated.se);
 }
 
 // The --components grammar from the table the Blender add-on's parser is tested against too.
