@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "reference_tracer/bsdf.h"
+#include "tests/reference_tracer/lobe_albedo.h"
 
 namespace ct::rt {
 namespace {
@@ -178,21 +179,9 @@ TEST(Lobes, AreReciprocal) {
 // incidence angle and roughness; the estimate's standard error sets the tolerance (4 σ).
 template <class Lobe>
 void expect_energy_conserving(const Lobe& lobe, const std::string& name) {
-  std::mt19937_64 rng(17);
-  std::uniform_real_distribution<double> uni(0.0, 1.0);
-  constexpr int kN = 100000;
   for (double c : {0.02, 0.1, 0.3, 0.5, 0.7, 0.9, 1.0}) {
-    const Vec3 wo = direction_with_cos(c);
-    double sum = 0.0, sum2 = 0.0;
-    for (int i = 0; i < kN; ++i) {
-      const auto s = lobe.sample(wo, Vec2(uni(rng), uni(rng)));
-      const double w = s ? s->weight : 0.0;
-      sum += w;
-      sum2 += w * w;
-    }
-    const double mean = sum / kN;
-    const double se = std::sqrt(std::max(0.0, sum2 / kN - mean * mean) / kN);
-    EXPECT_LE(mean, 1.0 + 4.0 * se + 1e-12) << name << " at cos θo = " << c;
+    const test::AlbedoEstimate a = test::directional_albedo(lobe, direction_with_cos(c), 100000, 17);
+    EXPECT_LE(a.mean, 1.0 + 4.0 * a.se + 1e-12) << name << " at cos θo = " << c;
   }
 }
 

@@ -21,6 +21,7 @@
 #include "core/scene.h"
 #include "core/spectral_exr.h"
 #include "reference_tracer/render.h"
+#include "tests/reference_tracer/lobe_albedo.h"
 #include "tests/common/view_factor.h"
 
 namespace ct::rt {
@@ -293,21 +294,8 @@ TEST(GgxMasking, RendersAgreeWhereTheyMustAndDifferWhereTheyMust) {
   };
   // ρ(θo) from the lobe's own samples: E[weight].
   const auto albedo = [](double roughness, bool correlated, double view_deg) {
-    const GgxLobe lobe{roughness * roughness, correlated};
     const double t = view_deg * kPi / 180;
-    const Vec3 wo(std::sin(t), 0, std::cos(t));
-    std::mt19937_64 rng(19);
-    std::uniform_real_distribution<double> uni(0.0, 1.0);
-    constexpr int kN = 400000;
-    double sum = 0, sum2 = 0;
-    for (int i = 0; i < kN; ++i) {
-      const auto s = lobe.sample(wo, Vec2(uni(rng), uni(rng)));
-      const double w = s ? s->weight : 0.0;
-      sum += w;
-      sum2 += w * w;
-    }
-    const double mean = sum / kN;
-    return Stats{mean, std::sqrt(std::max(0.0, sum2 / kN - mean * mean) / kN)};
+    return test::directional_albedo(GgxLobe{roughness * roughness, correlated}, Vec3(std::sin(t), 0, std::cos(t)), 400000, 19);
   };
   const auto near = [](const Stats& a, const Stats& b) { return std::abs(a.mean - b.mean) <= 4 * std::hypot(a.se, b.se); };
 
