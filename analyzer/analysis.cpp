@@ -55,9 +55,22 @@ ImageAnalysis analyse_image(const AnalysisImage& input, const std::string& layer
   a.context = layer_context(pixels, a.encoding, options.bins);
   a.options = options;
   a.regions = std::move(regions);
+  // Values encoded by a known non-linear curve are analysed twice: as stored (what the histogram shows) and in
+  // linear light (what the light did); the illuminant is estimated from the light.
+  const std::optional<ToneCurve> curve =
+      a.encoding.curve && !a.encoding.curve->linear() ? a.encoding.curve : std::nullopt;
+  const double full_scale = a.encoding.integer ? a.encoding.full_scale : 1.0;
+  const RgbImage linear = curve ? linear_light(input) : RgbImage{};
+  const LayerContext linear_context = curve ? linear_light_context(a.context, *curve, full_scale) : LayerContext{};
   Progress bar("analyze", a.regions.size(), progress);
   for (const Region& r : a.regions) {
     a.results.push_back(analyse_region(pixels, a.context, r, options));
+    if (curve) {
+      ClusterShape light = analyse_region(linear, linear_context, r, options).shape;
+      // The whole image mixes every cluster: its class only describes; the curve's bend is judged per object.
+      if (r.source == "image") a.results.back().linear_light = std::move(light);
+      else apply_tone_curve(a.results.back(), std::move(light), *curve, options.criteria);
+    }
     if (r.source == "labels" && !input.object_ids.empty()) {
       RegionAnalysis& result = a.results.back();
       // Mixing turns a colour's direction; the noise that matters is across the cluster's first axis (along it,
@@ -80,7 +93,16 @@ ImageAnalysis analyse_image(const AnalysisImage& input, const std::string& layer
     bar.advance();
   }
   bar.finish();
-  a.illuminant = estimate_illuminant(a.results, pixels.rgb, known_illuminant);
+  if (curve) {
+    std::vector<RegionAnalysis> light = a.results;
+    for (RegionAnalysis& r : light) r.shape = *r.linear_light;
+    a.illuminant = estimate_illuminant(light, linear.rgb, known_illuminant);
+    a.notes.push_back(fmt::format("R, G, B were encoded by {} (the file's chromatrace.curve_*): classes are of the "
+                                  "values as stored, each region's class in linear light is given beside it, and "
+                                  "the illuminant is estimated in linear light", curve->describe()));
+  } else {
+    a.illuminant = estimate_illuminant(a.results, pixels.rgb, known_illuminant);
+  }
   const std::size_t non_finite = a.results.empty() ? 0 : a.results.front().non_finite;  // the whole image
   if (non_finite > 0)
     a.notes.push_back(fmt::format("{} pixel{} NaN or infinite: left out of every histogram", non_finite, non_finite == 1 ? " is" : "s are"));

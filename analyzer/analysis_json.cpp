@@ -90,7 +90,13 @@ json input_json(const ImageAnalysis& a) {
           {"read_noise", number(e.read_noise)},
           {"bits", e.adc_bits ? json(*e.adc_bits) : json(nullptr)},
           {"noise", e.noise ? json(*e.noise) : json(nullptr)},
-          {"adc", e.adc ? json(*e.adc) : json(nullptr)}};
+          {"adc", e.adc ? json(*e.adc) : json(nullptr)},
+          {"curve", e.curve ? json{{"description", e.curve->describe()},
+                                   {"gamma", e.curve->srgb ? json(nullptr) : json(e.curve->gamma)},
+                                   {"k", e.curve->srgb ? json(nullptr) : json(e.curve->k)},
+                                   {"srgb", e.curve->srgb},
+                                   {"linearised", !e.curve->linear()}}
+                            : json(nullptr)}};
 }
 
 }  // namespace
@@ -170,6 +176,9 @@ json analysis_to_json(const ImageAnalysis& a) {
               {"valid_pixels", r.shape.samples},
               {"occupied_bins", r.histogram.cells.size()},
               {"shape", shape_to_json(r.shape)},
+              {"linear_light", r.linear_light ? json{{"class", class_name(r.linear_light->shape)},
+                                                     {"reason", r.linear_light->reason}}
+                                              : json(nullptr)},
               {"files", {{"histogram", "histograms/" + stem + ".json"}, {"plot", "plots/" + stem + ".png"}}}};
     j["explanation"] = i < a.explanations.size() ? optional_json(a.explanations[i], explanation_json) : json(nullptr);
     regions.push_back(std::move(j));

@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "core/colour.h"
 #include "core/error.h"
 
 namespace ct::analyzer {
@@ -27,7 +28,8 @@ struct RawImage {
 
 constexpr const char* kCameraKeys[] = {"chromatrace.black_level", "chromatrace.white_level", "chromatrace.dark_signal",
                                        "chromatrace.read_noise",  "chromatrace.bits",        "chromatrace.noise",
-                                       "chromatrace.adc",         "chromatrace.pixel_area"};
+                                       "chromatrace.adc",         "chromatrace.pixel_area",
+                                       "chromatrace.curve_gamma", "chromatrace.curve_k",     "chromatrace.curve_srgb"};
 
 // The camera's numbers: numeric attributes (EXR), numbers spelled as text (PNG keeps attributes as text), or
 // the JSON object a TIFF or PNG holds in ImageDescription.
@@ -195,6 +197,20 @@ void apply_camera_metadata(const RawImage& raw, AnalysisImage& out) {
   if (const auto noise = camera_number(raw, "chromatrace.noise")) e.noise = *noise != 0;
   if (const auto adc = camera_number(raw, "chromatrace.adc")) e.adc = *adc != 0;
   if (const auto area = camera_number(raw, "chromatrace.pixel_area")) e.pixel_area = *area != 0;
+  const auto gamma = camera_number(raw, "chromatrace.curve_gamma");
+  const auto srgb = camera_number(raw, "chromatrace.curve_srgb");
+  if (gamma || srgb) {
+    ToneCurve curve;
+    curve.srgb = srgb.value_or(0) != 0;
+    if (!curve.srgb) {
+      curve.gamma = gamma.value_or(1.0);
+      curve.k = camera_number(raw, "chromatrace.curve_k").value_or(1.0);
+      if (!(curve.gamma > 0) || !(curve.k > 0))
+        throw InputError(fmt::format("{}: chromatrace.curve_gamma and chromatrace.curve_k must be > 0 (are {:g}, {:g})",
+                                     out.file, curve.gamma, curve.k));
+    }
+    e.curve = curve;
+  }
   if (e.black_level && *e.black_level != 0) {
     const auto black = static_cast<float>(*e.black_level);
     for (float& v : out.image.rgb) v -= black;
@@ -203,6 +219,29 @@ void apply_camera_metadata(const RawImage& raw, AnalysisImage& out) {
 }
 
 }  // namespace
+
+std::string ToneCurve::describe() const {
+  if (srgb) return "the sRGB curve";
+  if (linear()) return "linear";
+  return fmt::format("I' = {:g}·I^{:g}", k, gamma);
+}
+
+double ToneCurve::decode(double stored, double full_scale) const {
+  const double n = std::abs(stored) / full_scale;
+  const double v = srgb ? srgb_decode(n) : std::pow(n / k, 1.0 / gamma);
+  return std::copysign(v * full_scale, stored);
+}
+
+RgbImage linear_light(const AnalysisImage& input) {
+  RgbImage out = input.image;
+  const ImageEncoding& e = input.encoding;
+  if (!e.curve || e.curve->linear()) return out;
+  // Codes of integer files are fractions of full scale; a float file stores the normalised signal itself.
+  const double full_scale = e.integer ? e.full_scale : 1.0;
+  for (float& v : out.rgb)
+    if (std::isfinite(v)) v = static_cast<float>(e.curve->decode(v, full_scale));
+  return out;
+}
 
 AnalysisImage read_analysis_image(const std::filesystem::path& file) {
   const std::string name = file.string();

@@ -25,6 +25,20 @@ struct RgbImage {
   std::size_t pixel_count() const { return static_cast<std::size_t>(width) * static_cast<std::size_t>(height); }
 };
 
+// The response curve that encoded R, G, B from a normalised linear signal n (1 = the camera's white):
+// stored = full_scale · f(n) with f(n) = k·n^γ, or the sRGB curve; odd-symmetric, so that values below black
+// keep their sign (docs/sensor.md, "Output").
+struct ToneCurve {
+  double gamma = 1;
+  double k = 1;
+  bool srgb = false;
+
+  bool linear() const { return !srgb && gamma == 1 && k == 1; }
+  std::string describe() const;
+  // The linear signal, in the file's units, of a stored value.
+  double decode(double stored, double full_scale) const;
+};
+
 struct ImageEncoding {
   bool integer = false;    // stored as unsigned integers
   int bits = 0;            // bits per sample of integer files (8, 16, 32); 0 for float
@@ -42,6 +56,7 @@ struct ImageEncoding {
   std::optional<bool> noise = std::nullopt;  // whether noise was on
   std::optional<bool> adc = std::nullopt;    // whether the ADC was on
   std::optional<bool> pixel_area = std::nullopt;  // whether pixels integrate an area (false: point samples)
+  std::optional<ToneCurve> curve = std::nullopt;   // the response curve R, G, B were encoded with
 
   // The value R, G, B hold for black: −black_level once subtracted, else 0 (the ADC's code 0 lies at
   // −black_level after subtraction).
@@ -69,6 +84,10 @@ struct AnalysisImage {
   std::vector<std::int32_t> object_ids;    // channel object_id, [y][x]; empty when absent
   std::map<std::int32_t, std::string> object_names;  // attribute chromatrace.objects
 };
+
+// The final image in linear light: R, G, B with the encoding's curve undone (a copy of the image when the
+// curve is linear or unknown).
+RgbImage linear_light(const AnalysisImage& input);
 
 // Reads R, G, B (or a grey-free file's first three channels) and whatever extra layers are present.
 // When the file says what the camera's black level was (chromatrace.black_level, as an attribute or in the

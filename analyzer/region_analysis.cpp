@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include <fmt/core.h>
+
 #include "analyzer/noise_level.h"
 
 namespace ct::analyzer {
@@ -40,6 +42,53 @@ LayerContext layer_context(const RgbImage& layer, const ImageEncoding& encoding,
       if (!(level > 0)) level = std::numeric_limits<double>::infinity();
   }
   return c;
+}
+
+LayerContext linear_light_context(const LayerContext& stored, const ToneCurve& curve, double full_scale) {
+  LayerContext c = stored;
+  for (double& level : c.high_levels)
+    if (std::isfinite(level)) level = curve.decode(level, full_scale);
+  for (int k = 0; k < 3; ++k) {
+    c.spec.lo[k] = curve.decode(stored.spec.lo[k], full_scale);
+    c.spec.hi[k] = curve.decode(stored.spec.hi[k], full_scale);
+  }
+  c.clipping.low.fill(curve.decode(stored.clipping.low[0], full_scale));
+  c.quantisation_sigma = 0;
+  return c;
+}
+
+void apply_tone_curve(RegionAnalysis& stored, ClusterShape linear, const ToneCurve& curve, const ShapeCriteria& k) {
+  ClusterShape& s = stored.shape;
+  // The flat the light's cluster lies in: a line (d = 1) or a plane (d = 2). Other classes (no samples, one
+  // colour, clipped faces, volumes) have no flat for the curve to bend, and a gamma class is already the curve's.
+  int d = 0;
+  switch (linear.shape) {
+    case ShapeClass::Linear: d = 1; break;
+    case ShapeClass::L: case ShapeClass::SkewedT: case ShapeClass::Fork: case ShapeClass::P: case ShapeClass::Planar:
+      d = 2; break;
+    default: break;
+  }
+  if (d > 0 && s.shape != ShapeClass::Gamma && s.shape != ShapeClass::Clipped && s.samples == linear.samples) {
+    const auto axis = static_cast<Eigen::Index>(d);
+    // The spread off that flat as stored, against the noise along that axis …
+    const double off = s.sigma[axis], noise = s.noise_sigma[axis];
+    const bool significant = off > k.noise_factor * noise;
+    s.decisions.push_back({fmt::format("spread off the light's {} as stored / noise", d == 1 ? "line" : "plane"),
+                           off / std::max(1e-300, noise), k.noise_factor, significant});
+    // … and what is left of it, relative to the cluster's length, once the curve is undone.
+    const double stored_relative = off / std::max(1e-300, s.sigma[0]);
+    const double linear_relative = linear.sigma[axis] / std::max(1e-300, linear.sigma[0]);
+    const double left = linear_relative * linear_relative / std::max(1e-300, stored_relative * stored_relative);
+    const bool straightened = left <= k.gamma_straightening;
+    if (significant)
+      s.decisions.push_back({"relative off-flat variance in linear light / as stored", left, k.gamma_straightening, straightened});
+    if (significant && straightened) {
+      s.reason = fmt::format("{} bends the {} cluster of linear light off its {} (by {:.2g} of its length as stored)",
+                             curve.describe(), class_name(linear.shape), d == 1 ? "line" : "plane", stored_relative);
+      s.shape = ShapeClass::Gamma;
+    }
+  }
+  stored.linear_light = std::move(linear);
 }
 
 RegionAnalysis analyse_region(const RgbImage& layer, const LayerContext& context, const Region& region,

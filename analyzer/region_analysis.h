@@ -4,6 +4,7 @@
 
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <string>
 
 #include "analyzer/cluster_shape.h"
@@ -43,7 +44,20 @@ struct RegionAnalysis {
   std::size_t non_finite = 0;  // of those, NaN or infinite: left out
   Histogram3 histogram;
   ClusterShape shape;
+  // The cluster in linear light, when the analysed values were encoded by a known non-linear response curve
+  // (ImageEncoding::curve): the class the light itself gives, before the curve bent it.
+  std::optional<ClusterShape> linear_light;
 };
+
+// The context of the same layer with its response curve undone (linear_light()): the clipping levels go
+// through the curve's inverse, and the quantisation step, uneven in linear light, is left to the measured noise.
+LayerContext linear_light_context(const LayerContext& stored, const ToneCurve& curve, double full_scale);
+
+// Compares the region's cluster as stored with its cluster in linear light: where the light's cluster is a line
+// or a plane, and as stored it spreads off that flat by more than the noise, a spread that undoing the curve
+// removes (its variance relative to the cluster's length falls to gamma_straightening), the structure the
+// histogram shows is the curve's bend, and the class becomes gamma (docs/analyze.md).
+void apply_tone_curve(RegionAnalysis& stored, ClusterShape linear, const ToneCurve& curve, const ShapeCriteria& criteria);
 
 RegionAnalysis analyse_region(const RgbImage& layer, const LayerContext& context, const Region& region,
                               const AnalyzeOptions& options);

@@ -150,6 +150,7 @@ json summary(const RegionAnalysis& r, const std::optional<Explanation>& e) {
   if (s.curve && (s.shape == ShapeClass::Curved || s.shape == ShapeClass::Gamma)) row("bend (sagitta / chord)", fmt::format("{:.3f}", s.curve->bend));
   if (s.gamma && s.shape == ShapeClass::Gamma) row("γ", fmt::format("{:.3f}", s.gamma->gamma));
   if (!s.clipping.faces.empty()) row("clipped", percent(s.clipping.fraction));
+  if (r.linear_light) row("class in linear light (curve undone)", std::string(class_name(r.linear_light->shape)));
   if (e) {
     if (e->direct_share) row("direct / indirect", percent(*e->direct_share) + " / " + percent(e->indirect_share.value_or(0)));
     if (e->diffuse_share) row("diffuse / glossy", percent(*e->diffuse_share) + " / " + percent(e->glossy_share.value_or(0)));

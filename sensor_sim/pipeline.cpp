@@ -413,7 +413,8 @@ DisplayRendering display_rendering(const Survey& survey, const LinearModel& unit
 void camera_levels(const SensorConfig& c, double exposure_s, OutputLayout& layout) {
   for (const char* key : {"chromatrace.black_level", "chromatrace.white_level", "chromatrace.dark_signal",
                           "chromatrace.read_noise", "chromatrace.bits", "chromatrace.noise", "chromatrace.adc",
-                          "chromatrace.pixel_area"})
+                          "chromatrace.pixel_area", "chromatrace.curve_gamma", "chromatrace.curve_k",
+                          "chromatrace.curve_srgb"})
     layout.attributes.erase(key);  // an input's own, passed through as text, would clash
   auto& number = layout.number_attributes;
   const double dark_e = c.noise.dark_current_e_per_s * exposure_s;
@@ -441,6 +442,13 @@ void camera_levels(const SensorConfig& c, double exposure_s, OutputLayout& layou
   // TIFF and PNG store R, G, B as codes round(value · code_scale): the levels are given in codes.
   if (layout.format != OutputFormat::Exr)
     for (auto& [key, value] : number) value *= layout.code_scale;
+  // The response curve that encoded R, G, B from the normalised signal (1 = rendering.white_level), so that
+  // the analyzer can undo it: I' = k·I^γ, or the sRGB curve. Without a rendering, R, G, B are linear.
+  const bool srgb = c.rendering.enabled && c.rendering.curve == ResponseCurve::Srgb;
+  const bool power = c.rendering.enabled && c.rendering.curve == ResponseCurve::Gamma;
+  number["chromatrace.curve_gamma"] = power ? c.rendering.gamma : 1.0;
+  number["chromatrace.curve_k"] = power ? c.rendering.k : 1.0;
+  layout.integer_attributes["chromatrace.curve_srgb"] = srgb ? 1 : 0;
   layout.integer_attributes["chromatrace.bits"] = c.adc.enabled ? c.adc.bits : 0;
   layout.integer_attributes["chromatrace.noise"] = c.noise.enabled ? 1 : 0;
   layout.integer_attributes["chromatrace.adc"] = c.adc.enabled ? 1 : 0;
@@ -656,7 +664,9 @@ RunReport simulate_sensor(const fs::path& input, const fs::path& output, SensorC
   layout.integer_attributes["chromatrace.pixel_area"] = pixel_area(info, config);
   if (picture) {  // the codes are the display rendering's (sRGB, 0…255), not the camera's numbers
     layout.attributes["chromatrace.signal"] = "display";
-    layout.number_attributes = {{"chromatrace.black_level", 0.0}, {"chromatrace.white_level", 255.0}};
+    layout.number_attributes = {{"chromatrace.black_level", 0.0}, {"chromatrace.white_level", 255.0},
+                                {"chromatrace.curve_gamma", 1.0}, {"chromatrace.curve_k", 1.0}};
+    layout.integer_attributes["chromatrace.curve_srgb"] = 1;
   }
   SensorImageWriter writer(output, layout);
 

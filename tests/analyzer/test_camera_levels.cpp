@@ -14,6 +14,7 @@
 #include "analyzer/clipping.h"
 #include "analyzer/cluster_shape.h"
 #include "analyzer/report.h"
+#include "core/error.h"
 #include "core/file_io.h"
 #include "tests/analyzer/synthetic.h"
 #include "tests/cli/run_command.h"
@@ -28,14 +29,15 @@ using namespace ct::analyzer;
 // Writes R, G, B (plus object_id, display.R/G/B when given) as a float EXR with numeric attributes, as the
 // sensor simulator does.
 void write_camera_exr(const fs::path& file, const RgbImage& image, const std::vector<std::int32_t>& ids,
-                      const std::map<std::string, double>& numbers, const RgbImage* display = nullptr) {
+                      const std::map<std::string, double>& numbers, const RgbImage* display = nullptr,
+                      const std::string& objects = R"({"1": "shaded", "2": "blown"})") {
   std::vector<std::string> names = {"R", "G", "B"};
   if (!ids.empty()) names.push_back("object_id");
   if (display) names.insert(names.end(), {"display.R", "display.G", "display.B"});
   OIIO::ImageSpec spec(image.width, image.height, static_cast<int>(names.size()), OIIO::TypeDesc::FLOAT);
   spec.channelnames = names;
   for (const auto& [key, value] : numbers) spec.attribute(key, OIIO::TypeDesc::DOUBLE, &value);
-  if (!ids.empty()) spec.attribute("chromatrace.objects", R"({"1": "shaded", "2": "blown"})");
+  if (!ids.empty()) spec.attribute("chromatrace.objects", objects);
   std::vector<float> pixels;
   for (std::size_t p = 0; p < image.pixel_count(); ++p) {
     for (std::size_t c = 0; c < 3; ++c) pixels.push_back(image.rgb[p * 3 + c]);
@@ -260,6 +262,81 @@ TEST(CameraLevels, ReportShowsTheDisplayLayer) {
   EXPECT_EQ(left[2], 204);                          // round(255 · 0.8)
   EXPECT_EQ(left[1], 51);
   EXPECT_EQ(left[0], 26);
+}
+
+// The response curve's inverse, against its definition: stored = full_scale · k·n^γ, odd-symmetric.
+TEST(ToneCurve, DecodeInvertsTheCurve) {
+  const ToneCurve power{0.45, 1.2, false};
+  for (const double n : {0.0, 0.01, 0.18, 0.5, 1.0}) {
+    EXPECT_NEAR(power.decode(1.2 * std::pow(n, 0.45), 1.0), n, 1e-12);
+    EXPECT_NEAR(power.decode(255 * 1.2 * std::pow(n, 0.45), 255.0), 255 * n, 1e-9);
+    EXPECT_NEAR(power.decode(-1.2 * std::pow(n, 0.45), 1.0), -n, 1e-12);
+  }
+  const ToneCurve srgb{1, 1, true};
+  EXPECT_NEAR(srgb.decode(0.5, 1.0), 0.214041140, 1e-8);  // IEC 61966-2-1: ((0.5 + 0.055) / 1.055)^2.4
+  EXPECT_NEAR(srgb.decode(0.04045 * 255, 255.0), 255 * 0.04045 / 12.92, 1e-9);  // the linear toe's end
+  EXPECT_TRUE(ToneCurve{}.linear());
+  EXPECT_FALSE(power.linear());
+}
+
+// Three objects, encoded with I' = I^0.45 and the curve named in the file: a dichromatic L (its plane passes
+// through black, but a power curve keeps only lines through black straight), a matte line offset from black
+// (an ambient term), and a matte line through black. The curve bends the first two — gamma, their class in
+// linear light beside it — and leaves the third a line (the paper's remark).
+TEST(ToneCurve, AKnownCurveBendsWhatDoesNotPassThroughBlack) {
+  TempDir dir;
+  const double gamma = 0.45;
+  const Vec3 ambient = 0.08 * Vec3(0.3, 0.5, 0.9);
+  const RgbImage light = make_image(96, 64, [&](double u, double v) -> Vec3 {
+    const double t = 0.05 + 0.95 * v;
+    if (u < 1 / 3.0) return t < 0.85 ? Vec3(0.8 * t / 0.85 * kBody) : Vec3(0.8 * kBody + 0.6 * (t - 0.85) / 0.15 * kIlluminant);
+    if (u < 2 / 3.0) return ambient + 0.8 * t * kBody;
+    return 0.8 * t * kBody;
+  });
+  RgbImage stored = light;
+  for (float& x : stored.rgb) x = static_cast<float>(std::pow(x, gamma));
+  std::vector<std::int32_t> ids;
+  for (int y = 0; y < 64; ++y)
+    for (int x = 0; x < 96; ++x) ids.push_back(1 + 3 * x / 96);
+  const std::string names = R"({"1": "dichromatic", "2": "offset", "3": "through_black"})";
+  write_camera_exr(dir.file("encoded.exr"), stored, ids,
+                   {{"chromatrace.black_level", 0}, {"chromatrace.curve_gamma", gamma}, {"chromatrace.curve_k", 1}},
+                   nullptr, names);
+  const AnalysisImage input = read_analysis_image(dir.file("encoded.exr"));
+  ASSERT_TRUE(input.encoding.curve);
+  EXPECT_EQ(input.encoding.curve->gamma, gamma);
+  const ImageAnalysis a = analyse(input);
+  const auto classes = [&](const std::string& name) {
+    const RegionAnalysis* r = region_named(a, name);
+    return r ? std::pair(r->shape.shape, r->linear_light ? r->linear_light->shape : ShapeClass::None)
+             : std::pair(ShapeClass::None, ShapeClass::None);
+  };
+  EXPECT_EQ(classes("object 1 (dichromatic)"), std::pair(ShapeClass::Gamma, ShapeClass::L));
+  EXPECT_EQ(classes("object 2 (offset)"), std::pair(ShapeClass::Gamma, ShapeClass::Linear));
+  EXPECT_EQ(classes("object 3 (through_black)"), std::pair(ShapeClass::Linear, ShapeClass::Linear));
+  // The illuminant is estimated in linear light: from the L's highlight, the true illuminant colour.
+  EXPECT_LT(angle_deg(a.illuminant.best().rgb, kIlluminant), 1.0) << a.illuminant.best().method;
+  const nlohmann::json j = analysis_to_json(a);
+  EXPECT_EQ(j["input"]["curve"]["gamma"], gamma);
+  EXPECT_EQ(j["regions"][1]["linear_light"]["class"], "L");
+
+  // The same numbers with no curve named are taken as light: no region is judged in linear light.
+  write_camera_exr(dir.file("unnamed.exr"), stored, ids, {{"chromatrace.black_level", 0}}, nullptr, names);
+  const ImageAnalysis as_light = analyse(read_analysis_image(dir.file("unnamed.exr")));
+  for (const RegionAnalysis& r : as_light.results) EXPECT_FALSE(r.linear_light) << r.name;
+}
+
+// A curve that cannot be undone is refused by name.
+TEST(ToneCurve, ANonPositiveGammaIsRefused) {
+  TempDir dir;
+  const RgbImage image = make_image(8, 8, [](double u, double v) { return Vec3(u, v, 0.5); });
+  write_camera_exr(dir.file("bad.exr"), image, {}, {{"chromatrace.curve_gamma", -0.45}});
+  try {
+    read_analysis_image(dir.file("bad.exr"));
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("bad.exr: chromatrace.curve_gamma"), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace
