@@ -11,6 +11,7 @@
 
 #include "core/colour.h"
 #include "core/error.h"
+#include "core/exr_vocabulary.h"
 
 namespace ct::analyzer {
 namespace {
@@ -82,8 +83,8 @@ RawImage read_raw(const std::filesystem::path& file) {
     raw.encoding.bits = static_cast<int>(type.size() * 8);
     raw.encoding.full_scale = std::ldexp(1.0, raw.encoding.bits) - 1.0;
   }
-  raw.objects_attribute = spec.get_string_attribute("chromatrace.objects");
-  raw.components_attribute = spec.get_string_attribute("chromatrace.components");
+  raw.objects_attribute = spec.get_string_attribute(exr::kObjectsAttribute);
+  raw.components_attribute = spec.get_string_attribute(exr::kComponentsAttribute);
   read_camera_metadata(spec, raw);
   if (raw.width < 1 || raw.height < 1) throw InputError(fmt::format("{}: image has no pixels", name));
   raw.values.resize(static_cast<std::size_t>(raw.width) * static_cast<std::size_t>(raw.height) *
@@ -125,50 +126,23 @@ std::vector<std::int32_t> whole_numbers(const std::string& file, const std::stri
   const auto stride = static_cast<std::size_t>(raw.channels);
   for (std::size_t i = 0; i < out.size(); ++i) {
     const float v = raw.values[i * stride + static_cast<std::size_t>(channel)];
-    if (!(v >= 0.0f && v <= 16777216.0f) || v != std::floor(v))
-      throw InputError(fmt::format("{}: {}: pixel ({}, {}) holds {}, not a whole number in [0, 2^24]", file, what,
-                                   i % static_cast<std::size_t>(raw.width), i / static_cast<std::size_t>(raw.width), v));
+    if (!exr::is_object_id(v))
+      throw InputError(fmt::format("{}: {}: pixel ({}, {}) holds {}, not a whole number in [0, {}]", file, what,
+                                   i % static_cast<std::size_t>(raw.width), i / static_cast<std::size_t>(raw.width), v,
+                                   exr::kMaxObjectId));
     out[i] = static_cast<std::int32_t>(v);
   }
   return out;
 }
 
 std::map<std::int32_t, std::string> parse_object_names(const std::string& file, const std::string& text) {
-  std::map<std::int32_t, std::string> names;
-  if (text.empty()) return names;
-  nlohmann::json j;
-  try {
-    j = nlohmann::json::parse(text);
-  } catch (const nlohmann::json::exception& e) {
-    throw InputError(fmt::format("{}: attribute chromatrace.objects: not JSON: {}", file, e.what()));
-  }
-  if (!j.is_object()) throw InputError(fmt::format("{}: attribute chromatrace.objects: must be a JSON object", file));
-  for (const auto& [key, value] : j.items()) {
-    std::size_t used = 0;
-    int id = -1;
-    try {
-      id = std::stoi(key, &used);
-    } catch (const std::exception&) {
-      used = 0;
-    }
-    if (used != key.size() || id < 0 || !value.is_string())
-      throw InputError(fmt::format("{}: attribute chromatrace.objects: entry \"{}\" must map a whole number to a name", file, key));
-    names[id] = value.get<std::string>();
-  }
-  return names;
+  if (text.empty()) return {};
+  return exr::parse_object_names(text, fmt::format("{}: attribute {}", file, exr::kObjectsAttribute));
 }
 
 std::vector<std::string> component_names(const RawImage& raw) {
+  if (!raw.components_attribute.empty()) return exr::parse_component_list(raw.components_attribute);
   std::vector<std::string> names;
-  if (!raw.components_attribute.empty()) {
-    std::stringstream list(raw.components_attribute);
-    for (std::string item; std::getline(list, item, ',');) {
-      item.erase(0, item.find_first_not_of(' '));
-      item.erase(item.find_last_not_of(' ') + 1);
-      if (!item.empty()) names.push_back(item);
-    }
-    return names;
-  }
   // Without the attribute, any <prefix>.R/G/B triplet other than linear is a component.
   for (const std::string& c : raw.names) {
     if (c.size() < 3 || c.compare(c.size() - 2, 2, ".R") != 0) continue;
@@ -268,7 +242,8 @@ AnalysisImage read_analysis_image(const std::filesystem::path& file) {
   // only RGB layers explain a camera image.
   for (const std::string& c : component_names(raw))
     if (auto layer = extract_rgb(raw, c)) out.components.push_back({c, std::move(*layer)});
-  if (const int id = channel_index(raw, "object_id"); id >= 0) out.object_ids = whole_numbers(name, "object_id", raw, id);
+  if (const int id = channel_index(raw, exr::kObjectIdChannel); id >= 0)
+    out.object_ids = whole_numbers(name, exr::kObjectIdChannel, raw, id);
   out.object_names = parse_object_names(name, raw.objects_attribute);
   return out;
 }

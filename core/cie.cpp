@@ -6,6 +6,7 @@
 #include <map>
 
 #include <fmt/core.h>
+#include <nlohmann/json.hpp>
 
 #include "core/csv.h"
 #include "core/embedded_data.h"
@@ -45,8 +46,8 @@ const PiecewiseLinearSpectrum& y_bar() { return observer().y; }
 const PiecewiseLinearSpectrum& z_bar() { return observer().z; }
 
 const std::vector<std::string>& illuminant_names() {
-  static const std::vector<std::string> names = {"A",  "D50", "D65", "F1", "F2",  "F3",  "F4", "F5",
-                                                 "F6", "F7",  "F8",  "F9", "F10", "F11", "F12"};
+  static const std::vector<std::string> names =
+      nlohmann::json::parse(embedded::file("defaults.json"))["illuminants"].get<std::vector<std::string>>();
   return names;
 }
 

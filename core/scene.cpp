@@ -12,6 +12,7 @@
 
 #include "core/cie.h"
 #include "core/csv.h"
+#include "core/embedded_data.h"
 #include "core/error.h"
 #include "core/parallel.h"
 #include "core/ply.h"
@@ -505,33 +506,6 @@ const char* material_type_name(const Material& material) {
   return names[material.model.index()];
 }
 
-Vec3 Camera::forward() const { return (look_at - position).normalized(); }
-Vec3 Camera::right() const { return forward().cross(up).normalized(); }
-Vec3 Camera::image_up() const { return right().cross(forward()); }
-
-double Camera::tan_half_width() const {
-  const double t = std::tan(fov_deg * std::numbers::pi / 360.0);
-  const bool horizontal = fov_axis == FovAxis::Horizontal || (fov_axis == FovAxis::Smaller && width <= height) ||
-                          (fov_axis == FovAxis::Larger && width >= height);
-  return horizontal ? t : t * width / height;
-}
-
-double Camera::tan_half_height() const { return tan_half_width() * height / width; }
-
-double Camera::focal_length_mm() const { return 0.5 * sensor_width_mm / tan_half_width(); }
-
-Vec3 Camera::ray_direction(double px, double py) const {
-  const double x = (2.0 * px / width - 1.0) * tan_half_width();
-  const double y = (1.0 - 2.0 * py / height) * tan_half_height();
-  return (forward() + x * right() + y * image_up()).normalized();
-}
-
-double Camera::off_axis_angle(double px, double py) const {
-  const double x = (2.0 * px / width - 1.0) * tan_half_width();
-  const double y = (1.0 - 2.0 * py / height) * tan_half_height();
-  return std::atan(std::hypot(x, y));
-}
-
 const Material* Scene::find_material(std::string_view name) const { return find_by_name(materials, name); }
 const NamedSpectrum* Scene::find_spectrum(std::string_view name) const { return find_by_name(spectra, name); }
 
@@ -764,6 +738,21 @@ Series load_series(const std::filesystem::path& file, int threads) {
   for (const std::exception_ptr& error : errors)
     if (error) std::rethrow_exception(error);
   return series;
+}
+
+const RenderDefaults& render_defaults() {
+  static const RenderDefaults defaults = [] {
+    const Json render = Json::parse(embedded::file("defaults.json"))["render"];
+    RenderDefaults d;
+    d.samples = render["samples"].get<int>();
+    d.max_bounces = render["max_bounces"].get<int>();
+    d.seed = render["seed"].get<std::uint64_t>();
+    d.pixel_filter = render["pixel_filter"] == "point" ? PixelFilter::Point : PixelFilter::Box;
+    d.spectral_mode = render["spectral_mode"] == "continuous" ? SpectralMode::Continuous : SpectralMode::Bands;
+    d.bands = render["bands"].get<std::string>();
+    return d;
+  }();
+  return defaults;
 }
 
 }  // namespace ct

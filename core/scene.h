@@ -18,6 +18,7 @@
 #include <variant>
 #include <vector>
 
+#include "core/camera.h"
 #include "core/geometry.h"
 #include "core/json_input.h"
 #include "core/spectrum.h"
@@ -108,32 +109,6 @@ struct Object {
 
 // ---- Camera and render settings -----------------------------------------------------------------------
 
-enum class FovAxis { Horizontal, Vertical, Smaller, Larger };
-
-// A pinhole camera. The sensor is `sensor_width_mm` wide along the image's horizontal axis with square
-// pixels, which with the field of view fixes the focal length (and so cos⁴ fall-off and f-number).
-struct Camera {
-  Vec3 position = Vec3::Zero();
-  Vec3 look_at = Vec3::UnitY();
-  Vec3 up = Vec3::UnitZ();
-  double fov_deg = 40.0;  // along fov_axis
-  FovAxis fov_axis = FovAxis::Horizontal;
-  int width = 256, height = 256;
-  double sensor_width_mm = 36.0;
-
-  Vec3 forward() const;            // unit, towards look_at
-  Vec3 right() const;              // unit, forward × up
-  Vec3 image_up() const;           // unit, right × forward
-  double tan_half_width() const;   // tan(horizontal field of view / 2)
-  double tan_half_height() const;  // tan(vertical field of view / 2)
-  double focal_length_mm() const;
-  // Unit world direction of the ray through image point (px, py), in pixels from the top-left corner of
-  // the image: px in [0, width], py in [0, height]; pixel (i, j) has its centre at (i + 0.5, j + 0.5).
-  Vec3 ray_direction(double px, double py) const;
-  // The angle α (radians) between that ray and the optical axis: paper eq. (2), cos⁴α fall-off.
-  double off_axis_angle(double px, double py) const;
-};
-
 enum class PixelFilter { Box, Point };
 enum class SpectralMode { Bands, Continuous };
 
@@ -143,13 +118,25 @@ struct Tessellation {
 };
 
 // Defaults that command-line options override.
-struct RenderSettings {
-  int samples = 64;     // paths per pixel
-  int max_bounces = 8;  // scattering events per path: 0 emitters only, 1 direct light, >= 2 global
-  std::uint64_t seed = 1;
-  PixelFilter pixel_filter = PixelFilter::Box;  // box: integrate over the pixel area; point: its centre
+// The render settings a scene may leave out, as core/data/defaults.json gives them: the one source the tracer,
+// check-scene and the Blender add-on (which reads the same file) share.
+struct RenderDefaults {
+  int samples = 0;
+  int max_bounces = 0;
+  std::uint64_t seed = 0;
+  PixelFilter pixel_filter = PixelFilter::Box;
   SpectralMode spectral_mode = SpectralMode::Bands;
-  Bands bands = Bands::uniform(380.0, 780.0, 10.0);
+  std::string bands;  // lo:hi:width
+};
+const RenderDefaults& render_defaults();
+
+struct RenderSettings {
+  int samples = render_defaults().samples;          // paths per pixel
+  int max_bounces = render_defaults().max_bounces;  // scattering events per path: 0 emitters only, 1 direct light, >= 2 global
+  std::uint64_t seed = render_defaults().seed;
+  PixelFilter pixel_filter = render_defaults().pixel_filter;  // box: integrate over the pixel area; point: its centre
+  SpectralMode spectral_mode = render_defaults().spectral_mode;
+  Bands bands = Bands::parse(render_defaults().bands, "defaults.json: render.bands");
   Tessellation tessellation;
 };
 

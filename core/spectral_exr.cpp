@@ -34,6 +34,8 @@
 #include "core/cie.h"
 #include "core/colour.h"
 #include "core/error.h"
+#include "core/exr_output.h"
+#include "core/exr_vocabulary.h"
 #include "core/file_io.h"
 
 namespace ct {
@@ -44,11 +46,10 @@ namespace fs = std::filesystem;
 constexpr const char* kLayoutVersion = "1.0";
 constexpr const char* kEmissiveUnits = "W.m^-2.sr^-1";
 constexpr const char* kBandEdgesAttribute = "chromatrace.bandEdgesNm";
-constexpr const char* kObjectsAttribute = "chromatrace.objects";
-constexpr const char* kComponentsAttribute = "chromatrace.components";
-constexpr const char* kObjectIdChannel = "object_id";
-// Object ids are stored in a FLOAT channel, which holds every whole number up to 2^24 exactly.
-constexpr std::int32_t kMaxObjectId = 1 << 24;
+using exr::kComponentsAttribute;
+using exr::kMaxObjectId;
+using exr::kObjectIdChannel;
+using exr::kObjectsAttribute;
 
 // Two channel wavelengths name the same band when they agree to 1e-10 (relative): far below the
 // resolution of the names (six decimals of nm, 1e-9 relative at 1000 nm), far above the rounding of the
@@ -233,21 +234,7 @@ std::optional<double> ev_attribute(const Imf::Header& header, const std::string&
 std::map<std::int32_t, std::string> object_names_attribute(const Imf::Header& header, const std::string& file) {
   const std::optional<std::string> text = string_attribute(header, kObjectsAttribute, file);
   if (!text) return {};
-  const nlohmann::json json = nlohmann::json::parse(*text, nullptr, false);
-  const std::string where = fmt::format("{}: attribute {}", file, kObjectsAttribute);
-  if (json.is_discarded() || !json.is_object())
-    throw InputError(fmt::format("{}: not a JSON object from object id to name", where));
-  std::map<std::int32_t, std::string> names;
-  for (const auto& [key, value] : json.items()) {
-    std::int32_t id = -1;
-    const auto [end, error] = std::from_chars(key.data(), key.data() + key.size(), id);
-    if (error != std::errc{} || end != key.data() + key.size() || id < 0 || id > kMaxObjectId)
-      throw InputError(
-          fmt::format("{}: key \"{}\" is not an object id (a whole number in [0, {}])", where, key, kMaxObjectId));
-    if (!value.is_string()) throw InputError(fmt::format("{}: object {}: name must be a string", where, key));
-    names[id] = value.get<std::string>();
-  }
-  return names;
+  return exr::parse_object_names(*text, fmt::format("{}: attribute {}", file, kObjectsAttribute));
 }
 
 // Band edges: chromatrace.bandEdgesNm when present (checked against the channels' centres), else halfway
@@ -397,43 +384,6 @@ SpectralExrInfo describe(const Imf::Header& header, const std::string& file, std
 
 // ---------------------------------------------------------------------------------------------------------
 // Writing
-
-// An OpenEXR output stream on a file descriptor that remembers its first failure: OpenEXR writes the line
-// offset table from OutputFile's destructor and swallows errors there, so finish() asks the stream instead.
-class DescriptorStream final : public Imf::OStream {
- public:
-  DescriptorStream(int fd, const std::string& name) : Imf::OStream(name.c_str()), fd_(fd) {}
-
-  void write(const char c[], int n) override {
-    while (n > 0) {
-      const ssize_t written = ::write(fd_, c, static_cast<std::size_t>(n));
-      if (written < 0 && errno == EINTR) continue;
-      if (written == 0) errno = EIO;  // no progress and no reason given
-      if (written <= 0) fail("cannot write");
-      c += written;
-      n -= static_cast<int>(written);
-      position_ += static_cast<std::uint64_t>(written);
-    }
-  }
-  uint64_t tellp() override { return position_; }
-  void seekp(uint64_t position) override {
-    if (::lseek(fd_, static_cast<off_t>(position), SEEK_SET) < 0) fail("cannot seek");
-    position_ = position;
-  }
-  // Empty while every write succeeded.
-  const std::string& error() const { return error_; }
-
- private:
-  [[noreturn]] void fail(const char* what) {
-    const std::string message = fmt::format("{}: {}", what, std::strerror(errno));
-    if (error_.empty()) error_ = message;
-    throw Iex::ErrnoExc(message);
-  }
-
-  int fd_;
-  std::uint64_t position_ = 0;
-  std::string error_;
-};
 
 void check_layout(const SpectralExrLayout& layout, const std::string& file) {
   if (layout.width < 1 || layout.height < 1)
@@ -620,7 +570,7 @@ void SpectralExrReader::read_object_ids(int y0, int y1, std::span<std::int32_t> 
   read_channels({kObjectIdChannel}, y0, y1, values);
   for (std::size_t i = 0; i < values.size(); ++i) {
     const float v = values[i];
-    if (!(v >= 0 && v <= static_cast<float>(kMaxObjectId) && v == std::floor(v))) {
+    if (!exr::is_object_id(v)) {
       const std::size_t width = static_cast<std::size_t>(info_.width);
       throw InputError(fmt::format(
           "{}: channel {}: value {} at pixel ({}, {}) is not an object id (a whole number in "
@@ -635,10 +585,7 @@ void SpectralExrReader::read_object_ids(int y0, int y1, std::span<std::int32_t> 
 // SpectralExrWriter
 
 struct SpectralExrWriter::File {
-  explicit File(const fs::path& target) : output(target) {}
-  AtomicFile output;  // declared first: destroyed last, after OpenEXR has let go of the stream
-  std::unique_ptr<DescriptorStream> stream;
-  std::unique_ptr<Imf::OutputFile> exr;
+  std::unique_ptr<AtomicExrOutput> output;
   std::vector<std::string> total_channels;
   std::vector<std::vector<std::string>> component_channels;
   std::array<std::vector<double>, 3> preview;
@@ -650,7 +597,7 @@ SpectralExrWriter::SpectralExrWriter(const fs::path& path, SpectralExrLayout lay
   const std::string file = path_.string();
   check_layout(layout_, file);
 
-  auto out = std::make_unique<File>(path_);
+  auto out = std::make_unique<File>();
   const SpectralQuantity quantity = layout_.reflective ? SpectralQuantity::T : SpectralQuantity::S0;
   out->total_channels = layer_channel_names(layout_.bands, "", quantity);
   for (const std::string& component : layout_.components)
@@ -670,20 +617,11 @@ SpectralExrWriter::SpectralExrWriter(const fs::path& path, SpectralExrLayout lay
   const std::vector<double>& edges = layout_.bands.edges();
   header.insert(kBandEdgesAttribute, Imf::FloatVectorAttribute(std::vector<float>(edges.begin(), edges.end())));
   if (!layout_.components.empty())
-    header.insert(kComponentsAttribute, Imf::StringAttribute(join(layout_.components, ",")));
-  if (layout_.object_ids) {
-    nlohmann::json names = nlohmann::json::object();
-    for (const auto& [id, name] : layout_.object_names) names[std::to_string(id)] = name;
-    header.insert(kObjectsAttribute, Imf::StringAttribute(names.dump()));
-  }
+    header.insert(kComponentsAttribute, Imf::StringAttribute(exr::component_list_text(layout_.components)));
+  if (layout_.object_ids) header.insert(kObjectsAttribute, Imf::StringAttribute(exr::object_names_text(layout_.object_names)));
   for (const auto& [name, value] : layout_.attributes) header.insert(name, Imf::StringAttribute(value));
 
-  out->stream = std::make_unique<DescriptorStream>(out->output.descriptor(), out->output.temporary().string());
-  try {
-    out->exr = std::make_unique<Imf::OutputFile>(*out->stream, header, Imf::globalThreadCount());
-  } catch (const std::exception& e) {
-    throw std::runtime_error(fmt::format("{}: cannot start writing: {}", file, one_line(e.what())));
-  }
+  out->output = std::make_unique<AtomicExrOutput>(path_, header);
   file_ = std::move(out);
 }
 
@@ -729,13 +667,7 @@ void SpectralExrWriter::write_rows(const SpectralRowBlock& block) {
   for (std::size_t c = 0; c < layout_.components.size(); ++c)
     insert_slices(frame, file_->component_channels[c], block.components[c].data(), rows);
   if (layout_.object_ids) insert_slices(frame, {kObjectIdChannel}, ids.data(), rows);
-  try {
-    file_->exr->setFrameBuffer(frame);
-    file_->exr->writePixels(block.rows);
-  } catch (const std::exception& e) {
-    throw std::runtime_error(
-        fmt::format("{}: cannot write rows {}-{}: {}", path_.string(), rows.min.y, rows.max.y, one_line(e.what())));
-  }
+  file_->output->write_rows(frame, rows_written_, block.rows);
   rows_written_ += block.rows;
 }
 
@@ -744,10 +676,7 @@ void SpectralExrWriter::finish() {
   if (rows_written_ != layout_.height)
     throw std::logic_error(
         fmt::format("{}: finish after {} of {} rows", path_.string(), rows_written_, layout_.height));
-  file_->exr.reset();  // writes the line offset table
-  if (!file_->stream->error().empty())
-    throw std::runtime_error(fmt::format("{}: {}", path_.string(), file_->stream->error()));
-  file_->output.commit();
+  file_->output->finish();
   file_.reset();
 }
 

@@ -44,16 +44,10 @@ std::optional<FieldOfView> field_of_view(const SpectralExrInfo& info, std::optio
 
 double aperture_factor(double f_number) { return std::numbers::pi / 4.0 / (f_number * f_number); }
 
-Cos4Falloff::Cos4Falloff(const FieldOfView& fov, int width, int height) {
-  const double tx = tan_half(fov.horizontal_deg), ty = tan_half(fov.vertical_deg);
-  for (int i = 0; i < width; ++i) {
-    const double x = (2.0 * (i + 0.5) / width - 1.0) * tx;
-    x2_.push_back(x * x);
-  }
-  for (int j = 0; j < height; ++j) {
-    const double y = (1.0 - 2.0 * (j + 0.5) / height) * ty;
-    y2_.push_back(y * y);
-  }
+Cos4Falloff::Cos4Falloff(const FieldOfView& fov, int width, int height)
+    : plane_(ImagePlane::from_fov_deg(fov.horizontal_deg, fov.vertical_deg, width, height)) {
+  for (int i = 0; i < width; ++i) x_.push_back(plane_.x(i + 0.5));
+  for (int j = 0; j < height; ++j) y_.push_back(plane_.y(j + 0.5));
 }
 
 }  // namespace ct::sensor

@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "core/camera.h"
 #include "core/spectral_exr.h"
 
 namespace ct::sensor {
@@ -26,18 +27,16 @@ std::optional<FieldOfView> field_of_view(const SpectralExrInfo& info, std::optio
 double aperture_factor(double f_number);
 
 // The cos⁴ fall-off at the centres of the pixels of a width × height image (pixel (i, j) from the top-left
-// corner, centre at (i + 0.5, j + 0.5)). With (x, y) the pixel centre on the image plane at unit distance
-// from the pinhole, cos α = 1/√(1 + x² + y²), so cos⁴α = 1/(1 + x² + y²)² needs no trigonometry per pixel.
+// corner, centre at (i + 0.5, j + 0.5)), on the camera's image plane (core/camera.h).
 class Cos4Falloff {
  public:
   Cos4Falloff(const FieldOfView& fov, int width, int height);
-  double at(int i, int j) const {
-    const double s = 1.0 + x2_[static_cast<std::size_t>(i)] + y2_[static_cast<std::size_t>(j)];
-    return 1.0 / (s * s);
-  }
+  double at(int i, int j) const { return ImagePlane::cos4(x_[static_cast<std::size_t>(i)], y_[static_cast<std::size_t>(j)]); }
+  const ImagePlane& plane() const { return plane_; }
 
  private:
-  std::vector<double> x2_, y2_;  // x² per column, y² per row
+  ImagePlane plane_;
+  std::vector<double> x_, y_;  // the pixel centres on the plane, per column and per row
 };
 
 }  // namespace ct::sensor

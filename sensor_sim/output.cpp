@@ -23,6 +23,8 @@
 #include <OpenImageIO/imageio.h>
 
 #include "core/error.h"
+#include "core/exr_output.h"
+#include "core/exr_vocabulary.h"
 #include "core/file_io.h"
 
 namespace ct::sensor {
@@ -62,15 +64,12 @@ OutputFormat output_format(const fs::path& file) {
 }
 
 struct SensorImageWriter::File {
-  explicit File(const fs::path& target) : output(target) {}
-  AtomicFile output;  // declared first: destroyed last, after the writers have let go of the file
   // EXR
-  std::ofstream stream;
-  std::unique_ptr<Imf::StdOFStream> exr_stream;
-  std::unique_ptr<Imf::OutputFile> exr;
+  std::unique_ptr<AtomicExrOutput> exr;
   std::vector<float> ids;  // object ids as floats, for the current block
   std::vector<Imath::half> display;  // the display layer as half, for the current block
   // TIFF / PNG
+  std::unique_ptr<AtomicFile> output;  // declared before the image writer: destroyed after it lets go of the file
   std::unique_ptr<OIIO::ImageOutput> image;
 };
 
@@ -80,8 +79,7 @@ SensorImageWriter::SensorImageWriter(const fs::path& path, OutputLayout layout)
   if (layout_.width < 1 || layout_.height < 1)
     throw InputError(
         fmt::format("{}: image size must be at least 1 x 1, got {} x {}", name, layout_.width, layout_.height));
-  auto file = std::make_unique<File>(path_);
-  const std::string temporary = file->output.temporary().string();
+  auto file = std::make_unique<File>();
 
   if (layout_.format == OutputFormat::Exr) {
     Imf::Header header(layout_.width, layout_.height);
@@ -95,19 +93,16 @@ SensorImageWriter::SensorImageWriter(const fs::path& path, OutputLayout layout)
       for (int c = 0; c < 3; ++c)
         header.channels().insert(layer_channel(layer, c), Imf::Channel(layer == "display" ? Imf::HALF : Imf::FLOAT));
     if (layout_.object_ids) {
-      header.channels().insert("object_id", Imf::Channel(Imf::FLOAT));
-      nlohmann::json names = nlohmann::json::object();
-      for (const auto& [id, object] : layout_.object_names) names[std::to_string(id)] = object;
-      header.insert("chromatrace.objects", Imf::StringAttribute(names.dump()));
+      header.channels().insert(exr::kObjectIdChannel, Imf::Channel(Imf::FLOAT));
+      header.insert(exr::kObjectsAttribute, Imf::StringAttribute(exr::object_names_text(layout_.object_names)));
     }
     for (const auto& [key, value] : layout_.attributes) header.insert(key, Imf::StringAttribute(value));
     for (const auto& [key, value] : layout_.number_attributes) header.insert(key, Imf::DoubleAttribute(value));
     for (const auto& [key, value] : layout_.integer_attributes) header.insert(key, Imf::IntAttribute(value));
-    file->stream.open(temporary, std::ios::binary | std::ios::trunc);
-    if (!file->stream) throw std::runtime_error(fmt::format("{}: cannot open {} for writing", name, temporary));
-    file->exr_stream = std::make_unique<Imf::StdOFStream>(file->stream, temporary.c_str());
-    file->exr = std::make_unique<Imf::OutputFile>(*file->exr_stream, header, Imf::globalThreadCount());
+    file->exr = std::make_unique<AtomicExrOutput>(path_, header);
   } else {
+    file->output = std::make_unique<AtomicFile>(path_);
+    const std::string temporary = file->output->temporary().string();
     const char* format = layout_.format == OutputFormat::Tiff ? "tiff" : "png";
     file->image = OIIO::ImageOutput::create(format);
     if (!file->image) throw std::runtime_error(fmt::format("{}: OpenImageIO cannot write {}", name, format));
@@ -165,16 +160,10 @@ void SensorImageWriter::write_rows(const OutputRows& block) {
     if (layout_.object_ids) {
       file_->ids.assign(block.object_ids.begin(), block.object_ids.end());
       const Imath::Box2i window({0, y0}, {layout_.width - 1, y0 + block.rows - 1});
-      frame.insert("object_id",
+      frame.insert(exr::kObjectIdChannel,
                    Imf::Slice::Make(Imf::FLOAT, file_->ids.data(), window, sizeof(float), sizeof(float) * width));
     }
-    try {
-      file_->exr->setFrameBuffer(frame);
-      file_->exr->writePixels(block.rows);
-    } catch (const std::exception& e) {
-      throw std::runtime_error(
-          fmt::format("{}: cannot write rows {}-{}: {}", path_.string(), y0, y0 + block.rows - 1, e.what()));
-    }
+    file_->exr->write_rows(frame, y0, block.rows);
   } else {
     const double top = std::ldexp(1.0, layout_.bits) - 1.0;
     const auto code = [&](float v) { return std::clamp(std::round(v * layout_.code_scale), 0.0, top); };
@@ -201,15 +190,12 @@ void SensorImageWriter::finish() {
     throw std::logic_error(
         fmt::format("{}: finish after {} of {} rows", path_.string(), rows_written_, layout_.height));
   if (file_->exr) {
-    // OpenEXR writes the line offset table while closing and swallows errors there; the stream keeps them.
-    file_->exr.reset();
-    file_->stream.flush();
-    if (!file_->stream) throw std::runtime_error(fmt::format("{}: cannot write the file", path_.string()));
-    file_->stream.close();
-  } else if (!file_->image->close()) {
-    throw std::runtime_error(fmt::format("{}: cannot complete the file: {}", path_.string(), file_->image->geterror()));
+    file_->exr->finish();
+  } else {
+    if (!file_->image->close())
+      throw std::runtime_error(fmt::format("{}: cannot complete the file: {}", path_.string(), file_->image->geterror()));
+    file_->output->commit();
   }
-  file_->output.commit();
   file_.reset();
 }
 

@@ -10,6 +10,7 @@
 #include <fmt/core.h>
 #include <fmt/format.h>
 
+#include "core/exr_vocabulary.h"
 #include "core/cie.h"
 #include "core/colour.h"
 #include "core/error.h"
@@ -149,16 +150,11 @@ std::vector<std::int32_t> sensor_ids(const std::vector<std::int32_t>& rendered, 
 std::pair<std::vector<std::string>, std::vector<const SpectralLayer*>> component_layers_of(
     const SpectralExrInfo& info) {
   std::vector<std::string> order;
-  if (const auto it = info.metadata.find("chromatrace.components"); it != info.metadata.end())
-    for (std::size_t start = 0; start <= it->second.size();) {
-      const std::size_t comma = std::min(it->second.find(',', start), it->second.size());
-      order.push_back(it->second.substr(start, comma - start));
-      start = comma + 1;
-    }
+  if (const auto it = info.metadata.find(exr::kComponentsAttribute); it != info.metadata.end())
+    order = exr::parse_component_list(it->second);
   std::vector<const SpectralLayer*> layers;
   for (const std::string& name : order)
-    if (const SpectralLayer* layer = info.find_layer(name, SpectralQuantity::S0); layer && !name.empty())
-      layers.push_back(layer);
+    if (const SpectralLayer* layer = info.find_layer(name, SpectralQuantity::S0)) layers.push_back(layer);
   for (const SpectralLayer& layer : info.layers)
     if (!layer.component.empty() && layer.quantity == SpectralQuantity::S0 &&
         std::find(layers.begin(), layers.end(), &layer) == layers.end())
@@ -649,11 +645,11 @@ RunReport simulate_sensor(const fs::path& input, const fs::path& output, SensorC
     layout.object_names = info.object_names;
     // The renderer's description of the scene and camera travels on with the image.
     for (const auto& [key, value] : info.metadata)
-      if (key.starts_with("chromatrace.") && key != "chromatrace.components") layout.attributes[key] = value;
+      if (key.starts_with("chromatrace.") && key != exr::kComponentsAttribute) layout.attributes[key] = value;
     layout.attributes["chromatrace.sensor"] = report.effective_config.dump();
     layout.attributes["chromatrace.units"] = units_json(config, run.intent).dump();
     if (!components.empty())
-      layout.attributes["chromatrace.components"] = fmt::format("{}", fmt::join(components, ","));
+      layout.attributes[exr::kComponentsAttribute] = exr::component_list_text(components);
     if (want_display) {
       layout.display = true;
       display_description["scale"] = display.scale;

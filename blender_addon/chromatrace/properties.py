@@ -7,7 +7,7 @@ import bpy
 from bpy.props import (BoolProperty, CollectionProperty, EnumProperty, FloatProperty, FloatVectorProperty,
                        IntProperty, PointerProperty, StringProperty)
 
-from . import spectra
+from . import defaults, spectra
 from .floats import short_float
 
 _KIND_ITEMS = [
@@ -179,18 +179,19 @@ class CHROMATRACE_PG_scene(bpy.types.PropertyGroup):
     band_plan: EnumProperty(name="Band plan", items=[("RANGE", "Range", "Uniform bands lo:hi:width"),
                                                      ("FILE", "File", "A band plan file (chromatrace-bands/1)")],
                             default="RANGE")
-    bands_lo: FloatProperty(name="From (nm)", default=380.0, min=200.0, max=2000.0)
-    bands_hi: FloatProperty(name="To (nm)", default=780.0, min=200.0, max=2000.0)
-    bands_width: FloatProperty(name="Width (nm)", default=10.0, min=0.1, max=1000.0)
+    bands_lo: FloatProperty(name="From (nm)", default=defaults.band_range()[0], min=200.0, max=2000.0)
+    bands_hi: FloatProperty(name="To (nm)", default=defaults.band_range()[1], min=200.0, max=2000.0)
+    bands_width: FloatProperty(name="Width (nm)", default=defaults.band_range()[2], min=0.1, max=1000.0)
     bands_file: StringProperty(name="Plan file", subtype="FILE_PATH")
-    samples: IntProperty(name="Samples", min=1, default=64)
-    max_bounces: IntProperty(name="Max bounces", min=0, default=8,
+    samples: IntProperty(name="Samples", min=1, default=defaults.RENDER["samples"])
+    max_bounces: IntProperty(name="Max bounces", min=0, default=defaults.RENDER["max_bounces"],
                              description="Scattering events per path: 0 emitters only, 1 direct light, >= 2 global")
-    seed: IntProperty(name="Seed", min=0, default=1)
+    seed: IntProperty(name="Seed", min=0, default=defaults.RENDER["seed"])
     pixel_filter: EnumProperty(name="Pixel filter", items=[("box", "Box", "Integrate over the pixel"),
                                                            ("point", "Point", "The pixel centre (nearly: a Gaussian 0.01 pixel wide)")],
-                               default="box")
-    spectral_mode: StringProperty(default="bands", description="Kept for export: Cycles always renders bands")
+                               default=defaults.RENDER["pixel_filter"])
+    spectral_mode: StringProperty(default=defaults.RENDER["spectral_mode"],
+                                  description="Kept for export: Cycles always renders bands")
     tessellation_segments: IntProperty(name="Segments", min=0, default=0, description="0: the format's default")
     tessellation_rings: IntProperty(name="Rings", min=0, default=0, description="0: the format's default")
     use_paths: BoolProperty(name="Path types", default=True,

@@ -16,7 +16,7 @@ import tempfile
 import bpy
 from mathutils import Matrix
 
-from . import camera_math, materials, ply
+from . import camera_math, defaults, materials, ply
 from .errors import BadInput
 from .geometry_digest import camera_digest, object_digest
 
@@ -107,15 +107,15 @@ def import_scene(path, scene, tool, log=print):
         entry.name = name
         entry.source.set_from_json(source, scene_dir)
 
-    render = document.get("render", {})
-    s.samples = render.get("samples", 64)
-    s.max_bounces = render.get("max_bounces", 8)
-    s.seed = render.get("seed", 1)
-    s.pixel_filter = render.get("pixel_filter", "box")
-    s.spectral_mode = render.get("spectral_mode", "bands")
+    # The render settings as the tool resolved them, the scene's own or the shared defaults.
+    render, resolved = document.get("render", {}), summary["render"]
+    s.samples = resolved["samples"]
+    s.max_bounces = resolved["max_bounces"]
+    s.seed = resolved["seed"]
+    s.pixel_filter = resolved["pixel_filter"]
+    s.spectral_mode = resolved["spectral_mode"]
     s.band_plan = "RANGE"
-    lo, hi, width = (float(v) for v in render.get("bands", "380:780:10").split(":"))
-    s.bands_lo, s.bands_hi, s.bands_width = lo, hi, width
+    s.bands_lo, s.bands_hi, s.bands_width = defaults.band_range(render.get("bands"))
     tessellation = render.get("tessellation", {})
     s.tessellation_segments = tessellation.get("segments", 0)
     s.tessellation_rings = tessellation.get("rings", 0)

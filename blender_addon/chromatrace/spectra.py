@@ -6,9 +6,10 @@ illuminants, blackbodies, RGB upsampling) are evaluated only by the `chromatrace
 import csv
 import os
 
+from . import defaults
 from .floats import short_float
 
-ILLUMINANTS = ["A", "D50", "D65", "F1", "F2", "F3", "F4", "F5", "F6", "F7", "F8", "F9", "F10", "F11", "F12", "D"]
+ILLUMINANTS = defaults.ILLUMINANTS + ["D"]
 
 
 def library_directory():

@@ -24,7 +24,7 @@ import time
 
 import bpy
 
-from . import VERSION, cache, components, cycles_setup, manifest, materials, node_rules
+from . import VERSION, cache, components, cycles_setup, defaults, manifest, materials, node_rules
 from .bands import band_groups, describe_band_range, group_colour
 from .errors import BadInput
 from .geometry_digest import update_with_mesh
@@ -41,10 +41,10 @@ class Request:
     """What to render: the scene's chromatrace settings, optionally overridden (batch.py's options)."""
 
     def __init__(self, **values):
-        self.samples = 64
-        self.max_bounces = 8
-        self.seed = 1
-        self.bands = "380:780:10"
+        self.samples = defaults.RENDER["samples"]
+        self.max_bounces = defaults.RENDER["max_bounces"]
+        self.seed = defaults.RENDER["seed"]
+        self.bands = defaults.RENDER["bands"]
         self.bands_file = None
         self.families = {"paths", "lights"}
         self.object_ids = True

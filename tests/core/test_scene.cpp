@@ -2,9 +2,11 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <numbers>
 #include <string>
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include "core/cie.h"
@@ -483,6 +485,35 @@ TEST(Series, VariantErrors) {
   } catch (const InputError& e) {
     EXPECT_TRUE(std::string(e.what()).find("variants[1] \"rough\": materials.plastic.roughness") != std::string::npos);
   }
+}
+
+// The render defaults are core/data/defaults.json's (the file the Blender add-on reads too), and
+// docs/scene-format.md's table states them.
+TEST(RenderDefaults, AreTheSharedFilesAndTheDocsSayThem) {
+  const std::filesystem::path source(CHROMATRACE_SOURCE_DIR);
+  std::ifstream file(source / "core" / "data" / "defaults.json");
+  const Json shared = Json::parse(file)["render"];
+  const RenderSettings render;
+  EXPECT_EQ(render.samples, shared["samples"].get<int>());
+  EXPECT_EQ(render.max_bounces, shared["max_bounces"].get<int>());
+  EXPECT_EQ(render.seed, shared["seed"].get<std::uint64_t>());
+  EXPECT_EQ(render.pixel_filter == PixelFilter::Box ? "box" : "point", shared["pixel_filter"]);
+  EXPECT_EQ(render.spectral_mode == SpectralMode::Bands ? "bands" : "continuous", shared["spectral_mode"]);
+  EXPECT_EQ(render.bands.edges(), Bands::parse(shared["bands"].get<std::string>()).edges());
+  EXPECT_EQ(render.bands.size(), 40u);  // 380:780:10, the docs' example
+  std::ifstream docs_file(source / "docs" / "scene-format.md");
+  const std::string docs((std::istreambuf_iterator<char>(docs_file)), std::istreambuf_iterator<char>());
+  for (const std::string& row : {fmt::format("| `samples` | {} |", shared["samples"].get<int>()),
+                                fmt::format("| `max_bounces` | {} |", shared["max_bounces"].get<int>()),
+                                fmt::format("| `seed` | {} |", shared["seed"].get<int>()),
+                                fmt::format("| `pixel_filter` | `\"{}\"` |", shared["pixel_filter"].get<std::string>()),
+                                fmt::format("| `bands` | `\"{}\"` |", shared["bands"].get<std::string>()),
+                                fmt::format("| `spectral_mode` | `\"{}\"` |", shared["spectral_mode"].get<std::string>())})
+    EXPECT_NE(docs.find(row), std::string::npos) << row;
+  // The illuminants the library knows are the ones the file names, each with its table.
+  std::ifstream again(source / "core" / "data" / "defaults.json");
+  EXPECT_EQ(cie::illuminant_names(), Json::parse(again)["illuminants"].get<std::vector<std::string>>());
+  for (const std::string& name : cie::illuminant_names()) EXPECT_GT(cie::illuminant(name)(560.0), 0.0) << name;
 }
 
 }  // namespace

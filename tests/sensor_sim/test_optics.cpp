@@ -4,6 +4,7 @@
 #include <cmath>
 #include <numbers>
 
+#include "core/camera.h"
 #include "core/error.h"
 #include "sensor_sim/optics.h"
 #include "tests/core/spectral_exr_fixtures.h"
@@ -43,6 +44,23 @@ TEST(Optics, Cos4CornerToCentreRatioFollowsTheFieldOfView) {
       EXPECT_NEAR(image.at(cx, cy, c) / centre, expected, 1e-6) << "corner " << cx << "," << cy;
   }
   EXPECT_LT(expected, 0.6);  // a wide field: the fall-off is large, not a rounding effect
+}
+
+// The sensor's fall-off and the scene camera's off-axis angle are one image plane: for a camera of the scene
+// format (here 4:3, field of view on the smaller axis), cos⁴ of the angle the camera gives each pixel centre is
+// the fall-off the sensor applies there, with the fields of view the renderer writes into chromatrace.camera.
+TEST(Optics, Cos4IsTheSceneCamerasOffAxisAngle) {
+  Camera camera;
+  camera.width = 40;
+  camera.height = 30;
+  camera.fov_deg = 50;
+  camera.fov_axis = FovAxis::Smaller;
+  const double to_deg = 360.0 / std::numbers::pi;
+  const sensor::FieldOfView fov{std::atan(camera.tan_half_width()) * to_deg, std::atan(camera.tan_half_height()) * to_deg, "test"};
+  EXPECT_NEAR(fov.vertical_deg, 50.0, 1e-12);
+  const sensor::Cos4Falloff falloff(fov, camera.width, camera.height);
+  for (const auto& [i, j] : {std::pair{0, 0}, {39, 0}, {17, 11}, {39, 29}, {20, 15}})
+    EXPECT_NEAR(falloff.at(i, j), std::pow(std::cos(camera.off_axis_angle(i + 0.5, j + 0.5)), 4), 1e-12) << i << "," << j;
 }
 
 TEST(Optics, FieldOfViewOptionStandsInForAMissingCameraElseCos4IsOff) {

@@ -8,7 +8,7 @@ import unittest
 
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "..", "..", "blender_addon"))
 
-from chromatrace import bands, batch_args, cache, camera_math, components, floats, manifest, node_rules, ply, spectra  # noqa: E402
+from chromatrace import bands, batch_args, cache, camera_math, components, defaults, floats, manifest, node_rules, ply, spectra  # noqa: E402
 from chromatrace.errors import BadInput  # noqa: E402
 from chromatrace.journal import Journal  # noqa: E402
 
@@ -26,6 +26,17 @@ class Bands(unittest.TestCase):
         self.assertEqual(bands.group_colour(values, [3]), (0.4, 0.0, 0.0))
         self.assertEqual(bands.group_colour(values, [3], replicate=True), (0.4, 0.4, 0.4))
         self.assertEqual(bands.channel_of([3, 4, 5], 5), "B")
+
+
+class Defaults(unittest.TestCase):
+    def test_the_files_the_library_embeds(self):
+        """The add-on's render defaults and illuminant names are core/data/defaults.json's, the C++ library's."""
+        with open(os.path.join(os.path.dirname(__file__), "..", "..", "..", "core", "data", "defaults.json")) as f:
+            shared = json.load(f)
+        self.assertEqual(defaults.RENDER, shared["render"])
+        self.assertEqual(spectra.ILLUMINANTS, shared["illuminants"] + ["D"])
+        self.assertEqual(defaults.band_range(), (380.0, 780.0, 10.0))
+        self.assertEqual(defaults.band_range("400:700:20"), (400.0, 700.0, 20.0))
 
 
 class Components(unittest.TestCase):
