@@ -52,16 +52,12 @@ std::optional<OffStructure> off_structure(const AnalysisImage& input, const Regi
     total_colours.push_back(d + i);
   }
   if (direct_colours.size() < 3) return std::nullopt;
-  Mat3 second = Mat3::Zero();
-  for (const Vec3& x : direct_colours) second += x * x.transpose();
-  Vec3 values;
-  Mat3 axes;
-  principal_axes(second, values, axes);
+  const PrincipalAxes direct_axes = principal_axes_of(direct_colours, About::Black);
   OffStructure o;
   // A matte object's direct light is a line through black: a plane through it would be arbitrary.
-  const bool plane = values[1] > 1e-6 * values[0];
+  const bool plane = direct_axes.values[1] > 1e-6 * direct_axes.values[0];
   o.structure = plane ? "dichromatic plane" : "body line";
-  o.direction = plane ? plane_through_black(direct_colours).normal : Vec3(axes.col(0));
+  o.direction = plane ? plane_through_black(direct_colours).normal : Vec3(direct_axes.axes.col(0));
   o.rms_total = rms_off(total_colours, o.direction, plane);
   o.rms_direct = rms_off(direct_colours, o.direction, plane);
   o.indirect_share = o.rms_total > 0 ? std::clamp(1.0 - std::pow(o.rms_direct / o.rms_total, 2), 0.0, 1.0) : 0.0;

@@ -9,18 +9,10 @@ namespace {
 constexpr std::size_t kMaxPoints = 4000;
 
 double straightness(const std::vector<Vec3>& points, double inverse_gamma) {
-  Vec3 mean = Vec3::Zero();
   std::vector<Vec3> y(points.size());
-  for (std::size_t i = 0; i < points.size(); ++i) {
+  for (std::size_t i = 0; i < points.size(); ++i)
     for (int c = 0; c < 3; ++c) y[i][c] = std::pow(points[i][c], inverse_gamma);
-    mean += y[i];
-  }
-  mean /= static_cast<double>(y.size());
-  Mat3 scatter = Mat3::Zero();
-  for (const Vec3& p : y) scatter += (p - mean) * (p - mean).transpose();
-  Vec3 values;
-  Mat3 axes;
-  principal_axes(scatter, values, axes);
+  const Vec3 values = principal_axes_of(y, About::Mean).values;
   return values[0] > 0 ? (values[1] + values[2]) / values[0] : 0.0;
 }
 

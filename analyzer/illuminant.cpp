@@ -27,15 +27,12 @@ double angular_error_deg(const Vec3& a, const Vec3& b) {
 
 std::optional<Vec3> intersect_planes(const std::vector<Vec3>& normals) {
   if (normals.size() < 2) return std::nullopt;
-  Mat3 sum = Mat3::Zero();
-  for (const Vec3& n : normals) sum += n * n.transpose();
-  Vec3 values;
-  Mat3 axes;
-  principal_axes(sum, values, axes);
+  // The direction nearest to lying in every plane: the least eigenvector of the normals' second moments.
+  const PrincipalAxes a = principal_axes_of(normals, About::Black);
   // All planes alike leave two small eigenvalues: the intersection is undetermined.
   const double sin1deg = std::sin(std::numbers::pi / 180.0);
-  if (values[1] < sin1deg * sin1deg * static_cast<double>(normals.size()) / 2) return std::nullopt;
-  return positive(axes.col(2));
+  if (a.values[1] < sin1deg * sin1deg / 2) return std::nullopt;
+  return positive(a.axes.col(2));
 }
 
 IlluminantAnalysis estimate_illuminant(const std::vector<RegionAnalysis>& regions, std::span<const float> rgb,
