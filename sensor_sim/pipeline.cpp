@@ -524,6 +524,88 @@ OutputLayout output_layout(const fs::path& output, const SensorConfig& c, int wi
   return layout;
 }
 
+// The input's total radiance, checked against what the camera needs: emitted radiance (S0), bands the curves
+// cover (unless told to treat them as zero), and room for the supersampling.
+const SpectralLayer& total_radiance(const SpectralExrInfo& info, SensorConfig& config) {
+  const SpectralLayer* total = info.find_layer("", SpectralQuantity::S0);
+  if (total == nullptr) {
+    if (!info.spectral()) info.total();  // the reader's "no spectral channels" message
+    throw InputError(
+        fmt::format("{}: channels S0.<λ>nm: missing; the sensor needs emitted radiance, and this "
+                    "file is {}",
+                    info.file, info.kind()));
+  }
+  if (config.response.outside_curve == CurveOutside::Error)
+    check_band_coverage(info.bands, config.response.curves, info.file);
+  const int k = config.pixel.supersample;
+  if (k > info.width || k > info.height)
+    throw InputError(
+        fmt::format("{}: pixel.supersample: {} x {} rendered pixels per sensor pixel do not fit the "
+                    "{} x {} image",
+                    info.file, k, k, info.width, info.height));
+  if (info.width % k != 0 || info.height % k != 0)
+    config.notes.push_back(fmt::format("supersample {}: the last {} column(s) and {} row(s) are dropped", k,
+                                       info.width % k, info.height % k));
+  return *total;
+}
+
+// Stage 1's cos⁴ needs the camera's field of view: from the renderer's chromatrace.camera or optics.fov_deg,
+// else the fall-off is switched off, with a note either way.
+std::optional<FieldOfView> cos4_field_of_view(const SpectralExrInfo& info, SensorConfig& config) {
+  if (!config.optics.enabled || !config.optics.cos4) return std::nullopt;
+  std::optional<FieldOfView> fov = field_of_view(info, config.optics.fov_deg);
+  if (!fov) {
+    config.optics.cos4 = false;
+    config.notes.push_back(
+        "cos4 fall-off off: the image has no chromatrace.camera and no optics.fov_deg (--fov-deg) was given");
+  } else {
+    config.notes.push_back(fmt::format("cos4 fall-off over a {:.6g} x {:.6g} degree field of view (from {})",
+                                       fov->horizontal_deg, fov->vertical_deg, fov->source));
+  }
+  return fov;
+}
+
+// What the output says of itself: the renderer's description passed on, the sensor's configuration and units,
+// the components, the display layer's making, and the camera's numbers (black, white, curve, pixel area).
+void describe_output(const SpectralExrInfo& info, const SensorConfig& config, const Run& run, const RunReport& report,
+                     const std::vector<std::string>& components, bool want_display, bool picture,
+                     Json display_description, double display_scale, OutputLayout& layout) {
+  if (layout.format == OutputFormat::Exr) {
+    layout.components = components;
+    layout.object_ids = info.has_object_ids;
+    layout.object_names = info.object_names;
+    // The renderer's description of the scene and camera travels on with the image.
+    for (const auto& [key, value] : info.metadata)
+      if (key.starts_with("chromatrace.") && key != exr::kComponentsAttribute) layout.attributes[key] = value;
+    layout.attributes["chromatrace.sensor"] = report.effective_config.dump();
+    layout.attributes["chromatrace.units"] = units_json(config, run.intent).dump();
+    if (!components.empty())
+      layout.attributes[exr::kComponentsAttribute] = exr::component_list_text(components);
+    if (want_display) {
+      layout.display = true;
+      display_description["scale"] = display_scale;
+      layout.attributes["chromatrace.display"] = display_description.dump();
+    }
+  }
+  camera_levels(config, run.exposure_s, layout);
+  layout.integer_attributes["chromatrace.pixel_area"] = pixel_area(info, config);
+  if (picture) {  // the codes are the display rendering's (sRGB, 0…255), not the camera's numbers
+    layout.attributes["chromatrace.signal"] = "display";
+    layout.number_attributes = {{"chromatrace.black_level", 0.0}, {"chromatrace.white_level", 255.0},
+                                {"chromatrace.curve_gamma", 1.0}, {"chromatrace.curve_k", 1.0}};
+    layout.integer_attributes["chromatrace.curve_srgb"] = 1;
+  }
+}
+
+// The display rendering of `count` pixels of linear signal from `linear`, into `out`.
+void display_pixels(const DisplayRendering& display, const float* linear, std::size_t count, int threads, float* out) {
+  parallel_for(count, threads, [&](std::size_t p) {
+    const float* c = linear + 3 * p;
+    const Eigen::Vector3d v = display_value(display, Eigen::Vector3d(c[0], c[1], c[2]));
+    for (int ch = 0; ch < 3; ++ch) out[3 * p + to_size(ch)] = static_cast<float>(v[ch]);
+  });
+}
+
 }  // namespace
 
 void check_output_path(const fs::path& output) {
@@ -539,39 +621,9 @@ RunReport simulate_sensor(const fs::path& input, const fs::path& output, SensorC
   check_output_path(output);
   SpectralExrReader reader(input);
   const SpectralExrInfo& info = reader.info();
-  const SpectralLayer* total = info.find_layer("", SpectralQuantity::S0);
-  if (total == nullptr) {
-    if (!info.spectral()) info.total();  // the reader's "no spectral channels" message
-    throw InputError(
-        fmt::format("{}: channels S0.<λ>nm: missing; the sensor needs emitted radiance, and this "
-                    "file is {}",
-                    info.file, info.kind()));
-  }
-  if (config.response.outside_curve == CurveOutside::Error)
-    check_band_coverage(info.bands, config.response.curves, info.file);
-
+  const SpectralLayer* total = &total_radiance(info, config);
   const int k = config.pixel.supersample;
-  if (k > info.width || k > info.height)
-    throw InputError(
-        fmt::format("{}: pixel.supersample: {} x {} rendered pixels per sensor pixel do not fit the "
-                    "{} x {} image",
-                    info.file, k, k, info.width, info.height));
-  if (info.width % k != 0 || info.height % k != 0)
-    config.notes.push_back(fmt::format("supersample {}: the last {} column(s) and {} row(s) are dropped", k,
-                                       info.width % k, info.height % k));
-
-  std::optional<FieldOfView> fov;
-  if (config.optics.enabled && config.optics.cos4) {
-    fov = field_of_view(info, config.optics.fov_deg);
-    if (!fov) {
-      config.optics.cos4 = false;
-      config.notes.push_back(
-          "cos4 fall-off off: the image has no chromatrace.camera and no optics.fov_deg (--fov-deg) was given");
-    } else {
-      config.notes.push_back(fmt::format("cos4 fall-off over a {:.6g} x {:.6g} degree field of view (from {})",
-                                         fov->horizontal_deg, fov->vertical_deg, fov->source));
-    }
-  }
+  const std::optional<FieldOfView> fov = cos4_field_of_view(info, config);
 
   const auto component_list = component_layers_of(info);
   const std::vector<std::string>& components = component_list.first;
@@ -639,31 +691,7 @@ RunReport simulate_sensor(const fs::path& input, const fs::path& output, SensorC
   report.exposure_s = run.exposure_s;
   report.notes = config.notes;
   report.effective_config = config_json(config);
-  if (layout.format == OutputFormat::Exr) {
-    layout.components = components;
-    layout.object_ids = info.has_object_ids;
-    layout.object_names = info.object_names;
-    // The renderer's description of the scene and camera travels on with the image.
-    for (const auto& [key, value] : info.metadata)
-      if (key.starts_with("chromatrace.") && key != exr::kComponentsAttribute) layout.attributes[key] = value;
-    layout.attributes["chromatrace.sensor"] = report.effective_config.dump();
-    layout.attributes["chromatrace.units"] = units_json(config, run.intent).dump();
-    if (!components.empty())
-      layout.attributes[exr::kComponentsAttribute] = exr::component_list_text(components);
-    if (want_display) {
-      layout.display = true;
-      display_description["scale"] = display.scale;
-      layout.attributes["chromatrace.display"] = display_description.dump();
-    }
-  }
-  camera_levels(config, run.exposure_s, layout);
-  layout.integer_attributes["chromatrace.pixel_area"] = pixel_area(info, config);
-  if (picture) {  // the codes are the display rendering's (sRGB, 0…255), not the camera's numbers
-    layout.attributes["chromatrace.signal"] = "display";
-    layout.number_attributes = {{"chromatrace.black_level", 0.0}, {"chromatrace.white_level", 255.0},
-                                {"chromatrace.curve_gamma", 1.0}, {"chromatrace.curve_k", 1.0}};
-    layout.integer_attributes["chromatrace.curve_srgb"] = 1;
-  }
+  describe_output(info, config, run, report, components, want_display, picture, display_description, display.scale, layout);
   SensorImageWriter writer(output, layout);
 
   const auto read_block = [&](int y0) {
@@ -698,11 +726,7 @@ RunReport simulate_sensor(const fs::path& input, const fs::path& output, SensorC
     image.erase(image.begin(), image.begin() + static_cast<std::ptrdiff_t>(own));
     if (config.rendering.enabled) render_rows(run, image);
     if (picture)  // the picture for people in place of the raw numbers
-      parallel_for(image.size() / 3, run.threads, [&](std::size_t p) {
-        const float* c = linear_ext.data() + own + 3 * p;
-        const Eigen::Vector3d v = display_value(display, Eigen::Vector3d(c[0], c[1], c[2]));
-        for (int ch = 0; ch < 3; ++ch) image[3 * p + to_size(ch)] = static_cast<float>(v[ch]);
-      });
+      display_pixels(display, linear_ext.data() + own, image.size() / 3, run.threads, image.data());
 
     OutputRows rows;
     rows.rows = y1 - y0;
@@ -714,11 +738,7 @@ RunReport simulate_sensor(const fs::path& input, const fs::path& output, SensorC
       rows.linear = std::span<const float>(linear_ext).subspan(own, own_size);
       if (layout.display) {
         display_rows.resize(own_size);
-        parallel_for(own_size / 3, run.threads, [&](std::size_t p) {
-          const float* c = linear_ext.data() + own + 3 * p;
-          const Eigen::Vector3d v = display_value(display, Eigen::Vector3d(c[0], c[1], c[2]));
-          for (int ch = 0; ch < 3; ++ch) display_rows[3 * p + to_size(ch)] = static_cast<float>(v[ch]);
-        });
+        display_pixels(display, linear_ext.data() + own, own_size / 3, run.threads, display_rows.data());
         rows.display = display_rows;
       }
       for (const std::vector<float>& spectral : in.components)
