@@ -37,6 +37,25 @@ TEST_HOOK = None
 _GEOMETRY_TYPES = {"MESH", "CURVE", "SURFACE", "META", "FONT", "CURVES", "POINTCLOUD", "VOLUME"}
 
 
+class RenderPlan:
+    """What _prepare decided: the objects and materials rendered, their spectral inputs and band averages, the
+    band groups, light groups, components, render variants, passes and object ids, and the cache key."""
+
+    def __init__(self, **fields):
+        self.key = None
+        self.__dict__.update(fields)
+
+
+def _used_materials(objects):
+    """The materials of the objects' slots, each once, in slot order."""
+    used = []
+    for ob in objects:
+        for slot in getattr(ob, "material_slots", []):
+            if slot.material is not None and slot.material not in used:
+                used.append(slot.material)
+    return used
+
+
 class Request:
     """What to render: the scene's chromatrace settings, optionally overridden (batch.py's options)."""
 
@@ -174,33 +193,44 @@ class SpectralRender:
         return {"rgb": rgb}, factor
 
     def _prepare(self, work_dir):
+        """The plan of the renders: what is rendered, with which band values, into which components."""
         scene, request = self.scene, self.request
         view_layer = self._view_layer()
         if scene.camera is None:
             raise BadInput(f"scene \"{scene.name}\": no camera")
         objects = self._objects(view_layer)
-        used = []
-        for ob in objects:
-            for slot in getattr(ob, "material_slots", []):
-                if slot.material is not None and slot.material not in used:
-                    used.append(slot.material)
+        used = _used_materials(objects)
         replicate = self._check_nodes(used)
+        keys, inputs, emitters = self._spectral_inputs(used, [ob for ob in objects if ob.type == "LIGHT"])
+        bands = self._band_averages(work_dir, keys, inputs)
+        edges = bands["bands"]["edges_nm"]
+        per_render = 1 if replicate else request.bands_per_render
+        transmission = any(materials.has_transmission(m) for m in used)
+        light_groups, assignments = self._light_groups(view_layer, objects, emitters)
+        total, planned = components.component_plan(request.families, light_groups, request.max_bounces, transmission)
+        plan = RenderPlan(view_layer=view_layer, objects=objects, materials=used, inputs=inputs, bands=bands, edges=edges,
+                          groups=band_groups(len(edges) - 1, per_render), replicate=replicate, per_render=per_render,
+                          light_groups=light_groups, assignments=assignments, total=total, components=planned,
+                          variants=components.render_variants(request.max_bounces, "bounces" in request.families),
+                          passes=components.passes_needed(planned), ids=self._object_ids(objects))
+        plan.key = cache.cache_key(self._cache_description(plan))
+        return plan
 
-        # Every spectral input, its source and scale; identical sources are evaluated once.
-        keys, inputs = {}, []
+    def _spectral_inputs(self, used, lights):
+        """Every spectral input of the materials and lights, with its source's key and its scale; identical
+        sources share a key (they are evaluated once). Also the names of the emitting materials."""
+        keys, inputs, emitters = {}, [], set()
 
         def key_of(source):
             text = json.dumps(source, sort_keys=True)
             return keys.setdefault(text, f"s{len(keys)}")
 
-        emitters = set()
         for material in used:
             for spectral_input in materials.spectral_inputs(material):
                 source, scale = self._input_source(material, spectral_input)
                 inputs.append((spectral_input, key_of(source), scale, material.name))
                 if spectral_input.role == "emission":
                     emitters.add(material.name)
-        lights = [ob for ob in objects if ob.type == "LIGHT"]
         for ob in lights:
             light = ob.data
             settings = light.chromatrace
@@ -212,63 +242,57 @@ class SpectralRender:
                 source, scale = self._resolve(settings.emission, None, what), settings.emission_scale
             inputs.append((materials.SpectralInput(light, "color", "emission", tuple(light.color), None,
                                                    what, False), key_of(source), scale, ob.name))
+        return keys, inputs, emitters
 
+    def _band_averages(self, work_dir, keys, inputs):
+        """The band averages of every source (`chromatrace scene-bands`), a reflectance above 1 refused."""
+        request = self.request
         request_file = os.path.join(work_dir, "spectra.json")
+        spectra = {k: json.loads(t) for t, k in keys.items()} or {"flat": {"constant": 1.0}}  # no spectra: the edges
         with open(request_file, "w") as f:
-            json.dump({"format": "chromatrace-spectra/1", "spectra": {k: json.loads(t) for t, k in keys.items()}}, f)
-        if not keys:  # nothing spectral: still ask for the band edges
-            with open(request_file, "w") as f:
-                json.dump({"format": "chromatrace-spectra/1", "spectra": {"flat": {"constant": 1.0}}}, f)
+            json.dump({"format": "chromatrace-spectra/1", "spectra": spectra}, f)
         bands = self.tool.band_averages(request_file, request.bands, request.bands_file)
         for spectral_input, key, _scale, owner in inputs:
             entry = bands["spectra"][key]
             if spectral_input.role == "reflectance" and entry["max"] > 1.0:
                 raise BadInput(f"material \"{owner}\": the reflectance of {spectral_input.label} reaches "
                                f"{entry['max']:g} at {entry['max_nm']:g} nm, but a reflectance must be in [0, 1]")
+        return bands
 
-        edges = bands["bands"]["edges_nm"]
-        per_render = 1 if replicate else request.bands_per_render
-        groups = band_groups(len(edges) - 1, per_render)
-        transmission = any(materials.has_transmission(m) for m in used)
-
-        # Light groups: every emitter in one (its own, or one named after it).
+    def _light_groups(self, view_layer, objects, emitters):
+        """Light groups: every emitter in one (its own, or one named after it); none without the lights family."""
         light_groups, assignments = [], {}
-        if "lights" in request.families:
-            if not hasattr(view_layer, "lightgroups"):
-                raise BadInput("light-group components need Blender 3.2 or later (or leave out the lights family)")
-            for ob in objects:
-                emits = ob.type == "LIGHT" or any(
-                    slot.material is not None and slot.material.name in emitters for slot in ob.material_slots)
-                if not emits:
-                    continue
-                group = ob.lightgroup or _group_name(ob.name)
-                assignments[ob.name] = group
-                if group not in light_groups:
-                    light_groups.append(group)
-        total, planned = components.component_plan(request.families, light_groups, request.max_bounces, transmission)
-        variants = components.render_variants(request.max_bounces, "bounces" in request.families)
-        passes = components.passes_needed(planned)
+        if "lights" not in self.request.families:
+            return light_groups, assignments
+        if not hasattr(view_layer, "lightgroups"):
+            raise BadInput("light-group components need Blender 3.2 or later (or leave out the lights family)")
+        for ob in objects:
+            emits = ob.type == "LIGHT" or any(
+                slot.material is not None and slot.material.name in emitters for slot in ob.material_slots)
+            if not emits:
+                continue
+            group = ob.lightgroup or _group_name(ob.name)
+            assignments[ob.name] = group
+            if group not in light_groups:
+                light_groups.append(group)
+        return light_groups, assignments
 
-        ids = {}
-        if request.object_ids:  # written by their own render (manifest.IDS_FILE), not by the band renders
-            geometry = [ob for ob in objects if ob.type in _GEOMETRY_TYPES]
-            indices = [ob.pass_index for ob in geometry]
-            if all(i > 0 for i in indices) and len(set(indices)) == len(indices):
-                ids = {ob.name: ob.pass_index for ob in geometry}
-            else:
-                ids = {ob.name: i + 1 for i, ob in enumerate(sorted(geometry, key=lambda o: o.name))}
-
-        plan = dict(view_layer=view_layer, objects=objects, materials=used, inputs=inputs, bands=bands, edges=edges, groups=groups,
-                    replicate=replicate, per_render=per_render, light_groups=light_groups, assignments=assignments,
-                    total=total, components=planned, variants=variants, passes=passes, ids=ids)
-        plan["key"] = cache.cache_key(self._cache_description(plan))
-        return plan
+    def _object_ids(self, objects):
+        """Object ids, written by their own render (manifest.IDS_FILE), not by the band renders: the objects'
+        pass indices when they are distinct and positive, else 1, 2, … by name."""
+        if not self.request.object_ids:
+            return {}
+        geometry = [ob for ob in objects if ob.type in _GEOMETRY_TYPES]
+        indices = [ob.pass_index for ob in geometry]
+        if all(i > 0 for i in indices) and len(set(indices)) == len(indices):
+            return {ob.name: ob.pass_index for ob in geometry}
+        return {ob.name: i + 1 for i, ob in enumerate(sorted(geometry, key=lambda o: o.name))}
 
     def _cache_description(self, plan):
         scene, request = self.scene, self.request
         depsgraph = bpy.context.evaluated_depsgraph_get()
         geometry = {}
-        for ob in plan["objects"]:
+        for ob in plan.objects:
             digest = hashlib.sha256()
             digest.update(repr([list(row) for row in ob.matrix_world]).encode())
             if ob.type == "LIGHT":
@@ -286,14 +310,14 @@ class SpectralRender:
         world = scene.world
         return {
             "addon": list(VERSION), "blender": bpy.app.version_string,
-            "edges": plan["edges"], "per_render": plan["per_render"], "replicate": plan["replicate"],
-            "inputs": [[i.label, i.role, key, scale] for i, key, scale, _owner in plan["inputs"]],
-            "averages": {k: v["bands"] for k, v in plan["bands"]["spectra"].items()},
+            "edges": plan.edges, "per_render": plan.per_render, "replicate": plan.replicate,
+            "inputs": [[i.label, i.role, key, scale] for i, key, scale, _owner in plan.inputs],
+            "averages": {k: v["bands"] for k, v in plan.bands["spectra"].items()},
             "samples": request.samples, "seed": request.seed, "max_bounces": request.max_bounces,
-            "variants": plan["variants"], "point_filter": request.point_filter, "resolution": self._resolution(),
-            "passes": sorted(plan["passes"]), "light_groups": plan["assignments"], "ids": plan["ids"],
+            "variants": plan.variants, "point_filter": request.point_filter, "resolution": self._resolution(),
+            "passes": sorted(plan.passes), "light_groups": plan.assignments, "ids": plan.ids,
             "geometry": geometry,
-            "nodes": {m.name: materials.node_tree_digest(m.node_tree) for m in plan["materials"]},
+            "nodes": {m.name: materials.node_tree_digest(m.node_tree) for m in plan.materials},
             "camera": [repr([list(r) for r in camera.matrix_world]), _rna_plain(camera.data)],
             "world": materials.node_tree_digest(world.node_tree) if world and world.use_nodes else None,
         }
@@ -308,9 +332,9 @@ class SpectralRender:
 
     def _apply_settings(self, journal, plan):
         scene, request = self.scene, self.request
-        view_layer = plan["view_layer"]
+        view_layer = plan.view_layer
         cycles_setup.apply(journal, scene, view_layer, request.samples, request.seed, request.point_filter,
-                           self._resolution(), plan["passes"])
+                           self._resolution(), plan.passes)
         world = scene.world
         if world is not None:
             journal.set(world, "color", (0.0, 0.0, 0.0))
@@ -319,22 +343,22 @@ class SpectralRender:
                     if node.bl_idname == "ShaderNodeBackground":
                         journal.set(node.inputs["Strength"], "default_value", 0.0)
         existing = set(view_layer.lightgroups.keys()) if hasattr(view_layer, "lightgroups") else set()
-        for group in plan["light_groups"]:
+        for group in plan.light_groups:
             if group not in existing:
                 view_layer.lightgroups.add(name=group)
                 existing.add(group)
                 journal.call_on_restore(lambda name=group: _remove_lightgroup(scene, view_layer, name))
-        for ob in plan["objects"]:
-            if ob.name in plan["assignments"] and ob.lightgroup != plan["assignments"][ob.name]:
-                journal.set(ob, "lightgroup", plan["assignments"][ob.name])
-            if ob.name in plan["ids"] and ob.pass_index != plan["ids"][ob.name]:
-                journal.set(ob, "pass_index", plan["ids"][ob.name])
+        for ob in plan.objects:
+            if ob.name in plan.assignments and ob.lightgroup != plan.assignments[ob.name]:
+                journal.set(ob, "lightgroup", plan.assignments[ob.name])
+            if ob.name in plan.ids and ob.pass_index != plan.ids[ob.name]:
+                journal.set(ob, "pass_index", plan.ids[ob.name])
 
     def _set_colours(self, journal, plan, group):
         no_reflection = self.request.max_bounces == 0  # emitters only
-        for spectral_input, key, scale, _owner in plan["inputs"]:
-            values = plan["bands"]["spectra"][key]["bands"]
-            r, g, b = group_colour(values, group, plan["replicate"])
+        for spectral_input, key, scale, _owner in plan.inputs:
+            values = plan.bands["spectra"][key]["bands"]
+            r, g, b = group_colour(values, group, plan.replicate)
             factor = 0.0 if no_reflection and spectral_input.role != "emission" else scale
             colour = (r * factor, g * factor, b * factor)
             if spectral_input.alpha is not None:
@@ -353,10 +377,10 @@ class SpectralRender:
         work_dir = tempfile.mkdtemp(prefix="chromatrace-")
         try:
             plan = self._prepare(work_dir)
-            self.cache_dir = cache.cache_directory(request.cache_root, plan["key"])
-            groups, variants = plan["groups"], plan["variants"]
+            self.cache_dir = cache.cache_directory(request.cache_root, plan.key)
+            groups, variants = plan.groups, plan.variants
             total = len(groups) * len(variants) + (1 if request.object_ids else 0)
-            request.log(f"{len(plan['edges']) - 1} bands in {len(groups)} renders of {plan['per_render']} band(s)"
+            request.log(f"{len(plan.edges) - 1} bands in {len(groups)} renders of {plan.per_render} band(s)"
                         f"{' x ' + str(len(variants)) + ' bounce limits' if len(variants) > 1 else ''}; "
                         f"cache {self.cache_dir}")
             todo = set(manifest.missing_renders(self.cache_dir, groups, list(variants)))
@@ -369,7 +393,7 @@ class SpectralRender:
                     if (g, variant) not in todo:
                         self.cached += 1
                         done += 1
-                        request.log(f"render {done}/{total} ({describe_band_range(plan['edges'], group)}, {variant}): "
+                        request.log(f"render {done}/{total} ({describe_band_range(plan.edges, group)}, {variant}): "
                                     "already in the cache")
                         yield done, total, "cached"
                         continue
@@ -391,7 +415,7 @@ class SpectralRender:
                     cache.commit(temporary, final)
                     self.rendered += 1
                     done += 1
-                    message = (f"render {done}/{total} ({describe_band_range(plan['edges'], group)}, {variant}): "
+                    message = (f"render {done}/{total} ({describe_band_range(plan.edges, group)}, {variant}): "
                                f"{time.monotonic() - start:.2f} s, {time.process_time() - start_cpu:.2f} s CPU")
                     request.log(message)
                     yield done, total, message
@@ -420,7 +444,7 @@ class SpectralRender:
 
     def _render_ids(self, journal, plan, final):
         """The object-id render: one sample per pixel, at the pixel's centre."""
-        cycles_setup.set_id_render(journal, self.scene, plan["view_layer"])
+        cycles_setup.set_id_render(journal, self.scene, plan.view_layer)
         temporary = final + ".partial"
         journal.set(self.scene.render, "filepath", temporary)
         start = time.monotonic()
@@ -436,12 +460,12 @@ class SpectralRender:
         names = None
         if request.object_ids:
             names = {}
-            for ob in plan["objects"]:
-                if ob.name in plan["ids"]:
-                    names[plan["ids"][ob.name]] = ob.chromatrace.scene_name or ob.name
+            for ob in plan.objects:
+                if ob.name in plan.ids:
+                    names[plan.ids[ob.name]] = ob.chromatrace.scene_name or ob.name
         document = manifest.build_manifest(
-            plan["edges"], plan["groups"], list(plan["variants"]), plan["view_layer"].name, plan["total"],
-            plan["components"], object_names=names, attributes=self._attributes(plan), replicate=plan["replicate"])
+            plan.edges, plan.groups, list(plan.variants), plan.view_layer.name, plan.total,
+            plan.components, object_names=names, attributes=self._attributes(plan), replicate=plan.replicate)
         manifest_file = os.path.join(self.cache_dir, "manifest.json")
         with open(manifest_file, "w") as f:
             json.dump(document, f, indent=1)
@@ -454,7 +478,7 @@ class SpectralRender:
         source = s.source_json or json.dumps({"blend": bpy.data.filepath, "scene": scene.name})
         return {
             "chromatrace.renderer": (f"Cycles (Blender {bpy.app.version_string}) via the chromatrace add-on: "
-                                     f"{plan['per_render']} band(s) per render, max {request.max_bounces} bounces"),
+                                     f"{plan.per_render} band(s) per render, max {request.max_bounces} bounces"),
             "chromatrace.samples": str(request.samples),
             "chromatrace.seed": str(request.seed),
             "chromatrace.scene": source,
