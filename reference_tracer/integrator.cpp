@@ -1,6 +1,7 @@
 #include "reference_tracer/integrator.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <sstream>
@@ -192,155 +193,222 @@ void PathTracer::trace(double px, double py, std::uint64_t stream, PixelAccumula
   }
 }
 
-void PathTracer::trace_lanes(const Vec3& origin, const Vec3& direction, Random& rng, const Chunk* chunk,
-                             PixelAccumulator& pixel) const {
-  const Bands& bands = settings_.bands;
-  const int lanes = chunk ? chunk->count : kHeroLanes;
-
-  // Where each lane's value goes: bands mode, lane i is band first + i; continuous mode, lane j is a hero
-  // wavelength, splatted into its band with weight range / (lanes · width) (an unbiased band average).
-  Lanes wavelengths(lanes);
+// The state a path carries from one scattering event to the next.
+struct PathTracer::Path {
+  // The lanes. Bands mode: lane i is band chunk->first_band + i. Continuous mode (chunk null): lane j is a
+  // hero wavelength, splatted into its band with weight range / (lanes · width) (an unbiased band average).
+  const Chunk* chunk = nullptr;
+  int lanes = 0;
+  Lanes wavelengths;
   std::array<int, kMaxLanes> band_of{};
-  Lanes splat_weight = Lanes::Ones(lanes);
+  Lanes splat_weight;
+  // Throughput. Before the first scattering event the path is undivided and t_diffuse holds it (= 1); that
+  // event splits it into the parts that left it diffusely and glossily, which are carried on separately.
+  Lanes t_diffuse, t_glossy;
+  // The ray to follow, and what the MIS weight of an emitter it hits needs: the solid-angle density with
+  // which its direction was sampled, whether that was a delta lobe, and the point it left.
+  Vec3 o, d;
+  double prev_pdf = 0.0;
+  bool prev_delta = true;  // the camera ray: emitters it sees are counted without MIS
+  Vec3 prev_p;
+};
+
+// A scattering event: the hit seen from the side the ray arrived on, its shading frame, and the material's
+// two spectral weights in the path's lanes.
+struct PathTracer::Shading {
+  SurfaceHit s;  // normals flipped towards the viewer
+  const TracerMaterial* material;
+  Frame frame;   // z = shading normal
+  Vec3 wo;       // towards the viewer, in the frame
+  Lanes rho_d;   // diffuse reflectance ρ_d (0 without a diffuse term)
+  Lanes k_s;     // glossy weight k_s
+};
+
+// Camera ray: a path leaving the camera with throughput 1, carrying a chunk of bands or hero wavelengths.
+PathTracer::Path PathTracer::start_path(const Vec3& origin, const Vec3& direction, Random& rng,
+                                        const Chunk* chunk) const {
+  const Bands& bands = settings_.bands;
+  Path path;
+  path.chunk = chunk;
+  path.lanes = chunk ? chunk->count : kHeroLanes;
+  const int lanes = path.lanes;
+  path.wavelengths.resize(lanes);
+  path.splat_weight = Lanes::Ones(lanes);
   if (chunk) {
-    for (int i = 0; i < lanes; ++i) band_of[i] = chunk->first_band + i;
+    for (int i = 0; i < lanes; ++i) path.band_of[i] = chunk->first_band + i;
   } else {
+    // Hero wavelengths: evenly spaced over the range from one random offset (the path's first number).
     const double lo = bands.min_wavelength(), range = bands.max_wavelength() - lo;
     const double u = rng.uniform();
     for (int j = 0; j < lanes; ++j) {
       const double t = std::fmod(u + static_cast<double>(j) / lanes, 1.0);
-      wavelengths[j] = lo + t * range;
-      const auto it = std::upper_bound(bands.edges().begin(), bands.edges().end(), wavelengths[j]);
-      band_of[j] = std::clamp(static_cast<int>(it - bands.edges().begin()) - 1, 0, static_cast<int>(bands.size()) - 1);
-      splat_weight[j] = range / (lanes * bands.width(static_cast<std::size_t>(band_of[j])));
+      path.wavelengths[j] = lo + t * range;
+      const auto it = std::upper_bound(bands.edges().begin(), bands.edges().end(), path.wavelengths[j]);
+      path.band_of[j] = std::clamp(static_cast<int>(it - bands.edges().begin()) - 1, 0, static_cast<int>(bands.size()) - 1);
+      path.splat_weight[j] = range / (lanes * bands.width(static_cast<std::size_t>(path.band_of[j])));
     }
   }
-  auto splat = [&](int layer, const Lanes& value) {
-    if (layer < 0) return;
-    double* out = pixel.layer(layer);
-    for (int i = 0; i < lanes; ++i) out[band_of[i]] += value[i] * splat_weight[i];
-  };
+  path.t_diffuse = Lanes::Ones(lanes);
+  path.t_glossy = Lanes::Zero(lanes);
+  path.o = origin;
+  path.d = direction;
+  path.prev_p = origin;
+  return path;
+}
 
-  // Adds a contribution that arrived after `scatterings` events from light `light`, split into the parts
-  // that left the first scattering event diffusely and glossily (or, before it, all emission).
-  auto contribute = [&](int scatterings, const TracerLight& light, const Lanes& diffuse_part, const Lanes& glossy_part) {
-    const Lanes total = diffuse_part + glossy_part;
-    splat(0, total);
-    if (scatterings == 0) {
-      splat(layers_.emission, total);
-    } else if (scatterings == 1) {
-      splat(layers_.diffuse_direct, diffuse_part);
-      splat(layers_.glossy_direct, glossy_part);
-    } else {
-      splat(layers_.diffuse_indirect, diffuse_part);
-      splat(layers_.glossy_indirect, glossy_part);
-    }
-    if (!layers_.light_group.empty()) splat(layers_.light_group[static_cast<std::size_t>(light.group)], total);
-    if (!layers_.bounce.empty() && scatterings < static_cast<int>(layers_.bounce.size()))
-      splat(layers_.bounce[static_cast<std::size_t>(scatterings)], total);
-  };
+// Film: adds a value per lane to one layer of the pixel, each lane into its band.
+void PathTracer::splat(const Path& path, PixelAccumulator& pixel, int layer, const Lanes& value) const {
+  if (layer < 0) return;
+  double* out = pixel.layer(layer);
+  for (int i = 0; i < path.lanes; ++i) out[path.band_of[i]] += value[i] * path.splat_weight[i];
+}
 
-  const Lanes zero = Lanes::Zero(lanes);
-  // Throughput before the first scattering event is 1; after it, the diffuse and glossy parts.
-  Lanes t_diffuse = Lanes::Ones(lanes), t_glossy = zero;
-  Vec3 o = origin, d = direction;
-  double prev_pdf = 0.0;
-  bool prev_delta = true;  // the camera ray: emitters it sees are counted without MIS
-  Vec3 prev_p = origin;
-  const double scale = scene_.accel().scale();
+// Accumulation into components: a contribution that arrived after `scatterings` events from `light`, split
+// into the parts that left the first scattering event diffusely and glossily (or, before it, all emission).
+void PathTracer::contribute(const Path& path, PixelAccumulator& pixel, int scatterings, const TracerLight& light,
+                            const Lanes& diffuse_part, const Lanes& glossy_part) const {
+  const Lanes total = diffuse_part + glossy_part;
+  splat(path, pixel, 0, total);
+  if (scatterings == 0) {
+    splat(path, pixel, layers_.emission, total);
+  } else if (scatterings == 1) {
+    splat(path, pixel, layers_.diffuse_direct, diffuse_part);
+    splat(path, pixel, layers_.glossy_direct, glossy_part);
+  } else {
+    splat(path, pixel, layers_.diffuse_indirect, diffuse_part);
+    splat(path, pixel, layers_.glossy_indirect, glossy_part);
+  }
+  if (!layers_.light_group.empty()) splat(path, pixel, layers_.light_group[static_cast<std::size_t>(light.group)], total);
+  if (!layers_.bounce.empty() && scatterings < static_cast<int>(layers_.bounce.size()))
+    splat(path, pixel, layers_.bounce[static_cast<std::size_t>(scatterings)], total);
+}
 
+// Emission at a hit: radiance of an emitter the path reached by sampling a direction, MIS-weighted against
+// next-event estimation having picked the same point (unweighted after the camera or a delta lobe, which
+// next-event estimation cannot reproduce).
+void PathTracer::add_emission(const Path& path, const SurfaceHit& s, int depth, PixelAccumulator& pixel) const {
+  const Vec3 wo_world = -path.d;
+  const TracerLight* light = scene_.light_of(s.mesh);
+  if (!light || !TracerScene::emits_towards(*light, s.ng, wo_world)) return;
+  double weight = 1.0;
+  if (!path.prev_delta) {
+    // The light-sampling density of this point, converted from area to solid angle at prev_p.
+    const double dist2 = (s.p - path.prev_p).squaredNorm();
+    const double pdf_light = scene_.light_pdf_area(*light) * dist2 / std::abs(s.ng.dot(wo_world));
+    weight = power_heuristic(path.prev_pdf, pdf_light);
+  }
+  const Lanes le = lane_values(light->radiance, path.chunk, path.wavelengths) * weight;
+  if (depth == 0) contribute(path, pixel, 0, *light, le, Lanes::Zero(path.lanes));
+  else contribute(path, pixel, depth, *light, path.t_diffuse * le, path.t_glossy * le);
+}
+
+// Shading setup: the material at a hit, seen from the side the ray arrived on. None when the path ends there:
+// the surface only emits, or its shading normal is turned away from the viewer.
+std::optional<PathTracer::Shading> PathTracer::shade(SurfaceHit s, const Path& path) const {
+  const TracerMaterial* material = scene_.material_of(s.mesh);
+  if (!material) return std::nullopt;
+  const Vec3 wo_world = -path.d;
+  // Surfaces are two-sided: shade the side the ray arrived from.
+  if (s.ng.dot(wo_world) < 0.0) {
+    s.ng = -s.ng;
+    s.ns = -s.ns;
+  }
+  const Frame frame(s.ns);
+  const Vec3 wo = frame.to_local(wo_world);
+  if (wo.z() <= 0.0) return std::nullopt;
+  const Lanes rho_d = material->diffuse ? lane_values(*material->diffuse, path.chunk, path.wavelengths)
+                                        : Lanes::Zero(path.lanes);
+  const Lanes k_s = material->specular ? lane_values(*material->specular, path.chunk, path.wavelengths)
+                                       : Lanes::Constant(path.lanes, material->specular_weight);
+  return Shading{s, material, frame, wo, rho_d, k_s};
+}
+
+// Next-event estimation: one point sampled on the lights (∝ power, then uniform in area), its radiance
+// through the BSDF if unoccluded, MIS-weighted against BSDF sampling finding it.
+void PathTracer::sample_direct(const Path& path, const Shading& at, int depth, Random& rng,
+                               PixelAccumulator& pixel) const {
+  // Drawn even where no light can be sampled, so that the path's later numbers do not depend on it.
+  const double u_light = rng.uniform();
+  const Vec2 u_point(rng.uniform(), rng.uniform());
+  const TracerMaterial& material = *at.material;
+  if (!material.diffuse && material.is_delta()) return;  // a pure mirror: no sampled light meets its delta lobe
+  const auto ls = scene_.sample_light(u_light, u_point);
+  if (!ls) return;
+  Vec3 to_light = ls->p - at.s.p;
+  const double dist = to_light.norm();
+  to_light /= dist;
+  const double cos_light = std::abs(ls->n.dot(to_light));
+  const Vec3 wi = at.frame.to_local(to_light);
+  // The light point must lie above both the shading and the geometric surface, and emit towards us.
+  if (!(dist > 0.0 && cos_light > 0.0 && wi.z() > 0.0 && to_light.dot(at.s.ng) > 0.0 &&
+        TracerScene::emits_towards(*ls->light, ls->n, -to_light)))
+    return;
+  const LobeValues f = evaluate(material, at.wo, wi);
+  const double pdf_light = ls->pdf_area * dist * dist / cos_light;  // per solid angle
+  const double weight = power_heuristic(pdf_light, f.pdf);
+  if (!(f.diffuse > 0.0 || f.glossy > 0.0)) return;                      // the BSDF sends nothing that way
+  if (!scene_.accel().visible(at.s.p, at.s.ng, ls->p, ls->n)) return;  // shadow ray: occluded
+  const Lanes le = lane_values(ls->light->radiance, path.chunk, path.wavelengths) * (weight / pdf_light);
+  const Lanes fd = at.rho_d * f.diffuse, fg = at.k_s * f.glossy;
+  if (depth == 0) contribute(path, pixel, 1, *ls->light, fd * le, fg * le);
+  else contribute(path, pixel, depth + 1, *ls->light, path.t_diffuse * (fd + fg) * le, path.t_glossy * (fd + fg) * le);
+}
+
+// BSDF sampling: the direction the path continues in, its throughput through this event, and the next ray.
+// False when the path ends here (no direction, or one below the geometric surface).
+bool PathTracer::sample_continuation(Path& path, const Shading& at, int depth, Random& rng) const {
+  const double u_lobe = rng.uniform();
+  const Vec2 u_dir(rng.uniform(), rng.uniform());
+  const auto ms = sample_material(*at.material, at.wo, u_lobe, u_dir);
+  if (!ms) return false;
+  const Vec3 wi_world = at.frame.to_world(ms->wi);
+  if (wi_world.dot(at.s.ng) <= 0.0) return false;
+  const Lanes wd = at.rho_d * (ms->values.diffuse / ms->values.pdf);
+  const Lanes wg = at.k_s * (ms->values.glossy / ms->values.pdf);
+  if (depth == 0) {
+    // The first event splits the undivided throughput into its diffuse and glossy parts.
+    const Lanes throughput = path.t_diffuse + path.t_glossy;
+    path.t_diffuse = throughput * wd;
+    path.t_glossy = throughput * wg;
+  } else {
+    const Lanes w = wd + wg;
+    path.t_diffuse *= w;
+    path.t_glossy *= w;
+  }
+  path.prev_delta = ms->delta;
+  path.prev_pdf = ms->values.pdf;
+  path.prev_p = at.s.p;
+  path.o = offset_origin(at.s.p, at.s.ng, wi_world, scene_.accel().scale());
+  path.d = wi_world;
+  return true;
+}
+
+// Russian roulette from the third event on: survive with probability q, divide by q. False: the path ends.
+bool PathTracer::survives_roulette(Path& path, int depth, Random& rng) {
+  if (depth < 2) return true;
+  const double q = std::min(0.95, (path.t_diffuse + path.t_glossy).maxCoeff());
+  if (rng.uniform() >= q) return false;
+  path.t_diffuse /= q;
+  path.t_glossy /= q;
+  return true;
+}
+
+// One path from the camera; `depth` counts the scattering events before the current hit.
+void PathTracer::trace_lanes(const Vec3& origin, const Vec3& direction, Random& rng, const Chunk* chunk,
+                             PixelAccumulator& pixel) const {
+  Path path = start_path(origin, direction, rng, chunk);
   for (int depth = 0;; ++depth) {
-    const auto hit = scene_.accel().intersect(o, d, std::numeric_limits<double>::infinity());
+    // Intersection: the path leaves the scene if the ray hits nothing (there is no environment light).
+    const auto hit = scene_.accel().intersect(path.o, path.d, std::numeric_limits<double>::infinity());
     if (!hit) break;
-    SurfaceHit s = scene_.surface(*hit);
-    const Vec3 wo_world = -d;
-
-    if (const TracerLight* light = scene_.light_of(s.mesh); light && TracerScene::emits_towards(*light, s.ng, wo_world)) {
-      double weight = 1.0;
-      if (!prev_delta) {
-        const double dist2 = (s.p - prev_p).squaredNorm();
-        const double pdf_light = scene_.light_pdf_area(*light) * dist2 / std::abs(s.ng.dot(wo_world));
-        weight = power_heuristic(prev_pdf, pdf_light);
-      }
-      const Lanes le = lane_values(light->radiance, chunk, wavelengths) * weight;
-      if (depth == 0) contribute(0, *light, le, zero);
-      else contribute(depth, *light, t_diffuse * le, t_glossy * le);
-    }
+    const SurfaceHit s = scene_.surface(*hit);
+    add_emission(path, s, depth, pixel);
     if (depth >= settings_.max_bounces) break;
-    const TracerMaterial* material = scene_.material_of(s.mesh);
-    if (!material) break;
-
-    // Surfaces are two-sided: shade the side the ray arrived from.
-    if (s.ng.dot(wo_world) < 0.0) {
-      s.ng = -s.ng;
-      s.ns = -s.ns;
-    }
-    const Frame frame(s.ns);
-    const Vec3 wo = frame.to_local(wo_world);
-    if (wo.z() <= 0.0) break;  // shading normal turned away from the viewer
-    const Lanes rho_d = material->diffuse ? lane_values(*material->diffuse, chunk, wavelengths) : zero;
-    const Lanes k_s = material->specular ? lane_values(*material->specular, chunk, wavelengths)
-                                         : Lanes::Constant(lanes, material->specular_weight);
-    // Before the first event the path is undivided (t_diffuse holds it); the event splits it.
-    const bool first = depth == 0;
-    const Lanes throughput = t_diffuse + t_glossy;
-
-    // Next-event estimation.
-    const double u_light = rng.uniform();
-    const Vec2 u_point(rng.uniform(), rng.uniform());
-    if (material->diffuse || !material->is_delta()) {
-      if (const auto ls = scene_.sample_light(u_light, u_point)) {
-        Vec3 to_light = ls->p - s.p;
-        const double dist = to_light.norm();
-        to_light /= dist;
-        const double cos_light = std::abs(ls->n.dot(to_light));
-        const Vec3 wi = frame.to_local(to_light);
-        if (dist > 0.0 && cos_light > 0.0 && wi.z() > 0.0 && to_light.dot(s.ng) > 0.0 &&
-            TracerScene::emits_towards(*ls->light, ls->n, -to_light)) {
-          const LobeValues f = evaluate(*material, wo, wi);
-          const double pdf_light = ls->pdf_area * dist * dist / cos_light;
-          const double weight = material->is_delta() && !material->diffuse ? 1.0 : power_heuristic(pdf_light, f.pdf);
-          if ((f.diffuse > 0.0 || f.glossy > 0.0) &&
-              scene_.accel().visible(s.p, s.ng, ls->p, ls->n)) {
-            const Lanes le = lane_values(ls->light->radiance, chunk, wavelengths) * (weight / pdf_light);
-            const Lanes fd = rho_d * f.diffuse, fg = k_s * f.glossy;
-            if (first) contribute(1, *ls->light, fd * le, fg * le);
-            else contribute(depth + 1, *ls->light, t_diffuse * (fd + fg) * le, t_glossy * (fd + fg) * le);
-          }
-        }
-      }
-    }
-
-    // Continue the path by sampling the material.
-    const double u_lobe = rng.uniform();
-    const Vec2 u_dir(rng.uniform(), rng.uniform());
-    const auto ms = sample_material(*material, wo, u_lobe, u_dir);
-    if (!ms) break;
-    const Vec3 wi_world = frame.to_world(ms->wi);
-    if (wi_world.dot(s.ng) <= 0.0) break;
-    const Lanes wd = rho_d * (ms->values.diffuse / ms->values.pdf);
-    const Lanes wg = k_s * (ms->values.glossy / ms->values.pdf);
-    if (first) {
-      t_diffuse = throughput * wd;
-      t_glossy = throughput * wg;
-    } else {
-      const Lanes w = wd + wg;
-      t_diffuse *= w;
-      t_glossy *= w;
-    }
-    prev_delta = ms->delta;
-    prev_pdf = ms->values.pdf;
-    prev_p = s.p;
-
-    // Russian roulette from the third event on: survive with probability q, divide by q.
-    if (depth >= 2) {
-      const double q = std::min(0.95, (t_diffuse + t_glossy).maxCoeff());
-      if (rng.uniform() >= q) break;
-      t_diffuse /= q;
-      t_glossy /= q;
-    }
-    o = offset_origin(s.p, s.ng, wi_world, scale);
-    d = wi_world;
+    const std::optional<Shading> at = shade(s, path);
+    if (!at) break;
+    sample_direct(path, *at, depth, rng, pixel);
+    if (!sample_continuation(path, *at, depth, rng)) break;
+    if (!survives_roulette(path, depth, rng)) break;
   }
 }
 

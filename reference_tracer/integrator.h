@@ -9,6 +9,7 @@
 // and to bounce.<k>, k = number of scattering events. Each family of components sums to the total.
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -78,9 +79,20 @@ class PathTracer {
   struct Chunk {
     int first_band, count;
   };
-  struct Path;
+  struct Path;     // a path's lanes, throughput and next ray
+  struct Shading;  // a scattering event: hit, frame, material spectra
+  // One path, traced in the steps of a path tracer with next-event estimation (integrator.cpp).
   void trace_lanes(const Vec3& origin, const Vec3& direction, Random& rng, const Chunk* chunk,
                    PixelAccumulator& pixel) const;
+  Path start_path(const Vec3& origin, const Vec3& direction, Random& rng, const Chunk* chunk) const;
+  void add_emission(const Path& path, const SurfaceHit& s, int depth, PixelAccumulator& pixel) const;
+  std::optional<Shading> shade(SurfaceHit s, const Path& path) const;
+  void sample_direct(const Path& path, const Shading& at, int depth, Random& rng, PixelAccumulator& pixel) const;
+  bool sample_continuation(Path& path, const Shading& at, int depth, Random& rng) const;
+  static bool survives_roulette(Path& path, int depth, Random& rng);
+  void contribute(const Path& path, PixelAccumulator& pixel, int scatterings, const TracerLight& light,
+                  const Lanes& diffuse_part, const Lanes& glossy_part) const;
+  void splat(const Path& path, PixelAccumulator& pixel, int layer, const Lanes& value) const;
   Lanes lane_values(const PiecewiseLinearSpectrum& s, const Chunk* chunk, const Lanes& wavelengths) const;
 
   const TracerScene& scene_;
