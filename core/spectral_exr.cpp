@@ -273,6 +273,85 @@ Bands band_edges(const Imf::Header& header, const SpectralLayer& reference, cons
   return Bands::from_edges(std::vector<double>(edges.begin(), edges.end()), where);
 }
 
+// The channels sorted into spectral ones, bi-spectral re-radiation ones, object ids and others.
+struct SortedChannels {
+  std::vector<NamedChannel> spectral, reradiation;
+};
+SortedChannels sort_channels(const Imf::Header& header, const std::string& file, SpectralExrInfo& info) {
+  SortedChannels sorted;
+  for (auto it = header.channels().begin(); it != header.channels().end(); ++it) {
+    const std::string name = it.name();
+    info.channels.push_back(ExrChannel{name, pixel_type(it.channel().type)});
+    std::optional<SpectralChannelName> parsed = parse_spectral_channel_name(name);
+    const bool ours = parsed || name == kObjectIdChannel;
+    // Slices are read at full resolution, which subsampled channels do not have.
+    if (ours && (it.channel().xSampling != 1 || it.channel().ySampling != 1))
+      throw InputError(fmt::format("{}: channel {}: subsampled ({}x{}); spectral channels must be full resolution",
+                                   file, name, it.channel().xSampling, it.channel().ySampling));
+    if (parsed && parsed->reradiated_nm)
+      sorted.reradiation.push_back(NamedChannel{std::move(*parsed), name});
+    else if (parsed)
+      sorted.spectral.push_back(NamedChannel{std::move(*parsed), name});
+    else if (name == kObjectIdChannel)
+      info.has_object_ids = true;
+    else
+      info.other_channels.push_back(name);
+  }
+  return sorted;
+}
+
+// Bi-spectral files: the re-radiation channels in wavelength order, next to the diagonal T they need.
+void describe_reradiation(std::vector<NamedChannel> reradiation, const std::string& file, SpectralExrInfo& info) {
+  info.bispectral = !reradiation.empty();
+  if (!info.bispectral) return;
+  if (info.find_layer("", SpectralQuantity::T) == nullptr)
+    throw InputError(fmt::format("{}: channel {}: bi-spectral re-radiation without the diagonal T channels", file,
+                                 reradiation.front().name));
+  std::sort(reradiation.begin(), reradiation.end(), [](const NamedChannel& a, const NamedChannel& b) {
+    return std::pair(a.parsed.wavelength_nm, *a.parsed.reradiated_nm) <
+           std::pair(b.parsed.wavelength_nm, *b.parsed.reradiated_nm);
+  });
+  for (const NamedChannel& channel : reradiation) info.reradiation_channels.push_back(channel.name);
+}
+
+// The band centres and edges every spectral layer shares.
+void describe_bands(const Imf::Header& header, const std::string& file, const std::vector<std::vector<double>>& wavelengths,
+                    SpectralExrInfo& info) {
+  if (!info.spectral()) return;
+  check_same_wavelengths(info.layers, wavelengths, file);
+  info.centres_nm = wavelengths.front();
+  info.bands = band_edges(header, info.layers.front(), info.centres_nm, file, info.edges_from_file);
+  const std::size_t n = info.centres_nm.size();
+  if (info.bispectral && info.reradiation_channels.size() != n * (n - 1) / 2)
+    info.notes.push_back(
+        fmt::format("bi-spectral: {} re-radiation channels, where the upper triangle over {} bands has {}",
+                    info.reradiation_channels.size(), n, n * (n - 1) / 2));
+}
+
+// The layout's own attributes (version, units, handedness, EV), with a note where one is missing or unknown.
+void describe_layout_attributes(const Imf::Header& header, const std::string& file, SpectralExrInfo& info) {
+  info.layout_version = string_attribute(header, "spectralLayoutVersion", file);
+  info.emissive_units = string_attribute(header, "emissiveUnits", file);
+  info.polarisation_handedness = string_attribute(header, "polarisationHandedness", file);
+  info.ev = ev_attribute(header, file);
+  if (info.polarisation_handedness && *info.polarisation_handedness != "left" &&
+      *info.polarisation_handedness != "right")
+    throw InputError(fmt::format("{}: attribute polarisationHandedness: must be \"left\" or \"right\", got \"{}\"",
+                                 file, *info.polarisation_handedness));
+  if (!info.spectral()) return;
+  if (!info.layout_version)
+    info.notes.push_back("no spectralLayoutVersion attribute (the layout requires \"1.0\")");
+  else if (*info.layout_version != kLayoutVersion)
+    info.notes.push_back(fmt::format("spectralLayoutVersion is \"{}\"; this reader knows \"1.0\"", *info.layout_version));
+  if (info.emissive && !info.emissive_units)
+    info.notes.push_back(fmt::format("no emissiveUnits attribute: assuming {}", kEmissiveUnits));
+  else if (info.emissive && *info.emissive_units != kEmissiveUnits)
+    info.notes.push_back(
+        fmt::format("emissiveUnits is \"{}\"; the layout defines only \"{}\"", *info.emissive_units, kEmissiveUnits));
+  if (info.polarised && !info.polarisation_handedness)
+    info.notes.push_back("no polarisationHandedness attribute: the reference library assumes right-handed");
+}
+
 SpectralExrInfo describe(const Imf::Header& header, const std::string& file, std::uintmax_t file_bytes) {
   SpectralExrInfo info;
   info.file = file;
@@ -284,86 +363,23 @@ SpectralExrInfo describe(const Imf::Header& header, const std::string& file, std
   info.origin_y = window.min.y;
   info.compression = compression_name(header.compression());
 
-  std::vector<NamedChannel> spectral;
-  std::vector<NamedChannel> reradiation;
-  for (auto it = header.channels().begin(); it != header.channels().end(); ++it) {
-    const std::string name = it.name();
-    info.channels.push_back(ExrChannel{name, pixel_type(it.channel().type)});
-    std::optional<SpectralChannelName> parsed = parse_spectral_channel_name(name);
-    const bool ours = parsed || name == kObjectIdChannel;
-    // Slices are read at full resolution, which subsampled channels do not have.
-    if (ours && (it.channel().xSampling != 1 || it.channel().ySampling != 1))
-      throw InputError(fmt::format("{}: channel {}: subsampled ({}x{}); spectral channels must be full resolution",
-                                   file, name, it.channel().xSampling, it.channel().ySampling));
-    if (parsed && parsed->reradiated_nm)
-      reradiation.push_back(NamedChannel{std::move(*parsed), name});
-    else if (parsed)
-      spectral.push_back(NamedChannel{std::move(*parsed), name});
-    else if (name == kObjectIdChannel)
-      info.has_object_ids = true;
-    else
-      info.other_channels.push_back(name);
-  }
-
+  SortedChannels channels = sort_channels(header, file, info);
   std::vector<std::vector<double>> wavelengths;
-  info.layers = build_layers(std::move(spectral), file, wavelengths);
+  info.layers = build_layers(std::move(channels.spectral), file, wavelengths);
   for (const SpectralLayer& layer : info.layers) {
     info.emissive = info.emissive || is_stokes(layer.quantity);
     info.polarised = info.polarised || (is_stokes(layer.quantity) && layer.quantity != SpectralQuantity::S0);
     info.reflective = info.reflective || layer.quantity == SpectralQuantity::T;
   }
   check_complete_stokes(info.layers, file);
-
-  info.bispectral = !reradiation.empty();
-  if (info.bispectral) {
-    if (info.find_layer("", SpectralQuantity::T) == nullptr)
-      throw InputError(fmt::format("{}: channel {}: bi-spectral re-radiation without the diagonal T channels", file,
-                                   reradiation.front().name));
-    std::sort(reradiation.begin(), reradiation.end(), [](const NamedChannel& a, const NamedChannel& b) {
-      return std::pair(a.parsed.wavelength_nm, *a.parsed.reradiated_nm) <
-             std::pair(b.parsed.wavelength_nm, *b.parsed.reradiated_nm);
-    });
-    for (const NamedChannel& channel : reradiation) info.reradiation_channels.push_back(channel.name);
-  }
-
-  if (info.spectral()) {
-    check_same_wavelengths(info.layers, wavelengths, file);
-    info.centres_nm = wavelengths.front();
-    info.bands = band_edges(header, info.layers.front(), info.centres_nm, file, info.edges_from_file);
-    const std::size_t n = info.centres_nm.size();
-    if (info.bispectral && info.reradiation_channels.size() != n * (n - 1) / 2)
-      info.notes.push_back(
-          fmt::format("bi-spectral: {} re-radiation channels, where the upper triangle over {} bands has {}",
-                      info.reradiation_channels.size(), n, n * (n - 1) / 2));
-  }
+  describe_reradiation(std::move(channels.reradiation), file, info);
+  describe_bands(header, file, wavelengths, info);
 
   info.object_names = object_names_attribute(header, file);
   if (!info.object_names.empty() && !info.has_object_ids)
     info.notes.push_back(
         fmt::format("{} names object ids but there is no {} channel", kObjectsAttribute, kObjectIdChannel));
-
-  info.layout_version = string_attribute(header, "spectralLayoutVersion", file);
-  info.emissive_units = string_attribute(header, "emissiveUnits", file);
-  info.polarisation_handedness = string_attribute(header, "polarisationHandedness", file);
-  info.ev = ev_attribute(header, file);
-  if (info.polarisation_handedness && *info.polarisation_handedness != "left" &&
-      *info.polarisation_handedness != "right")
-    throw InputError(fmt::format("{}: attribute polarisationHandedness: must be \"left\" or \"right\", got \"{}\"",
-                                 file, *info.polarisation_handedness));
-  if (info.spectral()) {
-    if (!info.layout_version)
-      info.notes.push_back("no spectralLayoutVersion attribute (the layout requires \"1.0\")");
-    else if (*info.layout_version != kLayoutVersion)
-      info.notes.push_back(
-          fmt::format("spectralLayoutVersion is \"{}\"; this reader knows \"1.0\"", *info.layout_version));
-    if (info.emissive && !info.emissive_units)
-      info.notes.push_back(fmt::format("no emissiveUnits attribute: assuming {}", kEmissiveUnits));
-    else if (info.emissive && *info.emissive_units != kEmissiveUnits)
-      info.notes.push_back(
-          fmt::format("emissiveUnits is \"{}\"; the layout defines only \"{}\"", *info.emissive_units, kEmissiveUnits));
-    if (info.polarised && !info.polarisation_handedness)
-      info.notes.push_back("no polarisationHandedness attribute: the reference library assumes right-handed");
-  }
+  describe_layout_attributes(header, file, info);
 
   // Structural attributes are reported through the fields above; everything else is metadata.
   static const std::set<std::string> kReported{

@@ -30,7 +30,7 @@ inline constexpr std::array<StructureWord, 16> kStructureWords{{
     {Structure::L, "L", "a body line with a highlight line leaving its bright end: a sharp highlight"},
     {Structure::SkewedT, "skewed-T", "a highlight line leaving the body line part-way along it"},
     {Structure::Fork, "fork", "two lines diverging from near black: two light colours on one surface (or two surfaces)"},
-    {Structure::Gamma, "gamma", "bent by a power-law response; a power curve straightens it"},
+    {Structure::Gamma, "gamma", "bent by the camera's response curve: a power curve, or undoing the file's named curve, straightens it"},
     {Structure::Curved, "curved", "bent, and no power curve straightens it: the \"banana\""},
     {Structure::Thickened, "thickened", "a plane with spread off it: interreflection or noise"},
     {Structure::Volume, "volume", "spread in all three directions"},

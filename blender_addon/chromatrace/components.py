@@ -88,7 +88,7 @@ def _term(passes, file=MAIN, sign=1):
 
 
 def component_plan(families, light_groups, max_bounces, transmission=False):
-    """The total's and each component's terms, for the manifest (see cli/cmd_assemble.cpp).
+    """The total's and each component's terms, for the manifest (see core/assembly.h).
 
     Returns (total_terms, [{"name": ..., "terms": [...]}, ...]) in the file's component order.
     With max_bounces 0 (emitters only) the caller renders with every reflectance set to 0, so that

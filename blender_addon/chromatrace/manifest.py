@@ -1,6 +1,6 @@
 """The manifest that `chromatrace assemble` turns into a spectral EXR (pure Python, no bpy).
 
-Format `chromatrace-assemble/1`, documented in cli/cmd_assemble.cpp.
+Format `chromatrace-assemble/1`, documented in core/assembly.h.
 """
 
 import os

@@ -457,6 +457,14 @@ TEST(Series, ExpectationsUseTheAnalyzersWords) {
   EXPECT_FALSE(structure_from_word("l"));
 }
 
+// docs/analyze.md defines every structure by numbers: one row of its class table per word.
+TEST(Series, EveryStructureIsDefinedInTheDocs) {
+  std::ifstream file(fs::path(CHROMATRACE_SOURCE_DIR) / "docs" / "analyze.md");
+  const std::string docs((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
+  for (const StructureWord& w : kStructureWords)
+    EXPECT_NE(docs.find(fmt::format("\n| `{}` |", w.word)), std::string::npos) << w.word;
+}
+
 TEST(Series, JsonMergePatchSemantics) {
   // RFC 7386: objects merge key by key, null deletes a key, arrays (and any non-object) replace.
   const Series series = load_series(kTestScenes / "series_merge.json");
