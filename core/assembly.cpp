@@ -178,6 +178,13 @@ void read_block(const AssemblyManifest& manifest, std::vector<SpectralExrReader>
     const std::vector<std::string>& channels = manifest.inputs[i].channels;
     block.values[i].assign(block.pixels() * channels.size(), 0.0f);
     readers[i].read_channels(channels, y0, y0 + rows, block.values[i]);
+    // A NaN or infinity would pass every sum check (NaN compares false) and reach the spectral file unseen.
+    const auto bad = std::find_if(block.values[i].begin(), block.values[i].end(), [](float v) { return !std::isfinite(v); });
+    if (bad != block.values[i].end()) {
+      const std::size_t k = static_cast<std::size_t>(bad - block.values[i].begin()), pixel = k / channels.size();
+      throw InputError(fmt::format("{}: channel {}: value {} at pixel ({}, {}) is not finite", manifest.inputs[i].path.string(),
+                                   channels[k % channels.size()], *bad, block.x(pixel), block.y(pixel)));
+    }
   }
 }
 

@@ -1,6 +1,7 @@
 // The `chromatrace` subcommands the Blender add-on calls: scene-bands, export-meshes and assemble, end to end
 // through the executable, with good and bad input.
 #include <algorithm>
+#include <limits>
 #include <fstream>
 #include <string>
 #include <vector>
@@ -270,6 +271,22 @@ TEST_F(Assemble, ComponentsThatDoNotSumToTheTotalAreRefused) {
   EXPECT_EQ(line_count(r.err), 1) << r.err;
   EXPECT_NE(r.err.find("path types sum to"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("pixel (0, 0), band 3"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(out));
+}
+
+// A NaN a renderer wrote passes no sum check (it compares false with everything): it is refused by name.
+TEST_F(Assemble, ANonFiniteValueIsRefusedNamingFileChannelAndPixel) {
+  std::vector<test::RawChannel> channels;
+  for (const char* pass : {"Emit", "DiffDir", "DiffCol", "DiffInd", "DiffCol2", "GlossDir", "GlossInd", "GlossCol", "Combined", "Combined_a"})
+    for (const char c : {'R', 'G', 'B'}) channels.push_back({fmt_name(pass, c), std::vector<float>(kW * kH, 1.0f), Imf::FLOAT});
+  channels[0].values[4] = std::numeric_limits<float>::quiet_NaN();  // L.Emit.R at pixel (1, 1)
+  channels.push_back({"L.IndexOB.X", {1, 1, 2, 0, 1, 1}, Imf::FLOAT});
+  test::write_raw_exr(dir_.file("g1.exr"), kW, kH, channels);
+  const fs::path out = dir_.file("out.exr");
+  const auto r = run_chromatrace({"assemble", write_manifest(manifest_).string(), "-o", out.string()});
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_EQ(line_count(r.err), 1) << r.err;
+  EXPECT_NE(r.err.find("g1.exr: channel L.Emit.R: value nan at pixel (1, 1) is not finite"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(out));
 }
 
