@@ -95,7 +95,8 @@ json input_json(const ImageAnalysis& a) {
                                    {"gamma", e.curve->srgb ? json(nullptr) : json(e.curve->gamma)},
                                    {"k", e.curve->srgb ? json(nullptr) : json(e.curve->k)},
                                    {"srgb", e.curve->srgb},
-                                   {"linearised", !e.curve->linear()}}
+                                   {"linearised", !e.curve->linear()},
+                                   {"source", e.curve_source}}
                             : json(nullptr)}};
 }
 
@@ -176,9 +177,7 @@ json analysis_to_json(const ImageAnalysis& a) {
               {"valid_pixels", r.shape.samples},
               {"occupied_bins", r.histogram.cells.size()},
               {"shape", shape_to_json(r.shape)},
-              {"linear_light", r.linear_light ? json{{"class", class_name(r.linear_light->shape)},
-                                                     {"reason", r.linear_light->reason}}
-                                              : json(nullptr)},
+              {"linear_light", r.linear_light ? shape_to_json(*r.linear_light) : json(nullptr)},
               {"files", {{"histogram", "histograms/" + stem + ".json"}, {"plot", "plots/" + stem + ".png"}}}};
     j["explanation"] = i < a.explanations.size() ? optional_json(a.explanations[i], explanation_json) : json(nullptr);
     regions.push_back(std::move(j));

@@ -25,6 +25,8 @@ struct RawImage {
   // The camera's numbers (chromatrace.black_level …) as found: attributes, else ImageDescription's JSON.
   nlohmann::json camera = nlohmann::json::object();
   std::string camera_source;
+  std::string colour_space;  // oiio:ColorSpace
+  float display_gamma = 0;   // oiio:Gamma (0: not given)
 };
 
 constexpr const char* kCameraKeys[] = {"chromatrace.black_level", "chromatrace.white_level", "chromatrace.dark_signal",
@@ -86,6 +88,8 @@ RawImage read_raw(const std::filesystem::path& file) {
   raw.objects_attribute = spec.get_string_attribute(exr::kObjectsAttribute);
   raw.components_attribute = spec.get_string_attribute(exr::kComponentsAttribute);
   read_camera_metadata(spec, raw);
+  raw.colour_space = spec.get_string_attribute("oiio:ColorSpace");
+  raw.display_gamma = spec.get_float_attribute("oiio:Gamma", 0.0f);
   if (raw.width < 1 || raw.height < 1) throw InputError(fmt::format("{}: image has no pixels", name));
   raw.values.resize(static_cast<std::size_t>(raw.width) * static_cast<std::size_t>(raw.height) *
                     static_cast<std::size_t>(raw.channels));
@@ -171,20 +175,6 @@ void apply_camera_metadata(const RawImage& raw, AnalysisImage& out) {
   if (const auto noise = camera_number(raw, "chromatrace.noise")) e.noise = *noise != 0;
   if (const auto adc = camera_number(raw, "chromatrace.adc")) e.adc = *adc != 0;
   if (const auto area = camera_number(raw, "chromatrace.pixel_area")) e.pixel_area = *area != 0;
-  const auto gamma = camera_number(raw, "chromatrace.curve_gamma");
-  const auto srgb = camera_number(raw, "chromatrace.curve_srgb");
-  if (gamma || srgb) {
-    ToneCurve curve;
-    curve.srgb = srgb.value_or(0) != 0;
-    if (!curve.srgb) {
-      curve.gamma = gamma.value_or(1.0);
-      curve.k = camera_number(raw, "chromatrace.curve_k").value_or(1.0);
-      if (!(curve.gamma > 0) || !(curve.k > 0))
-        throw InputError(fmt::format("{}: chromatrace.curve_gamma and chromatrace.curve_k must be > 0 (are {:g}, {:g})",
-                                     out.file, curve.gamma, curve.k));
-    }
-    e.curve = curve;
-  }
   if (e.black_level && *e.black_level != 0) {
     const auto black = static_cast<float>(*e.black_level);
     for (float& v : out.image.rgb) v -= black;
@@ -192,7 +182,70 @@ void apply_camera_metadata(const RawImage& raw, AnalysisImage& out) {
   e.black_subtracted = e.black_level.has_value();
 }
 
+// The curve the sensor simulator named (chromatrace.curve_*), if it did.
+std::optional<ToneCurve> simulator_curve(const RawImage& raw, const std::string& file) {
+  const auto gamma = camera_number(raw, "chromatrace.curve_gamma");
+  const auto srgb = camera_number(raw, "chromatrace.curve_srgb");
+  if (!gamma && !srgb) return std::nullopt;
+  ToneCurve curve;
+  curve.srgb = srgb.value_or(0) != 0;
+  if (!curve.srgb) {
+    curve.gamma = gamma.value_or(1.0);
+    curve.k = camera_number(raw, "chromatrace.curve_k").value_or(1.0);
+    if (!(curve.gamma > 0) || !(curve.k > 0))
+      throw InputError(fmt::format("{}: chromatrace.curve_gamma and chromatrace.curve_k must be > 0 (are {:g}, {:g})", file,
+                                   curve.gamma, curve.k));
+  }
+  return curve;
+}
+
+// --input-transfer auto: what the file says of its encoding, else what its type implies.
+void decide_curve(const RawImage& raw, AnalysisImage& out) {
+  ImageEncoding& e = out.encoding;
+  if (const auto curve = simulator_curve(raw, out.file)) {
+    e.curve = curve;
+    e.curve_source = fmt::format("the file's chromatrace.curve_* ({})", raw.camera_source);
+    return;
+  }
+  if (!raw.camera_source.empty()) {  // the simulator's camera numbers without a curve: linear signal
+    e.curve = ToneCurve{};
+    e.curve_source = "the file's camera metadata (chromatrace.*) names no curve: linear";
+    return;
+  }
+  std::string space = raw.colour_space;
+  std::transform(space.begin(), space.end(), space.begin(), [](unsigned char c) { return std::tolower(c); });
+  if (space == "srgb") {
+    e.curve = ToneCurve{1, 1, true};
+    e.curve_source = "the file's colour space (oiio:ColorSpace sRGB)";
+  } else if (space == "linear" || space == "lin_srgb" || space == "scene_linear" || space == "acescg") {
+    e.curve = ToneCurve{};
+    e.curve_source = fmt::format("the file's colour space (oiio:ColorSpace {})", raw.colour_space);
+  } else if (space == "gammacorrected" && raw.display_gamma > 0) {
+    e.curve = ToneCurve{1.0 / raw.display_gamma, 1, false};
+    e.curve_source = fmt::format("the file's gamma (oiio:Gamma {:g})", raw.display_gamma);
+  } else if (!e.integer) {
+    e.curve = ToneCurve{};
+    e.curve_source = "a float file without a colour space: linear";
+  } else {
+    e.curve = ToneCurve{1, 1, true};
+    e.curve_source = fmt::format("a {}-bit file without a colour space: sRGB, as cameras and phones store pictures", e.bits);
+  }
+}
+
 }  // namespace
+
+std::optional<ToneCurve> parse_input_transfer(const std::string& text) {
+  if (text == "auto") return std::nullopt;
+  if (text == "linear") return ToneCurve{};
+  if (text == "srgb" || text == "sRGB") return ToneCurve{1, 1, true};
+  if (text.starts_with("gamma=")) {
+    const std::string number = text.substr(6);
+    char* end = nullptr;
+    const double g = std::strtod(number.c_str(), &end);
+    if (!number.empty() && *end == '\0' && std::isfinite(g) && g > 0) return ToneCurve{1.0 / g, 1, false};
+  }
+  throw InputError(fmt::format("--input-transfer: \"{}\" is not auto, linear, srgb or gamma=G with G > 0", text));
+}
 
 std::string ToneCurve::describe() const {
   if (srgb) return "the sRGB curve";
@@ -217,7 +270,8 @@ RgbImage linear_light(const AnalysisImage& input) {
   return out;
 }
 
-AnalysisImage read_analysis_image(const std::filesystem::path& file) {
+AnalysisImage read_analysis_image(const std::filesystem::path& file, const std::string& input_transfer) {
+  const std::optional<ToneCurve> declared = parse_input_transfer(input_transfer);
   const std::string name = file.string();
   RawImage raw = read_raw(file);
   AnalysisImage out;
@@ -238,6 +292,12 @@ AnalysisImage read_analysis_image(const std::filesystem::path& file) {
   out.linear = extract_rgb(raw, "linear");
   out.display = extract_rgb(raw, "display");
   apply_camera_metadata(raw, out);
+  if (declared) {
+    out.encoding.curve = declared;
+    out.encoding.curve_source = fmt::format("--input-transfer {}", input_transfer);
+  } else {
+    decide_curve(raw, out);
+  }
   // A renderer's spectral EXR names its components too, but holds them as spectra, not as camera RGB:
   // only RGB layers explain a camera image.
   for (const std::string& c : component_names(raw))

@@ -57,6 +57,7 @@ struct ImageEncoding {
   std::optional<bool> adc = std::nullopt;    // whether the ADC was on
   std::optional<bool> pixel_area = std::nullopt;  // whether pixels integrate an area (false: point samples)
   std::optional<ToneCurve> curve = std::nullopt;   // the response curve R, G, B were encoded with
+  std::string curve_source = "";                   // why that curve: the metadata or rule it came from
 
   // The value R, G, B hold for black: −black_level once subtracted, else 0 (the ADC's code 0 lies at
   // −black_level after subtraction).
@@ -89,12 +90,19 @@ struct AnalysisImage {
 // curve is linear or unknown).
 RgbImage linear_light(const AnalysisImage& input);
 
+// What R, G, B are: "auto" (decide from the file, below), "linear", "srgb", or "gamma=G" (stored = I^(1/G), as
+// a display gamma G: gamma=2.2 is I' = I^0.4545). InputError naming --input-transfer for anything else.
+// auto: the sensor simulator's chromatrace.curve_* (or, from an older simulator, linear with its other camera
+// numbers); else the colour space OpenImageIO reports (oiio:ColorSpace sRGB, linear, or GammaCorrected with
+// oiio:Gamma); else a float file is linear and an integer file is sRGB, as cameras, phones and browsers store it.
+std::optional<ToneCurve> parse_input_transfer(const std::string& text);
+
 // Reads R, G, B (or a grey-free file's first three channels) and whatever extra layers are present.
 // When the file says what the camera's black level was (chromatrace.black_level, as an attribute or in the
 // ImageDescription JSON of a TIFF/PNG), it is subtracted from R, G, B, so that black is 0 for every fit
 // through black. An unreadable file, fewer than three channels or a malformed object_id /
 // chromatrace.objects is an InputError naming the file.
-AnalysisImage read_analysis_image(const std::filesystem::path& file);
+AnalysisImage read_analysis_image(const std::filesystem::path& file, const std::string& input_transfer = "auto");
 
 // The RGB layer the histograms are made of: "" or "final" for R,G,B, "linear", or a component's name.
 // An unknown name is an InputError listing the layers the file has.

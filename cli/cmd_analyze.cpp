@@ -27,7 +27,7 @@ analyzer::Vec3 parse_colour(const std::string& text) {
 Action add_analyze(CLI::App& app) {
   auto* cmd = app.add_subcommand("analyze", "Analyse the colour histograms of image regions: shapes, illuminant, light paths");
   struct Options {
-    std::string image, output, layer, illuminant;
+    std::string image, output, layer, illuminant, input_transfer = "auto";
     analyzer::RegionOptions regions;
     std::vector<std::string> rects;
     int bins = 64, threads = 0;
@@ -39,6 +39,10 @@ Action add_analyze(CLI::App& app) {
   cmd->add_option("image", o->image, "Image: PNG, TIFF, EXR … (the sensor simulator's EXR adds layers and object ids)")->required();
   cmd->add_option("-o,--output", o->output, "Output directory (created; its parent must exist)")->required();
   cmd->add_option("--layer", o->layer, "RGB layer to analyse: final (R,G,B), linear, or a component name")->default_str("final");
+  cmd->add_option("--input-transfer", o->input_transfer,
+                  "What R, G, B hold: auto (from the file's metadata and type), linear, srgb, or gamma=G (a display gamma, "
+                  "e.g. 2.2)")
+      ->capture_default_str();
   cmd->add_option("--labels", o->regions.labels, "Label regions: an id channel of the image (object_id) or a label image file");
   cmd->add_flag("--no-labels", o->regions.no_labels, "Ignore the image's object_id channel");
   cmd->add_option("--mask", o->regions.masks, "Mask image (non-zero pixels form a region); repeatable");
@@ -63,9 +67,14 @@ Action add_analyze(CLI::App& app) {
     if (!std::filesystem::is_directory(parent))
       throw InputError(fmt::format("{}: directory {} does not exist", o->output, parent.string()));
 
-    const analyzer::AnalysisImage input = analyzer::read_analysis_image(o->image);
+    const analyzer::AnalysisImage input = analyzer::read_analysis_image(o->image, o->input_transfer);
     const analyzer::RgbImage& layer = analyzer::select_layer(input, o->layer);
     std::vector<analyzer::Region> regions = analyzer::select_regions(input, layer, o->regions);
+    if (!o->quiet && input.encoding.curve)
+      fmt::print(stderr, "{}: R, G, B {} ({})\n", o->image,
+                 input.encoding.curve->linear() ? "taken as linear light" : "encoded by " + input.encoding.curve->describe() +
+                                                                               ": undone for the linear-light analysis",
+                 input.encoding.curve_source);
     analyzer::AnalyzeOptions options;
     options.bins = o->bins;
     options.threads = o->threads;

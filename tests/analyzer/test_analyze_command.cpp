@@ -1,11 +1,17 @@
 // chromatrace analyze end to end: outputs, regions, and bad input (unreadable image, empty, one-pixel,
 // all-black and all-NaN regions) answered with a reason, never a crash.
 #include <cmath>
+#include <cstdlib>
 #include <fstream>
+#include <map>
+#include <numbers>
 
 #include <gtest/gtest.h>
+#include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "analyzer/image_input.h"
+#include "core/colour.h"
 #include "core/file_io.h"
 #include "tests/analyzer/synthetic.h"
 #include "tests/cli/run_command.h"
@@ -67,6 +73,78 @@ TEST(AnalyzeCommand, ReadsEightBitImagesWithRegionsFromRectanglesAndSegments) {
   for (const auto& region : a["regions"]) segments += region["source"] == "segment";
   EXPECT_EQ(segments, 4) << a["regions"].dump(1);  // one per sphere; the black background is left out
   EXPECT_FALSE(std::filesystem::exists(out / "report.html"));
+}
+
+// What R, G, B are is decided (and said) before any fit through black: an sRGB picture and its linearised copy,
+// made by oiiotool, analysed with --input-transfer auto, give the same classes in linear light and the same
+// directions within 1° (the sRGB file's 16-bit codes keep the linear values to far better than that).
+TEST(AnalyzeCommand, AnSrgbPictureAndItsLinearCopyAgree) {
+  TempDir dir;
+  const Scene scene = dichromatic_scene(Vec3(1, 0.85, 0.6));
+  RgbImage encoded = scene.image, labels = scene.image;
+  for (float& v : encoded.rgb) v = static_cast<float>(srgb_encode(std::clamp(static_cast<double>(v), 0.0, 1.0)));
+  for (std::size_t p = 0; p < scene.ids.size(); ++p)
+    for (std::size_t c = 0; c < 3; ++c) labels.rgb[p * 3 + c] = static_cast<float>(scene.ids[p]) / 255.0f;
+  write_rgb(dir.file("scene.png"), encoded, 16);
+  write_rgb(dir.file("labels.png"), labels, 8);
+  const std::string convert = fmt::format("oiiotool {} --iscolorspace sRGB --colorconvert sRGB linear -d float -o {}",
+                                          dir.file("scene.png").string(), dir.file("linear.exr").string());
+  ASSERT_EQ(std::system(convert.c_str()), 0) << convert;
+  std::map<std::string, nlohmann::json> a;
+  for (const std::string file : {"scene.png", "linear.exr"}) {
+    const auto out = dir.file(file + ".out");
+    const CommandResult r = run_chromatrace({"analyze", dir.file(file).string(), "-o", out.string(), "--labels",
+                                             dir.file("labels.png").string(), "--no-plots", "--no-report"});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    a[file] = analysis(out);
+    // Said on stderr and in analysis.json.
+    EXPECT_NE(r.err.find(file == "scene.png" ? "encoded by the sRGB curve" : "taken as linear light"), std::string::npos) << r.err;
+  }
+  EXPECT_EQ(a["scene.png"]["input"]["curve"]["srgb"], true);
+  EXPECT_EQ(a["scene.png"]["input"]["curve"]["source"], "the file's colour space (oiio:ColorSpace sRGB)");
+  EXPECT_EQ(a["linear.exr"]["input"]["curve"]["linearised"], false);
+  const auto angle = [](const nlohmann::json& u, const nlohmann::json& v) {
+    const Vec3 x(u[0], u[1], u[2]), y(v[0], v[1], v[2]);
+    return std::acos(std::min(1.0, std::abs(x.normalized().dot(y.normalized())))) * 180 / std::numbers::pi;
+  };
+  const nlohmann::json &encoded_regions = a["scene.png"]["regions"], &linear_regions = a["linear.exr"]["regions"];
+  ASSERT_EQ(encoded_regions.size(), linear_regions.size());
+  for (std::size_t i = 1; i < linear_regions.size(); ++i) {  // the objects (the whole image mixes them)
+    const nlohmann::json &light = encoded_regions[i]["linear_light"], &shape = linear_regions[i]["shape"];
+    ASSERT_TRUE(light.is_object()) << encoded_regions[i]["name"];
+    EXPECT_EQ(light["class"], shape["class"]) << linear_regions[i]["name"];
+    EXPECT_LT(angle(light["axes"][0], shape["axes"][0]), 1.0) << linear_regions[i]["name"];
+    EXPECT_LT(angle(light["dichromatic_plane"]["normal"], shape["dichromatic_plane"]["normal"]), 1.0) << linear_regions[i]["name"];
+  }
+  EXPECT_LT(angle(a["scene.png"]["illuminant"]["estimate"]["rgb"], a["linear.exr"]["illuminant"]["estimate"]["rgb"]), 1.0);
+  EXPECT_LT(angle(a["linear.exr"]["illuminant"]["estimate"]["rgb"], std::vector<double>{1, 0.85, 0.6}), 1.0);
+}
+
+// --input-transfer declares what the file holds; anything else is refused by name.
+TEST(AnalyzeCommand, InputTransferIsDeclaredOrRefused) {
+  EXPECT_FALSE(analyzer::parse_input_transfer("auto"));
+  EXPECT_TRUE(analyzer::parse_input_transfer("linear")->linear());
+  EXPECT_TRUE(analyzer::parse_input_transfer("srgb")->srgb);
+  EXPECT_NEAR(analyzer::parse_input_transfer("gamma=2.2")->gamma, 1 / 2.2, 1e-15);
+  TempDir dir;
+  write_sensor_exr(dir.file("line.exr"), {matte_line(), matte_line(), {}, {}, {}});
+  for (const std::string bad : {"gamma=0", "gamma=x", "rec709", ""}) {
+    const CommandResult r = run_chromatrace({"analyze", dir.file("line.exr").string(), "-o", dir.file("o").string(),
+                                             "--input-transfer", bad});
+    EXPECT_EQ(r.exit_code, 2) << bad;
+    EXPECT_NE(r.err.find("--input-transfer: \"" + bad + "\" is not auto, linear, srgb or gamma=G"), std::string::npos) << r.err;
+    EXPECT_FALSE(std::filesystem::exists(dir.file("o")));
+  }
+  // A 16-bit file that names no colour space is a picture: sRGB, and said so.
+  write_rgb(dir.file("plain.tif"), matte_line(), 16);
+  const CommandResult r = run_chromatrace({"analyze", dir.file("plain.tif").string(), "-o", dir.file("t").string(), "--no-plots", "--no-report"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const nlohmann::json tif = analysis(dir.file("t"));
+  EXPECT_EQ(tif["input"]["curve"]["srgb"], true) << tif["input"].dump();
+  const CommandResult declared = run_chromatrace({"analyze", dir.file("plain.tif").string(), "-o", dir.file("d").string(),
+                                                  "--input-transfer", "linear", "--no-plots", "--no-report"});
+  ASSERT_EQ(declared.exit_code, 0) << declared.err;
+  EXPECT_EQ(analysis(dir.file("d"))["input"]["curve"]["source"], "--input-transfer linear");
 }
 
 TEST(AnalyzeCommand, LabelAndMaskImagesGiveRegions) {
