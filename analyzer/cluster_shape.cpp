@@ -246,7 +246,23 @@ class ShapeDecision {
                         m.angle_deg >= k_.min_line_angle_deg) &
                    test("gap between lines <= 2 * tolerance", m.gap, 2 * tolerance_, m.gap <= 2 * tolerance_) &
                    test("junction on highlight line <= highlight_end", m.junction_on_highlight, k_.highlight_end,
-                        m.junction_on_highlight <= k_.highlight_end);
+                        m.junction_on_highlight <= k_.highlight_end) &
+                   test("junction on body line within highlight_end of its ends", m.junction_on_body, k_.highlight_end,
+                        m.junction_on_body >= -k_.highlight_end && m.junction_on_body <= 1 + k_.highlight_end) &
+                   test("junction inside the colour cube (within 2 * tolerance) / tolerance", outside_cube(m.junction) / tolerance_,
+                        2.0, outside_cube(m.junction) <= 2 * tolerance_);
+  }
+
+  // How far a colour lies outside the cube of values the image can hold (0 inside): below the lowest code or
+  // above a clipping level. Where two lines meet outside it, no pixel could stand at their junction.
+  double outside_cube(const Vec3& colour) const {
+    double outside = 0;
+    for (int c = 0; c < 3; ++c) {
+      const double low = context_.clipping.low[static_cast<std::size_t>(c)];
+      const double high = context_.high_levels[static_cast<std::size_t>(c)];
+      outside = std::max({outside, low - colour[c], std::isfinite(high) ? colour[c] - high : 0.0});
+    }
+    return outside;
   }
 
   // linear: a line holding nearly every sample, unless the few others form a highlight line of their own.

@@ -23,6 +23,7 @@
 // noise_factor × the noise σ along axis k and relative_floor × σ1.
 
 #include <cstdint>
+#include <limits>
 #include <optional>
 #include <span>
 #include <string>
@@ -120,12 +121,14 @@ struct ClusterShape {
   std::vector<ClusterShape> unclipped;  // for clipped clusters: the shape of the samples off the faces
 };
 
+inline constexpr double kNoLevel = std::numeric_limits<double>::infinity();
+
 // What the cluster is judged against.
 struct ShapeContext {
   // Differences of neighbouring pixels of the region (analyzer/noise_level.h), [pair][channel].
   std::span<const float> differences;
   double quantisation_sigma = 0;  // step / √12 for integer images
-  std::array<double, 3> high_levels{};  // clipping levels (analyzer/clipping.h)
+  std::array<double, 3> high_levels{kNoLevel, kNoLevel, kNoLevel};  // clipping levels (analyzer/clipping.h); none known: +∞
   ClippingRules clipping;               // whether they are known, and the lower limits
   std::uint64_t seed = 1;
   int threads = 0;

@@ -1,5 +1,6 @@
 // Synthetic clusters of known structure are classified right, and noise-free fits find the true
 // directions (the dichromatic body and illuminant colours, the plane they span) within 0.5°.
+#include <algorithm>
 #include <cmath>
 
 #include <gtest/gtest.h>
@@ -94,6 +95,24 @@ TEST(ClusterShape, HighlightLeavingHalfWayIsASkewedT) {
   EXPECT_LT(line_angle_degrees(s.two_lines->body.direction, kBody), kDegrees);
   EXPECT_LT(line_angle_degrees(s.two_lines->highlight.direction, kIlluminant), kDegrees);
   EXPECT_LT(line_angle_degrees(s.black_plane->normal, kBody.cross(kIlluminant)), kDegrees);
+}
+
+// Two lines whose junction lies far beyond the body line's bright end are no L (docs/analyze.md: the junction
+// lies on the body line, within highlight_end of its ends): the second line approaches where the body line would
+// be at 0.9 of its colour, and the body's pixels reach only 0.5 of it, so the junction sits at 1.9 of its length.
+TEST(ClusterShape, AJunctionBeyondTheBodyLinesEndIsNoL) {
+  const RgbImage image = make_image(128, 128, [](double u, double) -> Vec3 {
+    if (u < 0.7) return (0.05 + 0.45 * u / 0.7) * kBody;
+    return 0.9 * kBody + (0.05 + 0.6 * (u - 0.7) / 0.3) * kIlluminant;
+  });
+  const ClusterShape s = shape_of(image);
+  EXPECT_NE(s.shape, ShapeClass::L) << describe(s);
+  EXPECT_NE(s.shape, ShapeClass::SkewedT) << describe(s);
+  const auto bound = std::find_if(s.decisions.begin(), s.decisions.end(),
+                                  [](const Decision& d) { return d.test == "junction on body line within highlight_end of its ends"; });
+  ASSERT_NE(bound, s.decisions.end()) << describe(s);
+  EXPECT_FALSE(bound->passed);
+  EXPECT_NEAR(bound->value, (0.9 - 0.05) / 0.45, 0.05);
 }
 
 TEST(ClusterShape, BroadHighlightIsAP) {
