@@ -103,7 +103,10 @@ ImageAnalysis analyse_image(const AnalysisImage& input, const std::string& layer
   } else {
     a.illuminant = estimate_illuminant(a.results, pixels.rgb, known_illuminant);
   }
-  const std::size_t non_finite = a.results.empty() ? 0 : a.results.front().non_finite;  // the whole image
+  for (const std::string& note : input.notes) a.notes.push_back(note);
+  // The whole image's left-out pixels, less those set aside while reading (said above).
+  const std::size_t set_aside = a.layer == "final" ? input.transparent_pixels + input.negative_pixels : 0;
+  const std::size_t non_finite = (a.results.empty() ? 0 : a.results.front().non_finite) - std::min(set_aside, a.results.empty() ? 0 : a.results.front().non_finite);
   if (non_finite > 0)
     a.notes.push_back(fmt::format("{} pixel{} NaN or infinite: left out of every histogram", non_finite, non_finite == 1 ? " is" : "s are"));
   for (const RegionAnalysis& r : a.results)

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <limits>
 #include <sstream>
 
 #include <OpenImageIO/imageio.h>
@@ -25,6 +26,7 @@ struct RawImage {
   // The camera's numbers (chromatrace.black_level …) as found: attributes, else ImageDescription's JSON.
   nlohmann::json camera = nlohmann::json::object();
   std::string camera_source;
+  int alpha = -1;            // the alpha channel's index, −1 without one
   std::string colour_space;  // oiio:ColorSpace
   float display_gamma = 0;   // oiio:Gamma (0: not given)
 };
@@ -88,6 +90,7 @@ RawImage read_raw(const std::filesystem::path& file) {
   raw.objects_attribute = spec.get_string_attribute(exr::kObjectsAttribute);
   raw.components_attribute = spec.get_string_attribute(exr::kComponentsAttribute);
   read_camera_metadata(spec, raw);
+  raw.alpha = spec.alpha_channel;
   raw.colour_space = spec.get_string_attribute("oiio:ColorSpace");
   raw.display_gamma = spec.get_float_attribute("oiio:Gamma", 0.0f);
   if (raw.width < 1 || raw.height < 1) throw InputError(fmt::format("{}: image has no pixels", name));
@@ -232,6 +235,34 @@ void decide_curve(const RawImage& raw, AnalysisImage& out) {
   }
 }
 
+// Sets aside (as NaN) the pixels no region should hold: fully transparent ones, and negative values in a file
+// that is not a camera's (whose black-subtracted noise may be negative). Nothing valid left is an InputError.
+void set_aside_invalid_pixels(const RawImage& raw, AnalysisImage& out) {
+  std::vector<float>& rgb = out.image.rgb;
+  const bool camera = !out.encoding.metadata.empty();
+  std::size_t valid = 0, non_finite = 0;
+  for (std::size_t p = 0; p < out.image.pixel_count(); ++p) {
+    float* v = &rgb[p * 3];
+    const bool transparent = raw.alpha >= 0 && raw.values[p * static_cast<std::size_t>(raw.channels) + static_cast<std::size_t>(raw.alpha)] <= 0.0f;
+    const bool finite = std::isfinite(v[0]) && std::isfinite(v[1]) && std::isfinite(v[2]);
+    const bool negative = !camera && finite && (v[0] < 0 || v[1] < 0 || v[2] < 0);
+    if (transparent) ++out.transparent_pixels;
+    else if (negative) ++out.negative_pixels;
+    else if (!finite) ++non_finite;
+    else ++valid;
+    if (transparent || negative) v[0] = v[1] = v[2] = std::numeric_limits<float>::quiet_NaN();
+  }
+  if (raw.alpha >= 0)
+    out.notes.push_back(fmt::format("alpha channel {}: {} fully transparent pixel{} left out of every region", raw.names[static_cast<std::size_t>(raw.alpha)],
+                                    out.transparent_pixels, out.transparent_pixels == 1 ? "" : "s"));
+  if (out.negative_pixels > 0)
+    out.notes.push_back(fmt::format("{} pixel{} with a negative value left out of every region (no light is negative)",
+                                    out.negative_pixels, out.negative_pixels == 1 ? "" : "s"));
+  if (valid == 0)
+    throw InputError(fmt::format("{}: no valid pixel: {} transparent, {} negative, {} NaN or infinite", out.file,
+                                 out.transparent_pixels, out.negative_pixels, non_finite));
+}
+
 }  // namespace
 
 std::optional<ToneCurve> parse_input_transfer(const std::string& text) {
@@ -292,6 +323,7 @@ AnalysisImage read_analysis_image(const std::filesystem::path& file, const std::
   out.linear = extract_rgb(raw, "linear");
   out.display = extract_rgb(raw, "display");
   apply_camera_metadata(raw, out);
+  set_aside_invalid_pixels(raw, out);
   if (declared) {
     out.encoding.curve = declared;
     out.encoding.curve_source = fmt::format("--input-transfer {}", input_transfer);

@@ -84,6 +84,12 @@ struct AnalysisImage {
   std::vector<ComponentLayer> components;  // in chromatrace.components order when the file names them
   std::vector<std::int32_t> object_ids;    // channel object_id, [y][x]; empty when absent
   std::map<std::int32_t, std::string> object_names;  // attribute chromatrace.objects
+  // Pixels of R, G, B set aside as they were read (set to NaN, so that every region leaves them out): those an
+  // alpha channel makes fully transparent, and, in a file without the camera's numbers, those with a negative
+  // value (no light is negative; a camera's noise below black comes with its black level).
+  std::size_t transparent_pixels = 0;
+  std::size_t negative_pixels = 0;
+  std::vector<std::string> notes;  // what was decided while reading (alpha, conversions)
 };
 
 // The final image in linear light: R, G, B with the encoding's curve undone (a copy of the image when the

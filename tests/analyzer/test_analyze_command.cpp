@@ -6,6 +6,7 @@
 #include <map>
 #include <numbers>
 
+#include <OpenImageIO/imageio.h>
 #include <gtest/gtest.h>
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -174,7 +175,8 @@ TEST(AnalyzeCommand, LabelAndMaskImagesGiveRegions) {
 TEST(AnalyzeCommand, DegenerateRegionsSayWhyNoShapeWasMeasured) {
   TempDir dir;
   const RgbImage black = make_image(16, 16, [](double, double) -> Vec3 { return Vec3::Zero(); });
-  const RgbImage nan = make_image(16, 16, [](double, double) -> Vec3 { return Vec3::Constant(std::nan("")); });
+  // NaN on the left half: a region there has no valid pixel (an image with none at all is refused, below).
+  const RgbImage nan = make_image(16, 16, [](double u, double) -> Vec3 { return u < 0.5 ? Vec3::Constant(std::nan("")) : Vec3(0.2, 0.3, 0.4); });
   write_sensor_exr(dir.file("black.exr"), {black, black, {}, {}, {}});
   write_sensor_exr(dir.file("nan.exr"), {nan, nan, {}, {}, {}});
   write_sensor_exr(dir.file("line.exr"), {matte_line(), matte_line(), {}, {}, {}});
@@ -185,7 +187,7 @@ TEST(AnalyzeCommand, DegenerateRegionsSayWhyNoShapeWasMeasured) {
   };
   const Case cases[] = {
       {"black.exr", {}, "image", "all pixels are black"},
-      {"nan.exr", {}, "image", "every pixel of the region is NaN or infinite"},
+      {"nan.exr", {"--rect", "0,0,8,16"}, "rect 0,0 8x16", "every pixel of the region is NaN or infinite"},
       {"line.exr", {"--rect", "500,500,10,10"}, "rect 500,500 10x10", "the region is empty"},
       {"line.exr", {"--rect", "3,4,1,1"}, "rect 3,4 1x1", "1 valid pixel: a shape needs at least 10"},
   };
@@ -202,6 +204,58 @@ TEST(AnalyzeCommand, DegenerateRegionsSayWhyNoShapeWasMeasured) {
     EXPECT_NE((*region)["shape"]["reason"].get<std::string>().find(c.reason), std::string::npos) << (*region)["shape"]["reason"];
     EXPECT_TRUE(std::filesystem::is_regular_file(out / "report.html"));
   }
+}
+
+// Pixels no light made are left out and said: transparent ones (alpha 0), negative values in a file that is not
+// a camera's; an image with no valid pixel at all is refused (exit 2), naming what was wrong with its pixels.
+TEST(AnalyzeCommand, TransparentNegativeAndNonFinitePixelsAreLeftOutAndCounted) {
+  TempDir dir;
+  const int w = 32, h = 16;
+  std::vector<float> rgba;
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const double t = 0.05 + 0.9 * x / (w - 1.0);
+      const Vec3 c = t * kBody;
+      const bool negative = y == 0 && x < 3;  // a ringing artefact of a resampled HDR image, say
+      rgba.insert(rgba.end(), {negative ? -0.01f : float(c[0]), float(c[1]), float(c[2]), y < 4 ? 0.0f : 1.0f});
+    }
+  OIIO::ImageSpec spec(w, h, 4, OIIO::TypeDesc::FLOAT);
+  spec.alpha_channel = 3;
+  auto writer = OIIO::ImageOutput::create(dir.file("rgba.exr").string());
+  ASSERT_TRUE(writer && writer->open(dir.file("rgba.exr").string(), spec) && writer->write_image(OIIO::TypeDesc::FLOAT, rgba.data()) &&
+              writer->close());
+  const CommandResult r = run_chromatrace({"analyze", dir.file("rgba.exr").string(), "-o", dir.file("o").string(), "--no-plots", "--no-report", "-q"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const nlohmann::json a = analysis(dir.file("o"));
+  EXPECT_EQ(a["regions"][0]["valid_pixels"], w * (h - 4));  // rows 0–3 transparent, the negative pixels among them
+  EXPECT_EQ(a["regions"][0]["shape"]["class"], "linear");  // a line of the body colour: no "clipped at 0"
+  const std::string notes = a["notes"].dump();
+  EXPECT_NE(notes.find("alpha channel A: 128 fully transparent pixels left out"), std::string::npos) << notes;
+
+  // Negative values outside the transparent rows: left out and counted.
+  for (int x = 0; x < 3; ++x) rgba[static_cast<std::size_t>((8 * w + x) * 4)] = -0.01f;
+  spec.nchannels = 3;
+  spec.alpha_channel = -1;
+  spec.channelnames = {"R", "G", "B"};
+  std::vector<float> rgb;
+  for (std::size_t p = 0; p < rgba.size() / 4; ++p) rgb.insert(rgb.end(), {rgba[p * 4], rgba[p * 4 + 1], rgba[p * 4 + 2]});
+  writer = OIIO::ImageOutput::create(dir.file("negative.exr").string());
+  ASSERT_TRUE(writer && writer->open(dir.file("negative.exr").string(), spec) && writer->write_image(OIIO::TypeDesc::FLOAT, rgb.data()) &&
+              writer->close());
+  const CommandResult n = run_chromatrace({"analyze", dir.file("negative.exr").string(), "-o", dir.file("n").string(), "--no-plots", "--no-report", "-q"});
+  ASSERT_EQ(n.exit_code, 0) << n.err;
+  const nlohmann::json b = analysis(dir.file("n"));
+  EXPECT_EQ(b["regions"][0]["valid_pixels"], w * h - 6);
+  EXPECT_NE(b["notes"].dump().find("6 pixels with a negative value left out"), std::string::npos) << b["notes"].dump();
+  EXPECT_EQ(b["regions"][0]["shape"]["clipping"]["fraction"], 0.0);
+
+  // Nothing valid: exit 2, one line, nothing written.
+  const RgbImage all_nan = make_image(8, 8, [](double, double) -> Vec3 { return Vec3::Constant(std::nan("")); });
+  write_sensor_exr(dir.file("nan.exr"), {all_nan, all_nan, {}, {}, {}});
+  const CommandResult bad = run_chromatrace({"analyze", dir.file("nan.exr").string(), "-o", dir.file("x").string()});
+  EXPECT_EQ(bad.exit_code, 2);
+  EXPECT_NE(bad.err.find("nan.exr: no valid pixel: 0 transparent, 0 negative, 64 NaN or infinite"), std::string::npos) << bad.err;
+  EXPECT_FALSE(std::filesystem::exists(dir.file("x")));
 }
 
 TEST(AnalyzeCommand, BadInputIsOneLineAndExitTwo) {
