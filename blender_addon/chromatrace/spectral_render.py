@@ -255,9 +255,9 @@ class SpectralRender:
             if max(rgb) > 1.0 or min(rgb) < 0.0:
                 raise BadInput(f"{what}: colour {tuple(round(c, 4) for c in rgb)} of {spectral_input.label} "
                                "is outside [0, 1], so it is not a reflectance")
-            return _rgb_source([max(0.0, float(c)) for c in rgb]), 1.0
+            return _rgb_source({"rgb": [max(0.0, float(c)) for c in rgb]}), 1.0
         rgb, factor = rgb_for_upsampling(rgb)
-        return _rgb_source(rgb), factor
+        return _rgb_source({"rgb": rgb}), factor
 
     def _input_source(self, material, spectral_input):
         """(source JSON, scale) of one spectral colour input of a material."""
@@ -282,7 +282,7 @@ class SpectralRender:
                 return _rgb_source(self._resolve(settings, rgb, what)), scale * factor
             return self._resolve(settings, None, what), scale
         rgb, factor = rgb_for_upsampling(rgb)
-        return _rgb_source(rgb), factor
+        return _rgb_source({"rgb": rgb}), factor
 
     def _owner_inputs(self, kind, thing, walk):
         """[(SpectralInput, source, scale)] of one material, light object or world; BadInput when one fails."""
