@@ -149,6 +149,15 @@ class BatchArgs(unittest.TestCase):
                                          "64x32", "--components", "paths,bounces", "--max-bounces", "0"])
         self.assertEqual((a.samples, a.resolution, a.components, a.max_bounces), (4, (64, 32), {"paths", "bounces"}, 0))
 
+    def test_explain_needs_no_output_and_writes_to_stdout_or_a_file(self):
+        a = batch_args.parse_batch_args(["--scene", self.scene, "--explain"])
+        self.assertEqual((a.explain, a.out), ("-", None))
+        a = batch_args.parse_batch_args(["--scene", self.scene, "--preflight", self.out, "--on-world", "omit"])
+        self.assertEqual((a.explain, a.on_world), (self.out, "omit"))
+        with self.assertRaises(BadInput) as caught:
+            batch_args.parse_batch_args(["--scene", self.scene, "--explain", "/no/such/dir/p.json"])
+        self.assertIn("--explain", str(caught.exception))
+
     def test_bad_input_is_one_line_naming_the_option(self):
         cases = [
             (["--out", self.out], "--scene"),
