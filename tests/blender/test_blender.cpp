@@ -8,6 +8,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -514,37 +515,63 @@ TEST_F(ArtistScene, LibraryMaterialsThatConvertRenderTheirSpectrum) {
 
   const fs::path out = dir_.file("converting.exr");
   const CommandResult r = batch({"--blend", blend.string(), "--out", out.string(), "--bands", "400:700:50",
-                                 "--resolution", "48x48", "--samples", "32", "--max-bounces", "2", "--components", "none"});
+                                 "--resolution", "64x64", "--samples", "32", "--max-bounces", "2", "--components", "none"});
   ASSERT_EQ(r.exit_code, 0) << r.err;
   SpectralExrReader reader(out);
   const SpectralExrInfo& info = reader.info();
   std::vector<std::int32_t> ids(static_cast<std::size_t>(info.width * info.height));
   reader.read_object_ids(0, info.height, ids);
   const std::vector<float> total = reader.read_layer(info.total());
+  // Objects lit by the light: materials with a reflectance or interface colour (a flat emitter is flat in
+  // every band, rightly).
+  std::set<std::string> reflective;
+  for (const json& o : plan["owners"])
+    if (o["kind"] == "material")
+      for (const json& c : o["colours"])
+        if (c["role"] != "emission") reflective.insert("sphere " + o["name"].get<std::string>());
   int checked = 0;
   for (const auto& [id, object] : info.object_names) {
     const auto pixels = object_pixels(total, ids, id, 6);
-    if (pixels[0].size() < 8) continue;  // too few pixels to judge
-    ++checked;
+    if (!reflective.count(object) || pixels[0].empty()) continue;  // (a transparent sphere may own no pixel id)
+    // The defect's signature is exact: both band groups rendered with the same colours and the same seed
+    // (Cycles is deterministic per seed) give identical pixels, band b + 3 equal to band b everywhere.
+    bool identical = true;
+    for (std::size_t b = 0; b < 3; ++b)
+      for (std::size_t p = 0; p < pixels[b].size(); ++p) identical = identical && pixels[b + 3][p] == pixels[b][p];
+    EXPECT_FALSE(identical) << object << ": band b + 3 repeats band b in every pixel";
+    // And beyond noise: a sign test per pair of bands b, b + 3. Under repetition the per-pixel differences are
+    // noise symmetric about 0, so the count of positive ones is Binomial(n, 1/2); more than 4 of its standard
+    // deviations from n / 2 in some pair means the bands do not repeat. Transparent objects that show little
+    // but noise over the black background may not reach it: asserted for the red plastic, printed for all.
     bool differs = false;
     for (std::size_t b = 0; b < 3; ++b) {
-      std::vector<double> d(pixels[b].size());
-      for (std::size_t p = 0; p < d.size(); ++p) d[p] = pixels[b + 3][p] - pixels[b][p];
-      const auto [m, se] = mean_and_se(d);
-      differs = differs || std::abs(m) > 6 * se;
+      int positive = 0, n = 0;
+      for (std::size_t p = 0; p < pixels[b].size(); ++p) {
+        const double d = pixels[b + 3][p] - pixels[b][p];
+        if (d == 0) continue;
+        ++n;
+        positive += d > 0;
+      }
+      differs = differs || (n >= 20 && std::abs(positive - 0.5 * n) > 4 * 0.5 * std::sqrt(static_cast<double>(n)));
     }
-    EXPECT_TRUE(differs) << object << ": bands repeat every three bands";
+    ++checked;
+    std::vector<double> means(6);
+    for (std::size_t b = 0; b < 6; ++b) means[b] = mean_of(pixels[b]);
+    fmt::print("{}: band means {:.4g} ({} pixels): {}\n", object, fmt::join(means, ", "), pixels[0].size(),
+               differs ? "bands b and b + 3 differ beyond noise" : "not separable from noise");
     if (object == "sphere High Gloss Plastic") {
       std::vector<double> reflectance(6);
-      for (std::size_t b = 0; b < 6; ++b) reflectance[b] = mean_of(pixels[b]) / light[b];
+      for (std::size_t b = 0; b < 6; ++b) reflectance[b] = means[b] / light[b];
       fmt::print("red plastic: band mean / light: {}\n", fmt::join(reflectance, ", "));
+      EXPECT_TRUE(differs);
       EXPECT_GT(reflectance[5], 3 * reflectance[0]);
       EXPECT_GT(reflectance[5], reflectance[3]);
       EXPECT_GT(reflectance[4], reflectance[2]);
       EXPECT_GT(reflectance[3], reflectance[1]);
     }
   }
-  EXPECT_GE(checked, static_cast<int>(names.size()) / 2);
+  EXPECT_GE(checked, static_cast<int>(reflective.size()) / 2);
+  EXPECT_GT(reflective.count("sphere High Gloss Plastic"), 0u);
 }
 
 // Planck's law averaged over [lo, hi] nm at T kelvin (arbitrary scale): Simpson's rule on 0.05 nm steps, and the
