@@ -3,7 +3,11 @@
     blender --background --factory-startup --python blender_addon/batch.py -- \
         --scene SCENE.json --out OUT.exr [--samples N] [--bands lo:hi:w | --bands-file F] [--max-bounces K]
         [--components paths,lights,bounces] [--resolution WxH] [--seed S] [--cache-dir DIR] [--keep-cache]
+        [--on-mixing-nodes refuse|one-band] [--on-world refuse|omit] [--explain [FILE]]
     (or --blend FILE.blend instead of --scene; the .blend is never written)
+
+--explain prints the pre-flight summary as JSON (to stdout, or FILE) and renders nothing: every material,
+light and the world, exact / upsampled / refused with the reasons in full, and the Cycles renders needed.
 
 Exit status 0 on success, 1 on a runtime failure, 2 on bad input, with one line on stderr naming the file,
 field or option at fault (as the `chromatrace` command). Progress lines go to stderr (--quiet: none).
@@ -13,6 +17,7 @@ For tests: CHROMATRACE_TEST_FAIL_AT_RENDER=N raises an exception just before the
 (counting from 0), CHROMATRACE_TEST_KILL_AT_RENDER=N kills the process there (SIGKILL).
 """
 
+import json
 import os
 import signal
 import sys
@@ -54,7 +59,8 @@ def _test_hook():
 
 
 def _empty_startup_scene(bpy):
-    for collection in (bpy.data.objects, bpy.data.meshes, bpy.data.materials, bpy.data.lights, bpy.data.cameras):
+    for collection in (bpy.data.objects, bpy.data.meshes, bpy.data.materials, bpy.data.lights, bpy.data.cameras,
+                       bpy.data.worlds):
         for item in list(collection):
             collection.remove(item)
 
@@ -76,14 +82,23 @@ def run(argv):
     scene = bpy.context.scene
     families = args.components
     request = spectral_render.Request.from_scene(
-        scene, output=os.path.abspath(args.out), samples=args.samples, max_bounces=args.max_bounces, seed=args.seed,
+        scene, output=os.path.abspath(args.out) if args.out else None, samples=args.samples, max_bounces=args.max_bounces, seed=args.seed,
         bands=args.bands, bands_file=args.bands_file, families=families, resolution=args.resolution,
         cache_root=args.cache_dir, keep_cache=args.keep_cache or None, log=log,
-        on_mixing_nodes=args.on_mixing_nodes, bands_per_render=args.bands_per_render)
+        on_mixing_nodes=args.on_mixing_nodes, bands_per_render=args.bands_per_render, on_world=args.on_world)
     if args.bands_file:
         request.bands = None
     elif args.bands:
         request.bands_file = None
+    if args.explain is not None:
+        summary = spectral_render.SpectralRender(scene, request, chromatrace_tool).preflight()
+        text = json.dumps(summary, indent=1)
+        if args.explain == "-":
+            print(text, flush=True)
+        else:
+            with open(args.explain, "w") as f:
+                f.write(text + "\n")
+        return
     spectral_render.TEST_HOOK = _test_hook()
     spectral_render.SpectralRender(scene, request, chromatrace_tool).run()
 

@@ -2,6 +2,7 @@
 
     blender --background --factory-startup --python blender_addon/batch.py -- \
         (--scene SCENE.json | --blend FILE.blend) --out OUT.exr [options]
+        (--scene SCENE.json | --blend FILE.blend) --explain [FILE] [options]   (the pre-flight summary only)
 
 Every mistake is a BadInput with one line naming the option, as the `chromatrace` command reports.
 """
@@ -35,6 +36,12 @@ def _parser():
     p.add_argument("--seed", type=int, help="Cycles seed (default: the scene's)")
     p.add_argument("--on-mixing-nodes", choices=["refuse", "one-band"],
                    help="node trees that mix colour channels: refuse to render, or render one band per render")
+    p.add_argument("--on-world", choices=["refuse", "omit"],
+                   help="a lit world whose colours cannot be spectra (an HDRI): refuse to render (default), or render "
+                        "without the world's light, with a warning and a note in the file")
+    p.add_argument("--explain", "--preflight", nargs="?", const="-", metavar="FILE",
+                   help="print (or write to FILE) the pre-flight summary as JSON: every material, light and the world "
+                        "exact, upsampled or refused, and the renders needed; render nothing")
     p.add_argument("--bands-per-render", type=int, choices=[1, 2, 3],
                    help="bands multiplexed into one render (default 3; fewer for comparisons)")
     p.add_argument("--cache-dir", help="where finished band groups are kept for resuming "
@@ -54,11 +61,11 @@ def parse_batch_args(argv):
     source = args.scene or args.blend
     if not os.path.isfile(source):
         raise BadInput(f"{source_option}: {source}: no such file")
-    if not args.out:
+    if not args.out and args.explain is None:
         raise BadInput("--out: no output file given")
-    out_dir = os.path.dirname(os.path.abspath(args.out))
-    if not os.path.isdir(out_dir):
-        raise BadInput(f"--out: {args.out}: directory {out_dir} does not exist")
+    for option, path in (("--out", args.out), ("--explain", args.explain)):
+        if path and path != "-" and not os.path.isdir(os.path.dirname(os.path.abspath(path))):
+            raise BadInput(f"{option}: {path}: directory {os.path.dirname(os.path.abspath(path))} does not exist")
     if args.samples is not None and args.samples < 1:
         raise BadInput(f"--samples: must be at least 1, got {args.samples}")
     if args.max_bounces is not None and args.max_bounces < 0:

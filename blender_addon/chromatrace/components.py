@@ -4,7 +4,7 @@ Cycles counts bounces after the first hit: its `max_bounces` = 0 still computes 
 counts scattering events (0: emitters only, 1: direct light; docs/scene-format.md), so a render with
 chromatrace's K uses Cycles' K - 1. Components, as the spectral EXR layout names them:
 
-  emission            Emit
+  emission            Emit (+ Env, the world seen directly, when the world is lit)
   diffuse_direct      DiffDir × DiffCol        (Cycles stores light passes divided by their colour pass)
   diffuse_indirect    DiffInd × DiffCol
   glossy_direct       GlossDir × GlossCol
@@ -87,30 +87,34 @@ def _term(passes, file=MAIN, sign=1):
     return term
 
 
-def component_plan(families, light_groups, max_bounces, transmission=False):
+def component_plan(families, light_groups, max_bounces, transmission=False, environment=False):
     """The total's and each component's terms, for the manifest (see core/assembly.h).
 
     Returns (total_terms, [{"name": ..., "terms": [...]}, ...]) in the file's component order.
     With max_bounces 0 (emitters only) the caller renders with every reflectance set to 0, so that
-    Combined is the emission alone.
+    Combined is the emission alone. With `environment` (a lit world) the world seen directly (Cycles' Env
+    pass) counts as emission.
     """
     components = []
+    emitted = [["Emit"], ["Env"]] if environment else [["Emit"]]
     if "paths" in families:
         for name, products in PATH_PASSES.items():
             if name in TRANSMISSION and not transmission:
                 continue
+            if name == "emission":
+                products = emitted
             components.append({"name": name, "terms": [_term(p) for p in products]})
     if "lights" in families:
         for group in light_groups:
             components.append({"name": f"light.{group}", "terms": [_term([f"Combined_{group}"])]})
     if "bounces" in families:
         if max_bounces == 0:
-            components.append({"name": "bounce.0", "terms": [_term(["Emit"])]})
+            components.append({"name": "bounce.0", "terms": [_term(p) for p in emitted]})
         else:
             first = bounce_variant(1, max_bounces)
-            components.append({"name": "bounce.0", "terms": [_term(["Emit"], first)]})
+            components.append({"name": "bounce.0", "terms": [_term(p, first) for p in emitted]})
             components.append({"name": "bounce.1",
-                               "terms": [_term(["Combined"], first), _term(["Emit"], first, -1)]})
+                               "terms": [_term(["Combined"], first)] + [_term(p, first, -1) for p in emitted]})
             for k in range(2, max_bounces + 1):
                 components.append({"name": f"bounce.{k}",
                                    "terms": [_term(["Combined"], bounce_variant(k, max_bounces)),

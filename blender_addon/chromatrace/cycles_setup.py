@@ -8,7 +8,7 @@ transform with look None, exposure 0 and gamma 1, Cycles film exposure 1, 32-bit
 """
 
 VIEW_LAYER_PASSES = {
-    "Emit": "use_pass_emit",
+    "Emit": "use_pass_emit", "Env": "use_pass_environment",
     "DiffDir": "use_pass_diffuse_direct", "DiffInd": "use_pass_diffuse_indirect", "DiffCol": "use_pass_diffuse_color",
     "GlossDir": "use_pass_glossy_direct", "GlossInd": "use_pass_glossy_indirect", "GlossCol": "use_pass_glossy_color",
     "TransDir": "use_pass_transmission_direct", "TransInd": "use_pass_transmission_indirect",

@@ -1,38 +1,25 @@
-"""Node trees: building the ones for chromatrace's material models, finding the spectral colour inputs of
-any tree, and describing trees for the channel-mixing checks (node_rules.py)."""
+"""Node trees: building the ones for chromatrace's material models, and the spectral colour inputs of any
+material's, light's or world's tree (found by colour_walk.py, checked by node_rules.py)."""
 
 from collections import namedtuple
 
 import bpy
 
+from . import colour_walk
 from .errors import BadInput
 
 REFLECTANCE_NODE = "ct_reflectance"
 EMISSION_NODE = "ct_emission"
 MANAGED_MODELS = ("LAMBERT", "DICHROMATIC", "MIRROR", "NONE")
 
-# Unlinked colour inputs that are reflectances (they get the material's reflectance spectrum) …
-_REFLECTANCE_INPUTS = {
-    "ShaderNodeBsdfDiffuse": ("Color",), "ShaderNodeBsdfPrincipled": ("Base Color",),
-    "ShaderNodeBsdfTranslucent": ("Color",), "ShaderNodeBsdfVelvet": ("Color",), "ShaderNodeBsdfSheen": ("Color",),
-    "ShaderNodeBsdfToon": ("Color",),
-}
-# … interface colours, spectrally flat when grey (left alone then; a non-grey one gets the reflectance) …
-_INTERFACE_INPUTS = {
-    "ShaderNodeBsdfGlossy": ("Color",), "ShaderNodeBsdfAnisotropic": ("Color",), "ShaderNodeBsdfGlass": ("Color",),
-    "ShaderNodeBsdfRefraction": ("Color",), "ShaderNodeBsdfTransparent": ("Color",),
-    "ShaderNodeBsdfMetallic": ("Base Color",),
-}
-# … and emission colours.
-_EMISSION_INPUTS = {"ShaderNodeEmission": ("Color",), "ShaderNodeBsdfPrincipled": ("Emission", "Emission Color")}
 _TRANSMISSION_NODES = ("ShaderNodeBsdfGlass", "ShaderNodeBsdfRefraction")
-_RULE_INPUTS = ("Specular Tint", "Sheen Tint", "Subsurface", "Subsurface Weight", "Specular", "Specular IOR Level",
-                "Sheen", "Sheen Weight")
-
 # A colour the spectral render sets: target.attribute gets the band values (× scale), keeping alpha. Roles:
 # "reflectance" and "emission" get spectra; "interface" is a grey (spectrally flat) reflectance that keeps its
 # value in every band, and like the reflectances becomes 0 when the render shows emitters only.
-SpectralInput = namedtuple("SpectralInput", "target attribute role current_rgb alpha label managed")
+# source: the spectrum when it is fixed by the node (a Blackbody node's Planck's law), else None; replace: a
+# Blackbody node the render replaces by an RGB node (whose colour is then the target), else None.
+SpectralInput = namedtuple("SpectralInput", "target attribute role current_rgb alpha label managed source replace",
+                           defaults=(None, None))
 
 
 def _new(nodes, kind, name, location):
@@ -119,55 +106,40 @@ def output_node(material):
     return material.node_tree.get_output_node("CYCLES")
 
 
-def upstream_nodes(material, into_groups=False):
-    """Nodes that feed the active output, as (path name, node); group contents when into_groups."""
-    out = output_node(material)
-    if out is None:
-        return []
-    found, order = set(), []
-
-    def visit(node, prefix):
-        key = (prefix, node.name)
-        if key in found:
-            return
-        found.add(key)
-        order.append((prefix + node.name, node))
-        for socket in node.inputs:
-            for link in socket.links:
-                if link.is_valid and not link.is_muted:
-                    visit(link.from_node, prefix)
-        if into_groups and node.type == "GROUP" and node.node_tree is not None:
-            for inner in node.node_tree.nodes:
-                visit(inner, f"{prefix}{node.name} > ")
-
-    visit(out, "")
-    return order
+def walk_material(material):
+    """The colour walk of a material's node tree (colour_walk.Walk): its shaders, colours and issues."""
+    walk = colour_walk.Walk("material", material.name)
+    if material.chromatrace.model == "NODES":
+        walk.walk_output(output_node(material))
+    else:  # the add-on's own nodes: their colours are its spectral inputs; the shaders are still checked
+        walk.walk_output(output_node(material))
+        walk.leaves.clear()
+    return walk.finish()
 
 
-def describe_node_tree(material):
-    """(node descriptions for node_rules.tree_issues, whether a volume shader is linked)."""
-    described = []
-    for name, node in upstream_nodes(material, into_groups=True):
-        props = {}
-        for key in ("distribution", "blend_type", "data_type"):
-            if hasattr(node, key):
-                props[key] = getattr(node, key)
-        inputs = {}
-        for key in _RULE_INPUTS:
-            socket = node.inputs.get(key)
-            if socket is not None:
-                value = socket.default_value
-                inputs[key] = None if socket.is_linked else (tuple(value) if hasattr(value, "__len__") else value)
-        linked = any(o.type == "RGBA" and o.is_linked for o in node.outputs)
-        described.append({"name": name, "type": node.bl_idname, "props": props, "inputs": inputs,
-                          "colour_output_linked": linked})
-    out = output_node(material)
-    volume = out is not None and out.inputs.get("Volume") is not None and out.inputs["Volume"].is_linked
-    return described, volume
+def walk_light(light):
+    """The colour walk of a light's node tree (when it uses nodes; Cycles ignores the tree otherwise)."""
+    walk = colour_walk.Walk("light", light.name)
+    if light.use_nodes and light.node_tree is not None:
+        walk.walk_output(light.node_tree.get_output_node("CYCLES"))
+    return walk.finish()
 
 
-def has_transmission(material):
-    for _name, node in upstream_nodes(material, into_groups=True):
+def walk_world(world):
+    """The colour walk of the world: its node tree, or its colour when it uses none (as Cycles renders it)."""
+    walk = colour_walk.Walk("world", world.name)
+    if world.use_nodes and world.node_tree is not None:
+        walk.walk_output(world.node_tree.get_output_node("CYCLES"))
+    elif max(world.color) > 0.0:
+        leaf = colour_walk.Leaf(world, "color", tuple(world.color), None, f"{world.name}/color")
+        leaf.roles.add("emission")
+        leaf.sinks.append("\"color\"")
+        walk.leaves[("world color",)] = leaf
+    return walk.finish()
+
+
+def has_transmission(walk):
+    for _name, node in walk.shaders:
         if node.bl_idname in _TRANSMISSION_NODES:
             return True
         for key in ("Transmission", "Transmission Weight"):
@@ -177,21 +149,18 @@ def has_transmission(material):
     return False
 
 
-def _strength_is_zero(node):
-    """An emission input whose strength is an unlinked 0 (Blender 4's Principled default) emits nothing."""
-    for name in ("Strength", "Emission Strength"):
-        socket = node.inputs.get(name)
-        if socket is not None:
-            return not socket.is_linked and socket.default_value == 0.0
-    return False
+def leaf_inputs(walk):
+    """The walk's colours as SpectralInputs (a Blackbody node's with its Planck source)."""
+    found = []
+    for leaf in walk.leaves.values():
+        source = {"blackbody_k": leaf.blackbody_k} if leaf.blackbody_k is not None else None
+        found.append(SpectralInput(leaf.target, leaf.attribute, leaf.role, leaf.rgb, leaf.alpha, leaf.label, False,
+                                   source, leaf.replace))
+    return found
 
 
-def _is_grey(rgb):
-    return max(rgb) - min(rgb) <= 1e-6
-
-
-def spectral_inputs(material):
-    """The colour inputs of a material that get spectra, as SpectralInputs."""
+def spectral_inputs(material, walk):
+    """The colour inputs of a material that get spectra, as SpectralInputs (walk: walk_material's)."""
     s = material.chromatrace
     if s.model in MANAGED_MODELS:
         nodes = material.node_tree.nodes if material.node_tree else {}
@@ -217,32 +186,7 @@ def spectral_inputs(material):
         value = material.diffuse_color
         return [SpectralInput(material, "diffuse_color", "reflectance", tuple(value[:3]), value[3],
                               f"{material.name}/diffuse_color", False)]
-
-    found = []
-    for name, node in upstream_nodes(material):
-        kind = node.bl_idname
-        candidates = ([(n, "reflectance") for n in _REFLECTANCE_INPUTS.get(kind, ())] +
-                      [(n, "interface") for n in _INTERFACE_INPUTS.get(kind, ())] +
-                      [(n, "emission") for n in _EMISSION_INPUTS.get(kind, ())])
-        for socket_name, role in candidates:
-            socket = node.inputs.get(socket_name)
-            if socket is None or socket.is_linked or socket.type != "RGBA":
-                continue
-            rgb = tuple(socket.default_value[:3])
-            if role == "interface" and not _is_grey(rgb):
-                role = "reflectance"  # a coloured interface: the material's colour after all
-            if role == "emission" and (max(rgb) == 0.0 or _strength_is_zero(node)):
-                continue
-            found.append(SpectralInput(socket, "default_value", role, rgb, socket.default_value[3],
-                                       f"{material.name}/{name}/{socket_name}", False))
-        if kind == "ShaderNodeRGB":
-            targets = [link.to_socket for link in node.outputs[0].links]
-            emission_only = targets and all(t.node.bl_idname in _EMISSION_INPUTS and t.name in
-                                            _EMISSION_INPUTS[t.node.bl_idname] for t in targets)
-            value = node.outputs[0].default_value
-            found.append(SpectralInput(node.outputs[0], "default_value", "emission" if emission_only else "reflectance",
-                                       tuple(value[:3]), value[3], f"{material.name}/{name}", False))
-    return found
+    return leaf_inputs(walk)
 
 
 def node_tree_digest(tree):

@@ -14,6 +14,14 @@ A node is described as a dict (materials.describe_node_tree makes them from Blen
   {"name": "Principled BSDF", "type": "ShaderNodeBsdfPrincipled", "props": {"distribution": "GGX"},
    "inputs": {"Specular Tint": 0.0, ...}  (values of unlinked inputs),
    "colour_output_linked": True}         (whether a colour output feeds anything)
+
+Colour paths (colour_node) say what happens to a colour on its way to a shader's colour input: every node a
+colour passes through before it reaches a shader is either a constant the add-on turns into a spectrum (an
+RGB node), an exact spectrum (a Blackbody node: Planck's law), a node that acts on each channel alike and
+separately and passes its colour inputs on (Mix, Gamma, Invert, Bright/Contrast), a channel-mixing node that
+only the one-band fallback renders (hue/saturation, RGB curves, hue/saturation/colour/value blends), or a
+node whose colours cannot be spectra, which refuses the render. There is no fourth case: a colour node the
+add-on does not know refuses.
 """
 
 _MIXING_BLENDS = {"HUE", "SATURATION", "COLOR", "VALUE"}
@@ -31,11 +39,11 @@ _CHANNEL_NODES = {
     "ShaderNodeBsdfHair": "hair colour is not a reflectance spectrum",
 }
 _NOT_SPECTRAL = {
-    "ShaderNodeBlackbody": "the Blackbody node makes an RGB colour, not a spectrum (use a blackbody emission spectrum)",
     "ShaderNodeWavelength": "the Wavelength node makes an RGB colour, not a spectrum",
     "ShaderNodeAttribute": "attribute colours are RGB, not spectra",
     "ShaderNodeVertexColor": "vertex colours are RGB, not spectra",
 }
+_SHADER_CHANNEL_NODES = {"ShaderNodeSubsurfaceScattering", "ShaderNodeBsdfHairPrincipled", "ShaderNodeBsdfHair"}
 _MULTISCATTER_NODES = {"ShaderNodeBsdfPrincipled", "ShaderNodeBsdfGlossy", "ShaderNodeBsdfAnisotropic",
                        "ShaderNodeBsdfGlass", "ShaderNodeBsdfRefraction"}
 
@@ -49,18 +57,12 @@ def _positive(value):
 
 
 def node_issues(node):
-    """[(reason, fallback_helps)] for one node."""
+    """[(reason, fallback_helps)] for one shader node the output reaches (a BSDF, emission, ...); what the
+    nodes on the way to its colour inputs do is colour_node's."""
     t, props, inputs = node["type"], node.get("props", {}), node.get("inputs", {})
     issues = []
-    if t in _NOT_SPECTRAL:
-        issues.append((_NOT_SPECTRAL[t], False))
-    if t.startswith("ShaderNodeTex") and node.get("colour_output_linked"):
-        issues.append(("an RGB texture's colours are not spectra", False))
-    if t in _CHANNEL_NODES:
+    if t in _SHADER_CHANNEL_NODES:
         issues.append((_CHANNEL_NODES[t], True))
-    if t in ("ShaderNodeMixRGB", "ShaderNodeMix") and props.get("blend_type") in _MIXING_BLENDS \
-            and props.get("data_type", "RGBA") == "RGBA":
-        issues.append((f"the {props['blend_type'].lower()} blend mode mixes colour channels", True))
     if t in _MULTISCATTER_NODES and props.get("distribution") == "MULTI_GGX":
         issues.append(("Multiscatter GGX couples the colour channels", True))
     if t == "ShaderNodeBsdfPrincipled":
@@ -76,20 +78,85 @@ def node_issues(node):
     return issues
 
 
-def tree_issues(material_name, nodes, volume_linked=False):
-    """Every issue of one material's node tree as dicts {material, node, reason, fallback}."""
+def tree_issues(material_name, nodes, volume_linked=False, kind="material"):
+    """Every issue of one material's (light's, world's) reached shader nodes as dicts
+    {kind, material (the owner's name), node, reason, fallback}."""
     found = []
     if volume_linked:
-        found.append({"material": material_name, "node": "Material Output",
+        found.append({"kind": kind, "material": material_name, "node": "Material Output",
                       "reason": "volume shaders are not supported", "fallback": False})
     for node in nodes:
         for reason, fallback in node_issues(node):
-            found.append({"material": material_name, "node": node["name"], "reason": reason, "fallback": fallback})
+            found.append({"kind": kind, "material": material_name, "node": node["name"], "reason": reason,
+                          "fallback": fallback})
     return found
 
 
 def summarise(issues, limit=3):
     """One line for messages: 'material "wall", node "Hue": hue/saturation mixes colour channels; ... (+2 more)'."""
-    parts = [f"material \"{i['material']}\", node \"{i['node']}\": {i['reason']}" for i in issues[:limit]]
+    parts = [describe_issue(i) for i in issues[:limit]]
     more = f" (+{len(issues) - limit} more)" if len(issues) > limit else ""
     return "; ".join(parts) + more
+
+
+# ---- colour paths -------------------------------------------------------------------------------------------
+
+# Nodes that act on each colour channel alike and separately: the colour inputs (identifiers) they pass on.
+_PER_CHANNEL = {
+    "ShaderNodeMixRGB": ("Color1", "Color2"),
+    "ShaderNodeMix": ("A_Color", "B_Color"),
+    "ShaderNodeGamma": ("Color",),
+    "ShaderNodeInvert": ("Color",),
+    "ShaderNodeBrightContrast": ("Color",),
+}
+# Channel-mixing nodes whose colour input can still be given a spectrum (the one-band fallback renders them).
+_MIXING_PASS = {
+    "ShaderNodeHueSaturation": ("Color",),
+    "ShaderNodeRGBCurve": ("Color",),
+}
+_NOT_A_SPECTRUM = {
+    "ShaderNodeValToRGB": "a colour ramp's colours are RGB, not spectra",
+    "ShaderNodeCombineRGB": "combining channels makes an RGB colour from three values, not a spectrum",
+    "ShaderNodeCombineColor": "combining channels makes an RGB colour from three values, not a spectrum",
+    "ShaderNodeTexEnvironment": "an environment texture (HDRI) holds RGB colours, not spectra",
+    "ShaderNodeTexSky": "the sky texture makes RGB colours, not spectra",
+    "ShaderNodeObjectInfo": "the object colour is RGB, not a spectrum",
+    "ShaderNodeParticleInfo": "particle colours are RGB, not spectra",
+    "ShaderNodeAmbientOcclusion": "the ambient-occlusion colour output is not converted",
+}
+_NOT_A_SPECTRUM.update(_NOT_SPECTRAL)
+
+
+def colour_node(node):
+    """What a node does to a colour on its way to a shader, from its description (as node_issues takes):
+    {"kind": "constant" | "blackbody" | "pass" | "refused", "inputs": colour input identifiers to follow,
+     "issue": (reason, fallback_helps) or None}."""
+    t, props = node["type"], node.get("props", {})
+    if t == "ShaderNodeRGB":
+        return {"kind": "constant", "inputs": (), "issue": None}
+    if t == "ShaderNodeBlackbody":
+        return {"kind": "blackbody", "inputs": (), "issue": None}
+    if t in _PER_CHANNEL and not (t == "ShaderNodeMix" and props.get("data_type", "RGBA") != "RGBA"):
+        issue = None
+        if t in ("ShaderNodeMixRGB", "ShaderNodeMix") and props.get("blend_type") in _MIXING_BLENDS:
+            issue = (f"the {props['blend_type'].lower()} blend mode mixes colour channels", True)
+        return {"kind": "pass", "inputs": _PER_CHANNEL[t], "issue": issue}
+    if t in _MIXING_PASS:
+        return {"kind": "pass", "inputs": _MIXING_PASS[t], "issue": (_CHANNEL_NODES[t], True)}
+    if t in _NOT_A_SPECTRUM:
+        return {"kind": "refused", "inputs": (), "issue": (_NOT_A_SPECTRUM[t], False)}
+    if t.startswith("ShaderNodeTex"):
+        return {"kind": "refused", "inputs": (), "issue": ("an RGB texture's colours are not spectra", False)}
+    return {"kind": "refused", "inputs": (),
+            "issue": (f"the add-on cannot give the colours of a {t} node spectra", False)}
+
+
+def owner_label(issue):
+    """'material "wall"', 'light "Area"' or 'world "World"'."""
+    return f"{issue.get('kind', 'material')} \"{issue['material']}\""
+
+
+def describe_issue(issue):
+    """One issue in one line: 'material "wall", node "Hue" (into "Principled BSDF"/"Base Color"): reason'."""
+    where = f" (into {issue['socket']})" if issue.get("socket") else ""
+    return f"{owner_label(issue)}, node \"{issue['node']}\"{where}: {issue['reason']}"

@@ -85,6 +85,32 @@ class CHROMATRACE_OT_render_spectral(bpy.types.Operator):
         return {"RUNNING_MODAL"}
 
 
+# The last pre-flight summary per scene (kept here, not in the scene, so that checking changes nothing).
+PREFLIGHT = {}
+
+
+class CHROMATRACE_OT_preflight(bpy.types.Operator):
+    """Check which colours become spectra: every material, light and the world exact, upsampled or refused"""
+
+    bl_idname = "chromatrace.preflight"
+    bl_label = "Check Spectra"
+
+    def execute(self, context):
+        request = spectral_render.Request.from_scene(context.scene, log=lambda m: None)
+        try:
+            summary = spectral_render.SpectralRender(context.scene, request, _tool(context)).preflight()
+        except BadInput as e:
+            self.report({"ERROR"}, str(e))
+            return {"CANCELLED"}
+        PREFLIGHT[context.scene.name] = summary
+        refused = [o for o in summary["owners"] if o["status"] == "refused"]
+        if refused:
+            self.report({"WARNING"}, "; ".join(o["reasons"][0] if o["reasons"] else o["name"] for o in refused[:3]))
+        else:
+            self.report({"INFO"}, f"{summary['renders']} Cycles renders; nothing refused")
+        return {"FINISHED"}
+
+
 class CHROMATRACE_OT_import_scene(bpy.types.Operator, ImportHelper):
     """Import a chromatrace scene (chromatrace-scene/1) into the current scene"""
 
@@ -180,7 +206,7 @@ def _menu_export(self, context):
     self.layout.operator(CHROMATRACE_OT_export_scene.bl_idname, text="chromatrace scene (.json)")
 
 
-_classes = (CHROMATRACE_OT_render_spectral, CHROMATRACE_OT_import_scene, CHROMATRACE_OT_export_scene,
+_classes = (CHROMATRACE_OT_render_spectral, CHROMATRACE_OT_preflight, CHROMATRACE_OT_import_scene, CHROMATRACE_OT_export_scene,
             CHROMATRACE_OT_build_material, CHROMATRACE_OT_spectrum_add, CHROMATRACE_OT_spectrum_remove)
 
 

@@ -205,6 +205,11 @@ class CHROMATRACE_PG_scene(bpy.types.PropertyGroup):
         items=[("REFUSE", "Refuse", "Do not render; list the nodes"),
                ("ONE_BAND", "One band per render", "Render each band alone (3× slower)")],
         default="REFUSE")
+    on_world: EnumProperty(
+        name="World light",
+        items=[("REFUSE", "Refuse", "Do not render when the world's light cannot be a spectrum (an HDRI)"),
+               ("OMIT", "Omit", "Render without the world's light; a warning is printed and noted in the file")],
+        default="REFUSE")
     output_path: StringProperty(name="Output", subtype="FILE_PATH", default="//spectral.exr")
     cache_dir: StringProperty(name="Cache", subtype="DIR_PATH",
                               description="Band groups already rendered, for resuming (empty: the user cache)")

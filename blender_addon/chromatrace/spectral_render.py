@@ -31,6 +31,9 @@ from .geometry_digest import update_with_mesh
 from .journal import Journal
 from .spectra import SourceError, rgb_for_upsampling
 
+WORLD_HINT = ("; to render without the world's light choose World light: Omit in the render settings "
+              "(batch.py --on-world omit)")
+
 # Tests set this to a callable f(event, **info); an exception it raises aborts the render at that point.
 TEST_HOOK = None
 
@@ -70,6 +73,7 @@ class Request:
         self.resolution = None
         self.point_filter = False
         self.on_mixing_nodes = "refuse"  # or "one-band"
+        self.on_world = "refuse"  # a lit world whose colours cannot be spectra (an HDRI): or "omit"
         self.bands_per_render = 3
         self.output = None
         self.cache_root = None
@@ -87,6 +91,7 @@ class Request:
                       bands_file=bpy.path.abspath(s.bands_file) if s.band_plan == "FILE" else None,
                       families=s.families(), object_ids=s.use_object_ids, point_filter=s.pixel_filter == "point",
                       on_mixing_nodes="one-band" if s.on_mixing_nodes == "ONE_BAND" else "refuse",
+                      on_world="omit" if s.on_world == "OMIT" else "refuse",
                       output=bpy.path.abspath(s.output_path),
                       cache_root=bpy.path.abspath(s.cache_dir) if s.cache_dir else None)
         values.update({k: v for k, v in overrides.items() if v is not None})
@@ -134,25 +139,93 @@ class SpectralRender:
     def _objects(self, view_layer):
         return [ob for ob in view_layer.objects if not ob.hide_render and (ob.type in _GEOMETRY_TYPES or ob.type == "LIGHT")]
 
-    def _check_nodes(self, used_materials):
+    def _scene_parts(self):
+        """(view layer, objects, used materials, light objects (one per light datablock))."""
+        scene = self.scene
+        view_layer = self._view_layer()
+        if scene.camera is None:
+            raise BadInput(f"scene \"{scene.name}\": no camera")
+        objects = self._objects(view_layer)
+        lights, seen = [], set()
+        for ob in objects:
+            if ob.type == "LIGHT" and ob.data.as_pointer() not in seen:
+                seen.add(ob.data.as_pointer())
+                lights.append(ob)
+        return view_layer, objects, _used_materials(objects), lights
+
+    def _walks(self, used, lights):
+        """The colour walk (colour_walk.Walk) of every material and light used, and of the world, by (kind, name)."""
+        walks = {}
+        world = self.scene.world
+        if world is not None:
+            walks[("world", world.name)] = materials.walk_world(world)
+        for ob in lights:
+            walk = materials.walk_light(ob.data)
+            walk.name = ob.name
+            for issue in walk.issues:
+                issue["material"] = ob.name
+            walks[("light", ob.name)] = walk
+        for material in used:
+            walks[("material", material.name)] = materials.walk_material(material)
+        return walks
+
+    def _world_state(self, walks):
+        """What the render does with the world: {"status": "none" | "dark" | "lit" | "omitted" | "refused",
+        "issues": [...]}. A world is lit when a background or emission it reaches has a colour and a strength;
+        lit worlds are converted, or refused when a colour cannot be (an HDRI), unless the request omits them."""
+        world = self.scene.world
+        if world is None:
+            return {"status": "none", "issues": [], "walk": None}
+        walk = walks[("world", world.name)]
+        lit = bool(walk.leaves) or bool(walk.issues) or any(
+            node.bl_idname in ("ShaderNodeBackground", "ShaderNodeEmission") and node.inputs["Color"].is_linked and
+            walk.constant_scalar((), node.inputs["Strength"]) != 0.0 for _path, node in walk.shaders)
+        if not lit:
+            return {"status": "dark", "issues": [], "walk": walk}
+        hard = [i for i in walk.issues if not i["fallback"]]
+        if hard:
+            for issue in hard:
+                if not issue["reason"].endswith(WORLD_HINT):
+                    issue["reason"] += WORLD_HINT
+            if self.request.on_world == "omit":
+                return {"status": "omitted", "issues": walk.issues, "walk": walk}
+            return {"status": "refused", "issues": walk.issues, "walk": walk}
+        return {"status": "lit", "issues": walk.issues, "walk": walk}
+
+    def _node_issues(self, used, walks, world):
+        """(hard issues, channel-mixing issues): the world's first (its message says how to proceed), then the
+        lights' and the materials'."""
         issues = []
-        for material in used_materials:
-            nodes, volume = materials.describe_node_tree(material)
-            issues += node_rules.tree_issues(material.name, nodes, volume)
+        if world["status"] in ("lit", "refused"):
+            issues += world["issues"]
+        for (kind, _name), walk in walks.items():
+            if kind != "world":
+                issues += walk.issues
+        for material in used:
             s = material.chromatrace
             if s.model == "DICHROMATIC" and s.lobe == "phong":
-                raise BadInput(f"material \"{material.name}\": the phong lobe has no Cycles counterpart "
-                               "(only the reference tracer renders it); use ggx")
-        hard = [i for i in issues if not i["fallback"]]
+                issues.append({"kind": "material", "material": material.name, "node": "ct_glossy", "socket": None,
+                               "reason": "the phong lobe has no Cycles counterpart (only the reference tracer "
+                                         "renders it); use ggx", "fallback": False})
+        return [i for i in issues if not i["fallback"]], [i for i in issues if i["fallback"]]
+
+    def _check_nodes(self, used, walks, world):
+        """Refuses (BadInput) what cannot be rendered; returns whether one band per render is needed."""
+        hard, mixing = self._node_issues(used, walks, world)
         if hard:
             raise BadInput(f"cannot render spectrally: {node_rules.summarise(hard)}")
-        mixing = [i for i in issues if i["fallback"]]
         if mixing and self.request.on_mixing_nodes != "one-band":
             raise BadInput(f"nodes mix colour channels: {node_rules.summarise(mixing)} "
                            "(choose one band per render to render anyway)")
         if mixing:
             self.request.log(f"one band per render: {node_rules.summarise(mixing)}")
+        if world["status"] == "omitted":
+            self.request.log(f"warning: {self._world_warning(world)}")
         return bool(mixing)
+
+    def _world_warning(self, world):
+        reasons = "; ".join(node_rules.describe_issue(i) for i in world["issues"] if not i["fallback"])
+        return f"rendered without the world's light (strength 0), as asked: {reasons}"
 
     def _resolve(self, spectrum_settings, current_rgb, what):
         """The source JSON of a spectrum setting, table names resolved."""
@@ -169,11 +242,30 @@ class SpectralRender:
                 raise BadInput(f"{what}: spectrum table entry \"{entry.name}\" refers to another name")
         return source
 
+    @staticmethod
+    def _node_source(spectral_input, what):
+        """(source, scale) of a colour a node tree fixes: a Blackbody node's Planck's law, a grey interface
+        colour, or the colour upsampled (an emission colour above 1 from its normalised colour)."""
+        rgb = spectral_input.current_rgb
+        if spectral_input.source is not None:
+            return spectral_input.source, 1.0
+        if spectral_input.role == "interface":
+            return {"constant": rgb[0]}, 1.0
+        if spectral_input.role == "reflectance":
+            if max(rgb) > 1.0 or min(rgb) < 0.0:
+                raise BadInput(f"{what}: colour {tuple(round(c, 4) for c in rgb)} of {spectral_input.label} "
+                               "is outside [0, 1], so it is not a reflectance")
+            return _rgb_source({"rgb": [max(0.0, float(c)) for c in rgb]}), 1.0
+        rgb, factor = rgb_for_upsampling(rgb)
+        return _rgb_source({"rgb": rgb}), factor
+
     def _input_source(self, material, spectral_input):
         """(source JSON, scale) of one spectral colour input of a material."""
         s = material.chromatrace
         what = f"material \"{material.name}\""
         rgb = spectral_input.current_rgb
+        if spectral_input.source is not None:
+            return spectral_input.source, 1.0
         if spectral_input.role == "interface":
             return {"constant": rgb[0]}, 1.0
         if spectral_input.role == "reflectance":
@@ -181,43 +273,65 @@ class SpectralRender:
             if settings.kind == "RGB" and settings.use_current_colour and (max(rgb) > 1.0 or min(rgb) < 0.0):
                 raise BadInput(f"{what}: colour {tuple(round(c, 4) for c in rgb)} of {spectral_input.label} "
                                "is outside [0, 1], so it is not a reflectance")
-            return self._resolve(settings, rgb, what), 1.0
+            return _rgb_source(self._resolve(settings, rgb, what)), 1.0
         if spectral_input.managed or s.emissive:
             settings = s.emission
             scale = 1.0 if spectral_input.managed else s.emission_scale
             if settings.kind == "RGB" and settings.use_current_colour:
                 rgb, factor = rgb_for_upsampling(rgb)
-                return self._resolve(settings, rgb, what), scale * factor
+                return _rgb_source(self._resolve(settings, rgb, what)), scale * factor
             return self._resolve(settings, None, what), scale
         rgb, factor = rgb_for_upsampling(rgb)
-        return {"rgb": rgb}, factor
+        return _rgb_source({"rgb": rgb}), factor
+
+    def _owner_inputs(self, kind, thing, walk):
+        """[(SpectralInput, source, scale)] of one material, light object or world; BadInput when one fails."""
+        found = []
+        if kind == "material":
+            for spectral_input in materials.spectral_inputs(thing, walk):
+                found.append((spectral_input, *self._input_source(thing, spectral_input)))
+            return found
+        what = f"{kind} \"{thing.name}\""
+        if kind == "light":
+            light = thing.data
+            settings = light.chromatrace
+            if settings.emission.kind == "RGB" and settings.emission.use_current_colour:
+                rgb, factor = rgb_for_upsampling(tuple(light.color))
+                source, scale = _rgb_source(self._resolve(settings.emission, rgb, what)), settings.emission_scale * factor
+            else:
+                source, scale = self._resolve(settings.emission, None, what), settings.emission_scale
+            found.append((materials.SpectralInput(light, "color", "emission", tuple(light.color), None, what, False),
+                          source, scale))
+        for spectral_input in materials.leaf_inputs(walk):
+            found.append((spectral_input, *self._node_source(spectral_input, what)))
+        return found
 
     def _prepare(self, work_dir):
         """The plan of the renders: what is rendered, with which band values, into which components."""
-        scene, request = self.scene, self.request
-        view_layer = self._view_layer()
-        if scene.camera is None:
-            raise BadInput(f"scene \"{scene.name}\": no camera")
-        objects = self._objects(view_layer)
-        used = _used_materials(objects)
-        replicate = self._check_nodes(used)
-        keys, inputs, emitters = self._spectral_inputs(used, [ob for ob in objects if ob.type == "LIGHT"])
+        request = self.request
+        view_layer, objects, used, lights = self._scene_parts()
+        walks = self._walks(used, lights)
+        world = self._world_state(walks)
+        replicate = self._check_nodes(used, walks, world)
+        keys, inputs, emitters = self._spectral_inputs(used, lights, walks, world)
         bands = self._band_averages(work_dir, keys, inputs)
         edges = bands["bands"]["edges_nm"]
         per_render = 1 if replicate else request.bands_per_render
-        transmission = any(materials.has_transmission(m) for m in used)
-        light_groups, assignments = self._light_groups(view_layer, objects, emitters)
-        total, planned = components.component_plan(request.families, light_groups, request.max_bounces, transmission)
+        transmission = any(materials.has_transmission(walks[("material", m.name)]) for m in used)
+        light_groups, assignments, world_group = self._light_groups(view_layer, objects, emitters, world)
+        total, planned = components.component_plan(request.families, light_groups, request.max_bounces, transmission,
+                                                    environment=world["status"] == "lit")
         plan = RenderPlan(view_layer=view_layer, objects=objects, materials=used, inputs=inputs, bands=bands, edges=edges,
                           groups=band_groups(len(edges) - 1, per_render), replicate=replicate, per_render=per_render,
                           light_groups=light_groups, assignments=assignments, total=total, components=planned,
                           variants=components.render_variants(request.max_bounces, "bounces" in request.families),
-                          passes=components.passes_needed(planned), ids=self._object_ids(objects))
+                          passes=components.passes_needed(planned), ids=self._object_ids(objects),
+                          world=world, world_group=world_group, lights=lights, replaced={})
         plan.key = cache.cache_key(self._cache_description(plan))
         return plan
 
-    def _spectral_inputs(self, used, lights):
-        """Every spectral input of the materials and lights, with its source's key and its scale; identical
+    def _spectral_inputs(self, used, lights, walks, world):
+        """Every spectral input of the materials, lights and world, with its source's key and its scale; identical
         sources share a key (they are evaluated once). Also the names of the emitting materials."""
         keys, inputs, emitters = {}, [], set()
 
@@ -226,44 +340,50 @@ class SpectralRender:
             return keys.setdefault(text, f"s{len(keys)}")
 
         for material in used:
-            for spectral_input in materials.spectral_inputs(material):
-                source, scale = self._input_source(material, spectral_input)
+            for spectral_input, source, scale in self._owner_inputs("material", material,
+                                                                    walks[("material", material.name)]):
                 inputs.append((spectral_input, key_of(source), scale, material.name))
                 if spectral_input.role == "emission":
                     emitters.add(material.name)
         for ob in lights:
-            light = ob.data
-            settings = light.chromatrace
-            what = f"light \"{ob.name}\""
-            if settings.emission.kind == "RGB" and settings.emission.use_current_colour:
-                rgb, factor = rgb_for_upsampling(tuple(light.color))
-                source, scale = self._resolve(settings.emission, rgb, what), settings.emission_scale * factor
-            else:
-                source, scale = self._resolve(settings.emission, None, what), settings.emission_scale
-            inputs.append((materials.SpectralInput(light, "color", "emission", tuple(light.color), None,
-                                                   what, False), key_of(source), scale, ob.name))
+            for spectral_input, source, scale in self._owner_inputs("light", ob, walks[("light", ob.name)]):
+                inputs.append((spectral_input, key_of(source), scale, ob.name))
+        if world["status"] == "lit":
+            for spectral_input, source, scale in self._owner_inputs("world", self.scene.world, world["walk"]):
+                inputs.append((spectral_input, key_of(source), scale, self.scene.world.name))
         return keys, inputs, emitters
 
     def _band_averages(self, work_dir, keys, inputs):
         """The band averages of every source (`chromatrace scene-bands`), a reflectance above 1 refused."""
+        bands = self._evaluate(work_dir, keys)
+        for spectral_input, key, _scale, owner in inputs:
+            problem = self._above_one(bands, spectral_input, key)
+            if problem:
+                raise BadInput(f"material \"{owner}\": {problem}")
+        return bands
+
+    def _evaluate(self, work_dir, keys):
         request = self.request
         request_file = os.path.join(work_dir, "spectra.json")
         spectra = {k: json.loads(t) for t, k in keys.items()} or {"flat": {"constant": 1.0}}  # no spectra: the edges
         with open(request_file, "w") as f:
             json.dump({"format": "chromatrace-spectra/1", "spectra": spectra}, f)
-        bands = self.tool.band_averages(request_file, request.bands, request.bands_file)
-        for spectral_input, key, _scale, owner in inputs:
-            entry = bands["spectra"][key]
-            if spectral_input.role == "reflectance" and entry["max"] > 1.0:
-                raise BadInput(f"material \"{owner}\": the reflectance of {spectral_input.label} reaches "
-                               f"{entry['max']:g} at {entry['max_nm']:g} nm, but a reflectance must be in [0, 1]")
-        return bands
+        return self.tool.band_averages(request_file, request.bands, request.bands_file)
 
-    def _light_groups(self, view_layer, objects, emitters):
-        """Light groups: every emitter in one (its own, or one named after it); none without the lights family."""
+    @staticmethod
+    def _above_one(bands, spectral_input, key):
+        entry = bands["spectra"][key]
+        if spectral_input.role == "reflectance" and entry["max"] > 1.0:
+            return (f"the reflectance of {spectral_input.label} reaches {entry['max']:g} at {entry['max_nm']:g} nm, "
+                    "but a reflectance must be in [0, 1]")
+        return None
+
+    def _light_groups(self, view_layer, objects, emitters, world):
+        """Light groups: every emitter in one (its own, or one named after it), a lit world too; none without the
+        lights family. Returns (groups, {object name: group}, the world's group or None)."""
         light_groups, assignments = [], {}
         if "lights" not in self.request.families:
-            return light_groups, assignments
+            return light_groups, assignments, None
         if not hasattr(view_layer, "lightgroups"):
             raise BadInput("light-group components need Blender 3.2 or later (or leave out the lights family)")
         for ob in objects:
@@ -275,7 +395,12 @@ class SpectralRender:
             assignments[ob.name] = group
             if group not in light_groups:
                 light_groups.append(group)
-        return light_groups, assignments
+        world_group = None
+        if world["status"] == "lit":
+            world_group = self.scene.world.lightgroup or "world"
+            if world_group not in light_groups:
+                light_groups.append(world_group)
+        return light_groups, assignments, world_group
 
     def _object_ids(self, objects):
         """Object ids, written by their own render (manifest.IDS_FILE), not by the band renders: the objects'
@@ -297,6 +422,8 @@ class SpectralRender:
             digest.update(repr([list(row) for row in ob.matrix_world]).encode())
             if ob.type == "LIGHT":
                 digest.update(json.dumps(_rna_plain(ob.data), sort_keys=True).encode())
+                if ob.data.use_nodes:
+                    digest.update(json.dumps(materials.node_tree_digest(ob.data.node_tree)).encode())
             else:
                 evaluated = ob.evaluated_get(depsgraph)
                 mesh = evaluated.to_mesh()
@@ -320,6 +447,8 @@ class SpectralRender:
             "nodes": {m.name: materials.node_tree_digest(m.node_tree) for m in plan.materials},
             "camera": [repr([list(r) for r in camera.matrix_world]), _rna_plain(camera.data)],
             "world": materials.node_tree_digest(world.node_tree) if world and world.use_nodes else None,
+            "world_state": [plan.world["status"], plan.world_group,
+                            list(world.color) if world is not None else None],
         }
 
     def _resolution(self):
@@ -327,6 +456,94 @@ class SpectralRender:
             return list(self.request.resolution)
         r = self.scene.render
         return [r.resolution_x * r.resolution_percentage // 100, r.resolution_y * r.resolution_percentage // 100]
+
+    # ---- pre-flight ----------------------------------------------------------------------------------
+
+    def preflight(self):
+        """What a render would do, without rendering or changing anything (batch.py --explain): every material,
+        light and the world with its status — "exact" (every colour a spectrum: the add-on's spectra, Blackbody
+        nodes, grey), "upsampled" (some colour upsampled from RGB), "refused" (with every reason in full), or
+        for the world also "none", "dark" (no light) and "omitted" (refused, rendered without it as asked) —
+        and the number of Cycles renders the plan needs (null when something is refused)."""
+        request = self.request
+        view_layer, objects, used, lights = self._scene_parts()
+        walks = self._walks(used, lights)
+        world = self._world_state(walks)
+        hard, mixing = self._node_issues(used, walks, world)
+        owners = []
+        keys = {}
+
+        def key_of(source):
+            text = json.dumps(source, sort_keys=True)
+            return keys.setdefault(text, f"s{len(keys)}")
+
+        def report(kind, thing, walk, status_override=None):
+            name = thing.name
+            issues = [i for i in hard + mixing if i["kind"] == kind and i["material"] == name]
+            entry = {"kind": kind, "name": name, "status": None, "reasons": [node_rules.describe_issue(i) for i in issues],
+                     "colours": []}
+            inputs = []
+            if status_override is None:
+                try:
+                    inputs = self._owner_inputs(kind, thing, walk)
+                except BadInput as e:
+                    entry["reasons"].append(str(e))
+                    entry["status"] = "refused"
+            for spectral_input, source, scale in inputs:
+                entry["colours"].append({"input": spectral_input.label, "role": spectral_input.role,
+                                         "source": source, "scale": scale, "key": key_of(source),
+                                         "upsampled": "rgb" in source})
+            refused = any(not i["fallback"] for i in issues) or (
+                any(i["fallback"] for i in issues) and request.on_mixing_nodes != "one-band")
+            if status_override is not None:
+                entry["status"] = status_override
+            elif refused or entry["status"] == "refused":
+                entry["status"] = "refused"
+            else:
+                entry["status"] = "upsampled" if any(c["upsampled"] for c in entry["colours"]) else "exact"
+            if any(i["fallback"] for i in issues) and entry["status"] != "refused":
+                entry["one_band_per_render"] = True
+            owners.append(entry)
+            return entry
+
+        for material in used:
+            report("material", material, walks[("material", material.name)])
+        for ob in lights:
+            report("light", ob, walks[("light", ob.name)])
+        if self.scene.world is not None:
+            status = world["status"]
+            report("world", self.scene.world, world["walk"], None if status in ("lit", "refused") else status)
+            if status == "omitted":
+                owners[-1]["reasons"] = [self._world_warning(world)]
+        else:
+            owners.append({"kind": "world", "name": None, "status": "none", "reasons": [], "colours": []})
+
+        work_dir = tempfile.mkdtemp(prefix="chromatrace-")
+        try:
+            bands = self._evaluate(work_dir, keys)
+        finally:
+            shutil.rmtree(work_dir, ignore_errors=True)
+        for entry in owners:
+            for colour in entry["colours"]:
+                values = bands["spectra"][colour["key"]]
+                colour["bands"] = [v * colour["scale"] for v in values["bands"]]
+                if colour["role"] == "reflectance" and values["max"] > 1.0:
+                    entry["status"] = "refused"
+                    entry["reasons"].append(
+                        f"{entry['kind']} \"{entry['name']}\": the reflectance of {colour['input']} reaches "
+                        f"{values['max']:g} at {values['max_nm']:g} nm, but a reflectance must be in [0, 1]")
+                del colour["key"]
+        edges = bands["bands"]["edges_nm"]
+        refused = [e for e in owners if e["status"] == "refused"]
+        replicate = bool(mixing) and request.on_mixing_nodes == "one-band"
+        per_render = 1 if replicate else request.bands_per_render
+        groups = band_groups(len(edges) - 1, per_render)
+        variants = components.render_variants(request.max_bounces, "bounces" in request.families)
+        renders = None if refused else len(groups) * len(variants) + (1 if request.object_ids else 0)
+        return {"format": "chromatrace-preflight/1", "scene": self.scene.name,
+                "ok": not refused, "renders": renders, "bands": len(edges) - 1, "edges_nm": edges,
+                "bands_per_render": per_render, "bounce_limits": len(variants),
+                "object_id_render": bool(request.object_ids), "owners": owners}
 
     # ---- rendering -----------------------------------------------------------------------------------
 
@@ -336,12 +553,18 @@ class SpectralRender:
         cycles_setup.apply(journal, scene, view_layer, request.samples, request.seed, request.point_filter,
                            self._resolution(), plan.passes)
         world = scene.world
-        if world is not None:
+        if world is not None and plan.world["status"] != "lit":  # dark, or omitted as asked: strength 0
             journal.set(world, "color", (0.0, 0.0, 0.0))
             if world.use_nodes and world.node_tree is not None:
                 for node in world.node_tree.nodes:
                     if node.bl_idname == "ShaderNodeBackground":
                         journal.set(node.inputs["Strength"], "default_value", 0.0)
+        if world is not None and plan.world_group and world.lightgroup != plan.world_group:
+            journal.set(world, "lightgroup", plan.world_group)
+        for spectral_input, _key, _scale, _owner in plan.inputs:
+            node = spectral_input.replace
+            if node is not None and node.as_pointer() not in plan.replaced:
+                plan.replaced[node.as_pointer()] = _replace_with_rgb(journal, node)
         existing = set(view_layer.lightgroups.keys()) if hasattr(view_layer, "lightgroups") else set()
         for group in plan.light_groups:
             if group not in existing:
@@ -363,7 +586,10 @@ class SpectralRender:
             colour = (r * factor, g * factor, b * factor)
             if spectral_input.alpha is not None:
                 colour = (*colour, spectral_input.alpha)
-            journal.set(spectral_input.target, spectral_input.attribute, colour)
+            target = spectral_input.target
+            if spectral_input.replace is not None:
+                target = plan.replaced[spectral_input.replace.as_pointer()]
+            journal.set(target, spectral_input.attribute, colour)
 
     def steps(self):
         """Generator: yields (renders done, renders in all, message) after each Cycles render."""
@@ -476,7 +702,10 @@ class SpectralRender:
         scene, request = self.scene, self.request
         s = scene.chromatrace
         source = s.source_json or json.dumps({"blend": bpy.data.filepath, "scene": scene.name})
-        return {
+        attributes = {}
+        if plan.world["status"] == "omitted":
+            attributes["chromatrace.warning"] = self._world_warning(plan.world)
+        return attributes | {
             "chromatrace.renderer": (f"Cycles (Blender {bpy.app.version_string}) via the chromatrace add-on: "
                                      f"{plan.per_render} band(s) per render, max {request.max_bounces} bounces"),
             "chromatrace.samples": str(request.samples),
@@ -506,6 +735,33 @@ def camera_description(scene, resolution):
     return {"position": position, "look_at": [position[i] + forward[i] for i in range(3)], "up": up,
             "horizontal_fov_deg": math.degrees(2 * math.atan(tan_w)), "vertical_fov_deg": math.degrees(2 * math.atan(tan_h)),
             "sensor_width_mm": sensor, "focal_length_mm": data.lens, "resolution": [width, height]}
+
+
+def _rgb_source(source):
+    """A grey RGB source as the constant it upsamples to (Jakob-Hanika's grey is flat): exact, not upsampled."""
+    if isinstance(source, dict) and "rgb" in source and max(source["rgb"]) == min(source["rgb"]):
+        return {"constant": source["rgb"][0]}
+    return source
+
+
+def _replace_with_rgb(journal, node):
+    """Replaces a Blackbody node's links by an RGB node's for the render (the node stays, unlinked); undone
+    through the journal. Returns the RGB node's output socket, whose colour the render sets per band group."""
+    tree = node.id_data
+    targets = [link.to_socket for link in node.outputs[0].links if link.is_valid and not link.is_muted]
+    rgb = tree.nodes.new("ShaderNodeRGB")
+    rgb.label = f"chromatrace: {node.name}"
+    rgb.location = node.location
+
+    def undo():
+        tree.nodes.remove(rgb)
+        for socket in targets:
+            tree.links.new(node.outputs[0], socket)
+
+    journal.call_on_restore(undo)
+    for socket in targets:
+        tree.links.new(rgb.outputs[0], socket)
+    return rgb.outputs[0]
 
 
 def _remove_lightgroup(scene, view_layer, name):

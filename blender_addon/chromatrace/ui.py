@@ -37,7 +37,32 @@ class CHROMATRACE_PT_render(_Panel, bpy.types.Panel):
         col.prop(s, "use_bounces")
         col.prop(s, "use_object_ids")
         layout.prop(s, "on_mixing_nodes")
+        layout.prop(s, "on_world")
         layout.prop(s, "cache_dir")
+
+
+class CHROMATRACE_PT_preflight(_Panel, bpy.types.Panel):
+    """The pre-flight summary: what becomes a spectrum (batch.py --explain shows the same as JSON)."""
+
+    bl_label = "Spectra Check"
+    bl_context = "render"
+    bl_parent_id = "CHROMATRACE_PT_render"
+    bl_options = {"DEFAULT_CLOSED"}
+
+    def draw(self, context):
+        from .operators import PREFLIGHT
+        layout = self.layout
+        layout.operator("chromatrace.preflight", icon="CHECKMARK")
+        summary = PREFLIGHT.get(context.scene.name)
+        if summary is None:
+            return
+        col = layout.column(align=True)
+        col.label(text=f"{summary['renders']} Cycles renders" if summary["ok"] else "Refused: nothing renders")
+        icons = {"exact": "CHECKMARK", "upsampled": "COLOR", "refused": "ERROR", "omitted": "ERROR"}
+        for owner in summary["owners"]:
+            col.label(text=f"{owner['kind']} {owner['name']}: {owner['status']}", icon=icons.get(owner["status"], "DOT"))
+            for reason in owner["reasons"][:2]:
+                col.label(text=f"    {reason}")
 
 
 class CHROMATRACE_UL_spectra(bpy.types.UIList):
@@ -131,7 +156,7 @@ class CHROMATRACE_PT_object(_Panel, bpy.types.Panel):
             layout.prop(ob, "lightgroup", text="Light group")
 
 
-_classes = (CHROMATRACE_PT_render, CHROMATRACE_UL_spectra, CHROMATRACE_PT_spectra, CHROMATRACE_PT_material,
+_classes = (CHROMATRACE_PT_render, CHROMATRACE_PT_preflight, CHROMATRACE_UL_spectra, CHROMATRACE_PT_spectra, CHROMATRACE_PT_material,
             CHROMATRACE_PT_light, CHROMATRACE_PT_object)
 
 

@@ -12,7 +12,8 @@ from chromatrace import scene_import, tool  # noqa: E402
 
 scene_file, blend = sys.argv[sys.argv.index("--") + 1:][:2]
 chromatrace.register()
-for collection in (bpy.data.objects, bpy.data.meshes, bpy.data.materials, bpy.data.lights, bpy.data.cameras):
+for collection in (bpy.data.objects, bpy.data.meshes, bpy.data.materials, bpy.data.lights, bpy.data.cameras,
+                   bpy.data.worlds):
     for item in list(collection):
         collection.remove(item)
 scene_import.import_scene(scene_file, bpy.context.scene, tool.Tool(tool.find_executable()))

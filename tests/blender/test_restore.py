@@ -173,6 +173,28 @@ if fallback.rendered != 7:  # one per band, and the object-id render
     failures.append(f"one band per render: expected 7 renders (6 bands and the object ids), got {fallback.rendered}")
 check_same(with_hue, "after a one-band-per-render fallback")
 
+# 5. A light whose colour is a Blackbody node (replaced by an RGB node during the render) and a Mix node of
+#    constant colours in a material: converted, then put back as they were (nodes, links, values).
+light = bpy.data.objects["Light"].data
+light.use_nodes = True
+blackbody = light.node_tree.nodes.new("ShaderNodeBlackbody")
+blackbody.name = "Blackbody"
+light.node_tree.links.new(blackbody.outputs[0], light.node_tree.nodes["Emission"].inputs["Color"])
+tree.nodes.remove(hue)
+mix = tree.nodes.new("ShaderNodeMix")
+mix.data_type = "RGBA"
+next(i for i in mix.inputs if i.identifier == "A_Color").default_value = (0.8, 0.1, 0.1, 1.0)
+tree.links.new(next(o for o in mix.outputs if o.identifier == "Result_Color"), principled.inputs["Base Color"])
+converted = snapshot()
+converted["light Light nodes"] = node_tree(light.node_tree)
+spectral_render.SpectralRender(scene, request("blackbody", cache_root=os.path.join(work, "cache5")), TOOL).run()
+after = snapshot()
+after["light Light nodes"] = node_tree(light.node_tree)
+if after != converted:
+    failures.append(f"after a Blackbody light render: changed {[k for k in after if after[k] != converted.get(k)][:5]}")
+else:
+    print("ok: after a Blackbody light and a Mix node: every setting restored", flush=True)
+
 if digest(blend) != blend_digest or os.path.exists(blend + "1"):
     failures.append("the .blend on disk was written")
 

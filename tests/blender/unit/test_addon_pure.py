@@ -71,6 +71,14 @@ class Components(unittest.TestCase):
                 count[key] = count.get(key, 0) + t.get("sign", 1)
         self.assertEqual({k: v for k, v in count.items() if v}, {("main", ("Combined",)): 1})
 
+    def test_a_lit_world_seen_directly_is_emission(self):
+        _total, planned = components.component_plan({"paths", "bounces"}, [], 2, environment=True)
+        by_name = {c["name"]: c["terms"] for c in planned}
+        self.assertEqual(by_name["emission"], [{"passes": ["Emit"]}, {"passes": ["Env"]}])
+        self.assertEqual(by_name["bounce.0"], [{"passes": ["Emit"], "file": "k1"}, {"passes": ["Env"], "file": "k1"}])
+        self.assertEqual(by_name["bounce.1"][1:], [{"passes": ["Emit"], "file": "k1", "sign": -1},
+                                                   {"passes": ["Env"], "file": "k1", "sign": -1}])
+
     def test_paths_and_lights(self):
         _total, planned = components.component_plan({"paths", "lights"}, ["ceiling", "lamp_2"], 8)
         names = [c["name"] for c in planned]
@@ -141,6 +149,15 @@ class BatchArgs(unittest.TestCase):
                                          "64x32", "--components", "paths,bounces", "--max-bounces", "0"])
         self.assertEqual((a.samples, a.resolution, a.components, a.max_bounces), (4, (64, 32), {"paths", "bounces"}, 0))
 
+    def test_explain_needs_no_output_and_writes_to_stdout_or_a_file(self):
+        a = batch_args.parse_batch_args(["--scene", self.scene, "--explain"])
+        self.assertEqual((a.explain, a.out), ("-", None))
+        a = batch_args.parse_batch_args(["--scene", self.scene, "--preflight", self.out, "--on-world", "omit"])
+        self.assertEqual((a.explain, a.on_world), (self.out, "omit"))
+        with self.assertRaises(BadInput) as caught:
+            batch_args.parse_batch_args(["--scene", self.scene, "--explain", "/no/such/dir/p.json"])
+        self.assertIn("--explain", str(caught.exception))
+
     def test_bad_input_is_one_line_naming_the_option(self):
         cases = [
             (["--out", self.out], "--scene"),
@@ -178,27 +195,46 @@ class Ply(unittest.TestCase):
 
 
 class NodeRules(unittest.TestCase):
-    def test_mixing_nodes_allow_the_fallback_and_non_spectral_ones_do_not(self):
+    def test_shader_rules_allow_the_fallback_and_volumes_do_not(self):
         nodes = [
             {"name": "Principled BSDF", "type": "ShaderNodeBsdfPrincipled", "props": {"distribution": "GGX"},
              "inputs": {"Specular": 0.5, "Specular Tint": 0.5, "Sheen": 0.0, "Sheen Tint": 0.5, "Subsurface": 0.0}},
             {"name": "Glossy", "type": "ShaderNodeBsdfGlossy", "props": {"distribution": "MULTI_GGX"}},
-            {"name": "Ramp", "type": "ShaderNodeValToRGB"},
-            {"name": "Mix", "type": "ShaderNodeMixRGB", "props": {"blend_type": "HUE"}},
-            {"name": "Mix ok", "type": "ShaderNodeMixRGB", "props": {"blend_type": "MULTIPLY"}},
-            {"name": "Gamma", "type": "ShaderNodeGamma"},
-            {"name": "Image", "type": "ShaderNodeTexImage", "colour_output_linked": True},
-            {"name": "Noise fac only", "type": "ShaderNodeTexNoise", "colour_output_linked": False},
+            {"name": "SSS", "type": "ShaderNodeSubsurfaceScattering"},
+            {"name": "Diffuse", "type": "ShaderNodeBsdfDiffuse"},
         ]
         issues = node_rules.tree_issues("wall", nodes, volume_linked=True)
         found = {(i["node"], i["fallback"]) for i in issues}
         self.assertEqual(found, {("Material Output", False), ("Principled BSDF", True), ("Glossy", True),
-                                 ("Ramp", True), ("Mix", True), ("Image", False)})
+                                 ("SSS", True)})
         self.assertIn('material "wall", node "Principled BSDF"', node_rules.summarise(issues[1:]))
         tinted_white = {"name": "P", "type": "ShaderNodeBsdfPrincipled", "inputs": {"Specular Tint": (1, 1, 1, 1)}}
         self.assertEqual(node_rules.node_issues(tinted_white), [])
         no_sheen = {"name": "P", "type": "ShaderNodeBsdfPrincipled", "inputs": {"Sheen": 0.0, "Sheen Tint": 0.5}}
         self.assertEqual(node_rules.node_issues(no_sheen), [])  # Blender 3's default: a tint without a lobe
+
+    def test_colour_paths_convert_pass_on_or_refuse_and_unknown_nodes_refuse(self):
+        def kind(t, **props):
+            rule = node_rules.colour_node({"name": "n", "type": t, "props": props})
+            return rule["kind"], rule["issue"][1] if rule["issue"] else None
+        self.assertEqual(kind("ShaderNodeRGB"), ("constant", None))
+        self.assertEqual(kind("ShaderNodeBlackbody"), ("blackbody", None))
+        self.assertEqual(kind("ShaderNodeMix", data_type="RGBA", blend_type="MULTIPLY"), ("pass", None))
+        self.assertEqual(kind("ShaderNodeMixRGB", blend_type="HUE"), ("pass", True))  # the one-band fallback
+        self.assertEqual(kind("ShaderNodeHueSaturation"), ("pass", True))
+        self.assertEqual(kind("ShaderNodeGamma"), ("pass", None))
+        for refused in ("ShaderNodeTexImage", "ShaderNodeTexEnvironment", "ShaderNodeTexNoise", "ShaderNodeValToRGB",
+                        "ShaderNodeVertexColor", "ShaderNodeAttribute", "ShaderNodeWavelength",
+                        "ShaderNodeCombineColor", "ShaderNodeSomethingNew"):
+            self.assertEqual(kind(refused), ("refused", False), refused)
+        self.assertEqual(node_rules.colour_node({"type": "ShaderNodeMixRGB", "props": {}})["inputs"],
+                         ("Color1", "Color2"))
+
+    def test_issue_lines_name_the_owner_node_and_socket(self):
+        issue = {"kind": "light", "material": "Area", "node": "Group > Image", "socket": '"Emission"/"Color"',
+                 "reason": "an RGB texture's colours are not spectra", "fallback": False}
+        self.assertEqual(node_rules.describe_issue(issue), 'light "Area", node "Group > Image" (into "Emission"/"Color"): '
+                         "an RGB texture's colours are not spectra")
 
 
 class Spectra(unittest.TestCase):

@@ -1,0 +1,122 @@
+"""Test helper: an ordinary artist's scene, built from Blender's default file, saved as a .blend.
+
+    blender -b --factory-startup --python make_artist_scene.py -- library OUT.blend [--only "NAME|NAME|..."]
+        one small sphere per material of Blender's bundled materials library (sample_materials.blend) that
+        carries colour, an area light whose colour is a Blackbody node (4000 K) in its node tree, and a world
+        lit by an HDRI of Blender's studio lights; --only keeps those materials, and a world without light
+    blender -b --factory-startup --python make_artist_scene.py -- blackbody OUT.blend KELVIN
+        a grey diffuse plane under an area light whose node tree's colour is a Blackbody node at KELVIN, no world
+
+The default cube and point light are removed; the default camera is moved to look down on the scene.
+"""
+
+import glob
+import math
+import os
+import sys
+
+import bpy
+
+LIBRARY = os.path.join(bpy.utils.system_resource("SCRIPTS"), "addons", "materials_library_vx", "sample_materials.blend")
+STUDIO_WORLDS = os.path.join(bpy.utils.system_resource("DATAFILES"), "studiolights", "world")
+
+
+def carries_colour(material):
+    """Whether a material's nodes hold any colour (a colour socket, an RGB or colour node, a ramp)."""
+    def tree_has(tree, seen):
+        if tree is None or tree.name in seen:
+            return False
+        seen.add(tree.name)
+        for node in tree.nodes:
+            if node.type == "GROUP" and tree_has(node.node_tree, seen):
+                return True
+            if any(s.type == "RGBA" for s in list(node.inputs) + list(node.outputs)):
+                return True
+        return False
+    return material.use_nodes and tree_has(material.node_tree, set())
+
+
+def area_light_with_blackbody(kelvin, location, size=1.0, power=300.0):
+    data = bpy.data.lights.new("Area", "AREA")
+    data.size = size
+    data.energy = power
+    data.use_nodes = True
+    tree = data.node_tree
+    emission = next(n for n in tree.nodes if n.bl_idname == "ShaderNodeEmission")
+    blackbody = tree.nodes.new("ShaderNodeBlackbody")
+    blackbody.inputs["Temperature"].default_value = kelvin
+    tree.links.new(blackbody.outputs["Color"], emission.inputs["Color"])
+    ob = bpy.data.objects.new("Area", data)
+    ob.location = location
+    bpy.context.scene.collection.objects.link(ob)
+    return ob
+
+
+def look_down(camera, height, ortho_scale):
+    camera.location = (0.0, 0.0, height)
+    camera.rotation_euler = (0.0, 0.0, 0.0)
+    camera.data.type = "ORTHO"
+    camera.data.ortho_scale = ortho_scale
+
+
+def clear_defaults():
+    for name in ("Cube", "Light"):
+        ob = bpy.data.objects.get(name)
+        if ob is not None:
+            bpy.data.objects.remove(ob)
+
+
+def library_scene(only):
+    with bpy.data.libraries.load(LIBRARY) as (source, loaded):
+        loaded.materials = [n for n in source.materials if only is None or n in only]
+    chosen = sorted((m for m in loaded.materials if carries_colour(m)), key=lambda m: m.name)
+    columns = math.ceil(math.sqrt(len(chosen)))
+    for i, material in enumerate(chosen):
+        row, column = divmod(i, columns)
+        bpy.ops.mesh.primitive_uv_sphere_add(radius=0.4, segments=24, ring_count=12,
+                                             location=(column - (columns - 1) / 2, (columns - 1) / 2 - row, 0.0))
+        sphere = bpy.context.object
+        sphere.name = f"sphere {material.name}"
+        sphere.data.materials.append(material)
+    area_light_with_blackbody(4000.0, (0.0, 0.0, 4.0), size=2.0, power=400.0 * columns * columns)
+    look_down(bpy.context.scene.camera, 10.0, columns + 0.5)
+    world = bpy.context.scene.world
+    if only is None:
+        hdri = sorted(glob.glob(os.path.join(STUDIO_WORLDS, "*.exr")))[0]
+        environment = world.node_tree.nodes.new("ShaderNodeTexEnvironment")
+        environment.image = bpy.data.images.load(hdri)
+        background = world.node_tree.nodes["Background"]
+        world.node_tree.links.new(environment.outputs["Color"], background.inputs["Color"])
+    else:
+        bpy.context.scene.world = None
+
+
+def blackbody_scene(kelvin):
+    bpy.ops.mesh.primitive_plane_add(size=4.0, location=(0.0, 0.0, 0.0))
+    plane = bpy.context.object
+    plane.name = "plane"
+    grey = bpy.data.materials.new("grey")
+    grey.use_nodes = True
+    nodes = grey.node_tree.nodes
+    nodes.remove(nodes["Principled BSDF"])
+    diffuse = nodes.new("ShaderNodeBsdfDiffuse")
+    diffuse.inputs["Color"].default_value = (0.5, 0.5, 0.5, 1.0)
+    grey.node_tree.links.new(diffuse.outputs[0], nodes["Material Output"].inputs["Surface"])
+    plane.data.materials.append(grey)
+    area_light_with_blackbody(kelvin, (0.0, 0.0, 1.5), size=1.0, power=100.0)
+    look_down(bpy.context.scene.camera, 5.0, 3.0)
+    bpy.context.scene.world = None
+
+
+argv = sys.argv[sys.argv.index("--") + 1:]
+mode, out = argv[0], argv[1]
+clear_defaults()
+bpy.context.scene.render.engine = "CYCLES"
+if mode == "library":
+    only = set(argv[3].split("|")) if len(argv) > 3 and argv[2] == "--only" else None
+    library_scene(only)
+elif mode == "blackbody":
+    blackbody_scene(float(argv[2]))
+else:
+    raise SystemExit(f"unknown mode {mode}")
+bpy.ops.wm.save_as_mainfile(filepath=os.path.abspath(out))
