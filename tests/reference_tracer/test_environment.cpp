@@ -161,12 +161,12 @@ TEST_F(EnvironmentTest, ConstantImageIsTheConstantEnvironment) {
   expect_furnace(s, render(s, quiet({true, true, false})), 0.7, 2.0);
 }
 
-// A black 16 × 8 image with one patch of radiance 5 (columns 6–9, rows 1–2: 45° either side of +X, polar angles
-// 22.5°–67.5°), seen by a white plane facing `normal`: its radiance is ρ/π ∫_patch L max(0, n·ω) dω, integrated
+// A black 16 × 8 image with one patch of radiance 5 (columns 4–7, rows 1–2: longitudes from +X to +Y, polar
+// angles 22.5°–67.5°), seen by a white plane facing `normal`: its radiance is ρ/π ∫_patch L max(0, n·ω) dω, integrated
 // here by the midpoint rule over the patch in (φ, cos θ), where dω = dφ d(cos θ).
 double patch_radiance(const Vec3& normal, double rotation_deg, double rho, double radiance) {
   const int n = 400;
-  const double phi0 = -kPi / 4, phi1 = kPi / 4;  // columns 6..9: u in [6/16, 10/16), φ = π(1 − 2u)
+  const double phi0 = 0, phi1 = kPi / 2;  // columns 4..7: u in [4/16, 8/16), φ = π(1 − 2u)
   const double z0 = std::cos(kPi * 1 / 8), z1 = std::cos(kPi * 3 / 8);
   const double r = rotation_deg * kPi / 180;
   double sum = 0;
@@ -182,17 +182,19 @@ double patch_radiance(const Vec3& normal, double rotation_deg, double rho, doubl
 TEST_F(EnvironmentTest, BrightPatchLightsAPlaneAsTheIntegralSays) {
   std::vector<float> pixels(16 * 8 * 3, 0.0f);
   for (int y = 1; y <= 2; ++y)
-    for (int x = 6; x <= 9; ++x)
+    for (int x = 4; x <= 7; ++x)
       for (int c = 0; c < 3; ++c) pixels[(y * 16 + x) * 3 + c] = 5.0f;
   const fs::path sky = write_image("patch.exr", 16, 8, pixels);
   struct Case {
     Vec3 normal;
     double rotation_deg;
   };
-  // +X sees the patch at the image's centre; +Z sees it as it lies above the horizon, −Z not at all; turned by
-  // 90° the patch moves to +Y (counter-clockwise seen from above).
-  const std::vector<Case> cases = {{{1, 0, 0}, 0}, {{0, 0, 1}, 0}, {{0, 0, -1}, 0}, {{0, 1, 0}, 90}, {{0, -1, 0}, 90},
-                                   {{-1, 0, 0}, 0}};
+  // The patch lies between +X (the image's centre) and +Y (a quarter from its left edge), above the horizon
+  // (the top row is +Z): planes facing +X, +Y and +Z see it, −X, −Y and −Z not at all. Turned by 90°
+  // (counter-clockwise seen from above) it lies between +Y and −X.
+  const std::vector<Case> cases = {{{1, 0, 0}, 0},  {{0, 1, 0}, 0},   {{0, -1, 0}, 0}, {{0, 0, 1}, 0},
+                                   {{0, 0, -1}, 0}, {{-1, 0, 0}, 0},  {{-1, 0, 0}, 90}, {{0, 1, 0}, 90},
+                                   {{1, 0, 0}, 90}};
   for (const Case& c : cases) {
     // A 2 m square facing `normal` through the origin, and a camera 3 m in front of it.
     const auto frame = orthonormal_frame(c.normal);
