@@ -36,6 +36,27 @@ Json spectrum_entry(const PiecewiseLinearSpectrum& spectrum, const Bands& bands)
           {"max_nm", spectrum.wavelengths()[static_cast<std::size_t>(peak - values.begin())]}};
 }
 
+// Textures and the environment have no band averages of their own here yet; failing keeps a caller (the Blender
+// add-on) from rendering a scene without them.
+void refuse_textures_and_environment(const Scene& scene) {
+  const auto refuse = [&](const SpectrumRef& ref, const std::string& where) {
+    if (ref.texture)
+      throw InputError(fmt::format("{}: {}: is an image texture ({}); scene-bands reports band averages of spectra only",
+                                   scene.source, where, ref.texture->file));
+  };
+  for (const Material& m : scene.materials)
+    std::visit(
+        [&](const auto& model) {
+          using M = std::decay_t<decltype(model)>;
+          if constexpr (std::is_same_v<M, DichromaticMaterial>) refuse(model.diffuse, "materials." + m.name + ".diffuse");
+          else refuse(model.reflectance, "materials." + m.name + ".reflectance");
+        },
+        m.model);
+  for (std::size_t i = 0; i < scene.lights.size(); ++i) refuse(scene.lights[i].radiance, fmt::format("lights[{}].radiance", i));
+  if (scene.environment)
+    throw InputError(fmt::format("{}: environment: scene-bands does not report the environment yet", scene.source));
+}
+
 Json material_entry(const Material& material, const Bands& bands) {
   return std::visit(
       [&](const auto& m) -> Json {
@@ -71,6 +92,7 @@ int run(const Options& o) {
   } else {
     scene = load_scene(o.file);
     spectra = scene->spectra;
+    refuse_textures_and_environment(*scene);
   }
   Bands bands = scene ? scene->render.bands : RenderSettings{}.bands;
   if (!o.bands.empty()) bands = Bands::parse(o.bands, "--bands");

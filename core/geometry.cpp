@@ -171,6 +171,80 @@ TriangleMesh tessellate(const Shape& shape) {
   return std::visit([](const auto& s) { return tessellate(s); }, shape);
 }
 
+namespace {
+
+void add_quad_uvs(std::vector<std::array<Vec2, 3>>& uvs) {
+  uvs.push_back({Vec2(0, 0), Vec2(1, 0), Vec2(1, 1)});
+  uvs.push_back({Vec2(0, 0), Vec2(1, 1), Vec2(0, 1)});
+}
+
+// Mirrors tessellate(): the triangles in the same order, each corner's (u, v).
+std::vector<std::array<Vec2, 3>> shape_uvs(const QuadShape&) {
+  std::vector<std::array<Vec2, 3>> uvs;
+  add_quad_uvs(uvs);
+  return uvs;
+}
+
+std::vector<std::array<Vec2, 3>> shape_uvs(const BoxShape&) {
+  std::vector<std::array<Vec2, 3>> uvs;
+  for (int face = 0; face < 6; ++face) add_quad_uvs(uvs);
+  return uvs;
+}
+
+std::vector<std::array<Vec2, 3>> shape_uvs(const SphereShape& sphere) {
+  const int segments = sphere.segments, rings = sphere.rings;
+  // Vertex (i, j) at u = j / segments (the seam's second side at u = 1), v = 1 − i / rings; a pole takes the
+  // u of the middle of its triangle's segment.
+  const auto at = [&](int i, int j) { return Vec2(static_cast<double>(j) / segments, 1.0 - static_cast<double>(i) / rings); };
+  std::vector<std::array<Vec2, 3>> uvs;
+  for (int j = 0; j < segments; ++j) {
+    const double mid = (j + 0.5) / segments;
+    uvs.push_back({Vec2(mid, 1.0), at(1, j), at(1, j + 1)});
+    for (int i = 1; i + 1 < rings; ++i) {
+      uvs.push_back({at(i, j), at(i + 1, j), at(i + 1, j + 1)});
+      uvs.push_back({at(i, j), at(i + 1, j + 1), at(i, j + 1)});
+    }
+    uvs.push_back({Vec2(mid, 0.0), at(rings - 1, j + 1), at(rings - 1, j)});
+  }
+  return uvs;
+}
+
+std::vector<std::array<Vec2, 3>> shape_uvs(const CylinderShape& cylinder) {
+  const int n = cylinder.segments;
+  std::vector<std::array<Vec2, 3>> uvs;
+  for (int j = 0; j < n; ++j) {
+    const double u0 = static_cast<double>(j) / n, u1 = static_cast<double>(j + 1) / n;
+    uvs.push_back({Vec2(u0, 0), Vec2(u1, 0), Vec2(u1, 1)});
+    uvs.push_back({Vec2(u0, 0), Vec2(u1, 1), Vec2(u0, 1)});
+  }
+  if (cylinder.caps) {
+    const auto rim = [&](int j) {
+      const double phi = 2.0 * std::numbers::pi * j / n;
+      return Vec2(0.5 + 0.5 * std::cos(phi), 0.5 + 0.5 * std::sin(phi));
+    };
+    const Vec2 middle(0.5, 0.5);
+    for (const bool is_top : {false, true})
+      for (int j = 0; j < n; ++j)
+        uvs.push_back(is_top ? std::array<Vec2, 3>{middle, rim(j), rim(j + 1)}
+                             : std::array<Vec2, 3>{middle, rim(j + 1), rim(j)});
+  }
+  return uvs;
+}
+
+std::vector<std::array<Vec2, 3>> shape_uvs(const MeshShape& shape) {
+  const TriangleMesh& mesh = shape.mesh;
+  std::vector<std::array<Vec2, 3>> uvs;
+  if (mesh.uvs.empty()) return uvs;
+  for (const auto& [a, b, c] : mesh.triangles) uvs.push_back({mesh.uvs[a], mesh.uvs[b], mesh.uvs[c]});
+  return uvs;
+}
+
+}  // namespace
+
+std::vector<std::array<Vec2, 3>> corner_uvs(const Shape& shape) {
+  return std::visit([](const auto& s) { return shape_uvs(s); }, shape);
+}
+
 double surface_area(const QuadShape& quad) { return quad.edge1.cross(quad.edge2).norm(); }
 
 double surface_area(const SphereShape& sphere) { return 4.0 * std::numbers::pi * sphere.radius * sphere.radius; }

@@ -19,12 +19,15 @@
 namespace ct {
 
 using Vec3 = Eigen::Vector3d;
+using Vec2 = Eigen::Vector2d;
 
 struct TriangleMesh {
   std::vector<Vec3> positions;
   // Empty (flat shading: use the geometric normal) or one unit normal per position (smooth shading).
   std::vector<Vec3> normals;
   std::vector<std::array<std::uint32_t, 3>> triangles;
+  // Empty or one texture coordinate (u, v) per position (a PLY mesh's u, v or s, t properties).
+  std::vector<Vec2> uvs;
 
   bool operator==(const TriangleMesh&) const = default;
 };
@@ -94,6 +97,14 @@ TriangleMesh tessellate(const CylinderShape& cylinder);
 TriangleMesh tessellate(const BoxShape& box);
 TriangleMesh tessellate(const MeshShape& mesh);
 TriangleMesh tessellate(const Shape& shape);
+
+// Texture coordinates: for each triangle of tessellate(shape), the (u, v) of its three corners (docs/scene-format.md,
+// "Texture coordinates"). Per corner, not per vertex, so that a seam (a sphere's longitude 0 = 1) needs no
+// vertices of its own. quad: (0, 0) at the corner, u along edge1, v along edge2; box: each face as a quad;
+// sphere: u = longitude / 2π from +X towards +Y, v = 1 at the north (+Z) pole and 0 at the south pole;
+// cylinder side: u = angle / 2π in its frame, v = height fraction; its caps: the unit disc mapped to
+// [0, 1]²; mesh: the file's per-vertex coordinates. Empty for a mesh without them.
+std::vector<std::array<Vec2, 3>> corner_uvs(const Shape& shape);
 
 // Exact surface area of the analytic shape (the tessellation converges to it as O(1/segments²)); for a
 // mesh, the area of its triangles.

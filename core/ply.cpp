@@ -228,7 +228,7 @@ TriangleMesh parse_ply(std::string_view bytes, const std::string& source) {
   bool vertices_seen = false, faces_seen = false;
 
   for (const Element& element : header.elements) {
-    std::optional<std::size_t> xyz[3], nxyz[3], face_list;
+    std::optional<std::size_t> xyz[3], nxyz[3], uv[2], face_list;
     if (element.name == "vertex") {
       vertices_seen = true;
       const char* names[] = {"x", "y", "z", "nx", "ny", "nz"};
@@ -239,6 +239,14 @@ TriangleMesh parse_ply(std::string_view bytes, const std::string& source) {
       }
       if (nxyz[0].has_value() != nxyz[1].has_value() || nxyz[0].has_value() != nxyz[2].has_value())
         throw InputError(fmt::format("{}: vertex normals need all of nx, ny, nz", source));
+      // Texture coordinates under the names exporters use (Blender writes s, t).
+      for (const auto& [u, v] : {std::pair{"u", "v"}, {"s", "t"}, {"texture_u", "texture_v"}, {"texture_s", "texture_t"}}) {
+        if (uv[0]) break;
+        uv[0] = element.find(u);
+        uv[1] = element.find(v);
+        if (uv[0].has_value() != uv[1].has_value())
+          throw InputError(fmt::format("{}: texture coordinates need both {} and {}", source, u, v));
+      }
     } else if (element.name == "face") {
       faces_seen = true;
       face_list = element.find("vertex_indices");
@@ -261,6 +269,11 @@ TriangleMesh parse_ply(std::string_view bytes, const std::string& source) {
             throw InputError(
                 fmt::format("{}: {}: normal ({}, {}, {}) has no direction", source, where, n.x(), n.y(), n.z()));
           mesh.normals.push_back(n / length);
+        }
+        if (uv[0]) {
+          const Vec2 t(record.scalars[*uv[0]], record.scalars[*uv[1]]);
+          if (!t.allFinite()) throw InputError(fmt::format("{}: {}: texture coordinate is not finite", source, where));
+          mesh.uvs.push_back(t);
         }
       } else if (element.name == "face") {
         faces.push_back(std::move(record.list));
@@ -304,17 +317,21 @@ std::string format_ply(const TriangleMesh& mesh, PlyFormat format) {
   if (mesh.positions.size() > static_cast<std::size_t>(std::numeric_limits<std::int32_t>::max()))
     throw std::runtime_error("PLY: too many vertices for int indices");
   const bool normals = !mesh.normals.empty();
+  const bool uvs = !mesh.uvs.empty();
   const bool ascii = format == PlyFormat::Ascii;
   std::string out = fmt::format("ply\nformat {} 1.0\ncomment written by chromatrace\nelement vertex {}\n",
                                 ascii ? "ascii" : "binary_little_endian", mesh.positions.size());
   for (const char* name : {"x", "y", "z"}) out += fmt::format("property double {}\n", name);
   if (normals)
     for (const char* name : {"nx", "ny", "nz"}) out += fmt::format("property double {}\n", name);
+  if (uvs)
+    for (const char* name : {"u", "v"}) out += fmt::format("property double {}\n", name);
   out += fmt::format("element face {}\nproperty list uchar int vertex_indices\nend_header\n", mesh.triangles.size());
 
   for (std::size_t i = 0; i < mesh.positions.size(); ++i) {
     std::vector<double> values(mesh.positions[i].data(), mesh.positions[i].data() + 3);
     if (normals) values.insert(values.end(), mesh.normals[i].data(), mesh.normals[i].data() + 3);
+    if (uvs) values.insert(values.end(), mesh.uvs[i].data(), mesh.uvs[i].data() + 2);
     if (ascii) {
       // fmt's shortest round-trip form, so reading back gives the same doubles.
       for (std::size_t k = 0; k < values.size(); ++k) out += fmt::format("{}{}", k ? " " : "", values[k]);

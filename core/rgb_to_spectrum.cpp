@@ -132,14 +132,34 @@ SigmoidPolynomial fit_rgb_reflectance(const std::array<double, 3>& rgb_in) {
   return {{c[0], c[1], c[2]}};
 }
 
-PiecewiseLinearSpectrum rgb_to_spectrum(const std::array<double, 3>& linear_srgb) {
-  const SigmoidPolynomial poly = fit_rgb_reflectance(linear_srgb);
+PiecewiseLinearSpectrum ScaledSigmoid::tabulated() const {
   std::vector<double> lambda, value;
   for (double nm = kLo; nm <= kHi; nm += 1.0) {
     lambda.push_back(nm);
-    value.push_back(poly(nm));
+    value.push_back(scale == 1.0 ? poly(nm) : scale * poly(nm));
   }
   return PiecewiseLinearSpectrum(std::move(lambda), std::move(value), Extrapolation::Clamp, "rgb spectrum");
+}
+
+double ScaledSigmoid::tabulated_at(double nm) const {
+  const double x = std::clamp(nm, kLo, kHi) - kLo;
+  const double i = std::min(std::floor(x), kHi - kLo - 1.0);
+  const double t = x - i;
+  const double a = (*this)(kLo + i), b = (*this)(kLo + i + 1.0);
+  return a + t * (b - a);
+}
+
+PiecewiseLinearSpectrum rgb_to_spectrum(const std::array<double, 3>& linear_srgb) {
+  return ScaledSigmoid{1.0, fit_rgb_reflectance(linear_srgb)}.tabulated();
+}
+
+ScaledSigmoid fit_rgb_unbounded(const std::array<double, 3>& linear_srgb) {
+  const std::array<double, 3> rgb = {std::max(0.0, linear_srgb[0]), std::max(0.0, linear_srgb[1]),
+                                     std::max(0.0, linear_srgb[2])};
+  const double m = std::max({rgb[0], rgb[1], rgb[2]});
+  if (!(m > 0.0)) return {0.0, fit_rgb_reflectance({0.0, 0.0, 0.0})};
+  const double scale = 2.0 * m;
+  return {scale, fit_rgb_reflectance({rgb[0] / scale, rgb[1] / scale, rgb[2] / scale})};
 }
 
 }  // namespace ct

@@ -6,6 +6,7 @@
 #include <limits>
 #include <map>
 #include <numbers>
+#include <tuple>
 
 #include <fmt/core.h>
 #include <fmt/format.h>
@@ -216,7 +217,11 @@ class SceneReader {
   PiecewiseLinearSpectrum illuminant_spectrum(const JsonNode& node);
   PiecewiseLinearSpectrum samples_spectrum(const JsonNode& node);
   SpectrumRef spectrum_ref(const JsonNode& node);
+  SpectrumRef texture_ref(const JsonNode& node, TextureUse use);
+  SpectrumRef radiance(const JsonNode& node);
   SpectrumRef reflectance(const JsonNode& node);
+  Environment environment(const JsonNode& node);
+  void check_texture_coordinates(const JsonNode& objects) const;
   Material material(const std::string& name, const JsonNode& node);
   std::size_t material_index(const JsonNode& node) const;
   Shape object_shape(const JsonNode& node) const;
@@ -225,6 +230,7 @@ class SceneReader {
 
   std::filesystem::path directory_;
   std::map<std::string, CsvTable> csv_tables_;
+  std::map<std::tuple<std::string, int, int, double>, std::shared_ptr<const ImageTexture>> textures_;
   Scene scene_;
 };
 
@@ -342,17 +348,53 @@ PiecewiseLinearSpectrum SceneReader::samples_spectrum(const JsonNode& node) {
 }
 
 SpectrumRef SceneReader::spectrum_ref(const JsonNode& node) {
-  if (node.json().is_object()) return {"", spectrum_source(node)};
+  if (node.json().is_object()) return {"", spectrum_source(node), nullptr};
   if (!node.json().is_string())
     node.fail(fmt::format("must be a spectrum name or {}, got {}", kSpectrumObject, describe_json(node.json())));
   const std::string name = node.string();
-  if (const NamedSpectrum* named = scene_.find_spectrum(name)) return {name, named->spectrum};
+  if (const NamedSpectrum* named = scene_.find_spectrum(name)) return {name, named->spectrum, nullptr};
   node.fail(scene_.spectra.empty()
                 ? fmt::format("unknown spectrum \"{}\" (the scene defines no spectra)", name)
                 : fmt::format("unknown spectrum \"{}\" (spectra: {})", name, names_of(scene_.spectra)));
 }
 
+bool is_texture_source(const JsonNode& node) { return node.json().is_object() && node.has("texture"); }
+
+// {"texture": file, "colour_space": "sRGB" | "linear", "scale": s}; each image is read once per scene and use.
+SpectrumRef SceneReader::texture_ref(const JsonNode& node, TextureUse use) {
+  node.expect_object({"texture", "colour_space", "scale"});
+  const JsonNode file = node["texture"];
+  const std::string written = file.non_empty_string();
+  std::optional<TextureColourSpace> colour_space;
+  if (const auto space = node.find("colour_space"))
+    colour_space = space->choice({"sRGB", "linear"}) == "sRGB" ? TextureColourSpace::Srgb : TextureColourSpace::Linear;
+  double scale = 1.0;
+  if (const auto n = node.find("scale"))
+    scale = use == TextureUse::Reflectance ? n->number_in(0.0, 1.0) : n->number_at_least(0.0);
+  const std::string path = (directory_ / written).lexically_normal().string();
+  const auto key = std::make_tuple(path, colour_space ? static_cast<int>(*colour_space) : -1, static_cast<int>(use), scale);
+  auto cached = textures_.find(key);
+  if (cached == textures_.end()) {
+    try {
+      cached = textures_
+                   .emplace(key, std::make_shared<const ImageTexture>(
+                                     read_image_texture(path, written, colour_space, use, scale)))
+                   .first;
+    } catch (const InputError& e) {
+      file.fail(e.what());
+    }
+  }
+  SpectrumRef ref;
+  ref.texture = cached->second;
+  return ref;
+}
+
+SpectrumRef SceneReader::radiance(const JsonNode& node) {
+  return is_texture_source(node) ? texture_ref(node, TextureUse::Radiance) : spectrum_ref(node);
+}
+
 SpectrumRef SceneReader::reflectance(const JsonNode& node) {
+  if (is_texture_source(node)) return texture_ref(node, TextureUse::Reflectance);
   SpectrumRef ref = spectrum_ref(node);
   const Sample highest = extreme_sample(ref.spectrum, true);
   if (highest.value > 1.0)
@@ -392,8 +434,10 @@ Material SceneReader::material(const std::string& name, const JsonNode& node) {
   } else {
     dichromatic.lobe = DichromaticMaterial::Phong{node["exponent"].number_at_least(0.0)};
   }
-  // Neither lobe reflects more than k_s, so this bound keeps the material from creating energy.
-  const double body = extreme_sample(dichromatic.diffuse.spectrum, true).value;
+  // Neither lobe reflects more than k_s, so this bound keeps the material from creating energy. A texture's
+  // spectra stay below its scale (the fitted sigmoid is < 1).
+  const double body = dichromatic.diffuse.texture ? dichromatic.diffuse.texture->scale
+                                                  : extreme_sample(dichromatic.diffuse.spectrum, true).value;
   if (body + dichromatic.specular > 1.0)
     node["specular"].fail(
         fmt::format("the diffuse maximum {} plus specular {} exceeds 1, so the material would "
@@ -429,7 +473,7 @@ Light SceneReader::light(const JsonNode& node) {
   Light light;
   light.name = node["name"].non_empty_string();
   light.shape = light_shape(node["shape"]);
-  light.radiance = spectrum_ref(node["radiance"]);
+  light.radiance = radiance(node["radiance"]);
   if (const auto scale = node.find("scale")) light.scale = scale->number_at_least(0.0);
   if (const auto group = node.find("group")) {
     light.group = group->string();
@@ -449,11 +493,49 @@ Light SceneReader::light(const JsonNode& node) {
   return light;
 }
 
+Environment SceneReader::environment(const JsonNode& node) {
+  node.expect_object({"radiance", "scale", "rotation_deg", "group"});
+  Environment environment;
+  environment.radiance = radiance(node["radiance"]);
+  if (const auto scale = node.find("scale")) environment.scale = scale->number_at_least(0.0);
+  if (const auto rotation = node.find("rotation_deg")) {
+    if (!environment.radiance.texture) rotation->fail("applies only to a texture radiance");
+    environment.rotation_deg = rotation->number_in(-360.0, 360.0);
+  }
+  if (const auto group = node.find("group")) {
+    environment.group = group->string();
+    if (!valid_group_name(environment.group))
+      group->fail(fmt::format("\"{}\" cannot name an output component: use letters, digits, \"_\" and \"-\"",
+                              environment.group));
+  }
+  return environment;
+}
+
+// A textured material on a mesh needs texture coordinates in its file; the analytic shapes always have them.
+void SceneReader::check_texture_coordinates(const JsonNode& objects) const {
+  const std::vector<JsonNode> nodes = objects.elements();
+  for (std::size_t i = 0; i < scene_.objects.size(); ++i) {
+    const Object& object = scene_.objects[i];
+    const auto* mesh = std::get_if<MeshShape>(&object.shape);
+    if (!mesh || !mesh->mesh.uvs.empty()) continue;
+    const Material& material = scene_.materials[object.material];
+    std::string textured;
+    if (const auto* m = std::get_if<LambertMaterial>(&material.model); m && m->reflectance.texture) textured = "reflectance";
+    if (const auto* m = std::get_if<DichromaticMaterial>(&material.model); m && m->diffuse.texture) textured = "diffuse";
+    if (const auto* m = std::get_if<MirrorMaterial>(&material.model); m && m->reflectance.texture) textured = "reflectance";
+    if (textured.empty()) continue;
+    nodes[i]["shape"]["file"].fail(fmt::format(
+        "{} has no texture coordinates (vertex properties u, v or s, t), but object \"{}\" has material \"{}\" "
+        "whose {} is a texture",
+        (directory_ / mesh->file).lexically_normal().string(), object.name, material.name, textured));
+  }
+}
+
 Scene SceneReader::read(const JsonNode& root) {
   const std::string format = root["format"].string();
   if (format != kSceneFormat) root["format"].fail(fmt::format("must be \"{}\", got \"{}\"", kSceneFormat, format));
-  root.expect_object(
-      {"format", "name", "description", "spectra", "materials", "objects", "lights", "camera", "render"});
+  root.expect_object({"format", "name", "description", "spectra", "materials", "objects", "lights", "environment",
+                      "camera", "render"});
   if (const auto name = root.find("name")) scene_.name = name->non_empty_string();
   if (const auto description = root.find("description")) scene_.description = description->string();
   // Render settings first: they hold the tessellation defaults the shapes use.
@@ -484,7 +566,10 @@ Scene SceneReader::read(const JsonNode& root) {
     light.id = id++;
     scene_.lights.push_back(std::move(light));
   }
-  if (scene_.lights.empty()) lights.fail("a scene needs at least one light");
+  check_texture_coordinates(root["objects"]);
+  if (const auto environment = root.find("environment")) scene_.environment = this->environment(*environment);
+  if (scene_.lights.empty() && !scene_.environment)
+    lights.fail("a scene needs at least one light or an \"environment\"");
 
   scene_.camera = read_camera(root["camera"]);
   return std::move(scene_);
@@ -556,7 +641,7 @@ void visit_paths(Json& node, std::string_view key, const std::function<void(Json
   }
   if (!node.is_object()) return;
   for (auto& [k, child] : node.items()) {
-    if ((k == "csv" || (k == "file" && key == "shape")) && child.is_string())
+    if ((k == "csv" || k == "texture" || (k == "file" && key == "shape")) && child.is_string())
       visit(child);
     else
       visit_paths(child, k, visit);

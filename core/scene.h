@@ -11,6 +11,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <functional>
+#include <memory>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -22,6 +23,7 @@
 #include "core/geometry.h"
 #include "core/json_input.h"
 #include "core/spectrum.h"
+#include "core/texture.h"
 
 namespace ct {
 
@@ -36,10 +38,13 @@ struct NamedSpectrum {
   PiecewiseLinearSpectrum spectrum;
 };
 
-// A spectrum as a material or light uses it: resolved, and named when it came from `spectra`.
+// A spectrum as a material or light uses it: resolved, and named when it came from `spectra`. A colour input
+// may instead be an image texture (docs/scene-format.md, "Textures"): then `texture` is set, `spectrum` is
+// empty and the spectrum varies over the surface's (u, v), or over directions for the environment.
 struct SpectrumRef {
   std::string name;  // key in the scene's `spectra`; empty when given inline
   PiecewiseLinearSpectrum spectrum;
+  std::shared_ptr<const ImageTexture> texture;  // shared by every input that names the same file
 };
 
 // f = R(λ) / π
@@ -100,6 +105,16 @@ struct Light {
   PiecewiseLinearSpectrum emitted_radiance() const { return radiance.spectrum.scaled(scale); }
 };
 
+// The light from every direction that leaves the scene (Blender's world): a spectrum, the same from every
+// direction, or a latitude-longitude (equirectangular) texture, mapped as Blender's Environment Texture node
+// maps it by default (docs/scene-format.md, "Environment"), turned about +Z by `rotation_deg`.
+struct Environment {
+  SpectrumRef radiance;  // relative; radiance · scale is in W m⁻² sr⁻¹ nm⁻¹
+  double scale = 1.0;
+  double rotation_deg = 0.0;  // counter-clockwise seen from +Z
+  std::string group = "environment";
+};
+
 struct Object {
   std::string name;
   int id = 0;                // 1, 2, ... in file order; 0 is the background
@@ -152,6 +167,7 @@ struct Scene {
   std::vector<Material> materials;
   std::vector<Object> objects;
   std::vector<Light> lights;
+  std::optional<Environment> environment;
   Camera camera;
   RenderSettings render;
 

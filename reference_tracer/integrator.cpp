@@ -9,6 +9,7 @@
 #include <fmt/core.h>
 
 #include "core/error.h"
+#include "core/parallel.h"
 #include "core/random.h"
 
 namespace ct::rt {
@@ -143,14 +144,47 @@ PathTracer::PathTracer(const TracerScene& scene, TracerSettings settings, LayerP
       if (entry.first == s) return;
     band_tables_.emplace_back(s, band_averages(*s, settings_.bands));
   };
-  for (const Material& material : scene.scene().materials) (void)material;
   for (std::size_t mesh = 0; mesh < scene.scene().objects.size() + scene.scene().lights.size(); ++mesh) {
     if (const TracerMaterial* m = scene.material_of(static_cast<std::uint32_t>(mesh))) {
-      table(m->diffuse);
-      table(m->specular);
+      table(m->diffuse.spectrum);
+      table(m->specular.spectrum);
     }
   }
-  for (const TracerLight& light : scene.lights()) table(&light.radiance);
+  for (const TracerLight& light : scene.lights()) table(light.radiance.spectrum);
+  if (scene.environment()) table(scene.environment()->radiance.spectrum);
+  if (settings_.mode == SpectralMode::Bands) {
+    // Each texel colour's spectrum in the form an {"rgb"} spectrum has (1 nm samples), averaged over each band.
+    for (const TracerTexture& texture : scene.textures()) {
+      const std::size_t entries = texture.spectra.palette.size(), nb = settings_.bands.size();
+      std::vector<double> values(entries * nb);
+      parallel_for(entries, settings_.threads, [&](std::size_t i) {
+        const std::vector<double> averages = band_averages(texture.spectra.palette[i].tabulated(), settings_.bands);
+        std::copy(averages.begin(), averages.end(), values.begin() + static_cast<std::ptrdiff_t>(i * nb));
+      });
+      texture_bands_.push_back(std::move(values));
+    }
+  }
+}
+
+Lanes PathTracer::texel_values(const ColourInput& in, std::size_t texel, const Chunk* chunk,
+                               const Lanes& wavelengths) const {
+  const TracerTexture& texture = scene_.textures()[static_cast<std::size_t>(in.texture)];
+  const std::uint32_t entry = texture.spectra.palette_of[texel];
+  if (chunk) {
+    const std::vector<double>& table = texture_bands_[static_cast<std::size_t>(in.texture)];
+    const std::size_t offset = static_cast<std::size_t>(entry) * settings_.bands.size() + static_cast<std::size_t>(chunk->first_band);
+    return Eigen::Map<const Eigen::ArrayXd>(table.data() + offset, chunk->count) * in.scale;
+  }
+  const ScaledSigmoid& s = texture.spectra.palette[entry];
+  Lanes out(wavelengths.size());
+  for (Eigen::Index i = 0; i < wavelengths.size(); ++i) out[i] = s.tabulated_at(wavelengths[i]) * in.scale;
+  return out;
+}
+
+Lanes PathTracer::lane_values(const ColourInput& in, const Vec2& uv, const Chunk* chunk, const Lanes& wavelengths) const {
+  if (in.texture < 0) return lane_values(*in.spectrum, chunk, wavelengths);
+  const ImageTexture& image = *scene_.textures()[static_cast<std::size_t>(in.texture)].image;
+  return texel_values(in, image.texel_at(uv.x(), uv.y()), chunk, wavelengths);
 }
 
 Lanes PathTracer::lane_values(const PiecewiseLinearSpectrum& s, const Chunk* chunk, const Lanes& wavelengths) const {
@@ -265,7 +299,7 @@ void PathTracer::splat(const Path& path, PixelAccumulator& pixel, int layer, con
 
 // Accumulation into components: a contribution that arrived after `scatterings` events from `light`, split
 // into the parts that left the first scattering event diffusely and glossily (or, before it, all emission).
-void PathTracer::contribute(const Path& path, PixelAccumulator& pixel, int scatterings, const TracerLight& light,
+void PathTracer::contribute(const Path& path, PixelAccumulator& pixel, int scatterings, int group,
                             const Lanes& diffuse_part, const Lanes& glossy_part) const {
   const Lanes total = diffuse_part + glossy_part;
   splat(path, pixel, 0, total);
@@ -278,7 +312,7 @@ void PathTracer::contribute(const Path& path, PixelAccumulator& pixel, int scatt
     splat(path, pixel, layers_.diffuse_indirect, diffuse_part);
     splat(path, pixel, layers_.glossy_indirect, glossy_part);
   }
-  if (!layers_.light_group.empty()) splat(path, pixel, layers_.light_group[static_cast<std::size_t>(light.group)], total);
+  if (!layers_.light_group.empty()) splat(path, pixel, layers_.light_group[static_cast<std::size_t>(group)], total);
   if (!layers_.bounce.empty() && scatterings < static_cast<int>(layers_.bounce.size()))
     splat(path, pixel, layers_.bounce[static_cast<std::size_t>(scatterings)], total);
 }
@@ -297,9 +331,24 @@ void PathTracer::add_emission(const Path& path, const SurfaceHit& s, int depth, 
     const double pdf_light = scene_.light_pdf_area(*light) * dist2 / std::abs(s.ng.dot(wo_world));
     weight = power_heuristic(path.prev_pdf, pdf_light);
   }
-  const Lanes le = lane_values(light->radiance, path.chunk, path.wavelengths) * weight;
-  if (depth == 0) contribute(path, pixel, 0, *light, le, Lanes::Zero(path.lanes));
-  else contribute(path, pixel, depth, *light, path.t_diffuse * le, path.t_glossy * le);
+  const Lanes le = lane_values(light->radiance, s.uv, path.chunk, path.wavelengths) * weight;
+  if (depth == 0) contribute(path, pixel, 0, light->group, le, Lanes::Zero(path.lanes));
+  else contribute(path, pixel, depth, light->group, path.t_diffuse * le, path.t_glossy * le);
+}
+
+// The environment seen by a path that leaves the scene: MIS-weighted against next-event estimation having
+// sampled the same direction (unweighted after the camera or a delta lobe).
+void PathTracer::add_environment(const Path& path, int depth, PixelAccumulator& pixel) const {
+  const auto& env = scene_.environment();
+  if (!env) return;
+  double weight = 1.0;
+  if (!path.prev_delta) weight = power_heuristic(path.prev_pdf, env->select_probability * scene_.environment_pdf(path.d.normalized()));
+  const Lanes le = (env->radiance.texture >= 0
+                        ? texel_values(env->radiance, scene_.environment_texel(path.d.normalized()), path.chunk, path.wavelengths)
+                        : lane_values(*env->radiance.spectrum, path.chunk, path.wavelengths)) *
+                   weight;
+  if (depth == 0) contribute(path, pixel, 0, env->group, le, Lanes::Zero(path.lanes));
+  else contribute(path, pixel, depth, env->group, path.t_diffuse * le, path.t_glossy * le);
 }
 
 // Shading setup: the material at a hit, seen from the side the ray arrived on. None when the path ends there:
@@ -316,9 +365,9 @@ std::optional<PathTracer::Shading> PathTracer::shade(SurfaceHit s, const Path& p
   const Frame frame(s.ns);
   const Vec3 wo = frame.to_local(wo_world);
   if (wo.z() <= 0.0) return std::nullopt;
-  const Lanes rho_d = material->diffuse ? lane_values(*material->diffuse, path.chunk, path.wavelengths)
+  const Lanes rho_d = material->diffuse ? lane_values(material->diffuse, s.uv, path.chunk, path.wavelengths)
                                         : Lanes::Zero(path.lanes);
-  const Lanes k_s = material->specular ? lane_values(*material->specular, path.chunk, path.wavelengths)
+  const Lanes k_s = material->specular ? lane_values(material->specular, s.uv, path.chunk, path.wavelengths)
                                        : Lanes::Constant(path.lanes, material->specular_weight);
   return Shading{s, material, frame, wo, rho_d, k_s};
 }
@@ -334,24 +383,40 @@ void PathTracer::sample_direct(const Path& path, const Shading& at, int depth, R
   if (!material.diffuse && material.is_delta()) return;  // a pure mirror: no sampled light meets its delta lobe
   const auto ls = scene_.sample_light(u_light, u_point);
   if (!ls) return;
-  Vec3 to_light = ls->p - at.s.p;
-  const double dist = to_light.norm();
-  to_light /= dist;
-  const double cos_light = std::abs(ls->n.dot(to_light));
+  Vec3 to_light;
+  double pdf_light = 0.0;  // per solid angle
+  if (ls->light) {
+    to_light = ls->p - at.s.p;
+    const double dist = to_light.norm();
+    to_light /= dist;
+    const double cos_light = std::abs(ls->n.dot(to_light));
+    // The light point must emit towards us.
+    if (!(dist > 0.0 && cos_light > 0.0 && TracerScene::emits_towards(*ls->light, ls->n, -to_light))) return;
+    pdf_light = ls->pdf_area * dist * dist / cos_light;
+  } else {
+    to_light = ls->wi;
+    pdf_light = ls->pdf_solid_angle;
+  }
+  // The light must lie above both the shading and the geometric surface.
   const Vec3 wi = at.frame.to_local(to_light);
-  // The light point must lie above both the shading and the geometric surface, and emit towards us.
-  if (!(dist > 0.0 && cos_light > 0.0 && wi.z() > 0.0 && to_light.dot(at.s.ng) > 0.0 &&
-        TracerScene::emits_towards(*ls->light, ls->n, -to_light)))
-    return;
+  if (!(pdf_light > 0.0 && wi.z() > 0.0 && to_light.dot(at.s.ng) > 0.0)) return;
   const LobeValues f = evaluate(material, at.wo, wi);
-  const double pdf_light = ls->pdf_area * dist * dist / cos_light;  // per solid angle
   const double weight = power_heuristic(pdf_light, f.pdf);
-  if (!(f.diffuse > 0.0 || f.glossy > 0.0)) return;                      // the BSDF sends nothing that way
-  if (!scene_.accel().visible(at.s.p, at.s.ng, ls->p, ls->n)) return;  // shadow ray: occluded
-  const Lanes le = lane_values(ls->light->radiance, path.chunk, path.wavelengths) * (weight / pdf_light);
+  if (!(f.diffuse > 0.0 || f.glossy > 0.0)) return;  // the BSDF sends nothing that way
+  // Shadow ray: occluded.
+  if (ls->light ? !scene_.accel().visible(at.s.p, at.s.ng, ls->p, ls->n)
+                : scene_.accel().occluded(offset_origin(at.s.p, at.s.ng, to_light, scene_.accel().scale()), to_light,
+                                          std::numeric_limits<double>::infinity()))
+    return;
+  const ColourInput& radiance = ls->light ? ls->light->radiance : scene_.environment()->radiance;
+  const Lanes le = (ls->light ? lane_values(radiance, ls->uv, path.chunk, path.wavelengths)
+                    : radiance.texture >= 0 ? texel_values(radiance, ls->texel, path.chunk, path.wavelengths)
+                                            : lane_values(*radiance.spectrum, path.chunk, path.wavelengths)) *
+                   (weight / pdf_light);
+  const int group = ls->light ? ls->light->group : scene_.environment()->group;
   const Lanes fd = at.rho_d * f.diffuse, fg = at.k_s * f.glossy;
-  if (depth == 0) contribute(path, pixel, 1, *ls->light, fd * le, fg * le);
-  else contribute(path, pixel, depth + 1, *ls->light, path.t_diffuse * (fd + fg) * le, path.t_glossy * (fd + fg) * le);
+  if (depth == 0) contribute(path, pixel, 1, group, fd * le, fg * le);
+  else contribute(path, pixel, depth + 1, group, path.t_diffuse * (fd + fg) * le, path.t_glossy * (fd + fg) * le);
 }
 
 // BSDF sampling: the direction the path continues in, its throughput through this event, and the next ray.
@@ -398,9 +463,12 @@ void PathTracer::trace_lanes(const Vec3& origin, const Vec3& direction, Random& 
                              PixelAccumulator& pixel) const {
   Path path = start_path(origin, direction, rng, chunk);
   for (int depth = 0;; ++depth) {
-    // Intersection: the path leaves the scene if the ray hits nothing (there is no environment light).
+    // Intersection: the path leaves the scene if the ray hits nothing, and sees the environment if there is one.
     const auto hit = scene_.accel().intersect(path.o, path.d, std::numeric_limits<double>::infinity());
-    if (!hit) break;
+    if (!hit) {
+      add_environment(path, depth, pixel);
+      break;
+    }
     const SurfaceHit s = scene_.surface(*hit);
     add_emission(path, s, depth, pixel);
     if (depth >= settings_.max_bounces) break;

@@ -2,6 +2,10 @@
 // Unidirectional spectral path tracing with next-event estimation and multiple importance sampling (power
 // heuristic) on area lights, and unbiased Russian roulette.
 //
+// The environment is a light like the others: next-event estimation samples it (∝ its texels' radiance × solid
+// angle), and a path that leaves the scene sees it, MIS-weighted against that sampling; seen from the camera it
+// is "emission", and its light group is the environment's.
+//
 // Path components (spectral-exr.md) are attributed exactly, not by sampling which lobe was chosen: at the
 // first scattering event the path's throughput splits into its diffuse and glossy parts, which are carried
 // on separately. A contribution after exactly one scattering event is "direct", after more "indirect"; one
@@ -45,6 +49,7 @@ struct TracerSettings {
   Bands bands;
   std::uint64_t seed = 1;
   bool box_filter = true;
+  int threads = 0;  // for the per-render tables (the textures' band values); 0: all cores
 };
 
 // Accumulates one pixel's layers: layer-major, layer_count × bands doubles.
@@ -86,14 +91,18 @@ class PathTracer {
                    PixelAccumulator& pixel) const;
   Path start_path(const Vec3& origin, const Vec3& direction, Random& rng, const Chunk* chunk) const;
   void add_emission(const Path& path, const SurfaceHit& s, int depth, PixelAccumulator& pixel) const;
+  void add_environment(const Path& path, int depth, PixelAccumulator& pixel) const;
   std::optional<Shading> shade(SurfaceHit s, const Path& path) const;
   void sample_direct(const Path& path, const Shading& at, int depth, Random& rng, PixelAccumulator& pixel) const;
   bool sample_continuation(Path& path, const Shading& at, int depth, Random& rng) const;
   static bool survives_roulette(Path& path, int depth, Random& rng);
-  void contribute(const Path& path, PixelAccumulator& pixel, int scatterings, const TracerLight& light,
-                  const Lanes& diffuse_part, const Lanes& glossy_part) const;
+  void contribute(const Path& path, PixelAccumulator& pixel, int scatterings, int group, const Lanes& diffuse_part,
+                  const Lanes& glossy_part) const;
   void splat(const Path& path, PixelAccumulator& pixel, int layer, const Lanes& value) const;
   Lanes lane_values(const PiecewiseLinearSpectrum& s, const Chunk* chunk, const Lanes& wavelengths) const;
+  // A colour input at texture coordinates `uv`, or (texel_values) at one texel of its texture.
+  Lanes lane_values(const ColourInput& in, const Vec2& uv, const Chunk* chunk, const Lanes& wavelengths) const;
+  Lanes texel_values(const ColourInput& in, std::size_t texel, const Chunk* chunk, const Lanes& wavelengths) const;
 
   const TracerScene& scene_;
   TracerSettings settings_;
@@ -101,6 +110,8 @@ class PathTracer {
   std::vector<Chunk> chunks_;
   // Band averages of every spectrum the tracer uses, for `bands` mode.
   std::vector<std::pair<const PiecewiseLinearSpectrum*, std::vector<double>>> band_tables_;
+  // Per texture, the band averages of each palette entry (palette-major), for `bands` mode.
+  std::vector<std::vector<double>> texture_bands_;
 };
 
 }  // namespace ct::rt

@@ -36,9 +36,10 @@ RenderedImage render(const Scene& scene, const RenderOptions& options) {
   settings.bands = options.bands.value_or(scene.render.bands);
   settings.seed = options.seed.value_or(scene.render.seed);
   settings.box_filter = scene.render.pixel_filter == PixelFilter::Box;
+  settings.threads = options.threads;
   const int spp = options.samples.value_or(scene.render.samples);
 
-  const TracerScene tracer_scene(scene);
+  const TracerScene tracer_scene(scene, options.threads);
   const LayerPlan plan = plan_layers(options.components, tracer_scene.groups(), settings.max_bounces);
   const PathTracer tracer(tracer_scene, settings, plan);
 

@@ -83,5 +83,27 @@ TEST_F(RenderCommand, BadInputGetsExitTwoAndOneLineNamingTheField) {
   EXPECT_TRUE(fs::is_empty(dir_));
 }
 
+TEST_F(RenderCommand, BadTexturesAndEnvironmentsGetExitTwoAndOneLineNamingTheFileAndField) {
+  const std::string bad = std::string(CHROMATRACE_TEST_DATA) + "/scenes/bad/";
+  const fs::path out = dir_ / "out.exr";
+  struct Case {
+    std::string scene;
+    std::vector<std::string> must_mention;
+  };
+  const std::vector<Case> cases = {
+      {"missing_texture.json", {"materials.wood.reflectance.texture", "textures/wood.png", "no such image file"}},
+      {"texture_on_mesh_without_uvs.json", {"objects[0].shape.file", "tetrahedron_no_uvs.ply", "tetra", "texture"}},
+      {"environment_not_an_image.json", {"environment.radiance.texture", "wavelengths_not_increasing.csv"}},
+      {"environment_rotation_without_texture.json", {"environment.rotation_deg"}},
+  };
+  for (const Case& c : cases) {
+    const auto r = run_chromatrace({"render", bad + c.scene, "-o", out.string(), "--spp", "1", "--quiet"});
+    EXPECT_EQ(r.exit_code, 2) << c.scene << ": " << r.err;
+    EXPECT_EQ(line_count(r.err), 1) << r.err;
+    for (const std::string& word : c.must_mention) EXPECT_NE(r.err.find(word), std::string::npos) << word << " in " << r.err;
+    EXPECT_FALSE(fs::exists(out)) << c.scene;
+  }
+}
+
 }  // namespace
 }  // namespace ct

@@ -17,7 +17,7 @@ inline const std::vector<BadScene>& bad_scenes() {
   static const std::vector<BadScene> cases = {
       {"unknown_top_key.json",
        "colour: unknown key (allowed: \"format\", \"name\", \"description\", \"spectra\", \"materials\", "
-       "\"objects\", \"lights\", \"camera\", \"render\")"},
+       "\"objects\", \"lights\", \"environment\", \"camera\", \"render\")"},
       {"unknown_nested_key.json", "materials.wall.colour: unknown key (allowed: \"type\", \"reflectance\")"},
       {"missing_material.json", "objects[0].material: unknown material \"plstic\" (materials: wall)"},
       {"negative_radius.json", "objects[1].shape.radius: must be > 0, got -0.2"},
@@ -41,7 +41,12 @@ inline const std::vector<BadScene>& bad_scenes() {
        "spectra.paint: wavelengths 0.4 to 0.7 do not overlap the visible range 360-830 nm (wavelengths are in nm)"},
       {"sensor_in_metres.json", "camera.sensor_width_mm: must be a width in mm within [1, 1000], got 0.036"},
       {"missing_mesh.json", "objects[0].shape.file: {dir}/meshes/bunny.ply: cannot open file"},
-      {"no_light.json", "lights: a scene needs at least one light"},
+      {"no_light.json", "lights: a scene needs at least one light or an \"environment\""},
+      {"missing_texture.json", "materials.wood.reflectance.texture: {dir}/textures/wood.png: no such image file"},
+      {"texture_on_mesh_without_uvs.json",
+       "objects[0].shape.file: {dir}/tetrahedron_no_uvs.ply has no texture coordinates (vertex properties u, v or "
+       "s, t), but object \"tetra\" has material \"wood\" whose reflectance is a texture"},
+      {"environment_rotation_without_texture.json", "environment.rotation_deg: applies only to a texture radiance"},
       {"duplicate_name.json", "lights[0].name: \"floor\" is already the name of objects[0]"},
       {"series_bad_variant.json", "variants[1] \"rough\": materials.plastic.roughness: must be in [0, 1], got 1.5"},
       {"series_cycle.json", "variants[0].extends: a cycle of extends: a → c → b → a"},

@@ -1,0 +1,60 @@
+#pragma once
+// Image textures: a colour input of the scene format (a reflectance, a diffuse colour, an emitter's or the
+// environment's radiance) that varies over a surface's (u, v) or over directions (docs/scene-format.md,
+// "Textures"). Each texel's RGB is decoded to linear sRGB and upsampled to a spectrum by core/rgb_to_spectrum,
+// the code an {"rgb": [...]} spectrum uses, so a texture of one colour is that colour's spectrum.
+//
+// Lookup is nearest-texel (no filtering): the texel that contains (u, v). (u, v) = (0, 0) is the image's
+// bottom-left corner and (1, 1) its top-right (Blender's convention); u and v repeat outside [0, 1).
+
+#include <array>
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/rgb_to_spectrum.h"
+
+namespace ct {
+
+enum class TextureColourSpace { Srgb, Linear };
+// What the texels mean, which fixes how they are upsampled: a reflectance must lie in [0, 1] and is fitted as
+// an {"rgb"} spectrum is; a radiance may exceed 1 and is fitted in the unbounded form (fit_rgb_unbounded).
+enum class TextureUse { Reflectance, Radiance };
+
+struct ImageTexture {
+  std::string file;  // as written in the scene
+  TextureColourSpace colour_space = TextureColourSpace::Srgb;
+  TextureUse use = TextureUse::Reflectance;
+  double scale = 1.0;  // multiplies every texel's spectrum
+  int width = 0, height = 0;
+  std::vector<float> rgb;  // linear sRGB, 3 per texel, row-major from the image's top row
+
+  std::size_t texel_count() const { return static_cast<std::size_t>(width) * static_cast<std::size_t>(height); }
+  std::array<double, 3> texel(std::size_t index) const {
+    return {rgb[3 * index], rgb[3 * index + 1], rgb[3 * index + 2]};
+  }
+  // The texel containing (u, v) (nearest lookup; u, v repeat), as an index y·width + x with y from the top.
+  std::size_t texel_at(double u, double v) const;
+};
+
+// Reads an image with OpenImageIO (any format it reads: PNG, JPEG, TIFF, EXR, HDR, ...): one channel is grey,
+// two grey and alpha, three or more RGB(A); alpha is ignored. `colour_space` unset: linear for float images
+// (EXR, HDR), sRGB for integer ones (8- or 16-bit PNG, JPEG, TIFF). sRGB texels are decoded with the sRGB
+// transfer curve. Errors are InputErrors "path: message" (a missing or unreadable file, no pixels, texels that
+// are not finite or are negative, a reflectance texel above 1 naming the texel).
+ImageTexture read_image_texture(const std::filesystem::path& path, const std::string& file,
+                                std::optional<TextureColourSpace> colour_space, TextureUse use, double scale);
+
+// The spectra of a texture's texels: each distinct colour is fitted once (on up to `threads` threads; 0: all),
+// in the order of its first texel, so the result does not depend on the thread count.
+struct TexelSpectra {
+  std::vector<std::uint32_t> palette_of;  // per texel: index into palette
+  std::vector<ScaledSigmoid> palette;     // scale · fitted sigmoid, the texture's scale included
+};
+TexelSpectra upsample_texels(const ImageTexture& texture, int threads = 0);
+// The spectrum of one linear sRGB colour as a texture of `use` upsamples it (before the texture's scale).
+ScaledSigmoid texel_spectrum(const std::array<double, 3>& linear_srgb, TextureUse use);
+
+}  // namespace ct
