@@ -25,5 +25,6 @@ Action add_scene_bands(CLI::App& app);
 Action add_export_meshes(CLI::App& app);
 Action add_assemble(CLI::App& app);
 Action add_compare(CLI::App& app);
+Action add_prepare_texture(CLI::App& app);
 
 }  // namespace ct::cli

@@ -31,6 +31,7 @@ int main(int argc, char** argv) {
   add(ct::cli::add_export_meshes(app));
   add(ct::cli::add_assemble(app));
   add(ct::cli::add_compare(app));
+  add(ct::cli::add_prepare_texture(app));
 
   try {
     app.parse(argc, argv);

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <memory>
 #include <unordered_map>
 
 #include <OpenImageIO/imageio.h>
@@ -28,7 +29,30 @@ std::size_t wrapped_cell(double t, int n) {
   return static_cast<std::size_t>(std::min(cell, n - 1.0));
 }
 
+std::unique_ptr<OIIO::ImageInput> open_image(const std::filesystem::path& path) {
+  const std::string name = path.string();
+  if (!std::filesystem::is_regular_file(path)) throw InputError(fmt::format("{}: no such image file", name));
+  auto in = OIIO::ImageInput::open(name);
+  if (!in) {
+    const std::string why = one_line(OIIO::geterror());
+    throw InputError(fmt::format("{}: cannot read image: {}", name, why.empty() ? "unknown format" : why));
+  }
+  const OIIO::ImageSpec& spec = in->spec();
+  if (spec.width < 1 || spec.height < 1 || spec.nchannels < 1)
+    throw InputError(fmt::format("{}: image has no pixels", name));
+  return in;
+}
+
+bool is_float_image(const OIIO::ImageSpec& spec) {
+  return spec.format.basetype == OIIO::TypeDesc::FLOAT || spec.format.basetype == OIIO::TypeDesc::HALF ||
+         spec.format.basetype == OIIO::TypeDesc::DOUBLE;
+}
+
 }  // namespace
+
+TextureColourSpace default_texture_colour_space(const std::filesystem::path& path) {
+  return is_float_image(open_image(path)->spec()) ? TextureColourSpace::Linear : TextureColourSpace::Srgb;
+}
 
 std::size_t ImageTexture::texel_at(double u, double v) const {
   // v runs up from the bottom row; image rows are stored from the top.
@@ -40,24 +64,16 @@ std::size_t ImageTexture::texel_at(double u, double v) const {
 ImageTexture read_image_texture(const std::filesystem::path& path, const std::string& file,
                                 std::optional<TextureColourSpace> colour_space, TextureUse use, double scale) {
   const std::string name = path.string();
-  if (!std::filesystem::is_regular_file(path)) throw InputError(fmt::format("{}: no such image file", name));
-  auto in = OIIO::ImageInput::open(name);
-  if (!in) {
-    const std::string why = one_line(OIIO::geterror());
-    throw InputError(fmt::format("{}: cannot read image: {}", name, why.empty() ? "unknown format" : why));
-  }
+  auto in = open_image(path);
   const OIIO::ImageSpec& spec = in->spec();
-  if (spec.width < 1 || spec.height < 1 || spec.nchannels < 1)
-    throw InputError(fmt::format("{}: image has no pixels", name));
-  const bool is_float = spec.format.basetype == OIIO::TypeDesc::FLOAT ||
-                        spec.format.basetype == OIIO::TypeDesc::HALF ||
-                        spec.format.basetype == OIIO::TypeDesc::DOUBLE;
+  const bool is_float = is_float_image(spec);
   ImageTexture texture;
   texture.file = file;
   texture.colour_space = colour_space.value_or(is_float ? TextureColourSpace::Linear : TextureColourSpace::Srgb);
   texture.use = use;
   texture.scale = scale;
   texture.width = spec.width;
+  texture.had_alpha = spec.alpha_channel >= 0 || spec.nchannels == 2 || spec.nchannels >= 4;
   texture.height = spec.height;
 
   const int channels = spec.nchannels;
@@ -128,6 +144,16 @@ TexelSpectra upsample_texels(const ImageTexture& texture, int threads) {
     out.palette[i] = s;
   });
   return out;
+}
+
+std::vector<double> palette_band_averages(const TexelSpectra& spectra, const Bands& bands, int threads) {
+  const std::size_t entries = spectra.palette.size(), nb = bands.size();
+  std::vector<double> values(entries * nb);
+  parallel_for(entries, threads, [&](std::size_t i) {
+    const std::vector<double> averages = band_averages(spectra.palette[i].tabulated(), bands);
+    std::copy(averages.begin(), averages.end(), values.begin() + static_cast<std::ptrdiff_t>(i * nb));
+  });
+  return values;
 }
 
 }  // namespace ct

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "core/rgb_to_spectrum.h"
+#include "core/spectrum.h"
 
 namespace ct {
 
@@ -30,6 +31,7 @@ struct ImageTexture {
   double scale = 1.0;  // multiplies every texel's spectrum
   int width = 0, height = 0;
   std::vector<float> rgb;  // linear sRGB, 3 per texel, row-major from the image's top row
+  bool had_alpha = false;  // the file has an alpha channel (ignored)
 
   std::size_t texel_count() const { return static_cast<std::size_t>(width) * static_cast<std::size_t>(height); }
   std::array<double, 3> texel(std::size_t index) const {
@@ -47,6 +49,10 @@ struct ImageTexture {
 ImageTexture read_image_texture(const std::filesystem::path& path, const std::string& file,
                                 std::optional<TextureColourSpace> colour_space, TextureUse use, double scale);
 
+// The colour space read_image_texture assumes for the file when none is given: linear for a float image, sRGB
+// for an integer one. Reads the header only; errors as read_image_texture's.
+TextureColourSpace default_texture_colour_space(const std::filesystem::path& path);
+
 // The spectra of a texture's texels: each distinct colour is fitted once (on up to `threads` threads; 0: all),
 // in the order of its first texel, so the result does not depend on the thread count.
 struct TexelSpectra {
@@ -54,6 +60,10 @@ struct TexelSpectra {
   std::vector<ScaledSigmoid> palette;     // scale · fitted sigmoid, the texture's scale included
 };
 TexelSpectra upsample_texels(const ImageTexture& texture, int threads = 0);
+// The band averages of each palette entry's spectrum in the form an {"rgb"} spectrum has (1 nm samples):
+// palette-major, bands.size() values per entry. What the tracer's bands mode looks up per texel, and what
+// `chromatrace prepare-texture` writes for Cycles.
+std::vector<double> palette_band_averages(const TexelSpectra& spectra, const Bands& bands, int threads = 0);
 // The spectrum of one linear sRGB colour as a texture of `use` upsamples it (before the texture's scale).
 ScaledSigmoid texel_spectrum(const std::array<double, 3>& linear_srgb, TextureUse use);
 

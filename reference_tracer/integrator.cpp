@@ -154,15 +154,8 @@ PathTracer::PathTracer(const TracerScene& scene, TracerSettings settings, LayerP
   if (scene.environment()) table(scene.environment()->radiance.spectrum);
   if (settings_.mode == SpectralMode::Bands) {
     // Each texel colour's spectrum in the form an {"rgb"} spectrum has (1 nm samples), averaged over each band.
-    for (const TracerTexture& texture : scene.textures()) {
-      const std::size_t entries = texture.spectra.palette.size(), nb = settings_.bands.size();
-      std::vector<double> values(entries * nb);
-      parallel_for(entries, settings_.threads, [&](std::size_t i) {
-        const std::vector<double> averages = band_averages(texture.spectra.palette[i].tabulated(), settings_.bands);
-        std::copy(averages.begin(), averages.end(), values.begin() + static_cast<std::ptrdiff_t>(i * nb));
-      });
-      texture_bands_.push_back(std::move(values));
-    }
+    for (const TracerTexture& texture : scene.textures())
+      texture_bands_.push_back(palette_band_averages(texture.spectra, settings_.bands, settings_.threads));
   }
 }
 

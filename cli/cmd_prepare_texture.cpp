@@ -1,0 +1,104 @@
+// chromatrace prepare-texture IMAGE -o DIR: per-band-group textures for Cycles (the Blender add-on), upsampled
+// per texel exactly as the tracer upsamples the original texture (core/texture_prep.h).
+#include <memory>
+#include <string>
+
+#include <fmt/core.h>
+
+#include "cli/command.h"
+#include "core/band_plan.h"
+#include "core/error.h"
+#include "core/json_input.h"
+#include "core/texture_prep.h"
+
+namespace ct::cli {
+namespace {
+
+struct Options {
+  std::string image, bands, bands_file, kind, colour_space = "auto", output;
+  int bands_per_render = 3;
+  int threads = 0;
+  bool json = false, quiet = false;
+};
+
+int run(const Options& o) {
+  if (!o.bands.empty() && !o.bands_file.empty())
+    throw InputError("--bands-file: give either --bands or --bands-file, not both");
+  if (o.bands.empty() && o.bands_file.empty()) throw InputError("--bands: give --bands lo:hi:width or --bands-file PLAN");
+  TexturePrepRequest request;
+  request.image = o.image;
+  if (o.kind == "reflectance") request.use = TextureUse::Reflectance;
+  else if (o.kind == "radiance") request.use = TextureUse::Radiance;
+  else throw InputError(fmt::format("--kind: expected reflectance or radiance, got \"{}\"", o.kind));
+  if (o.colour_space == "sRGB") request.colour_space = TextureColourSpace::Srgb;
+  else if (o.colour_space == "linear") request.colour_space = TextureColourSpace::Linear;
+  else if (o.colour_space != "auto")
+    throw InputError(fmt::format("--colour-space: expected sRGB, linear or auto, got \"{}\"", o.colour_space));
+  request.bands = o.bands.empty() ? read_band_plan(o.bands_file) : Bands::parse(o.bands, "--bands");
+  if (o.bands_per_render < 1 || o.bands_per_render > 3)
+    throw InputError(fmt::format("--bands-per-render: must be 1 to 3, got {}", o.bands_per_render));
+  request.bands_per_render = o.bands_per_render;
+  request.threads = o.threads;
+
+  const TexturePrepResult r = prepare_texture(request, o.output);
+  const char* space = r.colour_space == TextureColourSpace::Srgb ? "sRGB" : "linear";
+  if (!o.quiet) {
+    if (r.had_alpha) fmt::print(stderr, "chromatrace prepare-texture: {}: alpha channel ignored\n", o.image);
+    if (r.cached)
+      fmt::print(stderr, "chromatrace prepare-texture: {}: cached ({} files for hash {} in {}), nothing to do\n", o.image,
+                 r.files.size(), r.hash, o.output);
+    else
+      fmt::print(stderr, "chromatrace prepare-texture: {}: {}x{} texels ({} colours, {}) -> {} group files in {} ({:.2f} s)\n",
+                 o.image, r.width, r.height, r.distinct_colours, space, r.files.size(), o.output, r.seconds);
+  }
+  if (o.json) {
+    Json groups = Json::array();
+    for (std::size_t g = 0; g < r.groups.size(); ++g) {
+      std::vector<double> centres;
+      for (const std::size_t b : r.groups[g]) centres.push_back(request.bands.centre(b));
+      groups.push_back({{"group", g}, {"bands", r.groups[g]}, {"centres_nm", centres}, {"file", r.files[g].string()}});
+    }
+    const Json summary = {{"image", o.image},
+                          {"hash", r.hash},
+                          {"cached", r.cached},
+                          {"kind", o.kind},
+                          {"colour_space", space},
+                          {"width", r.width},
+                          {"height", r.height},
+                          {"texels", r.texels},
+                          {"distinct_colours", r.distinct_colours},
+                          {"alpha_ignored", r.had_alpha},
+                          {"bands_per_render", request.bands_per_render},
+                          {"manifest", r.manifest.string()},
+                          {"groups", groups},
+                          {"seconds", r.seconds}};
+    fmt::print("{}\n", summary.dump(1));
+  } else {
+    for (const auto& f : r.files) fmt::print("{}\n", f.string());
+  }
+  return 0;
+}
+
+}  // namespace
+
+Action add_prepare_texture(CLI::App& app) {
+  auto o = std::make_shared<Options>();
+  auto* cmd = app.add_subcommand(
+      "prepare-texture",
+      "Per-band-group EXR textures (R, G, B = band averages of each texel's spectrum) of an image texture or HDRI, "
+      "for Cycles through the Blender add-on; cached by content");
+  cmd->add_option("image", o->image, "image texture or HDRI (any format OpenImageIO reads)")->required();
+  cmd->add_option("--bands", o->bands, "Band plan lo:hi:width in nm");
+  cmd->add_option("--bands-file", o->bands_file, "Band plan file (chromatrace-bands/1: {\"edges_nm\": [...]})");
+  cmd->add_option("--kind", o->kind, "reflectance (texels in [0, 1]) or radiance (lights, environment)")->required();
+  cmd->add_option("--colour-space", o->colour_space,
+                  "sRGB, linear or auto (auto: linear for float images, sRGB for integer ones)")->capture_default_str();
+  cmd->add_option("--bands-per-render", o->bands_per_render, "Bands to a group (1 to 3), as the add-on renders them")->capture_default_str();
+  cmd->add_option("-o,--output", o->output, "Output directory (the cache)")->required();
+  cmd->add_option("--threads", o->threads, "Threads (0: all)")->capture_default_str();
+  cmd->add_flag("--json", o->json, "Print a JSON summary");
+  cmd->add_flag("--quiet", o->quiet, "No messages on stderr");
+  return [o] { return run(*o); };
+}
+
+}  // namespace ct::cli

@@ -1,0 +1,228 @@
+// `chromatrace prepare-texture`: per-band-group textures for Cycles, end to end through the executable. The
+// texel values must be the band averages of the tracer's own per-texel spectra (core/texture.h).
+#include <unistd.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <OpenImageIO/imageio.h>
+#include <fmt/core.h>
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "core/colour.h"
+#include "core/spectrum.h"
+#include "core/texture.h"
+#include "tests/cli/run_command.h"
+
+namespace ct {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+using test::run_chromatrace;
+
+int line_count(const std::string& s) { return static_cast<int>(std::count(s.begin(), s.end(), '\n')); }
+
+class PrepareTexture : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / fmt::format("ct-prep-{}-{}", ::getpid(), counter_++);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  // Float pixels for .exr, 8-bit (values 0..255 given as floats / 255) otherwise; rows from the top.
+  fs::path write_image(const std::string& name, int width, int height, const std::vector<float>& pixels,
+                       int channels = 3) const {
+    const fs::path path = dir_ / name;
+    auto out = OIIO::ImageOutput::create(path.string());
+    const bool exr = path.extension() == ".exr";
+    OIIO::ImageSpec spec(width, height, channels, exr ? OIIO::TypeDesc::FLOAT : OIIO::TypeDesc::UINT8);
+    EXPECT_TRUE(out->open(path.string(), spec));
+    EXPECT_TRUE(out->write_image(OIIO::TypeDesc::FLOAT, pixels.data()));
+    out->close();
+    return path;
+  }
+
+  static std::vector<float> read_rgb(const fs::path& path, int& width, int& height) {
+    auto in = OIIO::ImageInput::open(path.string());
+    EXPECT_TRUE(in) << path;
+    if (!in) return {};
+    const OIIO::ImageSpec& spec = in->spec();
+    EXPECT_EQ(spec.nchannels, 3);
+    EXPECT_EQ(spec.format, OIIO::TypeDesc::FLOAT);
+    width = spec.width;
+    height = spec.height;
+    std::vector<float> pixels(static_cast<std::size_t>(width * height * 3));
+    EXPECT_TRUE(in->read_image(0, 0, 0, 3, OIIO::TypeDesc::FLOAT, pixels.data()));
+    return pixels;
+  }
+
+  json run_json(const std::vector<std::string>& args) const {
+    std::vector<std::string> all = {"prepare-texture"};
+    all.insert(all.end(), args.begin(), args.end());
+    all.insert(all.end(), {"-o", (dir_ / "cache").string(), "--json"});
+    const auto r = run_chromatrace(all);
+    EXPECT_EQ(r.exit_code, 0) << r.err;
+    return r.exit_code == 0 ? json::parse(r.out) : json();
+  }
+
+  fs::path dir_;
+  static inline int counter_ = 0;
+};
+
+TEST_F(PrepareTexture, GroupTexelsAreTheTracersBandAverages) {
+  // 2×2 sRGB-encoded 8-bit colours, rows from the top.
+  const std::vector<int> bytes = {255, 0, 0, 0, 128, 255, 200, 180, 20, 64, 64, 64};
+  std::vector<float> pixels;
+  for (const int b : bytes) pixels.push_back(static_cast<float>(b) / 255.0f);
+  const fs::path png = write_image("colours.png", 2, 2, pixels);
+
+  const json summary = run_json({png.string(), "--bands", "400:470:10", "--kind", "reflectance"});
+  ASSERT_TRUE(summary.is_object());
+  EXPECT_FALSE(summary["cached"].get<bool>());
+  EXPECT_EQ(summary["colour_space"], "sRGB");
+  EXPECT_EQ(summary["texels"], 4);
+  EXPECT_EQ(summary["distinct_colours"], 4);
+  ASSERT_EQ(summary["groups"].size(), 3u);  // 7 bands, 3 to a render: [0,1,2], [3,4,5], [6]
+  EXPECT_EQ(summary["groups"][2]["bands"], json::array({6}));
+
+  const Bands bands = Bands::parse("400:470:10");
+  for (std::size_t g = 0; g < 3; ++g) {
+    int w = 0, h = 0;
+    const std::vector<float> out = read_rgb(summary["groups"][g]["file"].get<std::string>(), w, h);
+    ASSERT_EQ(w, 2);
+    ASSERT_EQ(h, 2);
+    for (std::size_t t = 0; t < 4; ++t) {
+      std::array<double, 3> rgb{};
+      // Decoded as read_image_texture does: the 8-bit value as a float, the sRGB curve, stored as a float.
+      for (std::size_t c = 0; c < 3; ++c) rgb[c] = static_cast<float>(srgb_decode(pixels[3 * t + c]));
+      const std::vector<double> expected =
+          band_averages(texel_spectrum(rgb, TextureUse::Reflectance).tabulated(), bands);
+      for (std::size_t c = 0; c < 3; ++c) {
+        const std::size_t band = 3 * g + c;
+        const float want = band < 7 ? static_cast<float>(expected[band]) : 0.0f;
+        EXPECT_EQ(out[3 * t + c], want) << "group " << g << " texel " << t << " channel " << c;
+      }
+    }
+  }
+}
+
+TEST_F(PrepareTexture, GreyIsFlat) {
+  const fs::path grey = write_image("grey.exr", 4, 2, std::vector<float>(4 * 2 * 3, 0.5f));
+  for (const char* kind : {"reflectance", "radiance"}) {
+    const json summary = run_json({grey.string(), "--bands", "400:700:20", "--kind", kind});
+    ASSERT_TRUE(summary.is_object());
+    EXPECT_EQ(summary["colour_space"], "linear");
+    EXPECT_EQ(summary["distinct_colours"], 1);
+    ASSERT_EQ(summary["groups"].size(), 5u);
+    for (const json& g : summary["groups"]) {
+      int w = 0, h = 0;
+      const std::vector<float> out = read_rgb(g["file"].get<std::string>(), w, h);
+      for (const float v : out) EXPECT_NEAR(v, 0.5f, 1e-6) << kind << " " << g["file"];
+    }
+  }
+}
+
+TEST_F(PrepareTexture, CachesByContent) {
+  const fs::path png = write_image("c.png", 3, 2, {0.1f, 0.2f, 0.3f, 0.4f, 0.5f, 0.6f, 0.7f, 0.8f, 0.9f,
+                                                   1.0f, 0.0f, 0.5f, 0.2f, 0.2f, 0.2f, 0.9f, 0.1f, 0.1f});
+  const json first = run_json({png.string(), "--bands", "400:500:20", "--kind", "reflectance"});
+  ASSERT_TRUE(first.is_object());
+  EXPECT_FALSE(first["cached"].get<bool>());
+  std::vector<fs::file_time_type> times;
+  for (const json& g : first["groups"]) times.push_back(fs::last_write_time(g["file"].get<std::string>()));
+  const auto count_files = [&] {
+    return std::distance(fs::directory_iterator(dir_ / "cache"), fs::directory_iterator());
+  };
+  const auto files_before = count_files();
+  EXPECT_EQ(files_before, 3);  // two groups and the manifest
+
+  const auto again = run_chromatrace({"prepare-texture", png.string(), "--bands", "400:500:20", "--kind",
+                                      "reflectance", "-o", (dir_ / "cache").string(), "--json"});
+  ASSERT_EQ(again.exit_code, 0) << again.err;
+  const json second = json::parse(again.out);
+  EXPECT_TRUE(second["cached"].get<bool>());
+  EXPECT_NE(again.err.find("cached"), std::string::npos) << again.err;
+  EXPECT_EQ(second["hash"], first["hash"]);
+  EXPECT_EQ(second["distinct_colours"], first["distinct_colours"]);
+  EXPECT_EQ(second["groups"], first["groups"]);
+  for (std::size_t g = 0; g < times.size(); ++g)
+    EXPECT_EQ(fs::last_write_time(first["groups"][g]["file"].get<std::string>()), times[g]);
+  EXPECT_EQ(count_files(), files_before);
+
+  const auto quiet = run_chromatrace({"prepare-texture", png.string(), "--bands", "400:500:20", "--kind",
+                                      "reflectance", "-o", (dir_ / "cache").string(), "--quiet"});
+  EXPECT_EQ(quiet.exit_code, 0);
+  EXPECT_EQ(quiet.err, "");
+
+  // Another band plan, group size, kind or colour space is another hash.
+  const json plan = run_json({png.string(), "--bands", "400:500:25", "--kind", "reflectance"});
+  const json per_render = run_json({png.string(), "--bands", "400:500:20", "--kind", "reflectance", "--bands-per-render", "2"});
+  const json kind = run_json({png.string(), "--bands", "400:500:20", "--kind", "radiance"});
+  const json space = run_json({png.string(), "--bands", "400:500:20", "--kind", "reflectance", "--colour-space", "linear"});
+  for (const json* other : {&plan, &per_render, &kind, &space}) {
+    EXPECT_FALSE((*other)["cached"].get<bool>());
+    EXPECT_NE((*other)["hash"], first["hash"]);
+  }
+  EXPECT_EQ(per_render["groups"].size(), 3u);
+  // Naming the default colour space is the same request as leaving it to the file's type.
+  EXPECT_EQ(run_json({png.string(), "--bands", "400:500:20", "--kind", "reflectance", "--colour-space", "sRGB"})["cached"], true);
+}
+
+TEST_F(PrepareTexture, ReflectanceAboveOneIsRefusedNamingTheTexel) {
+  std::vector<float> pixels(2 * 2 * 3, 0.25f);
+  pixels[3 * 1 + 1] = 1.5f;  // texel (1, 0), green
+  const fs::path hot = write_image("hot.exr", 2, 2, pixels);
+  const auto r = run_chromatrace({"prepare-texture", hot.string(), "--bands", "400:700:10", "--kind", "reflectance",
+                                  "-o", (dir_ / "cache").string()});
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_EQ(line_count(r.err), 1) << r.err;
+  EXPECT_NE(r.err.find(hot.string()), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("texel (1, 0)"), std::string::npos) << r.err;
+  EXPECT_TRUE(!fs::exists(dir_ / "cache") || fs::is_empty(dir_ / "cache"));
+  // The same image is a valid radiance (an HDRI may exceed 1).
+  EXPECT_EQ(run_json({hot.string(), "--bands", "400:700:10", "--kind", "radiance"})["texels"], 4);
+}
+
+TEST_F(PrepareTexture, BadInputIsOneLineExitTwo) {
+  const fs::path png = write_image("ok.png", 1, 1, {0.5f, 0.5f, 0.5f});
+  const std::string out = (dir_ / "cache").string();
+  struct Case {
+    std::vector<std::string> args;
+    std::string must_mention;
+  };
+  const std::vector<Case> cases = {
+      {{(dir_ / "missing.png").string(), "--bands", "400:700:10", "--kind", "reflectance"}, "missing.png: no such image file"},
+      {{png.string(), "--bands", "400:700:10", "--kind", "albedo"}, "--kind"},
+      {{png.string(), "--bands", "400:700:7", "--kind", "reflectance"}, "--bands"},
+      {{png.string(), "--bands", "400:700:10", "--kind", "reflectance", "--colour-space", "ACES"}, "--colour-space"},
+      {{png.string(), "--bands", "400:700:10", "--kind", "reflectance", "--bands-per-render", "4"}, "--bands-per-render"},
+      {{png.string(), "--bands-file", (dir_ / "no-plan.json").string(), "--kind", "reflectance"}, "no-plan.json"},
+      {{png.string(), "--kind", "reflectance"}, "--bands"},
+  };
+  for (const Case& c : cases) {
+    std::vector<std::string> args = {"prepare-texture"};
+    args.insert(args.end(), c.args.begin(), c.args.end());
+    args.insert(args.end(), {"-o", out});
+    const auto r = run_chromatrace(args);
+    EXPECT_EQ(r.exit_code, 2) << c.must_mention << ": " << r.err;
+    EXPECT_EQ(line_count(r.err), 1) << r.err;
+    EXPECT_NE(r.err.find(c.must_mention), std::string::npos) << r.err;
+  }
+}
+
+TEST_F(PrepareTexture, AlphaIsIgnoredAndSaid) {
+  const fs::path rgba = write_image("rgba.png", 1, 1, {0.5f, 0.25f, 0.75f, 0.0f}, 4);
+  const auto r = run_chromatrace({"prepare-texture", rgba.string(), "--bands", "400:700:100", "--kind", "reflectance",
+                                  "-o", (dir_ / "cache").string(), "--json"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find("alpha channel ignored"), std::string::npos) << r.err;
+  EXPECT_TRUE(json::parse(r.out)["alpha_ignored"].get<bool>());
+}
+
+}  // namespace
+}  // namespace ct
