@@ -91,15 +91,16 @@ TEST_F(PrepareTexture, GroupTexelsAreTheTracersBandAverages) {
   EXPECT_EQ(summary["groups"][2]["bands"], json::array({6}));
 
   const Bands bands = Bands::parse("400:470:10");
+  const ImageTexture texture = read_image_texture(png, "colours.png", std::nullopt, TextureUse::Reflectance, 1.0);
   for (std::size_t g = 0; g < 3; ++g) {
     int w = 0, h = 0;
     const std::vector<float> out = read_rgb(summary["groups"][g]["file"].get<std::string>(), w, h);
     ASSERT_EQ(w, 2);
     ASSERT_EQ(h, 2);
     for (std::size_t t = 0; t < 4; ++t) {
-      std::array<double, 3> rgb{};
-      // Decoded as read_image_texture does: the 8-bit value as a float, the sRGB curve, stored as a float.
-      for (std::size_t c = 0; c < 3; ++c) rgb[c] = static_cast<float>(srgb_decode(pixels[3 * t + c]));
+      // The texel as the tracer decodes it (OpenImageIO's 8-bit to float conversion, the sRGB curve).
+      const std::array<double, 3> rgb = texture.texel(t);
+      for (std::size_t c = 0; c < 3; ++c) EXPECT_NEAR(rgb[c], srgb_decode(pixels[3 * t + c]), 1e-6);
       const std::vector<double> expected =
           band_averages(texel_spectrum(rgb, TextureUse::Reflectance).tabulated(), bands);
       for (std::size_t c = 0; c < 3; ++c) {
