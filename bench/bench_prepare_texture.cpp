@@ -5,7 +5,8 @@
 // same process: the image only read with OpenImageIO and written back as float RGB EXRs (ZIP), as many as
 // there are band groups (the I/O limit), and the second, cached call. Times are medians of alternating runs.
 //
-//   bench_prepare_texture [--width W] [--height H] [--bands lo:hi:w] [--runs R] [--threads T] [--hdr] [--keep DIR]
+//   bench_prepare_texture [--width W] [--height H] [--bands lo:hi:w] [--runs R] [--threads T] [--noise N] [--levels L]
+//                         [--hdr] [--keep DIR]
 #include <unistd.h>
 
 #include <algorithm>
@@ -29,8 +30,10 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// Smooth colour fields with per-texel noise (two 8-bit levels, or 1 % in the HDR), like a photographed texture.
-void make_texture(const fs::path& path, int width, int height, bool hdr) {
+// Smooth colour fields with per-texel noise (--noise N: ±N/2 8-bit levels, default 0; 1 % in the HDR). The number
+// of distinct colours, which decides the time (each is fitted once), grows quickly with the noise. --levels L
+// posterises each 8-bit channel to L levels instead (at most L³ colours).
+void make_texture(const fs::path& path, int width, int height, bool hdr, double noise_levels, int levels) {
   std::vector<float> pixels(static_cast<std::size_t>(width) * static_cast<std::size_t>(height) * 3);
   for (int y = 0; y < height; ++y)
     for (int x = 0; x < width; ++x) {
@@ -40,7 +43,8 @@ void make_texture(const fs::path& path, int width, int height, bool hdr) {
       for (int c = 0; c < 3; ++c) {
         double value = 0.5 + 0.35 * std::sin(5 * u + 1.7 * c) * std::cos(4 * v - 0.9 * c);
         if (hdr) value = value * (1.0 + 0.01 * (noise.uniform() - 0.5)) * (v < 0.1 ? 20.0 : 1.0);
-        else value = std::clamp(std::round(value * 255 + 4 * (noise.uniform() - 0.5)), 0.0, 255.0) / 255.0;
+        else if (levels > 0) value = std::round(value * (levels - 1)) / (levels - 1);
+        else value = std::clamp(std::round(value * 255 + noise_levels * (noise.uniform() - 0.5)), 0.0, 255.0) / 255.0;
         pixels[3 * t + static_cast<std::size_t>(c)] = static_cast<float>(value);
       }
     }
@@ -93,6 +97,8 @@ int main(int argc, char** argv) {
   int width = 4096, height = 2048, runs = 3, threads = 0;
   std::string bands_text = "400:700:10";
   bool hdr = false, keep = false;
+  double noise_levels = 0.0;
+  int levels = 0;
   fs::path dir = fs::temp_directory_path() / fmt::format("ct-bench-prep-{}", ::getpid());
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
@@ -103,10 +109,12 @@ int main(int argc, char** argv) {
     else if (a == "--runs" && has_value) runs = std::stoi(argv[++i]);
     else if (a == "--threads" && has_value) threads = std::stoi(argv[++i]);
     else if (a == "--keep" && has_value) dir = argv[++i], keep = true;
+    else if (a == "--noise" && has_value) noise_levels = std::stod(argv[++i]);
+    else if (a == "--levels" && has_value) levels = std::stoi(argv[++i]);
     else if (a == "--hdr") hdr = true;
     else {
       fmt::print(stderr, "usage: bench_prepare_texture [--width W] [--height H] [--bands lo:hi:w] [--runs R] "
-                         "[--threads T] [--hdr] [--keep DIR]\n");
+                         "[--threads T] [--noise N] [--levels L] [--hdr] [--keep DIR]\n");
       return 2;
     }
   }
@@ -115,7 +123,7 @@ int main(int argc, char** argv) {
   OIIO::attribute("threads", threads);
   fs::create_directories(dir);
   const fs::path image = dir / (hdr ? "texture.exr" : "texture.png");
-  make_texture(image, width, height, hdr);
+  make_texture(image, width, height, hdr, noise_levels, levels);
 
   ct::TexturePrepRequest request;
   request.image = image;
