@@ -137,6 +137,8 @@ TexturePrepResult prepare_texture(const TexturePrepRequest& request, const std::
   const auto start = std::chrono::steady_clock::now();
   const auto elapsed = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
   if (request.bands.size() == 0) throw InputError("bands: no bands");
+  if (!std::filesystem::is_regular_file(request.image))
+    throw InputError(fmt::format("{}: no such image file", request.image.string()));
   TexturePrepResult result;
   result.groups = band_groups(request.bands.size(), request.bands_per_render);
   result.colour_space = resolved_colour_space(request);
