@@ -15,6 +15,7 @@
 #include "core/colour.h"
 #include "core/spectrum.h"
 #include "core/texture.h"
+#include "tests/core/image_fixtures.h"
 #include "tests/cli/run_command.h"
 
 namespace ct {
@@ -37,14 +38,7 @@ class PrepareTexture : public ::testing::Test {
   // Float pixels for .exr, 8-bit (values 0..255 given as floats / 255) otherwise; rows from the top.
   fs::path write_image(const std::string& name, int width, int height, const std::vector<float>& pixels,
                        int channels = 3) const {
-    const fs::path path = dir_ / name;
-    auto out = OIIO::ImageOutput::create(path.string());
-    const bool exr = path.extension() == ".exr";
-    OIIO::ImageSpec spec(width, height, channels, exr ? OIIO::TypeDesc::FLOAT : OIIO::TypeDesc::UINT8);
-    EXPECT_TRUE(out->open(path.string(), spec));
-    EXPECT_TRUE(out->write_image(OIIO::TypeDesc::FLOAT, pixels.data()));
-    out->close();
-    return path;
+    return test::write_test_image(dir_ / name, width, height, pixels, channels);
   }
 
   static std::vector<float> read_rgb(const fs::path& path, int& width, int& height) {

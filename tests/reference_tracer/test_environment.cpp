@@ -7,6 +7,8 @@
 // estimates), or float rounding where the answer is deterministic.
 #include <gtest/gtest.h>
 
+#include "tests/core/image_fixtures.h"
+
 #include <cmath>
 #include <filesystem>
 #include <numbers>
@@ -42,14 +44,7 @@ class EnvironmentTest : public ::testing::Test {
   // Writes an image of `channels` channels (float for .exr, 8-bit otherwise), rows from the top.
   fs::path write_image(const std::string& name, int width, int height, const std::vector<float>& pixels,
                        int channels = 3) const {
-    const fs::path path = dir_ / name;
-    auto out = OIIO::ImageOutput::create(path.string());
-    const bool exr = path.extension() == ".exr";
-    OIIO::ImageSpec spec(width, height, channels, exr ? OIIO::TypeDesc::FLOAT : OIIO::TypeDesc::UINT8);
-    EXPECT_TRUE(out->open(path.string(), spec));
-    EXPECT_TRUE(out->write_image(OIIO::TypeDesc::FLOAT, pixels.data()));
-    out->close();
-    return path;
+    return test::write_test_image(dir_ / name, width, height, pixels, channels);
   }
   Scene scene(const json& doc) const { return parse_scene(doc, "test-scene", dir_); }
 
