@@ -11,6 +11,7 @@
 
 #include "cli/command.h"
 #include "core/error.h"
+#include "core/geometry.h"
 #include "core/json_input.h"
 #include "core/ply.h"
 #include "core/scene.h"
@@ -22,7 +23,7 @@ namespace fs = std::filesystem;
 
 struct Options {
   std::string scene, directory;
-  bool ascii = false, json = false, quiet = false;
+  bool ascii = false, json = false, quiet = false, uvs = false;
 };
 
 // "007_left wall" -> "007_left_wall.ply": the id keeps names unique, the name keeps files readable.
@@ -54,7 +55,14 @@ int run(const Options& o) {
     const std::string& name = is_light ? scene.lights[i - scene.objects.size()].name : scene.objects[i].name;
     const int id = static_cast<int>(i) + 1;
     const std::string file = mesh_file_name(id, name);
-    write_ply(dir / file, meshes[i], format);
+    if (o.uvs) {
+      const std::vector<std::array<Vec2, 3>> uvs =
+          is_light ? std::visit([](const auto& shape) { return corner_uvs(Shape(shape)); }, scene.lights[i - scene.objects.size()].shape)
+                   : corner_uvs(scene.objects[i].shape);
+      write_ply(dir / file, with_vertex_uvs(meshes[i], uvs), format);
+    } else {
+      write_ply(dir / file, meshes[i], format);
+    }
     triangles += meshes[i].triangles.size();
     (is_light ? lights : objects)
         .push_back({{"name", name},
@@ -80,6 +88,9 @@ Action add_export_meshes(CLI::App& app) {
   cmd->add_option("scene", o->scene, "Scene file (chromatrace-scene/1)")->required();
   cmd->add_option("directory", o->directory, "Output directory (created if missing; its parent must exist)")->required();
   cmd->add_flag("--ascii", o->ascii, "Write ASCII PLY instead of binary little-endian");
+  cmd->add_flag("--uvs", o->uvs,
+                "Write each vertex's texture coordinates (u, v) as the tracer maps textures, a vertex on a seam once per "
+                "(u, v)");
   cmd->add_flag("--json", o->json, "Print the list of files (name, object id, file, triangles, smooth) as JSON");
   cmd->add_flag("-q,--quiet", o->quiet, "Print nothing on success");
   return [o] { return run(*o); };

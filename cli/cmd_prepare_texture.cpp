@@ -18,7 +18,7 @@ struct Options {
   std::string image, bands, bands_file, kind, colour_space = "auto", output;
   int bands_per_render = 3;
   int threads = 0;
-  bool json = false, quiet = false;
+  bool json = false, quiet = false, replicate = false;
 };
 
 int run(const Options& o) {
@@ -38,6 +38,9 @@ int run(const Options& o) {
   if (o.bands_per_render < 1 || o.bands_per_render > 3)
     throw InputError(fmt::format("--bands-per-render: must be 1 to 3, got {}", o.bands_per_render));
   request.bands_per_render = o.bands_per_render;
+  if (o.replicate && o.bands_per_render != 1)
+    throw InputError(fmt::format("--replicate: needs --bands-per-render 1, got {}", o.bands_per_render));
+  request.replicate = o.replicate;
   request.threads = o.threads;
 
   const TexturePrepResult r = prepare_texture(request, o.output);
@@ -69,6 +72,7 @@ int run(const Options& o) {
                           {"distinct_colours", r.distinct_colours},
                           {"alpha_ignored", r.had_alpha},
                           {"bands_per_render", request.bands_per_render},
+                          {"replicate", request.replicate},
                           {"manifest", r.manifest.string()},
                           {"groups", groups},
                           {"seconds", r.seconds}};
@@ -94,6 +98,8 @@ Action add_prepare_texture(CLI::App& app) {
   cmd->add_option("--colour-space", o->colour_space,
                   "sRGB, linear or auto (auto: linear for float images, sRGB for integer ones)")->capture_default_str();
   cmd->add_option("--bands-per-render", o->bands_per_render, "Bands to a group (1 to 3), as the add-on renders them")->capture_default_str();
+  cmd->add_flag("--replicate", o->replicate,
+                "With --bands-per-render 1: the band in R, G and B (the add-on's one-band fallback), not R alone");
   cmd->add_option("-o,--output", o->output, "Output directory (the cache)")->required();
   cmd->add_option("--threads", o->threads, "Threads (0: all)")->capture_default_str();
   cmd->add_flag("--json", o->json, "Print a JSON summary");

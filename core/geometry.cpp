@@ -1,6 +1,11 @@
 #include "core/geometry.h"
 
 #include <cmath>
+#include <map>
+#include <stdexcept>
+#include <tuple>
+
+#include <fmt/core.h>
 #include <numbers>
 
 namespace ct {
@@ -243,6 +248,32 @@ std::vector<std::array<Vec2, 3>> shape_uvs(const MeshShape& shape) {
 
 std::vector<std::array<Vec2, 3>> corner_uvs(const Shape& shape) {
   return std::visit([](const auto& s) { return shape_uvs(s); }, shape);
+}
+
+TriangleMesh with_vertex_uvs(const TriangleMesh& mesh, const std::vector<std::array<Vec2, 3>>& uvs) {
+  if (uvs.empty()) return mesh;
+  if (uvs.size() != mesh.triangles.size())
+    throw std::invalid_argument(fmt::format("with_vertex_uvs: {} corner (u, v) triples for {} triangles", uvs.size(),
+                                            mesh.triangles.size()));
+  TriangleMesh out;
+  std::map<std::tuple<std::uint32_t, double, double>, std::uint32_t> index;  // (vertex, u, v) -> new vertex
+  out.triangles.reserve(mesh.triangles.size());
+  for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
+    std::array<std::uint32_t, 3> triangle{};
+    for (std::size_t c = 0; c < 3; ++c) {
+      const std::uint32_t v = mesh.triangles[t][c];
+      const Vec2& uv = uvs[t][c];
+      const auto [it, added] = index.try_emplace({v, uv.x(), uv.y()}, static_cast<std::uint32_t>(out.positions.size()));
+      if (added) {
+        out.positions.push_back(mesh.positions[v]);
+        if (!mesh.normals.empty()) out.normals.push_back(mesh.normals[v]);
+        out.uvs.push_back(uv);
+      }
+      triangle[c] = it->second;
+    }
+    out.triangles.push_back(triangle);
+  }
+  return out;
 }
 
 double surface_area(const QuadShape& quad) { return quad.edge1.cross(quad.edge2).norm(); }

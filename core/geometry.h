@@ -105,6 +105,11 @@ TriangleMesh tessellate(const Shape& shape);
 // cylinder side: u = angle / 2π in its frame, v = height fraction; its caps: the unit disc mapped to
 // [0, 1]²; mesh: the file's per-vertex coordinates. Empty for a mesh without them.
 std::vector<std::array<Vec2, 3>> corner_uvs(const Shape& shape);
+// The mesh with one (u, v) per vertex, for formats that keep texture coordinates per vertex (PLY): each vertex
+// whose corners carry different (u, v) — a seam, a pole — becomes one vertex per (u, v), with the same position and
+// normal; the triangles keep their order and corners. `uvs`: corner_uvs of the shape `mesh` tessellates (one
+// entry per triangle); empty leaves the mesh as it is.
+TriangleMesh with_vertex_uvs(const TriangleMesh& mesh, const std::vector<std::array<Vec2, 3>>& uvs);
 
 // Exact surface area of the analytic shape (the tessellation converges to it as O(1/segments²)); for a
 // mesh, the area of its triangles.

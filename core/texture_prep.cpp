@@ -68,7 +68,8 @@ TextureColourSpace resolved_colour_space(const TexturePrepRequest& r) {
 std::string hash_of(const TexturePrepRequest& r, TextureColourSpace colour_space) {
   Hash128 h;
   h.add(read_file(r.image));
-  std::string key = fmt::format("{}|{}|{}|{}|", kPrepVersion, kind_name(r.use), space_name(colour_space), r.bands_per_render);
+  std::string key = fmt::format("{}|{}|{}|{}|{}", kPrepVersion, kind_name(r.use), space_name(colour_space),
+                                r.bands_per_render, r.replicate ? "replicate|" : "");
   for (const double e : r.bands.edges()) key += fmt::format("{:.17g},", e);
   h.add(key);
   return h.hex();
@@ -90,7 +91,8 @@ std::optional<Json> cached_manifest(const std::filesystem::path& manifest, const
 }
 
 void write_group(const std::filesystem::path& target, const ImageTexture& texture, const TexelSpectra& spectra,
-                 const std::vector<double>& averages, std::size_t band_count, const std::vector<std::size_t>& group) {
+                 const std::vector<double>& averages, std::size_t band_count, const std::vector<std::size_t>& group,
+                 bool replicate) {
   const int w = texture.width, h = texture.height;
   Imf::Header header(w, h);
   for (const char* c : {"R", "G", "B"}) header.channels().insert(c, Imf::Channel(Imf::FLOAT));
@@ -103,7 +105,10 @@ void write_group(const std::filesystem::path& target, const ImageTexture& textur
     const std::size_t first = static_cast<std::size_t>(y0) * width;
     for (std::size_t i = 0; i < static_cast<std::size_t>(n) * width; ++i) {
       const double* entry = averages.data() + static_cast<std::size_t>(spectra.palette_of[first + i]) * band_count;
-      for (std::size_t c = 0; c < 3; ++c) rows[3 * i + c] = c < group.size() ? static_cast<float>(entry[group[c]]) : 0.0f;
+      for (std::size_t c = 0; c < 3; ++c) {
+        const std::size_t k = replicate ? 0 : c;
+        rows[3 * i + c] = k < group.size() ? static_cast<float>(entry[group[k]]) : 0.0f;
+      }
     }
     const Imath::Box2i window({0, y0}, {w - 1, y0 + n - 1});
     Imf::FrameBuffer frame;
@@ -137,6 +142,8 @@ TexturePrepResult prepare_texture(const TexturePrepRequest& request, const std::
   const auto start = std::chrono::steady_clock::now();
   const auto elapsed = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
   if (request.bands.size() == 0) throw InputError("bands: no bands");
+  if (request.replicate && request.bands_per_render != 1)
+    throw InputError(fmt::format("replicate: needs one band per render, not {}", request.bands_per_render));
   if (!std::filesystem::is_regular_file(request.image))
     throw InputError(fmt::format("{}: no such image file", request.image.string()));
   TexturePrepResult result;
@@ -174,7 +181,7 @@ TexturePrepResult prepare_texture(const TexturePrepRequest& request, const std::
   set_exr_threads(request.threads);
   Json groups = Json::array();
   for (std::size_t g = 0; g < result.groups.size(); ++g) {
-    write_group(result.files[g], texture, spectra, averages, request.bands.size(), result.groups[g]);
+    write_group(result.files[g], texture, spectra, averages, request.bands.size(), result.groups[g], request.replicate);
     std::vector<double> lo, hi;
     for (const std::size_t b : result.groups[g]) {
       lo.push_back(request.bands.lo(b));
@@ -188,6 +195,7 @@ TexturePrepResult prepare_texture(const TexturePrepRequest& request, const std::
                          {"kind", kind_name(request.use)},
                          {"colour_space", space_name(result.colour_space)},
                          {"bands_per_render", request.bands_per_render},
+                         {"replicate", request.replicate},
                          {"edges_nm", request.bands.edges()},
                          {"width", result.width},
                          {"height", result.height},

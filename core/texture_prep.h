@@ -31,6 +31,9 @@ struct TexturePrepRequest {
   std::optional<TextureColourSpace> colour_space;  // unset: as read_image_texture guesses (float: linear)
   Bands bands;
   int bands_per_render = 3;
+  // One band per render copied into R, G and B (the add-on's one-band fallback for channel-mixing nodes, which
+  // then see grey): needs bands_per_render 1.
+  bool replicate = false;
   int threads = 0;  // 0: all
 };
 

@@ -139,6 +139,36 @@ TEST(ExportMeshes, WritesTheTracersTrianglesForEveryObjectAndLight) {
   }
 }
 
+// With --uvs every corner keeps the tracer's (u, v) (corner_uvs): a vertex on a seam or a pole is written once per
+// (u, v), so the triangles are the same in space but may index more vertices.
+TEST(ExportMeshes, UvsAreTheTracersCornerCoordinates) {
+  test::TempDir dir;
+  const auto r = run_chromatrace({"export-meshes", kBox, dir.path().string(), "--uvs", "--json"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const json index = json::parse(r.out);
+  const Scene scene = load_scene(kBox);
+  const std::vector<TriangleMesh> meshes = scene_meshes(scene);
+  for (std::size_t i = 0; i < scene.objects.size(); ++i) {
+    const TriangleMesh read = read_ply(dir.path() / index["objects"][i]["file"].get<std::string>());
+    const std::vector<std::array<Vec2, 3>> uvs = corner_uvs(scene.objects[i].shape);
+    ASSERT_EQ(read.triangles.size(), meshes[i].triangles.size());
+    ASSERT_EQ(read.uvs.size(), read.positions.size());
+    for (std::size_t t = 0; t < read.triangles.size(); ++t)
+      for (std::size_t c = 0; c < 3; ++c) {
+        EXPECT_EQ(read.positions[read.triangles[t][c]], meshes[i].positions[meshes[i].triangles[t][c]]);
+        EXPECT_EQ(read.uvs[read.triangles[t][c]], uvs[t][c]) << scene.objects[i].name << " triangle " << t;
+      }
+    const std::size_t split = read.positions.size() - meshes[i].positions.size();
+    // A quad needs no extra vertex; a tessellated sphere needs its seam's and its poles' copies.
+    if (scene.objects[i].name == "sphere") {
+      EXPECT_GT(split, 0u);
+    }
+    if (std::holds_alternative<QuadShape>(scene.objects[i].shape)) {
+      EXPECT_EQ(split, 0u) << scene.objects[i].name;
+    }
+  }
+}
+
 TEST(ExportMeshes, BadInputGetsExitTwoAndOneLine) {
   test::TempDir dir;
   write_text(dir.file("a_file"), "x");

@@ -122,6 +122,27 @@ TEST_F(PrepareTexture, GreyIsFlat) {
   }
 }
 
+// The one-band fallback: each render holds one band in all three channels, the band of a three-band group's R, G or B.
+TEST_F(PrepareTexture, ReplicatePutsTheOneBandInEveryChannel) {
+  const fs::path png = write_image("two.png", 2, 1, {1.0f, 0.0f, 0.0f, 0.2f, 0.6f, 0.9f});
+  const json three = run_json({png.string(), "--bands", "400:460:20", "--kind", "reflectance"});
+  const json one = run_json({png.string(), "--bands", "400:460:20", "--kind", "reflectance", "--bands-per-render", "1",
+                             "--replicate"});
+  ASSERT_TRUE(three.is_object() && one.is_object());
+  EXPECT_TRUE(one["replicate"].get<bool>());
+  EXPECT_NE(one["hash"], three["hash"]);
+  ASSERT_EQ(three["groups"].size(), 1u);
+  ASSERT_EQ(one["groups"].size(), 3u);
+  int w = 0, h = 0;
+  const std::vector<float> grouped = read_rgb(three["groups"][0]["file"].get<std::string>(), w, h);
+  for (std::size_t band = 0; band < 3; ++band) {
+    const std::vector<float> single = read_rgb(one["groups"][band]["file"].get<std::string>(), w, h);
+    ASSERT_EQ(single.size(), 6u);
+    for (std::size_t t = 0; t < 2; ++t)
+      for (std::size_t c = 0; c < 3; ++c) EXPECT_EQ(single[3 * t + c], grouped[3 * t + band]) << band << " " << t << " " << c;
+  }
+}
+
 TEST_F(PrepareTexture, CachesByContent) {
   const fs::path png = write_image("c.png", 3, 2, {0.1f, 0.2f, 0.3f, 0.4f, 0.5f, 0.6f, 0.7f, 0.8f, 0.9f,
                                                    1.0f, 0.0f, 0.5f, 0.2f, 0.2f, 0.2f, 0.9f, 0.1f, 0.1f});
@@ -200,6 +221,7 @@ TEST_F(PrepareTexture, BadInputIsOneLineExitTwo) {
       {{png.string(), "--bands", "400:700:10", "--kind", "reflectance", "--bands-per-render", "4"}, "--bands-per-render"},
       {{png.string(), "--bands-file", (dir_ / "no-plan.json").string(), "--kind", "reflectance"}, "no-plan.json"},
       {{png.string(), "--kind", "reflectance"}, "--bands"},
+      {{png.string(), "--bands", "400:700:10", "--kind", "reflectance", "--replicate"}, "--replicate"},
   };
   for (const Case& c : cases) {
     std::vector<std::string> args = {"prepare-texture"};
