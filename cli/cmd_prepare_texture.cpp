@@ -1,5 +1,6 @@
 // chromatrace prepare-texture IMAGE -o DIR: per-band-group textures for Cycles (the Blender add-on), upsampled
 // per texel exactly as the tracer upsamples the original texture (core/texture_prep.h).
+#include <cmath>
 #include <memory>
 #include <string>
 
@@ -18,6 +19,7 @@ struct Options {
   std::string image, bands, bands_file, kind, colour_space = "auto", output;
   int bands_per_render = 3;
   int threads = 0;
+  double scale = 1.0;
   bool json = false, quiet = false, replicate = false;
 };
 
@@ -41,6 +43,9 @@ int run(const Options& o) {
   if (o.replicate && o.bands_per_render != 1)
     throw InputError(fmt::format("--replicate: needs --bands-per-render 1, got {}", o.bands_per_render));
   request.replicate = o.replicate;
+  if (!(o.scale >= 0.0) || !std::isfinite(o.scale))
+    throw InputError(fmt::format("--scale: must be a finite number >= 0, got {}", o.scale));
+  request.scale = o.scale;
   request.threads = o.threads;
 
   const TexturePrepResult r = prepare_texture(request, o.output);
@@ -73,6 +78,7 @@ int run(const Options& o) {
                           {"alpha_ignored", r.had_alpha},
                           {"bands_per_render", request.bands_per_render},
                           {"replicate", request.replicate},
+                          {"scale", request.scale},
                           {"manifest", r.manifest.string()},
                           {"groups", groups},
                           {"seconds", r.seconds}};
@@ -98,6 +104,7 @@ Action add_prepare_texture(CLI::App& app) {
   cmd->add_option("--colour-space", o->colour_space,
                   "sRGB, linear or auto (auto: linear for float images, sRGB for integer ones)")->capture_default_str();
   cmd->add_option("--bands-per-render", o->bands_per_render, "Bands to a group (1 to 3), as the add-on renders them")->capture_default_str();
+  cmd->add_option("--scale", o->scale, "Multiplies every texel's spectrum (a texture's \"scale\")")->capture_default_str();
   cmd->add_flag("--replicate", o->replicate,
                 "With --bands-per-render 1: the band in R, G and B (the add-on's one-band fallback), not R alone");
   cmd->add_option("-o,--output", o->output, "Output directory (the cache)")->required();

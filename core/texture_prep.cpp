@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <string_view>
@@ -70,6 +71,7 @@ std::string hash_of(const TexturePrepRequest& r, TextureColourSpace colour_space
   h.add(read_file(r.image));
   std::string key = fmt::format("{}|{}|{}|{}|{}", kPrepVersion, kind_name(r.use), space_name(colour_space),
                                 r.bands_per_render, r.replicate ? "replicate|" : "");
+  if (r.scale != 1.0) key += fmt::format("scale={:.17g}|", r.scale);
   for (const double e : r.bands.edges()) key += fmt::format("{:.17g},", e);
   h.add(key);
   return h.hex();
@@ -144,6 +146,8 @@ TexturePrepResult prepare_texture(const TexturePrepRequest& request, const std::
   if (request.bands.size() == 0) throw InputError("bands: no bands");
   if (request.replicate && request.bands_per_render != 1)
     throw InputError(fmt::format("replicate: needs one band per render, not {}", request.bands_per_render));
+  if (!(request.scale >= 0.0) || !std::isfinite(request.scale))
+    throw InputError(fmt::format("scale: must be a finite number >= 0, got {}", request.scale));
   if (!std::filesystem::is_regular_file(request.image))
     throw InputError(fmt::format("{}: no such image file", request.image.string()));
   TexturePrepResult result;
@@ -165,7 +169,7 @@ TexturePrepResult prepare_texture(const TexturePrepRequest& request, const std::
   }
 
   const ImageTexture texture =
-      read_image_texture(request.image, request.image.string(), result.colour_space, request.use, 1.0);
+      read_image_texture(request.image, request.image.string(), result.colour_space, request.use, request.scale);
   const TexelSpectra spectra = upsample_texels(texture, request.threads);
   const std::vector<double> averages = palette_band_averages(spectra, request.bands, request.threads);
   result.width = texture.width;
@@ -196,6 +200,7 @@ TexturePrepResult prepare_texture(const TexturePrepRequest& request, const std::
                          {"colour_space", space_name(result.colour_space)},
                          {"bands_per_render", request.bands_per_render},
                          {"replicate", request.replicate},
+                         {"scale", request.scale},
                          {"edges_nm", request.bands.edges()},
                          {"width", result.width},
                          {"height", result.height},

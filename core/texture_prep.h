@@ -34,6 +34,7 @@ struct TexturePrepRequest {
   // One band per render copied into R, G and B (the add-on's one-band fallback for channel-mixing nodes, which
   // then see grey): needs bands_per_render 1.
   bool replicate = false;
+  double scale = 1.0;  // multiplies every texel's spectrum (the scene format's texture "scale")
   int threads = 0;  // 0: all
 };
 

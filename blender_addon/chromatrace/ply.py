@@ -1,9 +1,10 @@
 """PLY triangle meshes, the subset chromatrace uses (pure Python, no bpy; docs/scene-format.md, "PLY meshes").
 
-Reads `format ascii 1.0` and `binary_little_endian 1.0` with vertex x, y, z (and nx, ny, nz) and a face list
-`vertex_indices` (or `vertex_index`), splitting polygons into fans from their first vertex, as
-core/ply.cpp does. Writes what core's write_ply writes: binary little-endian, x y z [nx ny nz] as doubles and
-faces as `property list uchar int vertex_indices`, so `chromatrace` reads the add-on's meshes unchanged.
+Reads `format ascii 1.0` and `binary_little_endian 1.0` with vertex x, y, z (and nx, ny, nz; and texture
+coordinates u, v or s, t, texture_u, texture_v, texture_s, texture_t) and a face list `vertex_indices` (or
+`vertex_index`), splitting polygons into fans from their first vertex, as core/ply.cpp does. Writes what core's
+write_ply writes: binary little-endian, x y z [nx ny nz] [u v] as doubles and faces as
+`property list uchar int vertex_indices`, so `chromatrace` reads the add-on's meshes unchanged.
 """
 
 import struct
@@ -14,17 +15,22 @@ _TYPES = {
 }
 
 
+_UV_NAMES = (("u", "v"), ("s", "t"), ("texture_u", "texture_v"), ("texture_s", "texture_t"))
+
+
 class PlyError(ValueError):
     pass
 
 
 class Mesh:
-    """positions: [(x, y, z)]; normals: [] or one unit (nx, ny, nz) per position; triangles: [(a, b, c)]."""
+    """positions: [(x, y, z)]; normals: [] or one unit (nx, ny, nz) per position; triangles: [(a, b, c)];
+    uvs: [] or one (u, v) per position."""
 
-    def __init__(self, positions=None, normals=None, triangles=None):
+    def __init__(self, positions=None, normals=None, triangles=None, uvs=None):
         self.positions = positions or []
         self.normals = normals or []
         self.triangles = triangles or []
+        self.uvs = uvs or []
 
 
 def read_ply(path):
@@ -63,7 +69,12 @@ def parse_ply(data, source="mesh"):
     if not all(k in index for k in ("x", "y", "z")):
         raise PlyError(f"{source}: vertex element needs x, y, z")
     has_normals = all(k in index for k in ("nx", "ny", "nz"))
+    uv = next(((u, v) for u, v in _UV_NAMES if u in index or v in index), None)
+    if uv is not None and not (uv[0] in index and uv[1] in index):
+        raise PlyError(f"{source}: vertex element has only one of {uv[0]}, {uv[1]}")
     for row in vertices[1]:
+        if uv is not None:
+            mesh.uvs.append((row[index[uv[0]]], row[index[uv[1]]]))
         mesh.positions.append((row[index["x"]], row[index["y"]], row[index["z"]]))
         if has_normals:
             n = (row[index["nx"]], row[index["ny"]], row[index["nz"]])
@@ -137,11 +148,13 @@ def format_ply(mesh):
               "property double x", "property double y", "property double z"]
     if smooth:
         header += ["property double nx", "property double ny", "property double nz"]
+    if mesh.uvs:
+        header += ["property double u", "property double v"]
     header += [f"element face {len(mesh.triangles)}", "property list uchar int vertex_indices", "end_header"]
     parts = [("\n".join(header) + "\n").encode("ascii")]
-    vertex = struct.Struct("<6d" if smooth else "<3d")
+    vertex = struct.Struct(f"<{3 + (3 if smooth else 0) + (2 if mesh.uvs else 0)}d")
     for i, p in enumerate(mesh.positions):
-        parts.append(vertex.pack(*p, *mesh.normals[i]) if smooth else vertex.pack(*p))
+        parts.append(vertex.pack(*p, *(mesh.normals[i] if smooth else ()), *(mesh.uvs[i] if mesh.uvs else ())))
     face = struct.Struct("<B3i")
     parts.extend(face.pack(3, *t) for t in mesh.triangles)
     return b"".join(parts)

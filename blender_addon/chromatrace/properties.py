@@ -19,6 +19,13 @@ _KIND_ITEMS = [
     ("BLACKBODY", "Blackbody", "Planck's law at a temperature, normalised to 1 at its peak"),
     ("SAMPLES", "Samples", "Inline [wavelength_nm, value] pairs"),
     ("NAMED", "Scene spectrum", "A named spectrum of this scene's spectrum table"),
+    ("TEXTURE", "Image texture", "An image whose every texel is upsampled from RGB (Jakob and Hanika 2019), "
+                                 "mapped by the object's UV map"),
+]
+_TEXTURE_SPACE_ITEMS = [
+    ("auto", "Auto", "Linear for float images (EXR, HDR), sRGB for integer ones (PNG, JPEG, TIFF)"),
+    ("sRGB", "sRGB", "Texels are sRGB-encoded"),
+    ("linear", "Linear", "Texels are linear sRGB"),
 ]
 _ILLUMINANT_ITEMS = [(name, "D (any CCT)" if name == "D" else name, "") for name in spectra.ILLUMINANTS]
 
@@ -52,13 +59,18 @@ class CHROMATRACE_PG_spectrum(bpy.types.PropertyGroup):
     blackbody_k: FloatProperty(name="Temperature (K)", min=100.0, max=100000.0, default=3200.0)
     samples_json: StringProperty(name="Samples", description="JSON list of [wavelength_nm, value] pairs",
                                  default="[[400, 0.5], [700, 0.5]]")
+    texture_path: StringProperty(name="Image", subtype="FILE_PATH")
+    texture_colour_space: EnumProperty(name="Colour space", items=_TEXTURE_SPACE_ITEMS, default="auto")
+    texture_scale: FloatProperty(name="Scale", min=0.0, default=1.0, soft_max=10.0)
 
     def values(self):
         return {"name": self.spectrum_name, "library": self.library, "constant": self.constant,
                 "csv_path": bpy.path.abspath(self.csv_path), "csv_column": self.csv_column, "extend": self.extend,
                 "rgb": tuple(self.rgb), "use_current_colour": self.use_current_colour,
                 "illuminant": self.illuminant, "cct_k": self.cct_k, "blackbody_k": self.blackbody_k,
-                "samples": json.loads(self.samples_json) if self.kind == "SAMPLES" else []}
+                "samples": json.loads(self.samples_json) if self.kind == "SAMPLES" else [],
+                "texture_path": bpy.path.abspath(self.texture_path), "texture_colour_space": self.texture_colour_space,
+                "texture_scale": self.texture_scale}
 
     def to_json(self, current_rgb=None, base_dir=None):
         """The scene-format source object (or table name)."""
@@ -81,6 +93,10 @@ class CHROMATRACE_PG_spectrum(bpy.types.PropertyGroup):
             self.blackbody_k = values["blackbody_k"]
         elif kind == "SAMPLES":
             self.samples_json, self.extend = json.dumps(values["samples"]), values["extend"]
+        elif kind == "TEXTURE":
+            self.texture_path = values["texture_path"]
+            self.texture_colour_space = values["texture_colour_space"]
+            self.texture_scale = values["texture_scale"]
 
     def draw(self, layout, allow_rgb_current=True):
         layout.prop(self, "kind")
@@ -109,6 +125,10 @@ class CHROMATRACE_PG_spectrum(bpy.types.PropertyGroup):
         elif k == "SAMPLES":
             layout.prop(self, "samples_json")
             layout.prop(self, "extend")
+        elif k == "TEXTURE":
+            layout.prop(self, "texture_path")
+            layout.prop(self, "texture_colour_space")
+            layout.prop(self, "texture_scale")
 
 
 class CHROMATRACE_PG_named_spectrum(bpy.types.PropertyGroup):

@@ -73,6 +73,15 @@ def source_json(kind, values, current_rgb=None, base_dir=None):
         return source
     if kind == "BLACKBODY":
         return {"blackbody_k": short_float(values["blackbody_k"])}
+    if kind == "TEXTURE":
+        if not values.get("texture_path"):
+            raise SourceError("no image file chosen")
+        source = {"texture": _path(values["texture_path"], base_dir)}
+        if values.get("texture_colour_space", "auto") != "auto":
+            source["colour_space"] = values["texture_colour_space"]
+        if values.get("texture_scale", 1.0) != 1.0:
+            source["scale"] = short_float(values["texture_scale"])
+        return source
     if kind == "SAMPLES":
         source = {"samples": [[float(a), float(b)] for a, b in values["samples"]]}
         if values.get("extend") == "clamp":
@@ -96,6 +105,10 @@ def source_values(source, scene_dir):
         return "ILLUMINANT", {"illuminant": source["illuminant"], "cct_k": source.get("cct_k", 6504.0)}
     if "blackbody_k" in source:
         return "BLACKBODY", {"blackbody_k": source["blackbody_k"]}
+    if "texture" in source:
+        return "TEXTURE", {"texture_path": os.path.normpath(os.path.join(scene_dir, source["texture"])),
+                           "texture_colour_space": source.get("colour_space", "auto"),
+                           "texture_scale": source.get("scale", 1.0)}
     if "samples" in source:
         return "SAMPLES", {"samples": [list(s) for s in source["samples"]], "extend": source.get("extend", "zero")}
     raise SourceError(f"unknown spectrum source {source}")

@@ -143,6 +143,20 @@ TEST_F(PrepareTexture, ReplicatePutsTheOneBandInEveryChannel) {
   }
 }
 
+// A texture's "scale" multiplies every texel's spectrum, so every band average scales with it exactly (in float).
+TEST_F(PrepareTexture, ScaleMultipliesEveryBand) {
+  const fs::path png = write_image("scaled.png", 2, 1, {0.8f, 0.3f, 0.1f, 0.1f, 0.5f, 0.7f});
+  const json plain = run_json({png.string(), "--bands", "400:700:100", "--kind", "reflectance"});
+  const json half = run_json({png.string(), "--bands", "400:700:100", "--kind", "reflectance", "--scale", "0.5"});
+  ASSERT_TRUE(plain.is_object() && half.is_object());
+  EXPECT_NE(plain["hash"], half["hash"]);
+  int w = 0, h = 0;
+  const std::vector<float> a = read_rgb(plain["groups"][0]["file"].get<std::string>(), w, h);
+  const std::vector<float> b = read_rgb(half["groups"][0]["file"].get<std::string>(), w, h);
+  ASSERT_EQ(a.size(), b.size());
+  for (std::size_t i = 0; i < a.size(); ++i) EXPECT_NEAR(b[i], 0.5f * a[i], 1e-6f * a[i]) << i;
+}
+
 TEST_F(PrepareTexture, CachesByContent) {
   const fs::path png = write_image("c.png", 3, 2, {0.1f, 0.2f, 0.3f, 0.4f, 0.5f, 0.6f, 0.7f, 0.8f, 0.9f,
                                                    1.0f, 0.0f, 0.5f, 0.2f, 0.2f, 0.2f, 0.9f, 0.1f, 0.1f});
@@ -222,6 +236,7 @@ TEST_F(PrepareTexture, BadInputIsOneLineExitTwo) {
       {{png.string(), "--bands-file", (dir_ / "no-plan.json").string(), "--kind", "reflectance"}, "no-plan.json"},
       {{png.string(), "--kind", "reflectance"}, "--bands"},
       {{png.string(), "--bands", "400:700:10", "--kind", "reflectance", "--replicate"}, "--replicate"},
+      {{png.string(), "--bands", "400:700:10", "--kind", "reflectance", "--scale", "-1"}, "--scale"},
   };
   for (const Case& c : cases) {
     std::vector<std::string> args = {"prepare-texture"};

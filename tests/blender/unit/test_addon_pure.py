@@ -192,6 +192,21 @@ class Ply(unittest.TestCase):
         quad = ply.parse_ply(text)
         self.assertEqual(quad.triangles, [(0, 1, 2), (0, 2, 3)])  # a fan from the first vertex, as core splits
         self.assertEqual(quad.normals, [])
+        self.assertEqual(quad.uvs, [])
+
+    def test_texture_coordinates_round_trip_and_alternative_names(self):
+        uvs = [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 0.25)]
+        mesh = ply.Mesh([(0, 0, 0), (1, 0, 0), (1, 1, 0), (0, 1, 0)], [], [(0, 1, 2), (0, 2, 3)], uvs)
+        back = ply.parse_ply(ply.format_ply(mesh))
+        self.assertEqual((back.normals, back.uvs), ([], uvs))
+        smooth = ply.Mesh(mesh.positions, [(0, 0, 1)] * 4, mesh.triangles, uvs)
+        self.assertEqual(ply.parse_ply(ply.format_ply(smooth)).uvs, uvs)
+        header = b"ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+        faces = b"element face 1\nproperty list uchar int vertex_indices\nend_header\n"
+        text = header + b"property float s\nproperty float t\n" + faces + b"0 0 0 0 0\n1 0 0 1 0\n0 1 0 0 1\n3 0 1 2\n"
+        self.assertEqual(ply.parse_ply(text).uvs, [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0)])
+        with self.assertRaises(ply.PlyError):
+            ply.parse_ply(header + b"property float u\n" + faces + b"0 0 0 0\n1 0 0 1\n0 1 0 0\n3 0 1 2\n")
 
 
 class NodeRules(unittest.TestCase):
@@ -243,11 +258,13 @@ class Spectra(unittest.TestCase):
         for source in ["lamp", {"constant": 0.5}, {"csv": "../spectra/a.csv", "column": "red"},
                        {"csv": "../spectra/a.csv", "column": "red", "extend": "clamp"}, {"rgb": [0.5, 0.2, 0.1]},
                        {"illuminant": "D65"}, {"illuminant": "D", "cct_k": 5000}, {"blackbody_k": 3200},
-                       {"samples": [[400, 0.1], [700, 0.9]], "extend": "clamp"}]:
+                       {"samples": [[400, 0.1], [700, 0.9]], "extend": "clamp"}, {"texture": "textures/wood.png"},
+                       {"texture": "../hdri/sky.exr", "colour_space": "linear", "scale": 2.5}]:
             kind, values = spectra.source_values(source, scene_dir)
             full = {"name": "", "library": "", "constant": 0, "csv_path": "", "csv_column": "", "extend": "zero",
                     "rgb": (0, 0, 0), "use_current_colour": False, "illuminant": "D65", "cct_k": 6504,
-                    "blackbody_k": 0, "samples": []}
+                    "blackbody_k": 0, "samples": [], "texture_path": "", "texture_colour_space": "auto",
+                    "texture_scale": 1.0}
             full.update(values)
             self.assertEqual(spectra.source_json(kind, full, base_dir=scene_dir), source)
 
