@@ -9,17 +9,26 @@ Background, ...) is followed back to where its colour comes from (node_rules.col
 - a constant (an unlinked colour input, an RGB node): a Leaf the render upsamples and sets per band group;
 - a Blackbody node of constant temperature: a Leaf whose spectrum is Planck's law (the node is replaced by an
   RGB node for the render, through the journal);
+- an Image or Environment Texture node's colour: a Leaf whose texture source every texel of the image is
+  upsampled from (the render gives the node one prepared image per band group); refused when the image cannot
+  be read as a file (generated, movie, UDIM tiles), its colour space is neither sRGB nor linear, or its alpha
+  output is used (the prepared images carry no alpha);
 - a scalar (a Fresnel factor, a Math node, a texture's Fac): grey, the same in every band, so spectrally flat;
 - through per-channel nodes (Mix, Gamma, Invert, Bright/Contrast) to their colour inputs;
 - through channel-mixing nodes (hue/saturation, RGB curves) to their colour inputs, with an issue the one-band
   fallback may accept;
-- anything else (textures, attributes, vertex colours, ramps, vectors used as colours): an issue that refuses.
+- anything else (procedural textures, attributes, vertex colours, ramps, vectors used as colours): an issue that
+  refuses.
 
 A colour the render converts must not also drive a scalar input (a roughness, a mix factor) that Cycles
 reaches: that value would change with the band group. Such a use refuses too.
 
 Issues are node_rules dicts: {kind, material (the owner's name), node, socket, reason, fallback}.
 """
+
+import os
+
+import bpy
 
 from . import node_rules
 
@@ -54,17 +63,21 @@ def sink_role(node, socket):
 
 
 class Leaf:
-    """A colour the render sets per band group: target.attribute (a socket's default_value, a world's color),
-    or a Blackbody node to replace (blackbody_k set, target None)."""
+    """A colour the render sets per band group: target.attribute (a socket's default_value, a world's color, an
+    image node's image), or a Blackbody node to replace (blackbody_k set, target None). texture: the scene-format
+    texture source of an image node's colour ({"texture": path, "colour_space": ...}; "packed:<image>" for an
+    image packed into the .blend), else None."""
 
-    def __init__(self, target, attribute, rgb, alpha, label, blackbody_k=None, replace=None):
+    def __init__(self, target, attribute, rgb, alpha, label, blackbody_k=None, replace=None, texture=None):
         self.target, self.attribute, self.rgb, self.alpha, self.label = target, attribute, rgb, alpha, label
-        self.blackbody_k, self.replace = blackbody_k, replace
+        self.blackbody_k, self.replace, self.texture = blackbody_k, replace, texture
         self.roles = set()
         self.sinks = []
 
     @property
     def role(self):
+        if self.texture is not None:
+            return "emission" if self.roles == {"emission"} else "reflectance"
         if "reflectance" in self.roles or ("interface" in self.roles and max(self.rgb) - min(self.rgb) > 1e-6):
             return "reflectance"
         if "interface" in self.roles:
@@ -229,6 +242,8 @@ class Walk:
             return True
         if rule["kind"] == "blackbody":
             return self._blackbody(key, sctx, node, sink)
+        if rule["kind"] == "image":
+            return self._image(key, sctx, node, out, sink)
         if rule["kind"] == "pass":
             seen = (key, "colour-pass")
             first = seen not in self._seen
@@ -271,6 +286,20 @@ class Walk:
         self._add_leaf(bb_key, lambda: Leaf(None, "default_value", (1.0, 1.0, 1.0), 1.0,
                                             f"{self.name}/{self._path(ctx, node)}", blackbody_k=temperature,
                                             replace=node), sink)
+        return True
+
+    def _image(self, key, ctx, node, out, sink):
+        reason = image_problem(node, out)
+        if reason is not None:
+            self._issue(ctx, node, reason, False, sink[2])
+            return False
+        image_key = ("image", _ptr(node))
+        self._add_leaf(image_key, lambda: Leaf(node, "image", None, None, f"{self.name}/{self._path(ctx, node)}",
+                                               texture=texture_source(node.image)), sink)
+        leaf = self.leaves[image_key]
+        if "emission" in leaf.roles and len(leaf.roles) > 1:
+            self._issue(ctx, node, "its image is both an emission and a reflectance, which need different "
+                        "upsampling", False, sink[2])
         return True
 
     def _add_leaf(self, key, make, sink):
@@ -333,6 +362,39 @@ class Walk:
                             "change with the band", False)
         # Black emission constants emit nothing: not leaves of an emitter.
         for key in [k for k, leaf in self.leaves.items() if leaf.roles == {"emission"} and leaf.blackbody_k is None
-                    and max(leaf.rgb) == 0.0]:
+                    and leaf.texture is None and max(leaf.rgb) == 0.0]:
             del self.leaves[key]
         return self
+
+
+def image_problem(node, out):
+    """Why an Image or Environment Texture node's colour cannot be upsampled texel by texel, or None."""
+    if out.name != "Color":
+        return f"its {out.name} output is used as a colour"
+    image = node.image
+    if image is None:
+        return "it has no image"
+    if image.source != "FILE":
+        kind = {"TILED": "UDIM tiles", "SEQUENCE": "an image sequence", "MOVIE": "a movie",
+                "GENERATED": "a generated image", "VIEWER": "a viewer image"}.get(image.source, image.source.lower())
+        return f"its image \"{image.name}\" is {kind}, not an image file"
+    space = image.colorspace_settings.name
+    if space not in node_rules.IMAGE_COLOUR_SPACES:
+        return (f"its image \"{image.name}\" has colour space \"{space}\" (only "
+                f"{', '.join(sorted(node_rules.IMAGE_COLOUR_SPACES))} are read)")
+    alpha = node.outputs.get("Alpha")
+    if alpha is not None and _live_links(alpha):
+        return "its alpha output is used, which the per-band images the render makes do not carry"
+    if image.packed_file is None:
+        path = bpy.path.abspath(image.filepath, library=image.library)
+        if not os.path.isfile(path):
+            return f"its image file {path} does not exist"
+    return None
+
+
+def texture_source(image):
+    """The scene-format texture source of an image as Cycles reads it."""
+    colour_space = node_rules.IMAGE_COLOUR_SPACES[image.colorspace_settings.name]
+    if image.packed_file is not None:
+        return {"texture": f"packed:{image.name}", "colour_space": colour_space}
+    return {"texture": bpy.path.abspath(image.filepath, library=image.library), "colour_space": colour_space}

@@ -46,9 +46,14 @@ def build_material_nodes(material):
     output = _new(nodes, "ShaderNodeOutputMaterial", "ct_output", (600, 0))
     shader = None
     if s.model in ("LAMBERT", "DICHROMATIC", "MIRROR"):
-        colour = _new(nodes, "ShaderNodeRGB", REFLECTANCE_NODE, (-400, 100))
-        preview = tuple(s.reflectance.rgb) if s.reflectance.kind == "RGB" else (0.8, 0.8, 0.8)
-        colour.outputs[0].default_value = (*preview, 1.0)
+        if s.reflectance.kind == "TEXTURE":
+            colour = _new(nodes, "ShaderNodeTexImage", REFLECTANCE_NODE, (-500, 100))
+            colour.image = load_image(s.reflectance.texture_path, s.reflectance.texture_colour_space)
+            colour.interpolation = "Closest"  # the reference tracer looks up the nearest texel
+        else:
+            colour = _new(nodes, "ShaderNodeRGB", REFLECTANCE_NODE, (-400, 100))
+            preview = tuple(s.reflectance.rgb) if s.reflectance.kind == "RGB" else (0.8, 0.8, 0.8)
+            colour.outputs[0].default_value = (*preview, 1.0)
         if s.model in ("LAMBERT", "DICHROMATIC"):
             diffuse = _new(nodes, "ShaderNodeBsdfDiffuse", "ct_diffuse", (-100, 150))
             diffuse.inputs["Roughness"].default_value = 0.0
@@ -98,6 +103,21 @@ def build_material_nodes(material):
             shader = add
     if shader is not None:
         links.new(shader.outputs[0], output.inputs["Surface"])
+
+
+def load_image(path, colour_space="auto"):
+    """An image file as a Blender image (an existing one of the same file reused), its colour space set as the scene
+    format reads it: "sRGB", "linear", or "auto" (Blender's own guess: linear for float files, else sRGB). None
+    when the file cannot be read (the render then refuses the node by name)."""
+    try:
+        image = bpy.data.images.load(bpy.path.abspath(path), check_existing=True)
+    except RuntimeError:
+        return None
+    if colour_space == "sRGB":
+        image.colorspace_settings.name = "sRGB"
+    elif colour_space == "linear":
+        image.colorspace_settings.name = "Linear" if bpy.app.version < (4, 0, 0) else "Linear Rec.709"
+    return image
 
 
 def output_node(material):
@@ -153,7 +173,7 @@ def leaf_inputs(walk):
     """The walk's colours as SpectralInputs (a Blackbody node's with its Planck source)."""
     found = []
     for leaf in walk.leaves.values():
-        source = {"blackbody_k": leaf.blackbody_k} if leaf.blackbody_k is not None else None
+        source = {"blackbody_k": leaf.blackbody_k} if leaf.blackbody_k is not None else leaf.texture
         found.append(SpectralInput(leaf.target, leaf.attribute, leaf.role, leaf.rgb, leaf.alpha, leaf.label, False,
                                    source, leaf.replace))
     return found
@@ -173,6 +193,9 @@ def spectral_inputs(material, walk):
             if node is None:
                 raise BadInput(f"material \"{material.name}\": its chromatrace node {name} is missing; "
                                "choose the model again to rebuild the nodes")
+            if node.bl_idname == "ShaderNodeTexImage":  # an image texture: its source is the spectrum setting's
+                found.append(SpectralInput(node, "image", role, None, None, f"{material.name}/{name}", True))
+                continue
             value = node.outputs[0].default_value
             found.append(SpectralInput(node.outputs[0], "default_value", role, tuple(value[:3]), value[3],
                                        f"{material.name}/{name}", True))

@@ -7,8 +7,8 @@ channels or treats them differently — Principled specular or sheen tint (the h
 the base colour), Multiscatter GGX, subsurface radii per channel, colour ramps, hue/saturation, RGB curves,
 colour-to-BW, separating or combining channels, hue/saturation/colour/value blend modes. Rendering one band
 per render, copied to all three channels, makes those nodes see grey and act on each band alone: the
-"one-band" fallback. Some inputs are not spectra at all (RGB textures, vertex colours, the Blackbody and
-Wavelength nodes, volumes): no fallback helps, so those always refuse.
+"one-band" fallback. Some inputs are not spectra at all (procedural textures, vertex colours, the Wavelength
+node, volumes): no fallback helps, so those always refuse.
 
 A node is described as a dict (materials.describe_node_tree makes them from Blender nodes):
   {"name": "Principled BSDF", "type": "ShaderNodeBsdfPrincipled", "props": {"distribution": "GGX"},
@@ -17,7 +17,7 @@ A node is described as a dict (materials.describe_node_tree makes them from Blen
 
 Colour paths (colour_node) say what happens to a colour on its way to a shader's colour input: every node a
 colour passes through before it reaches a shader is either a constant the add-on turns into a spectrum (an
-RGB node), an exact spectrum (a Blackbody node: Planck's law), a node that acts on each channel alike and
+RGB node), an image whose every texel it upsamples (Image and Environment Texture nodes), an exact spectrum (a Blackbody node: Planck's law), a node that acts on each channel alike and
 separately and passes its colour inputs on (Mix, Gamma, Invert, Bright/Contrast), a channel-mixing node that
 only the one-band fallback renders (hue/saturation, RGB curves, hue/saturation/colour/value blends), or a
 node whose colours cannot be spectra, which refuses the render. There is no fourth case: a colour node the
@@ -25,6 +25,11 @@ add-on does not know refuses.
 """
 
 _MIXING_BLENDS = {"HUE", "SATURATION", "COLOR", "VALUE"}
+# Image nodes whose every texel the render upsamples (chromatrace prepare-texture): one texture per band group.
+IMAGE_NODES = ("ShaderNodeTexImage", "ShaderNodeTexEnvironment")
+# Blender colour spaces (OpenColorIO names) and how prepare-texture decodes them; others are refused.
+IMAGE_COLOUR_SPACES = {"sRGB": "sRGB", "Linear": "linear", "Linear Rec.709": "linear", "Non-Color": "linear",
+                       "Raw": "linear"}
 _CHANNEL_NODES = {
     "ShaderNodeValToRGB": "a colour ramp makes colours from a scalar",
     "ShaderNodeHueSaturation": "hue/saturation mixes colour channels",
@@ -118,7 +123,6 @@ _NOT_A_SPECTRUM = {
     "ShaderNodeValToRGB": "a colour ramp's colours are RGB, not spectra",
     "ShaderNodeCombineRGB": "combining channels makes an RGB colour from three values, not a spectrum",
     "ShaderNodeCombineColor": "combining channels makes an RGB colour from three values, not a spectrum",
-    "ShaderNodeTexEnvironment": "an environment texture (HDRI) holds RGB colours, not spectra",
     "ShaderNodeTexSky": "the sky texture makes RGB colours, not spectra",
     "ShaderNodeObjectInfo": "the object colour is RGB, not a spectrum",
     "ShaderNodeParticleInfo": "particle colours are RGB, not spectra",
@@ -136,6 +140,8 @@ def colour_node(node):
         return {"kind": "constant", "inputs": (), "issue": None}
     if t == "ShaderNodeBlackbody":
         return {"kind": "blackbody", "inputs": (), "issue": None}
+    if t in IMAGE_NODES:
+        return {"kind": "image", "inputs": (), "issue": None}
     if t in _PER_CHANNEL and not (t == "ShaderNodeMix" and props.get("data_type", "RGBA") != "RGBA"):
         issue = None
         if t in ("ShaderNodeMixRGB", "ShaderNodeMix") and props.get("blend_type") in _MIXING_BLENDS:

@@ -7,6 +7,7 @@ with a horizontal field of view. The result is checked with `chromatrace check-s
 """
 
 import json
+import math
 import os
 
 import bpy
@@ -67,13 +68,92 @@ def _mesh_shape(ob, depsgraph, mesh_dir, out_dir):
         positions = [tuple(matrix @ v.co) for v in mesh.vertices]
         normals = [tuple((normal_matrix @ v.normal).normalized()) for v in mesh.vertices] if smooth else []
         triangles = [tuple(t.vertices) for t in mesh.loop_triangles]
+        uvs = []
+        layer = mesh.uv_layers.active
+        if layer is not None:  # per face corner in Blender, per vertex in PLY: a vertex once per (u, v)
+            corner_uv = [tuple(layer.data[loop].uv) for t in mesh.loop_triangles for loop in t.loops]
+            index, split_positions, split_normals = {}, [], []
+            split_triangles = []
+            for t, triangle in enumerate(triangles):
+                corners = []
+                for c, v in enumerate(triangle):
+                    key = (v, corner_uv[3 * t + c])
+                    if key not in index:
+                        index[key] = len(split_positions)
+                        split_positions.append(positions[v])
+                        if normals:
+                            split_normals.append(normals[v])
+                        uvs.append(key[1])
+                    corners.append(index[key])
+                split_triangles.append(tuple(corners))
+            positions, normals, triangles = split_positions, split_normals, split_triangles
     finally:
         evaluated.to_mesh_clear()
     os.makedirs(mesh_dir, exist_ok=True)
     safe = "".join(ch if ch.isalnum() or ch in "-_." else "_" for ch in ob.name)
     path = os.path.join(mesh_dir, f"{safe}.ply")
-    ply.write_ply(path, ply.Mesh(positions, normals, triangles))
+    ply.write_ply(path, ply.Mesh(positions, normals, triangles, uvs))
     return {"type": "mesh", "file": os.path.relpath(path, out_dir)}
+
+
+def _environment(world, out_dir, log):
+    """The scene format's environment from Blender's world: a Background's colour from an Environment Texture (its
+    default vector, or a Mapping node that only turns it about Z) or a constant colour, × its strength; None for
+    no world or a dark one. Anything else is said and left out."""
+    if world is None:
+        return None
+    if not world.use_nodes or world.node_tree is None:
+        if max(world.color) <= 0.0:
+            return None
+        return {"radiance": {"rgb": [short_float(c) for c in world.color]}, "group": _world_group(world)}
+    output = world.node_tree.get_output_node("CYCLES")
+    surface = output.inputs["Surface"] if output is not None else None
+    links = [l for l in surface.links if l.is_valid and not l.is_muted] if surface is not None and surface.is_linked else []
+    background = links[0].from_node if links else None
+    if background is None or background.bl_idname != "ShaderNodeBackground":
+        if background is not None:
+            log(f"world \"{world.name}\": its surface is not a Background node, so no environment is written")
+        return None
+    strength = background.inputs["Strength"]
+    if strength.is_linked:
+        log(f"world \"{world.name}\": its strength is not a constant, so no environment is written")
+        return None
+    colour = background.inputs["Color"]
+    entry = {"scale": short_float(strength.default_value), "group": _world_group(world)}
+    if not colour.is_linked:
+        if max(colour.default_value[:3]) <= 0.0 or strength.default_value <= 0.0:
+            return None
+        entry["radiance"] = {"rgb": [short_float(c) for c in colour.default_value[:3]]}
+        return entry
+    node = colour.links[0].from_node
+    if node.bl_idname != "ShaderNodeTexEnvironment" or node.image is None or node.projection != "EQUIRECTANGULAR":
+        log(f"world \"{world.name}\": its colour is not an equirectangular Environment Texture, so no environment "
+            "is written")
+        return None
+    from .colour_walk import texture_source
+    source = texture_source(node.image)
+    if source["texture"].startswith("packed:"):
+        log(f"world \"{world.name}\": its image is packed into the .blend; unpack it to export the environment")
+        return None
+    source["texture"] = os.path.relpath(source["texture"], out_dir)
+    entry["radiance"] = source
+    vector = node.inputs["Vector"]
+    if vector.is_linked:
+        mapping = vector.links[0].from_node
+        rotation = mapping.inputs["Rotation"].default_value if mapping.bl_idname == "ShaderNodeMapping" else None
+        plain = rotation is not None and mapping.vector_type == "POINT" and abs(rotation[0]) < 1e-9 and \
+            abs(rotation[1]) < 1e-9 and tuple(mapping.inputs["Location"].default_value) == (0, 0, 0) and \
+            tuple(mapping.inputs["Scale"].default_value) == (1, 1, 1)
+        if not plain:
+            log(f"world \"{world.name}\": its environment's mapping is more than a turn about Z, so no environment "
+                "is written")
+            return None
+        entry["rotation_deg"] = short_float(-math.degrees(rotation[2]))
+    return entry
+
+
+def _world_group(world):
+    return getattr(world, "lightgroup", "") or "environment"
 
 
 def _light_quad(ob):
@@ -169,6 +249,9 @@ def export_scene(scene, path, tool, log=print):
     document["materials"] = materials
     document["objects"] = object_entries
     document["lights"] = light_entries
+    environment = _environment(scene.world, out_dir, log)
+    if environment is not None:
+        document["environment"] = environment
     document["camera"] = _camera(scene)
     render = {"samples": s.samples, "max_bounces": s.max_bounces, "seed": s.seed, "pixel_filter": s.pixel_filter,
               "spectral_mode": s.spectral_mode}

@@ -9,6 +9,7 @@ given, spectrum sources, render defaults) is kept in chromatrace properties, so 
 """
 
 import json
+import math
 import os
 import shutil
 import tempfile
@@ -78,10 +79,68 @@ def _mesh_object(name, path, collection):
         if hasattr(mesh, "use_auto_smooth"):  # Blender < 4.1 applies custom normals only with auto smooth
             mesh.use_auto_smooth = True
         mesh.normals_split_custom_set_from_vertices(data.normals)
+    if data.uvs:  # per vertex in the file (export-meshes --uvs splits seams), per face corner in Blender
+        layer = mesh.uv_layers.new(name="UVMap")
+        corners = [0] * len(mesh.loops)
+        mesh.loops.foreach_get("vertex_index", corners)
+        layer.data.foreach_set("uv", [c for v in corners for c in data.uvs[v]])
     mesh.update()
     ob = bpy.data.objects.new(name, mesh)
     collection.objects.link(ob)
     return ob
+
+
+def _world(environment, scene_dir, view_layer):
+    """Blender's world for the scene's environment: a Background (strength = scale) fed by an Environment Texture
+    (nearest texel, as the tracer looks it up; rotation_deg α as a Mapping node turning the vector by −α about Z)
+    or by the colour of an rgb or constant spectrum."""
+    world = bpy.data.worlds.new("environment")
+    world.use_nodes = True
+    nodes, links = world.node_tree.nodes, world.node_tree.links
+    nodes.clear()
+    output = nodes.new("ShaderNodeOutputWorld")
+    background = nodes.new("ShaderNodeBackground")
+    background.inputs["Strength"].default_value = environment.get("scale", 1.0)
+    links.new(background.outputs[0], output.inputs["Surface"])
+    radiance = environment["radiance"]
+    if isinstance(radiance, dict) and "texture" in radiance:
+        texture = nodes.new("ShaderNodeTexEnvironment")
+        texture.image = materials.load_image(os.path.join(scene_dir, radiance["texture"]),
+                                             radiance.get("colour_space", "auto"))
+        texture.interpolation = "Closest"
+        if radiance.get("scale", 1.0) != 1.0:
+            background.inputs["Strength"].default_value *= radiance["scale"]
+        links.new(texture.outputs["Color"], background.inputs["Color"])
+        rotation = environment.get("rotation_deg", 0.0)
+        if rotation:
+            coordinates = nodes.new("ShaderNodeTexCoord")
+            mapping = nodes.new("ShaderNodeMapping")
+            mapping.inputs["Rotation"].default_value[2] = -math.radians(rotation)
+            links.new(coordinates.outputs["Generated"], mapping.inputs["Vector"])
+            links.new(mapping.outputs["Vector"], texture.inputs["Vector"])
+    elif isinstance(radiance, dict) and ("rgb" in radiance or "constant" in radiance):
+        rgb = radiance["rgb"] if "rgb" in radiance else [radiance["constant"]] * 3
+        background.inputs["Color"].default_value = (*rgb, 1.0)
+    else:
+        raise BadInput("environment.radiance: only a texture, an rgb or a constant spectrum can be imported as "
+                       "Blender's world")
+    group = environment.get("group", "environment")
+    if hasattr(world, "lightgroup"):
+        _ensure_lightgroup(view_layer, group)
+        world.lightgroup = group
+    return world
+
+
+def _dark(world):
+    """Whether a world adds no light (as far as a constant colour or strength tells)."""
+    if not world.use_nodes or world.node_tree is None:
+        return max(world.color) <= 0.0
+    for node in world.node_tree.nodes:
+        if node.bl_idname in ("ShaderNodeBackground", "ShaderNodeEmission"):
+            colour, strength = node.inputs["Color"], node.inputs["Strength"]
+            if strength.is_linked or strength.default_value > 0.0 and (colour.is_linked or max(colour.default_value[:3]) > 0.0):
+                return False
+    return True
 
 
 def _ensure_lightgroup(view_layer, group):
@@ -137,6 +196,10 @@ def import_scene(path, scene, tool, log=print):
             ob.chromatrace.scene_name = obj["name"]
             ob.chromatrace.shape_json = json.dumps(obj["shape"])
         view_layer = scene.view_layers[0]
+        for i, light in enumerate(document["lights"]):
+            if isinstance(light["radiance"], dict) and "texture" in light["radiance"]:
+                raise BadInput(f"lights[{i}].radiance: a textured light is not imported (give the emitter an Image "
+                               "Texture node in Blender instead)")
         for entry, light in zip(index["lights"], document["lights"]):
             reflect = built.get(light["material"]) if "material" in light else None
             ob = _mesh_object(light["name"], os.path.join(mesh_dir, entry["file"]), collection)
@@ -151,6 +214,14 @@ def import_scene(path, scene, tool, log=print):
             if hasattr(ob, "lightgroup"):
                 _ensure_lightgroup(view_layer, group)
                 ob.lightgroup = group
+        if "environment" in document:
+            scene.world = _world(document["environment"], scene_dir, view_layer)
+        elif scene.world is not None and not _dark(scene.world):
+            # The scene's light is the file's: a world that lights the scene would add light the file has not.
+            dark = bpy.data.worlds.new("no environment")
+            dark.color = (0.0, 0.0, 0.0)
+            log(f"the scene has no environment: its world \"{scene.world.name}\" is replaced by a dark one")
+            scene.world = dark
         for material in built.values():
             if material.users == 0:
                 material.use_fake_user = True  # a scene material no object uses: keep it for export
@@ -179,5 +250,5 @@ def import_scene(path, scene, tool, log=print):
     finally:
         shutil.rmtree(mesh_dir, ignore_errors=True)
     log(f"imported {path}: {len(document['objects'])} objects, {len(document['lights'])} lights, "
-        f"{len(document['materials'])} materials")
+        f"{len(document['materials'])} materials{', an environment' if 'environment' in document else ''}")
     return collection

@@ -227,12 +227,15 @@ class SpectralRender:
         reasons = "; ".join(node_rules.describe_issue(i) for i in world["issues"] if not i["fallback"])
         return f"rendered without the world's light (strength 0), as asked: {reasons}"
 
-    def _resolve(self, spectrum_settings, current_rgb, what):
-        """The source JSON of a spectrum setting, table names resolved."""
+    def _resolve(self, spectrum_settings, current_rgb, what, texture_allowed=False):
+        """The source JSON of a spectrum setting, table names resolved; a texture only where texture_allowed."""
         try:
             source = spectrum_settings.to_json(current_rgb=current_rgb)
         except (SourceError, ValueError) as e:
             raise BadInput(f"{what}: {e}") from None
+        if _is_texture(source) and not texture_allowed:
+            raise BadInput(f"{what}: an image texture can be a material's reflectance here; for a textured emitter "
+                           "use an Image Texture node in the material's own nodes (Model: Node tree)")
         if isinstance(source, str):
             entry = self.scene.chromatrace.spectra.get(source)
             if entry is None:
@@ -240,6 +243,9 @@ class SpectralRender:
             source = entry.source.to_json()
             if isinstance(source, str):
                 raise BadInput(f"{what}: spectrum table entry \"{entry.name}\" refers to another name")
+            if _is_texture(source):
+                raise BadInput(f"{what}: spectrum table entry \"{entry.name}\" is an image texture (a texture is "
+                               "given where it is used, not in the table)")
         return source
 
     @staticmethod
@@ -273,7 +279,13 @@ class SpectralRender:
             if settings.kind == "RGB" and settings.use_current_colour and (max(rgb) > 1.0 or min(rgb) < 0.0):
                 raise BadInput(f"{what}: colour {tuple(round(c, 4) for c in rgb)} of {spectral_input.label} "
                                "is outside [0, 1], so it is not a reflectance")
-            return _rgb_source(self._resolve(settings, rgb, what)), 1.0
+            source = _rgb_source(self._resolve(settings, rgb, what, texture_allowed=True))
+            if _is_texture(source) != (spectral_input.attribute == "image"):
+                node_is = "is not an Image Texture node" if _is_texture(source) else "is an Image Texture node"
+                raise BadInput(f"{what}: its reflectance is {'an image texture' if _is_texture(source) else 'a spectrum'}"
+                               f" but its node {materials.REFLECTANCE_NODE} {node_is}; choose the model again to "
+                               "rebuild the nodes")
+            return source, 1.0
         if spectral_input.managed or s.emissive:
             settings = s.emission
             scale = 1.0 if spectral_input.managed else s.emission_scale
@@ -317,6 +329,7 @@ class SpectralRender:
         bands = self._band_averages(work_dir, keys, inputs)
         edges = bands["bands"]["edges_nm"]
         per_render = 1 if replicate else request.bands_per_render
+        textures = self._prepare_textures(work_dir, inputs, edges, per_render, replicate)
         transmission = any(materials.has_transmission(walks[("material", m.name)]) for m in used)
         light_groups, assignments, world_group = self._light_groups(view_layer, objects, emitters, world)
         total, planned = components.component_plan(request.families, light_groups, request.max_bounces, transmission,
@@ -326,7 +339,8 @@ class SpectralRender:
                           light_groups=light_groups, assignments=assignments, total=total, components=planned,
                           variants=components.render_variants(request.max_bounces, "bounces" in request.families),
                           passes=components.passes_needed(planned), ids=self._object_ids(objects),
-                          world=world, world_group=world_group, lights=lights, replaced={})
+                          world=world, world_group=world_group, lights=lights, replaced={}, textures=textures,
+                          texture_images={})
         plan.key = cache.cache_key(self._cache_description(plan))
         return plan
 
@@ -334,10 +348,14 @@ class SpectralRender:
         """Every spectral input of the materials, lights and world, with its source's key and its scale; identical
         sources share a key (they are evaluated once). Also the names of the emitting materials."""
         keys, inputs, emitters = {}, [], set()
+        self._texture_sources = {}
 
         def key_of(source):
             text = json.dumps(source, sort_keys=True)
-            return keys.setdefault(text, f"s{len(keys)}")
+            key = keys.setdefault(text, f"s{len(keys)}")
+            if isinstance(source, dict) and "texture" in source:
+                self._texture_sources[key] = source
+            return key
 
         for material in used:
             for spectral_input, source, scale in self._owner_inputs("material", material,
@@ -357,6 +375,8 @@ class SpectralRender:
         """The band averages of every source (`chromatrace scene-bands`), a reflectance above 1 refused."""
         bands = self._evaluate(work_dir, keys)
         for spectral_input, key, _scale, owner in inputs:
+            if key in self._texture_sources:
+                continue  # prepare-texture checks every texel
             problem = self._above_one(bands, spectral_input, key)
             if problem:
                 raise BadInput(f"material \"{owner}\": {problem}")
@@ -365,7 +385,8 @@ class SpectralRender:
     def _evaluate(self, work_dir, keys):
         request = self.request
         request_file = os.path.join(work_dir, "spectra.json")
-        spectra = {k: json.loads(t) for t, k in keys.items()} or {"flat": {"constant": 1.0}}  # no spectra: the edges
+        spectra = {k: json.loads(t) for t, k in keys.items() if not _is_texture(json.loads(t))}
+        spectra = spectra or {"flat": {"constant": 1.0}}  # no spectra: the band edges all the same
         with open(request_file, "w") as f:
             json.dump({"format": "chromatrace-spectra/1", "spectra": spectra}, f)
         return self.tool.band_averages(request_file, request.bands, request.bands_file)
@@ -377,6 +398,48 @@ class SpectralRender:
             return (f"the reflectance of {spectral_input.label} reaches {entry['max']:g} at {entry['max_nm']:g} nm, "
                     "but a reflectance must be in [0, 1]")
         return None
+
+    def _prepare_textures(self, work_dir, inputs, edges, per_render, replicate):
+        """Every image texture's per-band-group images (`chromatrace prepare-texture`, cached by content in
+        <cache root>/textures): {key: prepare-texture's --json summary}."""
+        textures = {}
+        wanted = {key: (spectral_input, owner) for spectral_input, key, _scale, owner in inputs
+                  if key in self._texture_sources}
+        if not wanted:
+            return textures
+        bands_file = os.path.join(work_dir, "bands.json")
+        with open(bands_file, "w") as f:
+            json.dump({"format": "chromatrace-bands/1", "edges_nm": edges}, f)
+        directory = os.path.join(self.request.cache_root or cache.default_root(), "textures")
+        os.makedirs(directory, exist_ok=True)
+        for key, (spectral_input, owner) in wanted.items():
+            source = self._texture_sources[key]
+            kind = "radiance" if spectral_input.role == "emission" else "reflectance"
+            scale = source.get("scale", 1.0)
+            if kind == "reflectance" and scale > 1.0:
+                raise BadInput(f"{owner}: the texture of {spectral_input.label} has scale {scale:g}, but a "
+                               "reflectance's scale must be in [0, 1]")
+            image = self._texture_file(source["texture"], work_dir)
+            start = time.monotonic()
+            textures[key] = self.tool.prepare_texture(image, kind, source.get("colour_space", "auto"), bands_file,
+                                                      per_render, replicate, scale, directory)
+            summary = textures[key]
+            self.request.log(f"texture {source['texture']} ({summary['width']}x{summary['height']}, "
+                             f"{summary['distinct_colours']} colours, {kind}): "
+                             f"{'cached' if summary['cached'] else f'{time.monotonic() - start:.1f} s'}")
+        return textures
+
+    @staticmethod
+    def _texture_file(texture, work_dir):
+        """The file of a texture source; an image packed into the .blend is written out into work_dir first."""
+        if not texture.startswith("packed:"):
+            return texture
+        image = bpy.data.images[texture[len("packed:"):]]
+        name = os.path.basename(image.filepath) or f"{image.name}.png"
+        path = os.path.join(work_dir, f"packed-{len(os.listdir(work_dir))}-{name}")
+        with open(path, "wb") as f:
+            f.write(image.packed_file.data)
+        return path
 
     def _light_groups(self, view_layer, objects, emitters, world):
         """Light groups: every emitter in one (its own, or one named after it), a lit world too; none without the
@@ -440,6 +503,7 @@ class SpectralRender:
             "edges": plan.edges, "per_render": plan.per_render, "replicate": plan.replicate,
             "inputs": [[i.label, i.role, key, scale] for i, key, scale, _owner in plan.inputs],
             "averages": {k: v["bands"] for k, v in plan.bands["spectra"].items()},
+            "textures": {k: v["hash"] for k, v in plan.textures.items()},
             "samples": request.samples, "seed": request.seed, "max_bounces": request.max_bounces,
             "variants": plan.variants, "point_filter": request.point_filter, "resolution": self._resolution(),
             "passes": sorted(plan.passes), "light_groups": plan.assignments, "ids": plan.ids,
@@ -492,7 +556,7 @@ class SpectralRender:
             for spectral_input, source, scale in inputs:
                 entry["colours"].append({"input": spectral_input.label, "role": spectral_input.role,
                                          "source": source, "scale": scale, "key": key_of(source),
-                                         "upsampled": "rgb" in source})
+                                         "upsampled": "rgb" in source or _is_texture(source)})
             refused = any(not i["fallback"] for i in issues) or (
                 any(i["fallback"] for i in issues) and request.on_mixing_nodes != "one-band")
             if status_override is not None:
@@ -525,6 +589,10 @@ class SpectralRender:
             shutil.rmtree(work_dir, ignore_errors=True)
         for entry in owners:
             for colour in entry["colours"]:
+                if _is_texture(colour["source"]):  # every texel upsampled when the render prepares it
+                    colour["bands"] = None
+                    del colour["key"]
+                    continue
                 values = bands["spectra"][colour["key"]]
                 colour["bands"] = [v * colour["scale"] for v in values["bands"]]
                 if colour["role"] == "reflectance" and values["max"] > 1.0:
@@ -565,6 +633,7 @@ class SpectralRender:
             node = spectral_input.replace
             if node is not None and node.as_pointer() not in plan.replaced:
                 plan.replaced[node.as_pointer()] = _replace_with_rgb(journal, node)
+        self._load_textures(journal, plan)
         existing = set(view_layer.lightgroups.keys()) if hasattr(view_layer, "lightgroups") else set()
         for group in plan.light_groups:
             if group not in existing:
@@ -577,9 +646,33 @@ class SpectralRender:
             if ob.name in plan.ids and ob.pass_index != plan.ids[ob.name]:
                 journal.set(ob, "pass_index", plan.ids[ob.name])
 
+    def _load_textures(self, journal, plan):
+        """The prepared images as Blender images (raw data: no colour transform), removed again on restore; a
+        black image stands in for reflectance textures when only emitters are shown."""
+        for key, summary in plan.textures.items():
+            images = []
+            for group in summary["groups"]:
+                image = bpy.data.images.load(group["file"], check_existing=False)
+                image.colorspace_settings.name = "Non-Color"
+                journal.call_on_restore(lambda image=image: bpy.data.images.remove(image))
+                images.append(image)
+            plan.texture_images[key] = images
+        if plan.textures and self.request.max_bounces == 0:
+            black = bpy.data.images.new("chromatrace black", 1, 1, alpha=False, float_buffer=True)
+            black.pixels[:] = (0.0, 0.0, 0.0, 1.0)
+            journal.call_on_restore(lambda: bpy.data.images.remove(black))
+            plan.texture_images[None] = [black]
+
     def _set_colours(self, journal, plan, group):
         no_reflection = self.request.max_bounces == 0  # emitters only
+        g = plan.groups.index(group)
         for spectral_input, key, scale, _owner in plan.inputs:
+            if key in plan.textures:
+                image = plan.texture_images[key][g]
+                if no_reflection and spectral_input.role != "emission":
+                    image = plan.texture_images[None][0]
+                journal.set(spectral_input.target, "image", image)
+                continue
             values = plan.bands["spectra"][key]["bands"]
             r, g, b = group_colour(values, group, plan.replicate)
             factor = 0.0 if no_reflection and spectral_input.role != "emission" else scale
@@ -735,6 +828,10 @@ def camera_description(scene, resolution):
     return {"position": position, "look_at": [position[i] + forward[i] for i in range(3)], "up": up,
             "horizontal_fov_deg": math.degrees(2 * math.atan(tan_w)), "vertical_fov_deg": math.degrees(2 * math.atan(tan_h)),
             "sensor_width_mm": sensor, "focal_length_mm": data.lens, "resolution": [width, height]}
+
+
+def _is_texture(source):
+    return isinstance(source, dict) and "texture" in source
 
 
 def _rgb_source(source):

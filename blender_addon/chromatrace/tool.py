@@ -60,7 +60,15 @@ class Tool:
         return self.run("check-scene", scene_file, "--json", json_output=True)
 
     def export_meshes(self, scene_file, directory):
-        return self.run("export-meshes", scene_file, directory, "--json", json_output=True)
+        return self.run("export-meshes", scene_file, directory, "--uvs", "--json", json_output=True)
+
+    def prepare_texture(self, image, kind, colour_space, bands_file, per_render, replicate, scale, directory):
+        """Per-band-group textures of an image (`chromatrace prepare-texture`): its --json summary."""
+        args = ["prepare-texture", image, "--kind", kind, "--colour-space", colour_space, "--bands-file", bands_file,
+                "--bands-per-render", per_render, "--scale", repr(float(scale)), "-o", directory, "--json", "--quiet"]
+        if replicate:
+            args.append("--replicate")
+        return self.run(*args, json_output=True)
 
     def assemble(self, manifest_file, output):
         return self.run("assemble", manifest_file, "-o", output, "--quiet")

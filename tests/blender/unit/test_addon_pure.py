@@ -238,7 +238,9 @@ class NodeRules(unittest.TestCase):
         self.assertEqual(kind("ShaderNodeMixRGB", blend_type="HUE"), ("pass", True))  # the one-band fallback
         self.assertEqual(kind("ShaderNodeHueSaturation"), ("pass", True))
         self.assertEqual(kind("ShaderNodeGamma"), ("pass", None))
-        for refused in ("ShaderNodeTexImage", "ShaderNodeTexEnvironment", "ShaderNodeTexNoise", "ShaderNodeValToRGB",
+        self.assertEqual(kind("ShaderNodeTexImage"), ("image", None))  # every texel upsampled
+        self.assertEqual(kind("ShaderNodeTexEnvironment"), ("image", None))
+        for refused in ("ShaderNodeTexNoise", "ShaderNodeTexSky", "ShaderNodeValToRGB",
                         "ShaderNodeVertexColor", "ShaderNodeAttribute", "ShaderNodeWavelength",
                         "ShaderNodeCombineColor", "ShaderNodeSomethingNew"):
             self.assertEqual(kind(refused), ("refused", False), refused)
