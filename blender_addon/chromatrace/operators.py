@@ -26,7 +26,16 @@ class CHROMATRACE_OT_render_spectral(bpy.types.Operator):
     def _start(self, context):
         self._messages = []
         request = spectral_render.Request.from_scene(context.scene, log=self._messages.append)
-        return spectral_render.SpectralRender(context.scene, request, _tool(context))
+        self._render = spectral_render.SpectralRender(context.scene, request, _tool(context))
+        return self._render
+
+    def _done(self, context):
+        """Reports the output (and its preview) and shows the preview in an Image Editor."""
+        output = bpy.path.abspath(context.scene.chromatrace.output_path)
+        preview = self._render.preview
+        self.report({"INFO"}, f"wrote {output}" + (f"; preview {preview}" if preview else ""))
+        if preview and not bpy.app.background:
+            show_image(context, preview)
 
     def execute(self, context):  # synchronous: background mode and scripts
         try:
@@ -34,7 +43,7 @@ class CHROMATRACE_OT_render_spectral(bpy.types.Operator):
         except BadInput as e:
             self.report({"ERROR"}, str(e))
             return {"CANCELLED"}
-        self.report({"INFO"}, f"wrote {bpy.path.abspath(context.scene.chromatrace.output_path)}")
+        self._done(context)
         return {"FINISHED"}
 
     def invoke(self, context, event):
@@ -70,7 +79,7 @@ class CHROMATRACE_OT_render_spectral(bpy.types.Operator):
             done, total, message = next(self._steps)
         except StopIteration:
             self._finish(context)
-            self.report({"INFO"}, self._messages[-1] if self._messages else "spectral render finished")
+            self._done(context)
             return {"FINISHED"}
         except BadInput as e:
             self._finish(context)
@@ -83,6 +92,22 @@ class CHROMATRACE_OT_render_spectral(bpy.types.Operator):
         context.window_manager.progress_update(done / total)
         context.workspace.status_text_set(f"chromatrace: {message} (Esc cancels)")
         return {"RUNNING_MODAL"}
+
+
+def show_image(context, path):
+    """Loads an image file (again, if it is loaded already) and shows it in an Image Editor: one of the window's,
+    or the render view Blender opens (Preferences > Interface > Render In)."""
+    image = bpy.data.images.load(path, check_existing=True)
+    image.reload()
+    editors = [a for a in context.window.screen.areas if a.type == "IMAGE_EDITOR"]
+    if not editors:
+        bpy.ops.render.view_show("INVOKE_DEFAULT")
+        for window in context.window_manager.windows:
+            editors += [a for a in window.screen.areas if a.type == "IMAGE_EDITOR"]
+    for area in editors[:1]:
+        area.spaces.active.image = image
+        area.tag_redraw()
+    return image
 
 
 # The last pre-flight summary per scene (kept here, not in the scene, so that checking changes nothing).

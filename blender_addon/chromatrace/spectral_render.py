@@ -123,6 +123,7 @@ class SpectralRender:
         self.rendered = 0  # Cycles renders made by this run (not found in the cache)
         self.cached = 0
         self.cache_dir = None
+        self.preview = None  # the picture a person would see, written beside the output when the render ends
 
     def run(self):
         for _ in self.steps():
@@ -665,10 +666,10 @@ class SpectralRender:
 
     def _set_colours(self, journal, plan, group):
         no_reflection = self.request.max_bounces == 0  # emitters only
-        g = plan.groups.index(group)
+        index = plan.groups.index(group)
         for spectral_input, key, scale, _owner in plan.inputs:
             if key in plan.textures:
-                image = plan.texture_images[key][g]
+                image = plan.texture_images[key][index]
                 if no_reflection and spectral_input.role != "emission":
                     image = plan.texture_images[None][0]
                 journal.set(spectral_input.target, "image", image)
@@ -755,6 +756,7 @@ class SpectralRender:
                     yield done, total, message
             journal.restore()
             self._assemble(plan)
+            self._write_preview()
             if not request.keep_cache:
                 cache.remove(self.cache_dir)
         finally:
@@ -790,6 +792,20 @@ class SpectralRender:
             json.dump(document, f, indent=1)
         self.tool.assemble(manifest_file, os.path.abspath(request.output))
         request.log(f"wrote {request.output} ({self.rendered} renders made, {self.cached} from the cache)")
+
+    def _write_preview(self):
+        """OUT.preview.png beside OUT.exr: the display rendering of a camera (tool.preview), so that a person sees
+        the scene as photographed, not the raw integral of radiance with the CIE observer. A failure is said, and
+        leaves the spectral file as it is."""
+        output = os.path.abspath(self.request.output)
+        preview = os.path.splitext(output)[0] + ".preview.png"
+        try:
+            self.tool.preview(output, preview)
+        except (BadInput, RuntimeError) as e:
+            self.request.log(f"warning: no preview: {e}")
+            return
+        self.preview = preview
+        self.request.log(f"preview {preview}")
 
     def _attributes(self, plan):
         scene, request = self.scene, self.request

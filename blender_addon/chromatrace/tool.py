@@ -70,6 +70,12 @@ class Tool:
             args.append("--replicate")
         return self.run(*args, json_output=True)
 
+    def preview(self, spectral_exr, png):
+        """The picture a person would see (`chromatrace sensor`'s display rendering: a Canon EOS 5D Mark III,
+        exposure from the scene's surfaces, white balance, colour matrix and sRGB), noise-free, as an 8-bit PNG."""
+        return self.run("sensor", spectral_exr, "-o", png, "--preset", "canon_eos_5d_mkiii", "--exposure-s", "auto",
+                        "--no-noise", "-q")
+
     def assemble(self, manifest_file, output):
         return self.run("assemble", manifest_file, "-o", output, "--quiet")
 

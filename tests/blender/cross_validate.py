@@ -4,6 +4,7 @@
     python3 cross_validate.py agree-point SCENE.json  # the same with the scene's pixels point samples
     python3 cross_validate.py filter-glossy SCENE.json  # Cycles' default Filter Glossy and Clamp Indirect left on: must fail
     python3 cross_validate.py reflectance SCENE.json OBJECT  # OBJECT's reflectance changed for Cycles: must fail there
+    python3 cross_validate.py turned SCENE.json  # the environment turned 90° more for Cycles: must fail
 
 Environment: CHROMATRACE_EXE, BLENDER (the executable), and optionally CROSS_SIZE (32x32), CROSS_BANDS
 (380:780:40), CROSS_SPP (tracer and Cycles samples per pixel), CROSS_KEEP (a folder to keep the files in).
@@ -64,9 +65,14 @@ def scene_copy(scene, work, change):
     with open(scene) as f:
         document = json.load(f)
     change(document)
-    for spectrum in document["spectra"].values():
+    here = os.path.dirname(scene)
+    for spectrum in document.get("spectra", {}).values():
         if "csv" in spectrum:
-            spectrum["csv"] = os.path.join(os.path.dirname(scene), spectrum["csv"])
+            spectrum["csv"] = os.path.join(here, spectrum["csv"])
+    for source in [m.get(k) for m in document["materials"].values() for k in ("reflectance", "diffuse")] + \
+            [document.get("environment", {}).get("radiance")]:
+        if isinstance(source, dict) and "texture" in source:
+            source["texture"] = os.path.join(here, source["texture"])
     changed = os.path.join(work, "changed.json")
     with open(changed, "w") as f:
         json.dump(document, f)
@@ -75,7 +81,11 @@ def scene_copy(scene, work, change):
 
 def scene_groups(scene):
     with open(scene) as f:
-        return sorted({light["group"] for light in json.load(f)["lights"]})
+        document = json.load(f)
+    groups = {light["group"] for light in document["lights"]}
+    if "environment" in document:
+        groups.add(document["environment"].get("group", "environment"))
+    return sorted(groups)
 
 
 def check(condition, message):
@@ -159,6 +169,20 @@ def main():
             check(len(on_target) >= len({c["band"] for c in doc["cells"]}) // 2,
                   f"{target}'s total must fail in most bands; failed cells: {[(c['object'], c['component'], c['band']) for c in failed[:8]]}")
             print(f"disagree as expected: {len(on_target)} bands of {target}'s total, {len(failed)} cells in all")
+        elif case == "turned":
+            # The sky turned a quarter turn further for Cycles: the sun lights the objects from another side, so
+            # direct light from the environment must disagree on most objects (and the agree case, where the
+            # turn is the same, shows that the add-on's Mapping node turns the way the tracer does).
+            def turn(document):
+                document["environment"]["rotation_deg"] = document["environment"].get("rotation_deg", 0) + 90
+
+            render_cycles(scene_copy(scene, work, turn), cycles, work)
+            doc = compare(cycles, tracer, os.path.join(work, "compare"))
+            failed = [c for c in doc["cells"] if not c["pass"]]
+            objects = {c["object"] for c in failed if c["component"] in ("diffuse_direct", "glossy_direct")}
+            named = {o["object"] for o in doc["objects"] if o["object_id"] > 0}
+            check(len(objects) * 2 > len(named), f"direct light must disagree on most objects; it does on {sorted(objects)}")
+            print(f"disagree as expected: direct light on {sorted(objects)}, {len(failed)} cells in all")
         else:
             sys.exit(f"unknown case {case}")
     finally:

@@ -406,7 +406,8 @@ const json* owner(const json& summary, const std::string& kind, const std::strin
 
 // Every material of Blender's bundled library that carries colour, on a sphere each, an area light coloured by a
 // Blackbody node, a world lit by an HDRI: the pre-flight summary names every material, the light and the world,
-// each exact, upsampled or refused by name with the node and the colour input it reaches; nothing in between.
+// each exact, upsampled (an RGB colour or every texel of an image) or refused by name with the node and the colour
+// input it reaches; nothing in between.
 TEST_F(ArtistScene, LibrarySceneIsExplainedWithEveryColourConvertedOrRefusedByName) {
   const fs::path blend = make({"library"}, "library.blend");
   const json summary = explain(blend);
@@ -427,14 +428,19 @@ TEST_F(ArtistScene, LibrarySceneIsExplainedWithEveryColourConvertedOrRefusedByNa
       }
     } else {
       ++converted;
-      // Every colour the render sets has a spectrum, evaluated in every band.
+      // Every colour the render sets has a spectrum, evaluated in every band — or is an image texture whose
+      // every texel the render upsamples.
       for (const json& c : o["colours"]) {
         EXPECT_TRUE(c["source"].is_object()) << name;
-        EXPECT_EQ(c["bands"].size(), 6u) << name;
+        if (c["source"].contains("texture")) {
+          EXPECT_TRUE(c["bands"].is_null()) << name;
+        } else {
+          EXPECT_EQ(c["bands"].size(), 6u) << name;
+        }
       }
       if (status == "upsampled") {
         bool any_rgb = false;
-        for (const json& c : o["colours"]) any_rgb = any_rgb || c["source"].contains("rgb");
+        for (const json& c : o["colours"]) any_rgb = any_rgb || c["source"].contains("rgb") || c["source"].contains("texture");
         EXPECT_TRUE(any_rgb) << name;
       }
     }
@@ -468,22 +474,21 @@ TEST_F(ArtistScene, LibrarySceneIsExplainedWithEveryColourConvertedOrRefusedByNa
   for (const json& c : (*light)["colours"]) planck = planck || c["source"] == json{{"blackbody_k", 4000.0}};
   EXPECT_TRUE(planck) << light->dump();
 
-  // The HDRI world: refused by name, saying how to proceed; nothing renders.
+  // The HDRI world: upsampled texel by texel (the render prepares its per-band-group images), as emission.
   const json* world = owner(summary, "world", "World");
   ASSERT_NE(world, nullptr);
-  EXPECT_EQ((*world)["status"], "refused");
-  const std::string why = (*world)["reasons"][0];
-  EXPECT_NE(why.find("world \"World\""), std::string::npos) << why;
-  EXPECT_NE(why.find("Environment Texture"), std::string::npos) << why;
-  EXPECT_NE(why.find("--on-world omit"), std::string::npos) << why;
-  EXPECT_FALSE(summary["ok"]);
+  EXPECT_EQ((*world)["status"], "upsampled") << world->dump();
+  ASSERT_EQ((*world)["colours"].size(), 1u) << world->dump();
+  const json& sky = (*world)["colours"][0];
+  EXPECT_EQ(sky["role"], "emission");
+  EXPECT_EQ(sky["source"]["colour_space"], "linear");
+  EXPECT_EQ(fs::path(sky["source"]["texture"].get<std::string>()).extension(), ".exr") << sky.dump();
+  EXPECT_FALSE(summary["ok"]);  // the refused materials
   EXPECT_TRUE(summary["renders"].is_null());
 
-  // With the option the world is left out (and says so); a render still refuses the refused materials by name.
-  const json omitted = explain(blend, {"--on-world", "omit"});
-  EXPECT_EQ((*owner(omitted, "world", "World"))["status"], "omitted");
+  // A render refuses the refused materials by name and writes nothing.
   const CommandResult r = batch({"--blend", blend.string(), "--out", dir_.file("library.exr").string(), "--bands",
-                                 "400:700:50", "--on-world", "omit", "--resolution", "16x16", "--samples", "1"});
+                                 "400:700:50", "--resolution", "16x16", "--samples", "1"});
   EXPECT_EQ(r.exit_code, 2) << r.err;
   EXPECT_NE(r.err.find("batch.py: error: cannot render spectrally: material \""), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(dir_.file("library.exr")));

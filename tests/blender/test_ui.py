@@ -115,12 +115,18 @@ s.output_path = os.path.join(work, "ui.exr")
 s.cache_dir = os.path.join(work, "cache")
 if bpy.ops.chromatrace.render_spectral() != {"FINISHED"} or not os.path.isfile(s.output_path):
     failures.append("Render Spectral did not write its file")
+if not os.path.isfile(os.path.join(work, "ui.preview.png")):
+    failures.append("Render Spectral wrote no preview (ui.preview.png) beside its file")
 if bpy.ops.chromatrace.preflight() != {"FINISHED"}:
     failures.append("Check Spectra did not finish")
 drawn = draw(ui.CHROMATRACE_PT_preflight, context)
 if "chromatrace.preflight" not in drawn:
     failures.append(f"the spectra check panel lacks its button: {drawn}")
 from chromatrace.operators import PREFLIGHT  # noqa: E402
+if [o["status"] for o in PREFLIGHT[scene.name]["owners"] if o["kind"] == "world"] != ["dark"]:
+    failures.append(f"the imported scene has no environment, so its world must be dark: {PREFLIGHT[scene.name]['owners']}")
+scene.world = bpy.data.worlds["World"]  # the factory world again, a grey background: exact
+bpy.ops.chromatrace.preflight()
 if [o["status"] for o in PREFLIGHT[scene.name]["owners"] if o["kind"] == "world"] != ["exact"]:
     failures.append(f"the factory world (a grey background) is not exact: {PREFLIGHT[scene.name]['owners']}")
 if bpy.ops.chromatrace.export_scene(filepath=os.path.join(work, "exported.json")) != {"FINISHED"}:
