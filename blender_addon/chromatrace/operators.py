@@ -7,7 +7,7 @@ from bpy_extras.io_utils import ExportHelper, ImportHelper
 
 from . import materials, scene_export, scene_import, spectral_render, tool
 from .errors import BadInput
-from .properties import executable_preference
+from .properties import MODEL_ITEMS, executable_preference
 
 
 def _tool(context):
@@ -190,6 +190,57 @@ class CHROMATRACE_OT_build_material(bpy.types.Operator):
         return {"FINISHED"}
 
 
+def current_colour(material):
+    """The colour the material shows now: its first upsampled reflectance colour (a Principled or Diffuse BSDF's
+    base colour, through groups and Mix nodes), else its viewport colour."""
+    walk = materials.walk_material(material) if material.chromatrace.model == "NODES" else None
+    if walk is not None:
+        for leaf in walk.leaves.values():
+            if leaf.texture is None and leaf.blackbody_k is None and leaf.role == "reflectance":
+                return tuple(min(1.0, max(0.0, c)) for c in leaf.rgb)
+    node = material.node_tree.nodes.get(materials.REFLECTANCE_NODE) if material.node_tree else None
+    if node is not None and node.bl_idname == "ShaderNodeRGB":
+        return tuple(node.outputs[0].default_value[:3])
+    return tuple(material.diffuse_color[:3])
+
+
+class CHROMATRACE_OT_set_model(bpy.types.Operator):
+    """Choose the material's model: its nodes are rebuilt for that BRDF, keeping the colour it shows now"""
+
+    bl_idname = "chromatrace.set_model"
+    bl_label = "Set Model"
+    bl_options = {"REGISTER", "UNDO"}
+    model: bpy.props.EnumProperty(name="Model", items=MODEL_ITEMS)
+
+    @classmethod
+    def poll(cls, context):
+        return getattr(context, "material", None) is not None
+
+    def invoke(self, context, event):
+        material = context.material
+        own = material.chromatrace.model == "NODES" and material.use_nodes and material.node_tree is not None \
+            and len(material.node_tree.nodes) > 0
+        if own and self.model != "NODES":
+            return context.window_manager.invoke_props_dialog(self, width=420)
+        return self.execute(context)
+
+    def draw(self, context):
+        material = context.material
+        colour = ", ".join(f"{c:.3f}" for c in current_colour(material))
+        column = self.layout.column()
+        column.label(text=f"Replace the {len(material.node_tree.nodes)} nodes of \"{material.name}\"")
+        column.label(text=f"by the {self.model.lower()} model's? Its colour ({colour}) is kept.")
+        column.label(text="Undo (Ctrl Z) brings the nodes back.")
+
+    def execute(self, context):
+        material = context.material
+        s = material.chromatrace
+        if self.model != "NODES" and s.model == "NODES" and s.reflectance.kind == "RGB":
+            s.reflectance.rgb = current_colour(material)
+        s.model = self.model  # rebuilds the nodes (properties._rebuild_nodes)
+        return {"FINISHED"}
+
+
 class CHROMATRACE_OT_spectrum_add(bpy.types.Operator):
     """Add a named spectrum to the scene's spectrum table"""
 
@@ -232,7 +283,7 @@ def _menu_export(self, context):
 
 
 _classes = (CHROMATRACE_OT_render_spectral, CHROMATRACE_OT_preflight, CHROMATRACE_OT_import_scene, CHROMATRACE_OT_export_scene,
-            CHROMATRACE_OT_build_material, CHROMATRACE_OT_spectrum_add, CHROMATRACE_OT_spectrum_remove)
+            CHROMATRACE_OT_build_material, CHROMATRACE_OT_set_model, CHROMATRACE_OT_spectrum_add, CHROMATRACE_OT_spectrum_remove)
 
 
 def register():

@@ -143,7 +143,7 @@ def _rebuild_nodes(self, context):
         materials.build_material_nodes(material)
 
 
-_MODEL_ITEMS = [
+MODEL_ITEMS = [
     ("NODES", "Node tree", "Keep the material's own nodes; its colour inputs get the spectra"),
     ("LAMBERT", "Lambert", "f = R(λ)/π: a Diffuse BSDF"),
     ("DICHROMATIC", "Dichromatic", "Lambertian body plus a spectrally flat GGX interface lobe (Shafer's model)"),
@@ -153,7 +153,7 @@ _MODEL_ITEMS = [
 
 
 class CHROMATRACE_PG_material(bpy.types.PropertyGroup):
-    model: EnumProperty(name="Model", items=_MODEL_ITEMS, default="NODES", update=_rebuild_nodes,
+    model: EnumProperty(name="Model", items=MODEL_ITEMS, default="NODES", update=_rebuild_nodes,
                         description="Choosing a model other than Node tree rebuilds the material's nodes")
     reflectance: PointerProperty(type=CHROMATRACE_PG_spectrum, name="Reflectance")
     specular: FloatProperty(name="Specular", min=0.0, max=1.0, default=0.05, update=_rebuild_nodes,

@@ -2,6 +2,8 @@
 
 import bpy
 
+from .properties import MODEL_ITEMS
+
 
 class _Panel:
     bl_space_type = "PROPERTIES"
@@ -101,7 +103,8 @@ class CHROMATRACE_PT_material(_Panel, bpy.types.Panel):
         layout = self.layout
         layout.use_property_split = True
         row = layout.row(align=True)
-        row.prop(s, "model")
+        label = next(name for key, name, _ in MODEL_ITEMS if key == s.model)
+        row.operator_menu_enum("chromatrace.set_model", "model", text=f"Model: {label}")
         row.operator("chromatrace.build_material", text="", icon="FILE_REFRESH")
         if s.model != "NONE":
             box = layout.box()

@@ -37,6 +37,13 @@ class Layout:
             failures.append(f"panel draws unknown operator {idname}")
         self.drawn.append(idname)
 
+    def operator_menu_enum(self, idname, prop, **kwargs):
+        self.operator(idname)
+        module, name = idname.split(".")
+        op = getattr(getattr(bpy.ops, module), name, None)
+        if op is None or prop not in op.get_rna_type().properties:
+            failures.append(f"panel draws a menu of unknown property {idname}.{prop}")
+
     def template_list(self, *args, **kwargs):
         self.drawn.append("list")
 
@@ -104,6 +111,18 @@ if abs(nodes["ct_glossy"].inputs["Roughness"].default_value - 0.4) > 1e-6:
 with bpy.context.temp_override(material=material):
     if bpy.ops.chromatrace.build_material() != {"FINISHED"}:
         failures.append("build_material did not run")
+
+# Set Model keeps the colour the material shows: a Principled BSDF's red base colour becomes the Lambert
+# model's reflectance colour (not grey).
+red = bpy.data.materials.new("red plastic")
+red.use_nodes = True
+red.node_tree.nodes["Principled BSDF"].inputs["Base Color"].default_value = (0.8, 0.05, 0.02, 1.0)
+with bpy.context.temp_override(material=red):
+    if bpy.ops.chromatrace.set_model(model="LAMBERT") != {"FINISHED"}:
+        failures.append("set_model did not run")
+kept = tuple(red.node_tree.nodes["ct_reflectance"].outputs[0].default_value[:3])
+if max(abs(a - b) for a, b in zip(kept, (0.8, 0.05, 0.02))) > 1e-6 or red.chromatrace.model != "LAMBERT":
+    failures.append(f"Set Model did not keep the red: {kept}, model {red.chromatrace.model}")
 
 # Import, render (synchronously in background mode) and export through the operators.
 work = tempfile.mkdtemp(prefix="chromatrace-ui-")
