@@ -241,6 +241,35 @@ class CHROMATRACE_OT_set_model(bpy.types.Operator):
         return {"FINISHED"}
 
 
+# Band plans and quality: (label, description, settings of the scene's chromatrace properties).
+PRESETS = {
+    "PREVIEW": ("Quick preview", "6 bands of 50 nm over 400-700 nm (2 Cycles renders), 16 samples, 4 bounces",
+                {"band_plan": "RANGE", "bands_lo": 400.0, "bands_hi": 700.0, "bands_width": 50.0, "samples": 16,
+                 "max_bounces": 4}),
+    "PAPER": ("The paper's settings", "40 bands of 10 nm over 380-780 nm (14 Cycles renders), 256 samples, "
+              "8 bounces, as scenes/paper/box.json", {"band_plan": "RANGE", "bands_lo": 380.0, "bands_hi": 780.0,
+                                                      "bands_width": 10.0, "samples": 256, "max_bounces": 8}),
+    "FINAL": ("Final", "31 bands of 10 nm over 400-710 nm (11 Cycles renders), 1024 samples, 12 bounces",
+              {"band_plan": "RANGE", "bands_lo": 400.0, "bands_hi": 710.0, "bands_width": 10.0, "samples": 1024,
+               "max_bounces": 12}),
+}
+
+
+class CHROMATRACE_OT_apply_preset(bpy.types.Operator):
+    """Set the band plan and the quality from a preset"""
+
+    bl_idname = "chromatrace.apply_preset"
+    bl_label = "Spectral Render Preset"
+    bl_options = {"REGISTER", "UNDO"}
+    preset: bpy.props.EnumProperty(name="Preset", items=[(k, v[0], v[1]) for k, v in PRESETS.items()])
+
+    def execute(self, context):
+        s = context.scene.chromatrace
+        for key, value in PRESETS[self.preset][2].items():
+            setattr(s, key, value)
+        return {"FINISHED"}
+
+
 class CHROMATRACE_OT_spectrum_add(bpy.types.Operator):
     """Add a named spectrum to the scene's spectrum table"""
 
@@ -283,7 +312,7 @@ def _menu_export(self, context):
 
 
 _classes = (CHROMATRACE_OT_render_spectral, CHROMATRACE_OT_preflight, CHROMATRACE_OT_import_scene, CHROMATRACE_OT_export_scene,
-            CHROMATRACE_OT_build_material, CHROMATRACE_OT_set_model, CHROMATRACE_OT_spectrum_add, CHROMATRACE_OT_spectrum_remove)
+            CHROMATRACE_OT_build_material, CHROMATRACE_OT_set_model, CHROMATRACE_OT_apply_preset, CHROMATRACE_OT_spectrum_add, CHROMATRACE_OT_spectrum_remove)
 
 
 def register():

@@ -1,5 +1,7 @@
 """Panels: spectral settings in the Render, Material, Light and Object properties."""
 
+import textwrap
+
 import bpy
 
 from .properties import MODEL_ITEMS
@@ -18,7 +20,9 @@ class CHROMATRACE_PT_render(_Panel, bpy.types.Panel):
         s = context.scene.chromatrace
         layout = self.layout
         layout.use_property_split = True
-        layout.operator("chromatrace.render_spectral", icon="RENDER_STILL")
+        row = layout.row(align=True)
+        row.operator("chromatrace.render_spectral", icon="RENDER_STILL")
+        row.operator_menu_enum("chromatrace.apply_preset", "preset", text="Presets", icon="PRESET")
         layout.prop(s, "output_path")
         col = layout.column(heading="Bands")
         col.prop(s, "band_plan")
@@ -49,7 +53,6 @@ class CHROMATRACE_PT_preflight(_Panel, bpy.types.Panel):
     bl_label = "Spectra Check"
     bl_context = "render"
     bl_parent_id = "CHROMATRACE_PT_render"
-    bl_options = {"DEFAULT_CLOSED"}
 
     def draw(self, context):
         from .operators import PREFLIGHT
@@ -61,10 +64,13 @@ class CHROMATRACE_PT_preflight(_Panel, bpy.types.Panel):
         col = layout.column(align=True)
         col.label(text=f"{summary['renders']} Cycles renders" if summary["ok"] else "Refused: nothing renders")
         icons = {"exact": "CHECKMARK", "upsampled": "COLOR", "refused": "ERROR", "omitted": "ERROR"}
+        region = getattr(context, "region", None)
+        width = max(30, int(region.width / (7 * context.preferences.system.ui_scale))) if region else 60
         for owner in summary["owners"]:
             col.label(text=f"{owner['kind']} {owner['name']}: {owner['status']}", icon=icons.get(owner["status"], "DOT"))
-            for reason in owner["reasons"][:2]:
-                col.label(text=f"    {reason}")
+            for reason in owner["reasons"]:  # in full: wrapped to the panel's width, never cut off
+                for line in textwrap.wrap(reason, width):
+                    col.label(text=f"    {line}")
 
 
 class CHROMATRACE_UL_spectra(bpy.types.UIList):

@@ -124,6 +124,13 @@ kept = tuple(red.node_tree.nodes["ct_reflectance"].outputs[0].default_value[:3])
 if max(abs(a - b) for a, b in zip(kept, (0.8, 0.05, 0.02))) > 1e-6 or red.chromatrace.model != "LAMBERT":
     failures.append(f"Set Model did not keep the red: {kept}, model {red.chromatrace.model}")
 
+# Presets set the band plan and the quality.
+if bpy.ops.chromatrace.apply_preset(preset="PAPER") != {"FINISHED"}:
+    failures.append("apply_preset did not run")
+sc = scene.chromatrace
+if (sc.bands_argument(), sc.samples, sc.max_bounces) != ("380:780:10", 256, 8):
+    failures.append(f"the paper preset set {sc.bands_argument()}, {sc.samples} samples, {sc.max_bounces} bounces")
+
 # Import, render (synchronously in background mode) and export through the operators.
 work = tempfile.mkdtemp(prefix="chromatrace-ui-")
 bpy.ops.chromatrace.import_scene(filepath=os.path.join(SOURCE, "scenes", "paper", "box.json"))
