@@ -1,8 +1,11 @@
 #!/usr/bin/env python3
-"""Benchmark of the Blender add-on: a spectral Cycles render of the paper box beside one plain RGB Cycles render.
+"""Benchmark of the Blender add-on: a spectral Cycles render of a scene beside one plain RGB Cycles render.
 
-    CHROMATRACE_EXE=build/cli/chromatrace python3 bench/bench_blender.py [--resolution 256] [--samples 128]
-        [--bands 395:705:10] [--blender blender]
+    CHROMATRACE_EXE=build/cli/chromatrace python3 bench/bench_blender.py [--scene scenes/paper/box.json]
+        [--resolution 256] [--samples 128] [--bands 395:705:10] [--blender blender]
+
+The scene is the paper box unless --scene names another (scenes/textured/textured.json: image textures and an
+HDRI world, whose per-band-group images the spectral run prepares first, with a cache of its own, so cold).
 
 Spectral: blender_addon/batch.py on scenes/paper/box.json (31 bands centred at 400, 410, ... 700 nm by
 default, so 11 renders of 3 bands, the last of 1; path and light-group components; the scene's 8 bounces).
@@ -57,6 +60,7 @@ def _children_cpu():
 
 def main():
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument("--scene", default=BOX)
     p.add_argument("--resolution", type=int, default=256)
     p.add_argument("--samples", type=int, default=128)
     p.add_argument("--bands", default="395:705:10")
@@ -65,11 +69,12 @@ def main():
     if not os.environ.get("CHROMATRACE_EXE"):
         sys.exit("set CHROMATRACE_EXE to the chromatrace executable (e.g. build/cli/chromatrace)")
     work = tempfile.mkdtemp(prefix="chromatrace-bench-")
+    scene = os.path.abspath(args.scene)
     blender = [args.blender, "--background", "--factory-startup"]
 
     start, start_cpu = time.monotonic(), _children_cpu()
     spectral = subprocess.run(
-        blender + ["--python", os.path.join(ROOT, "blender_addon", "batch.py"), "--", "--scene", BOX,
+        blender + ["--python", os.path.join(ROOT, "blender_addon", "batch.py"), "--", "--scene", scene,
                    "--out", os.path.join(work, "spectral.exr"), "--resolution", f"{args.resolution}x{args.resolution}",
                    "--samples", str(args.samples), "--bands", args.bands, "--cache-dir", os.path.join(work, "cache")],
         capture_output=True, text=True)
@@ -80,10 +85,11 @@ def main():
     groups = [float(wall) for wall, _cpu in timings]
     groups_cpu = [float(cpu) for _wall, cpu in timings]
     bands = re.search(r"(\d+) bands in (\d+) renders", spectral.stderr)
+    textures = [float(t) for t in re.findall(r"chromatrace: texture .*: ([0-9.]+) s$", spectral.stderr, re.M)]
 
     start, start_cpu = time.monotonic(), _children_cpu()
     plain = subprocess.run(blender + ["--python-expr", PLAIN.format(
-        root=ROOT, box=BOX, samples=args.samples, res=args.resolution, out=os.path.join(work, "rgb.exr"))],
+        root=ROOT, box=scene, samples=args.samples, res=args.resolution, out=os.path.join(work, "rgb.exr"))],
         capture_output=True, text=True)
     plain_wall, plain_cpu = time.monotonic() - start, _children_cpu() - start_cpu
     found = re.search(r"PLAIN_RENDER_SECONDS ([0-9.]+) ([0-9.]+)", plain.stdout)
@@ -91,11 +97,12 @@ def main():
         sys.exit(f"plain RGB render failed: {plain.stderr.strip()[-500:]}")
     plain_render, plain_render_cpu = float(found.group(1)), float(found.group(2))
 
-    print(f"paper box, {args.resolution}x{args.resolution}, {args.samples} samples, "
+    print(f"{os.path.basename(scene)}, {args.resolution}x{args.resolution}, {args.samples} samples, "
           f"{bands.group(1)} bands in {bands.group(2)} Cycles renders, {os.cpu_count()} cores, "
           f"load average {os.getloadavg()[0]:.1f}")
     print(f"{'':34}{'wall s':>10}{'CPU s':>10}")
-    rows = [("spectral: per band group (mean)", sum(groups) / len(groups), sum(groups_cpu) / len(groups_cpu)),
+    rows = [("spectral: texture preparation", sum(textures), float("nan"))] if textures else []
+    rows += [("spectral: per band group (mean)", sum(groups) / len(groups), sum(groups_cpu) / len(groups_cpu)),
             ("spectral: all band groups", sum(groups), sum(groups_cpu)),
             ("spectral: whole run", spectral_wall, spectral_cpu),
             ("plain RGB: one Cycles render", plain_render, plain_render_cpu),
@@ -105,7 +112,8 @@ def main():
     print(f"spectral / plain RGB render: {sum(groups) / plain_render:.1f}x wall, "
           f"{sum(groups_cpu) / plain_render_cpu:.1f}x CPU "
           f"(one band group / plain RGB: {sum(groups_cpu) / len(groups_cpu) / plain_render_cpu:.2f}x CPU)")
-    print("whole run: Blender start, import, renders (and for the spectral run, chromatrace assemble)")
+    print("whole run: Blender start, import, renders (and for the spectral run, the texture preparation, "
+          "chromatrace assemble and the preview)")
     shutil.rmtree(work, ignore_errors=True)
 
 if __name__ == "__main__":

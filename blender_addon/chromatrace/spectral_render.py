@@ -351,25 +351,26 @@ class SpectralRender:
         keys, inputs, emitters = {}, [], set()
         self._texture_sources = {}
 
-        def key_of(source):
-            text = json.dumps(source, sort_keys=True)
-            key = keys.setdefault(text, f"s{len(keys)}")
-            if isinstance(source, dict) and "texture" in source:
+        def key_of(source, role):
+            if _is_texture(source):  # one image is prepared once per use: a reflectance or a radiance
+                text = json.dumps({**source, "use": "radiance" if role == "emission" else "reflectance"}, sort_keys=True)
+                key = keys.setdefault(text, f"s{len(keys)}")
                 self._texture_sources[key] = source
-            return key
+                return key
+            return keys.setdefault(json.dumps(source, sort_keys=True), f"s{len(keys)}")
 
         for material in used:
             for spectral_input, source, scale in self._owner_inputs("material", material,
                                                                     walks[("material", material.name)]):
-                inputs.append((spectral_input, key_of(source), scale, material.name))
+                inputs.append((spectral_input, key_of(source, spectral_input.role), scale, material.name))
                 if spectral_input.role == "emission":
                     emitters.add(material.name)
         for ob in lights:
             for spectral_input, source, scale in self._owner_inputs("light", ob, walks[("light", ob.name)]):
-                inputs.append((spectral_input, key_of(source), scale, ob.name))
+                inputs.append((spectral_input, key_of(source, spectral_input.role), scale, ob.name))
         if world["status"] == "lit":
             for spectral_input, source, scale in self._owner_inputs("world", self.scene.world, world["walk"]):
-                inputs.append((spectral_input, key_of(source), scale, self.scene.world.name))
+                inputs.append((spectral_input, key_of(source, spectral_input.role), scale, self.scene.world.name))
         return keys, inputs, emitters
 
     def _band_averages(self, work_dir, keys, inputs):

@@ -4,6 +4,10 @@
         one small sphere per material of Blender's bundled materials library (sample_materials.blend) that
         carries colour, an area light whose colour is a Blackbody node (4000 K) in its node tree, and a world
         lit by an HDRI of Blender's studio lights; --only keeps those materials, and a world without light
+    blender -b --factory-startup --python make_artist_scene.py -- textured OUT.blend
+        a diffuse plane whose colour is an Image Texture node of a 2×1 float image packed into the .blend (red
+        0.8, 0.05, 0.05 on the left, blue 0.05, 0.1, 0.8 on the right, linear), under a white world of strength 1,
+        seen from above by an orthographic camera; no lights
     blender -b --factory-startup --python make_artist_scene.py -- blackbody OUT.blend KELVIN
         a grey diffuse plane under an area light whose node tree's colour is a Blackbody node at KELVIN, no world
 
@@ -108,6 +112,34 @@ def blackbody_scene(kelvin):
     bpy.context.scene.world = None
 
 
+def textured_scene(out):
+    bpy.ops.mesh.primitive_plane_add(size=4.0, location=(0.0, 0.0, 0.0))  # u = (x + 2) / 4
+    plane = bpy.context.object
+    plane.name = "plane"
+    image = bpy.data.images.new("two colours", 2, 1, alpha=False, float_buffer=True)
+    image.pixels[:] = (0.8, 0.05, 0.05, 1.0, 0.05, 0.1, 0.8, 1.0)
+    image.filepath_raw = os.path.join(os.path.dirname(os.path.abspath(out)), "two_colours.exr")
+    image.file_format = "OPEN_EXR"
+    image.save()
+    image.pack()
+    image.source = "FILE"
+    material = bpy.data.materials.new("painted")
+    material.use_nodes = True
+    nodes = material.node_tree.nodes
+    nodes.remove(nodes["Principled BSDF"])
+    diffuse = nodes.new("ShaderNodeBsdfDiffuse")
+    texture = nodes.new("ShaderNodeTexImage")
+    texture.image = image
+    texture.interpolation = "Closest"
+    material.node_tree.links.new(texture.outputs["Color"], diffuse.inputs["Color"])
+    material.node_tree.links.new(diffuse.outputs[0], nodes["Material Output"].inputs["Surface"])
+    plane.data.materials.append(material)
+    world = bpy.context.scene.world
+    world.node_tree.nodes["Background"].inputs["Color"].default_value = (1.0, 1.0, 1.0, 1.0)
+    world.node_tree.nodes["Background"].inputs["Strength"].default_value = 1.0
+    look_down(bpy.context.scene.camera, 5.0, 3.0)
+
+
 argv = sys.argv[sys.argv.index("--") + 1:]
 mode, out = argv[0], argv[1]
 clear_defaults()
@@ -115,6 +147,8 @@ bpy.context.scene.render.engine = "CYCLES"
 if mode == "library":
     only = set(argv[3].split("|")) if len(argv) > 3 and argv[2] == "--only" else None
     library_scene(only)
+elif mode == "textured":
+    textured_scene(out)
 elif mode == "blackbody":
     blackbody_scene(float(argv[2]))
 else:

@@ -10,6 +10,7 @@
 #include <fstream>
 #include <set>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include <fmt/core.h>
@@ -643,6 +644,48 @@ TEST_F(ArtistScene, BlackbodyLightBandShapeIsPlancksLaw) {
     // Not a repetition of three bands: Planck's law at these temperatures differs between b and b + 3.
     EXPECT_GT(std::abs(expected[3] / expected[0] - 1.0), 0.1);
   }
+}
+
+// An artist's own node tree: a Diffuse BSDF coloured by an Image Texture node whose 2×1 float image is packed into
+// the .blend (red on the left, blue on the right), under a white world of strength 1 (a flat spectrum). Each
+// texel's reflectance is upsampled (prepare-texture, from the packed bytes) and a Lambertian plane under a
+// uniform sky of radiance 1 has radiance ρ(λ): each half's band means must be the band averages of its colour's
+// {"rgb"} spectrum (scene-bands), within 4 standard errors (from the pixels) plus 0.1 % (the texel's float).
+TEST_F(ArtistScene, PackedImageTextureRendersEachTexelsSpectrum) {
+  const fs::path blend = make({"textured"}, "textured.blend");
+  fs::remove(dir_.file("two_colours.exr"));  // only the packed copy remains
+  const json plan = explain(blend);
+  const json* painted = owner(plan, "material", "painted");
+  ASSERT_NE(painted, nullptr);
+  EXPECT_EQ((*painted)["status"], "upsampled") << plan.dump(1);
+  EXPECT_EQ((*painted)["colours"][0]["source"]["texture"], "packed:two colours") << plan.dump(1);
+  EXPECT_EQ((*owner(plan, "world", "World"))["status"], "exact") << plan.dump(1);
+
+  const fs::path out = dir_.file("textured.exr");
+  const CommandResult r = batch({"--blend", blend.string(), "--out", out.string(), "--bands", "400:700:50",
+                                 "--resolution", "24x24", "--samples", "64", "--max-bounces", "1", "--components", "none"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const fs::path spectra = dir_.file("colours.json");
+  std::ofstream(spectra) << R"({"format": "chromatrace-spectra/1", "spectra": {)"
+                         << R"("red": {"rgb": [0.8, 0.05, 0.05]}, "blue": {"rgb": [0.05, 0.1, 0.8]}}})";
+  const CommandResult bands = test::run_chromatrace({"scene-bands", spectra.string(), "--bands", "400:700:50", "--json"});
+  ASSERT_EQ(bands.exit_code, 0) << bands.err;
+  const json averages = json::parse(bands.out)["spectra"];
+
+  SpectralExrReader reader(out);
+  const SpectralExrInfo& info = reader.info();
+  const std::vector<float> total = reader.read_layer(info.total());
+  const int w = info.width, h = info.height;
+  for (const auto& [name, first, last] : {std::tuple{"red", 1, w / 2 - 2}, std::tuple{"blue", w / 2 + 2, w - 2}})
+    for (std::size_t b = 0; b < 6; ++b) {
+      std::vector<double> values;
+      for (int y = 1; y < h - 1; ++y)
+        for (int x = first; x <= last; ++x) values.push_back(total[(static_cast<std::size_t>(y) * w + x) * 6 + b]);
+      const auto [m, se] = mean_and_se(values);
+      const double expected = averages[name]["bands"][b].get<double>();
+      fmt::print("{} band {}: {:.5f} (se {:.2g}), expected {:.5f}\n", name, b, m, se, expected);
+      EXPECT_LT(std::abs(m - expected), 4 * se + 1e-3 * expected) << name << " band " << b;
+    }
 }
 
 }  // namespace
