@@ -96,12 +96,12 @@ ImageAnalysis analyse_image(const AnalysisImage& input, const std::string& layer
   if (curve) {
     std::vector<RegionAnalysis> light = a.results;
     for (RegionAnalysis& r : light) r.shape = *r.linear_light;
-    a.illuminant = estimate_illuminant(light, linear.rgb, known_illuminant);
+    a.illuminant = estimate_illuminant(light, linear.rgb, known_illuminant, linear_context.high_levels);
     a.notes.push_back(fmt::format("R, G, B were encoded by {} (the file's chromatrace.curve_*): classes are of the "
                                   "values as stored, each region's class in linear light is given beside it, and "
                                   "the illuminant is estimated in linear light", curve->describe()));
   } else {
-    a.illuminant = estimate_illuminant(a.results, pixels.rgb, known_illuminant);
+    a.illuminant = estimate_illuminant(a.results, pixels.rgb, known_illuminant, a.context.high_levels);
   }
   for (const std::string& note : input.notes) a.notes.push_back(note);
   // The whole image's left-out pixels, less those set aside while reading (said above).

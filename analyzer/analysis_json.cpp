@@ -37,6 +37,7 @@ json optional_json(const std::optional<T>& v, F&& f) {
 json estimate_json(const IlluminantEstimate& e) {
   json j = {{"method", e.method}, {"rgb", vec(e.rgb)}, {"regions", e.regions}};
   j["error_deg"] = e.error_deg ? json(*e.error_deg) : json(nullptr);
+  j["uncertainty_deg"] = e.uncertainty_deg ? json(*e.uncertainty_deg) : json(nullptr);
   return j;
 }
 
@@ -223,6 +224,7 @@ json analysis_to_json(const ImageAnalysis& a) {
           {"regions", regions},
           {"illuminant",
            {{"estimate", estimate_json(il.best())},
+            {"choice", il.choice},
             {"highlight_lines", optional_json(il.highlight_lines, estimate_json)},
             {"dichromatic_planes", optional_json(il.planes, estimate_json)},
             {"grey_world", estimate_json(il.grey_world)},

@@ -22,13 +22,18 @@ struct IlluminantEstimate {
   Vec3 rgb = Vec3::Zero();
   std::vector<std::string> regions;  // the regions it came from (empty for grey world)
   std::optional<double> error_deg;   // against the known illuminant, when given
+  // The standard error of the direction in degrees, were the dichromatic model to hold: from the lines' or
+  // planes' fits (their spread about the fit, their extent, their sample counts) and, with several regions,
+  // from how far they disagree. None for grey world, which is a guess, not a measurement.
+  std::optional<double> uncertainty_deg;
 };
 
 struct IlluminantAnalysis {
   std::optional<IlluminantEstimate> highlight_lines, planes;
   IlluminantEstimate grey_world;
   std::optional<Vec3> known;  // as given, normalised
-  std::vector<std::string> notes;  // why an estimate is missing
+  std::vector<std::string> notes;  // why an estimate is missing, and regions left out
+  std::string choice;              // which estimate best() is, and why
 
   // The estimate to trust most: the planes' intersection (unbiased), else the highlight lines (tilted
   // towards the body colours when shading changes across a highlight), else grey world.
@@ -36,9 +41,12 @@ struct IlluminantAnalysis {
 };
 
 // From the regions other than the whole image (which mixes objects) when there are any. The grey world
-// averages `rgb`, the whole layer's finite pixels.
+// averages `rgb`, the whole layer's finite pixels. A highlight line whose bright end lies within 2τ of a
+// clipping level (`high_levels`, +∞ where none is known) is left out: past the level the highlight is cut off,
+// and what remains bends towards the face of the cube, not along the light.
 IlluminantAnalysis estimate_illuminant(const std::vector<RegionAnalysis>& regions, std::span<const float> rgb,
-                                       const std::optional<Vec3>& known);
+                                       const std::optional<Vec3>& known,
+                                       const std::array<double, 3>& high_levels = {kNoLevel, kNoLevel, kNoLevel});
 
 // The angle between two colour directions, in degrees.
 double angular_error_deg(const Vec3& a, const Vec3& b);

@@ -236,9 +236,13 @@ std::string report_html(const AnalysisImage& input, const ImageAnalysis& a, std:
   const IlluminantAnalysis& il = a.illuminant;
   for (const auto* e : {il.planes ? &*il.planes : nullptr, il.highlight_lines ? &*il.highlight_lines : nullptr, &il.grey_world})
     if (e)
-      illuminant += fmt::format("<tr><th>{}</th><td>{}</td><td>{}</td></tr>", escape_html(e->method), rgb_text(e->rgb),
+      illuminant += fmt::format("<tr><th>{}</th><td>{}</td><td>{}</td><td>{}</td></tr>", escape_html(e->method),
+                                rgb_text(e->rgb),
+                                e->uncertainty_deg ? fmt::format("± {:.2f}° (standard error)", *e->uncertainty_deg)
+                                                   : "a guess, no uncertainty",
                                 e->error_deg ? fmt::format("{:.2f}° from the known illuminant", *e->error_deg) : "");
   illuminant += "</table>";
+  if (!il.choice.empty()) illuminant += "<p>Chosen: " + escape_html(il.choice) + "</p>";
   for (const std::string& n : il.notes) illuminant += "<p class=\"hint\">" + escape_html(n) + "</p>";
   std::string notes;
   for (const std::string& n : a.notes) notes += "<p class=\"hint\">" + escape_html(n) + "</p>";

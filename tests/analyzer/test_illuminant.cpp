@@ -1,5 +1,6 @@
 // The illuminant colour from several dichromatic objects: within 1° noise-free, within 3° with shot and
 // read noise; grey world reported beside it (and, on coloured objects, far off).
+#include <fmt/core.h>
 #include <gtest/gtest.h>
 
 #include "analyzer/illuminant.h"
@@ -41,6 +42,61 @@ TEST(Illuminant, SensorNoiseKeepsItWithinThreeDegrees) {
   EXPECT_LT(*a.planes->error_deg, 3.0);
   ASSERT_TRUE(a.highlight_lines);
   EXPECT_LT(*a.highlight_lines->error_deg, 3.0);
+}
+
+// The stated uncertainty is a standard error: over noise seeds the planes' estimate lies within 3 of them of the
+// light in nearly every frame (a 2-D direction error within 3σ has probability 1 − e^(−4.5) ≈ 99 %; at least 17
+// of 20 allows for σ itself being estimated), and less noise gives a smaller uncertainty.
+TEST(Illuminant, UncertaintyCoversTheErrorOverNoiseSeeds) {
+  int covered = 0, frames = 0;
+  double mean_uncertainty = 0;
+  for (std::uint64_t seed = 1; seed <= 20; ++seed) {
+    Scene scene = dichromatic_scene(kWarm);
+    scene.image = add_sensor_noise(scene.image, 20000, 10, seed);
+    const IlluminantAnalysis a = estimate(scene);
+    ASSERT_TRUE(a.planes);
+    ASSERT_TRUE(a.planes->uncertainty_deg);
+    ++frames;
+    covered += *a.planes->error_deg <= 3 * *a.planes->uncertainty_deg;
+    mean_uncertainty += *a.planes->uncertainty_deg / 20;
+    fmt::print("seed {}: planes {:.3f}° ± {:.3f}°, highlight lines {:.3f}° ± {:.3f}°\n", seed, *a.planes->error_deg,
+               *a.planes->uncertainty_deg, a.highlight_lines ? *a.highlight_lines->error_deg : -1.0,
+               a.highlight_lines && a.highlight_lines->uncertainty_deg ? *a.highlight_lines->uncertainty_deg : -1.0);
+  }
+  EXPECT_GE(covered, 17) << "of " << frames;
+  Scene quiet = dichromatic_scene(kWarm);
+  quiet.image = add_sensor_noise(quiet.image, 2000000, 1, 7);
+  const IlluminantAnalysis q = estimate(quiet);
+  ASSERT_TRUE(q.planes && q.planes->uncertainty_deg);
+  EXPECT_LT(*q.planes->uncertainty_deg, mean_uncertainty / 3) << "100 times the full well: about a tenth of the noise";
+  EXPECT_FALSE(q.grey_world.uncertainty_deg);  // a guess
+  EXPECT_NE(q.choice.find("dichromatic planes"), std::string::npos) << q.choice;
+}
+
+// A highlight line that runs into a clipping level is cut off there: it is left out of the highlight-line
+// estimate, with a note naming the region and the channel; levels above every highlight leave all of them in.
+TEST(Illuminant, HighlightLinesEndingAtAClippingLevelAreLeftOut) {
+  const Scene scene = dichromatic_scene(kWarm);
+  const LayerContext context = layer_context(scene.image, {}, 64);
+  std::vector<RegionAnalysis> regions;
+  for (const Region& r : label_regions(scene.ids, "object", scene.names, {0}))
+    regions.push_back(analyse_region(scene.image, context, r, AnalyzeOptions{}));
+  std::array<double, 3> peak{0, 0, 0};
+  for (std::size_t i = 0; i + 2 < scene.image.rgb.size(); i += 3)
+    for (int c = 0; c < 3; ++c) peak[c] = std::max(peak[c], static_cast<double>(scene.image.rgb[i + c]));
+  const IlluminantAnalysis open = estimate_illuminant(regions, scene.image.rgb, kWarm, {2 * peak[0], 2 * peak[1], 2 * peak[2]});
+  ASSERT_TRUE(open.highlight_lines);
+  const std::size_t all = open.highlight_lines->regions.size();
+  ASSERT_GE(all, 2u);
+  // Red clips at the brightest red any highlight reaches: that highlight's line ends there.
+  const IlluminantAnalysis cut = estimate_illuminant(regions, scene.image.rgb, kWarm, {peak[0], kNoLevel, kNoLevel});
+  const std::size_t kept = cut.highlight_lines ? cut.highlight_lines->regions.size() : 0;
+  EXPECT_LT(kept, all);
+  int said = 0;
+  for (const std::string& n : cut.notes) said += n.find("ends at the clipping level of R") != std::string::npos;
+  EXPECT_EQ(static_cast<std::size_t>(said), all - kept);
+  ASSERT_TRUE(cut.planes);  // the planes do not depend on where a highlight ends
+  EXPECT_EQ(cut.planes->rgb, open.planes->rgb);
 }
 
 TEST(Illuminant, OnePlaneIsNotEnough) {
