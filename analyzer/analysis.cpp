@@ -13,6 +13,12 @@
 namespace ct::analyzer {
 namespace {
 
+// The clipping levels a highlight line can run into: the camera's white level or an integer file's full scale.
+// Channel maxima are no level a highlight was cut at (every highlight reaches its own maximum).
+std::array<double, 3> known_levels(const LayerContext& context) {
+  return context.clipping.known_high ? context.high_levels : std::array<double, 3>{kNoLevel, kNoLevel, kNoLevel};
+}
+
 void check_size(const LabelImage& image, const RgbImage& layer, const std::string& file) {
   if (image.width != layer.width || image.height != layer.height)
     throw InputError(fmt::format("{}: is {}×{}, the image is {}×{}", file, image.width, image.height, layer.width, layer.height));
@@ -96,12 +102,12 @@ ImageAnalysis analyse_image(const AnalysisImage& input, const std::string& layer
   if (curve) {
     std::vector<RegionAnalysis> light = a.results;
     for (RegionAnalysis& r : light) r.shape = *r.linear_light;
-    a.illuminant = estimate_illuminant(light, linear.rgb, known_illuminant, linear_context.high_levels);
+    a.illuminant = estimate_illuminant(light, linear.rgb, known_illuminant, known_levels(linear_context));
     a.notes.push_back(fmt::format("R, G, B were encoded by {} (the file's chromatrace.curve_*): classes are of the "
                                   "values as stored, each region's class in linear light is given beside it, and "
                                   "the illuminant is estimated in linear light", curve->describe()));
   } else {
-    a.illuminant = estimate_illuminant(a.results, pixels.rgb, known_illuminant, a.context.high_levels);
+    a.illuminant = estimate_illuminant(a.results, pixels.rgb, known_illuminant, known_levels(a.context));
   }
   for (const std::string& note : input.notes) a.notes.push_back(note);
   // The whole image's left-out pixels, less those set aside while reading (said above).
