@@ -127,6 +127,17 @@ json shape_to_json(const ClusterShape& s) {
   j["eigenvalues"] = vec(s.moments.eigenvalues);
   j["axes"] = axes(s.moments.axes);
   j["sigma"] = vec(s.sigma);
+  if (s.shape == ShapeClass::Clipped) {
+    // The faces hold the cluster; nothing of its shape was measured (noise, dimensionality, lines, planes are
+    // the unclipped part's, in "unclipped"), so those are null, not zero.
+    const ClusterShape* rest = s.unclipped.empty() ? nullptr : &s.unclipped.front();
+    for (const char* key : {"noise_sigma", "significant_axes", "linearity", "planarity", "scattering", "line", "body_line",
+                            "two_lines", "plane", "dichromatic_plane", "curve", "gamma"})
+      j[key] = nullptr;
+    j["unclipped_class"] = rest ? json(class_name(rest->shape)) : json(nullptr);
+    if (rest) j["unclipped"] = shape_to_json(*rest);
+    return j;
+  }
   j["noise_sigma"] = vec(s.noise_sigma);
   j["significant_axes"] = s.significant_axes;
   j["linearity"] = s.linearity;

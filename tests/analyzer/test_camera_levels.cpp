@@ -134,6 +134,13 @@ TEST(CameraLevels, ARegionAtTheWhiteLevelIsWhollyClipped) {
   EXPECT_EQ(in["clipping_level"], 16383.0 - 2048.0);
   EXPECT_EQ(in["bits"], 14);
   EXPECT_EQ(j["clipping_levels_source"], "white level");
+  // The wholly clipped region's shape statistics were never measured: null, not zero; its unclipped part has
+  // no pixel, so no class.
+  const nlohmann::json& blown_shape = j["regions"][static_cast<std::size_t>(blown - a.results.data())]["shape"];
+  EXPECT_EQ(blown_shape["class"], "clipped");
+  for (const char* key : {"noise_sigma", "linearity", "planarity", "scattering", "significant_axes"})
+    EXPECT_TRUE(blown_shape[key].is_null()) << key << ": " << blown_shape[key];
+  EXPECT_EQ(blown_shape["unclipped_class"], "none");
 }
 
 // The rule itself: known levels count every sample on them; estimated ones (channel maxima) still need the
