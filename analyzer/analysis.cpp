@@ -59,6 +59,14 @@ ImageAnalysis analyse_image(const AnalysisImage& input, const std::string& layer
   a.height = pixels.height;
   a.encoding = a.layer == "final" ? input.encoding : ImageEncoding{};
   a.context = layer_context(pixels, a.encoding, options.bins);
+  if (const HistogramSpec& spec = a.context.spec; spec.robust)
+    a.notes.push_back(fmt::format("{} pixel{} ({:.3g} % of the image) reach {:.4g}, more than {} times the {:g}th "
+                                  "percentile of the pixels' values: the histograms and plots end at {:.4g} and count "
+                                  "them in their last bins, so the rest of the image is not squeezed into one cell "
+                                  "(the shapes are measured on every value)",
+                                  spec.outliers, spec.outliers == 1 ? "" : "s",
+                                  100.0 * static_cast<double>(spec.outliers) / static_cast<double>(std::max<std::size_t>(1, pixels.pixel_count())),
+                                  spec.outlier_max, kRobustRatio, 100 * kRobustQuantile, spec.hi[0]));
   a.options = options;
   a.regions = std::move(regions);
   // Values encoded by a known non-linear curve are analysed twice: as stored (what the histogram shows) and in

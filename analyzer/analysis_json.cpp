@@ -201,7 +201,13 @@ json analysis_to_json(const ImageAnalysis& a) {
           {"image", {{"file", a.file}, {"width", a.width}, {"height", a.height}, {"layer", a.layer},
                      {"integer", a.encoding.integer}, {"bits", a.encoding.bits}, {"full_scale", a.encoding.full_scale}}},
           {"input", input_json(a)},
-          {"histogram", {{"bins", spec.bins}, {"lo", spec.lo}, {"hi", spec.hi}}},
+          {"histogram", {{"bins", spec.bins}, {"lo", spec.lo}, {"hi", spec.hi}, {"robust", spec.robust},
+                         {"outliers", spec.robust ? json{{"pixels", spec.outliers}, {"max", spec.outlier_max},
+                                                        {"rule", fmt::format("a pixel's brightest channel above {} × the "
+                                                                             "{:g}th percentile", kRobustMargin,
+                                                                             100 * kRobustQuantile)}}
+                                                  : json(nullptr)},
+                         {"full_max", spec.full_max}}},
           {"clipping_levels", a.context.high_levels},
           {"clipping_levels_source", a.context.high_levels_source},
           {"quantisation_sigma", a.context.quantisation_sigma},

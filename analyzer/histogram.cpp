@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <vector>
 
 #include "core/parallel.h"
 
@@ -43,20 +44,42 @@ HistogramSpec histogram_spec(std::span<const float> rgb, int bins, double full_s
   spec.bins = bins;
   if (full_scale > 0) {
     spec.hi = {full_scale, full_scale, full_scale};
+    spec.full_max = full_scale;
     return spec;
   }
   std::array<double, 3> lo{0, 0, 0}, hi{0, 0, 0};
-  for (std::size_t i = 0; i + 2 < rgb.size(); i += 3)
+  std::vector<float> brightest;  // per pixel, its largest finite channel
+  brightest.reserve(rgb.size() / 3);
+  for (std::size_t i = 0; i + 2 < rgb.size(); i += 3) {
+    float top = -std::numeric_limits<float>::infinity();
     for (std::size_t c = 0; c < 3; ++c) {
       const double v = rgb[i + c];
       if (!std::isfinite(v)) continue;
       lo[c] = std::min(lo[c], v);
       hi[c] = std::max(hi[c], v);
+      top = std::max(top, rgb[i + c]);
     }
+    if (std::isfinite(top)) brightest.push_back(top);
+  }
   // One range for all three channels keeps the cube a cube: angles and shapes are not distorted.
   const double low = *std::min_element(lo.begin(), lo.end()), high = *std::max_element(hi.begin(), hi.end());
+  spec.full_max = high;
   spec.lo.fill(low);
   spec.hi.fill(high > low ? high : low + 1.0);
+  if (brightest.size() < 1000) return spec;  // too few pixels for a 99.9th percentile
+  const std::size_t k = static_cast<std::size_t>(kRobustQuantile * static_cast<double>(brightest.size() - 1));
+  std::nth_element(brightest.begin(), brightest.begin() + static_cast<std::ptrdiff_t>(k), brightest.end());
+  const double quantile = brightest[k];
+  if (!(quantile > 0) || high <= kRobustRatio * quantile) return spec;
+  spec.robust = true;
+  spec.hi.fill(kRobustMargin * quantile);
+  for (std::size_t i = 0; i + 2 < rgb.size(); i += 3)
+    for (std::size_t c = 0; c < 3; ++c)
+      if (std::isfinite(rgb[i + c]) && rgb[i + c] > spec.hi[0]) {
+        ++spec.outliers;
+        spec.outlier_max = std::max(spec.outlier_max, static_cast<double>(rgb[i + c]));
+        break;
+      }
   return spec;
 }
 

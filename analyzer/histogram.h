@@ -20,11 +20,20 @@ struct HistogramSpec {
   int bins = 64;
   std::array<double, 3> lo{0, 0, 0};
   std::array<double, 3> hi{1, 1, 1};
+  // Float images whose brightest pixels lie far above the rest (a sun, a lamp in an HDR photograph): the range
+  // ends above the 99.9th percentile instead, and the pixels beyond it are outliers, counted into the last bins.
+  bool robust = false;
+  std::size_t outliers = 0;    // pixels with a channel above hi
+  double outlier_max = 0;      // the largest value among them
+  double full_max = 0;         // the largest finite value (the range's end when not robust)
 };
 
-// The range that holds every finite sample of an image, the same for the three channels: integer images
-// [0, full scale]; float images [min(0, smallest), largest] (HDR values above 1 included). `full_scale`
-// <= 0 means float.
+// The range of an image's samples, the same for the three channels: integer images [0, full scale]; float
+// images [min(0, smallest), largest] (HDR values above 1 included) — unless the largest pixel value (a pixel's
+// brightest channel) is more than kRobustRatio times the 99.9th percentile of the pixels' values, when the range
+// ends at kRobustMargin times that percentile and the pixels above it are counted as outliers, so that a few
+// extreme pixels do not squeeze every other pixel into one cell. `full_scale` <= 0 means float.
+inline constexpr double kRobustRatio = 4.0, kRobustMargin = 1.25, kRobustQuantile = 0.999;
 HistogramSpec histogram_spec(std::span<const float> rgb, int bins, double full_scale);
 
 struct HistogramCell {

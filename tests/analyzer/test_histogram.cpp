@@ -32,6 +32,32 @@ TEST(Histogram, CountsEverySampleOnce) {
   EXPECT_TRUE(std::is_sorted(h.cells.begin(), h.cells.end(), [](auto& a, auto& b) { return a.index < b.index; }));
 }
 
+// An HDR image whose few brightest pixels (a sun) lie far above the rest: the range ends at 1.25 × the 99.9th
+// percentile of the pixels' brightest channels, and the pixels above it are counted as outliers; without such
+// pixels, or with too few pixels to tell, the range is the full one.
+TEST(Histogram, ExtremePixelsOfAnHdrImageAreOutliers) {
+  std::vector<float> rgb;
+  for (int i = 0; i < 10000; ++i) {
+    const float v = static_cast<float>(i % 100) / 100.0f;  // the scene: up to 0.99
+    rgb.insert(rgb.end(), {v, 0.5f * v, 0.25f * v});
+  }
+  const HistogramSpec plain = histogram_spec(rgb, 64, 0);
+  EXPECT_FALSE(plain.robust);
+  EXPECT_FLOAT_EQ(static_cast<float>(plain.hi[0]), 0.99f);
+  for (int i = 0; i < 5; ++i) rgb.insert(rgb.end(), {20000.0f, 18000.0f + i, 15000.0f});  // the sun: 0.05 %
+  const HistogramSpec sunny = histogram_spec(rgb, 64, 0);
+  EXPECT_TRUE(sunny.robust);
+  EXPECT_FLOAT_EQ(static_cast<float>(sunny.hi[0]), 1.25f * 0.99f);
+  EXPECT_EQ(sunny.outliers, 5u);
+  EXPECT_EQ(sunny.outlier_max, 20000.0);
+  EXPECT_EQ(sunny.full_max, 20000.0);
+  // The scene's pixels now spread over the bins instead of sharing the first one.
+  const Histogram3 h = histogram_3d(rgb, sunny, 1);
+  EXPECT_GT(h.cells.size(), 50u);
+  const std::vector<float> few(rgb.end() - 300, rgb.end());  // 100 pixels: no percentile
+  EXPECT_FALSE(histogram_spec(few, 64, 0).robust);
+}
+
 TEST(Histogram, RangesFollowTheEncoding) {
   const std::vector<float> hdr = {0.5f, 2.0f, 7.5f, 0.0f, 0.1f, 0.2f};
   const HistogramSpec f = histogram_spec(hdr, 8, 0);
