@@ -167,6 +167,7 @@ json shape_to_json(const ClusterShape& s) {
   });
   j["gamma"] = optional_json(s.gamma, [](const GammaFit& g) {
     return json{{"gamma", g.gamma},
+                {"gamma_se", g.gamma_se ? json(*g.gamma_se) : json(nullptr)},
                 {"straightness_as_is", g.straightness_as_is},
                 {"straightness_linearised", g.straightness_linearised},
                 {"used", g.used}};

@@ -369,7 +369,11 @@ class ShapeDecision {
              s_.gamma->straightness_linearised <= k_.gamma_straightening * s_.gamma->straightness_as_is) &&
         test("|gamma - 1| >= min_gamma_departure", std::abs(s_.gamma->gamma - 1), k_.min_gamma_departure,
              std::abs(s_.gamma->gamma - 1) >= k_.min_gamma_departure);
-    if (gamma) return settle(ShapeClass::Gamma, fmt::format("a bent line that the power curve γ = {:.3f} straightens", s_.gamma->gamma));
+    if (gamma) {
+      s_.gamma->gamma_se = gamma_standard_error(points_, context_.seed);
+      return settle(ShapeClass::Gamma, fmt::format("a bent line that the power curve γ = {:.3f} ± {:.3f} straightens",
+                                                   s_.gamma->gamma, *s_.gamma->gamma_se));
+    }
     return settle(ShapeClass::Curved,
                   fmt::format("a curved cluster: bend {:.3f} (sagitta / chord) that no power curve straightens", s_.curve->bend));
   }

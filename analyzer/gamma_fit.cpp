@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <limits>
 
 namespace ct::analyzer {
 namespace {
@@ -18,20 +20,11 @@ double straightness(const std::vector<Vec3>& points, double inverse_gamma) {
 
 }  // namespace
 
-std::optional<GammaFit> fit_gamma(const std::vector<Vec3>& points) {
-  std::vector<Vec3> positive;
-  double largest = 0;
-  for (const Vec3& p : points)
-    if (p.minCoeff() > 0) positive.push_back(p), largest = std::max(largest, p.maxCoeff());
-  if (positive.size() < 10) return std::nullopt;
-  GammaFit fit;
-  fit.used = positive.size();
-  // An even stride keeps the search cheap on big regions; a common scale keeps pow() well conditioned.
-  const std::size_t stride = (positive.size() + kMaxPoints - 1) / kMaxPoints;
-  std::vector<Vec3> sample;
-  for (std::size_t i = 0; i < positive.size(); i += stride) sample.push_back(positive[i] / largest);
+namespace {
 
-  // Coarse grid over log γ, then golden-section search in the bracket around the best grid point.
+// The γ whose inverse makes `sample` straightest: a coarse grid over log γ, then golden-section search in the
+// bracket around the best grid point.
+double best_gamma(const std::vector<Vec3>& sample) {
   const double lo = std::log(0.2), hi = std::log(5.0);
   constexpr int kGrid = 48;
   auto cost = [&](double log_gamma) { return straightness(sample, std::exp(-log_gamma)); };
@@ -48,10 +41,61 @@ std::optional<GammaFit> fit_gamma(const std::vector<Vec3>& points) {
     if (f1 < f2) b = x2, x2 = x1, f2 = f1, x1 = b - r * (b - a), f1 = cost(x1);
     else a = x1, x1 = x2, f1 = f2, x2 = a + r * (b - a), f2 = cost(x2);
   }
-  fit.gamma = std::exp(0.5 * (a + b));
+  return std::exp(0.5 * (a + b));
+}
+
+// The positive samples, an even stride of at most kMaxPoints of them, scaled to a largest value of 1 (a common
+// scale keeps pow() well conditioned); `used` gets the number of positive samples.
+std::vector<Vec3> gamma_sample(const std::vector<Vec3>& points, std::size_t& used) {
+  std::vector<Vec3> positive;
+  double largest = 0;
+  for (const Vec3& p : points)
+    if (p.minCoeff() > 0) positive.push_back(p), largest = std::max(largest, p.maxCoeff());
+  used = positive.size();
+  std::vector<Vec3> sample;
+  if (positive.empty()) return sample;
+  const std::size_t stride = (positive.size() + kMaxPoints - 1) / kMaxPoints;
+  for (std::size_t i = 0; i < positive.size(); i += stride) sample.push_back(positive[i] / largest);
+  return sample;
+}
+
+}  // namespace
+
+std::optional<GammaFit> fit_gamma(const std::vector<Vec3>& points) {
+  GammaFit fit;
+  const std::vector<Vec3> sample = gamma_sample(points, fit.used);
+  if (fit.used < 10) return std::nullopt;
+  fit.gamma = best_gamma(sample);
   fit.straightness_as_is = straightness(sample, 1.0);
   fit.straightness_linearised = straightness(sample, 1.0 / fit.gamma);
   return fit;
+}
+
+double gamma_standard_error(const std::vector<Vec3>& points, std::uint64_t seed) {
+  std::size_t used = 0;
+  const std::vector<Vec3> sample = gamma_sample(points, used);
+  if (sample.size() < 10) return std::numeric_limits<double>::quiet_NaN();
+  constexpr int kReplicates = 16;
+  constexpr std::size_t kResample = 1000;
+  const std::size_t m = std::min(kResample, sample.size());
+  std::uint64_t state = seed * 0x9E3779B97F4A7C15ull + 1;
+  const auto next = [&] {  // splitmix64
+    std::uint64_t z = (state += 0x9E3779B97F4A7C15ull);
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+    return z ^ (z >> 31);
+  };
+  std::vector<double> gammas;
+  std::vector<Vec3> resample(m);
+  for (int r = 0; r < kReplicates; ++r) {
+    for (Vec3& p : resample) p = sample[next() % sample.size()];
+    gammas.push_back(best_gamma(resample));
+  }
+  double mean = 0, var = 0;
+  for (const double g : gammas) mean += g / kReplicates;
+  for (const double g : gammas) var += (g - mean) * (g - mean) / (kReplicates - 1);
+  // Resamples of m points spread as √(1/m); the fit used all of the sample's n points.
+  return std::sqrt(var) * std::sqrt(static_cast<double>(m) / static_cast<double>(sample.size()));
 }
 
 }  // namespace ct::analyzer

@@ -148,7 +148,9 @@ json summary(const RegionAnalysis& r, const std::optional<Explanation>& e) {
   if (s.black_plane && s.significant_axes >= 2) row("dichromatic plane normal", rgb_text(s.black_plane->normal));
   if (s.plane && s.significant_axes >= 2) row("thickness off plane / noise", fmt::format("{:.2f}", s.sigma[2] / std::max(1e-300, s.noise_sigma[2])));
   if (s.curve && (s.shape == ShapeClass::Curved || s.shape == ShapeClass::Gamma)) row("bend (sagitta / chord)", fmt::format("{:.3f}", s.curve->bend));
-  if (s.gamma && s.shape == ShapeClass::Gamma) row("γ", fmt::format("{:.3f}", s.gamma->gamma));
+  if (s.gamma && s.shape == ShapeClass::Gamma)
+    row("γ", s.gamma->gamma_se ? fmt::format("{:.3f} ± {:.3f}", s.gamma->gamma, *s.gamma->gamma_se)
+                               : fmt::format("{:.3f}", s.gamma->gamma));
   if (!s.clipping.faces.empty()) row("clipped", percent(s.clipping.fraction));
   if (r.linear_light) row("class in linear light (curve undone)", std::string(class_name(r.linear_light->shape)));
   if (e) {

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include <fmt/core.h>
 #include <gtest/gtest.h>
 
 #include "analyzer/region_analysis.h"
@@ -144,6 +145,34 @@ TEST(ClusterShape, PowerCurveBendsALineAndTheFitFindsGamma) {
   const ClusterShape s = shape_of(gamma_line());
   ASSERT_EQ(s.shape, ShapeClass::Gamma) << describe(s);
   EXPECT_NEAR(s.gamma->gamma, kGamma, 0.005);
+}
+
+// With sensor noise the fitted γ scatters from frame to frame; its bootstrap standard error must describe that
+// scatter: the true γ lies within 3 standard errors in nearly every frame (at least 9 of 10), and the standard
+// error is within a factor of 3 of the fits' spread over the frames. (The fit itself, on the noisy points: the
+// class decision also asks the curve to remove the spread, which noise keeps.)
+TEST(ClusterShape, GammaHasAStandardErrorThatCoversTheTruth) {
+  std::vector<double> gammas, errors;
+  int covered = 0;
+  for (std::uint32_t seed = 1; seed <= 10; ++seed) {
+    const RgbImage noisy = add_sensor_noise(gamma_line(), 1000000, 1, seed);
+    std::vector<Vec3> points;
+    for (std::size_t i = 0; i + 2 < noisy.rgb.size(); i += 3) points.emplace_back(noisy.rgb[i], noisy.rgb[i + 1], noisy.rgb[i + 2]);
+    const auto fit = fit_gamma(points);
+    ASSERT_TRUE(fit);
+    const double se = gamma_standard_error(points, seed);
+    gammas.push_back(fit->gamma);
+    errors.push_back(se);
+    covered += std::abs(fit->gamma - kGamma) <= 3 * se;
+  }
+  EXPECT_GE(covered, 9);
+  double mean = 0, var = 0, se = 0;
+  for (const double g : gammas) mean += g / 10;
+  for (const double g : gammas) var += (g - mean) * (g - mean) / 9;
+  for (const double e : errors) se += e / 10;
+  fmt::print("γ over 10 frames: mean {:.4f}, spread {:.4f}; mean standard error {:.4f}\n", mean, std::sqrt(var), se);
+  EXPECT_LT(se, 3 * std::sqrt(var));
+  EXPECT_GT(se, std::sqrt(var) / 3);
 }
 
 TEST(ClusterShape, SpreadOffThePlaneIsThickening) {
