@@ -162,6 +162,59 @@ PiecewiseLinearSpectrum ScaledSigmoid::tabulated(double lo_nm, double hi_nm) con
   return PiecewiseLinearSpectrum(std::move(lambda), std::move(value), Extrapolation::Clamp, "rgb spectrum");
 }
 
+void tabulated_band_averages(const ScaledSigmoid& s, const Bands& bands, double* out) {
+  const std::size_t nb = bands.size();
+  for (const double c : s.poly.c)
+    if (!std::isfinite(c)) {  // black and white: the general path (sigmoid's limits)
+      const std::vector<double> a = band_averages(s.tabulated(bands.min_wavelength(), bands.max_wavelength()), bands);
+      std::copy(a.begin(), a.end(), out);
+      return;
+    }
+  // The samples tabulated(lo, hi) holds: kLo + i for i in [first, last].
+  const int first = static_cast<int>(std::clamp(std::floor(bands.min_wavelength() - kLo) - 1.0, 0.0, kHi - kLo));
+  const int last = static_cast<int>(std::clamp(std::ceil(bands.max_wavelength() - kLo) + 1.0, 0.0, kHi - kLo));
+  const int count = last - first + 1;
+  std::array<double, kSamples> v;
+  const std::array<double, 3>& c = s.poly.c;
+  for (int i = 0; i < count; ++i) {
+    // SigmoidPolynomial::operator() and sigmoid(), term for term (finite coefficients, nm inside the range).
+    const double t = (kLo + (first + i) - kLo) / (kHi - kLo);
+    const double x = c[2] + t * (c[1] + t * c[0]);
+    const double p = 0.5 + x / (2.0 * std::sqrt(1.0 + x * x));
+    v[static_cast<std::size_t>(i)] = s.scale == 1.0 ? p : s.scale * p;
+  }
+  // PiecewiseLinearSpectrum's operator() and integral() with clamping, on wavelengths front + i.
+  const double front = kLo + first, back = kLo + last;
+  const auto value_at = [&](double nm) {
+    if (nm <= front) return v[0];
+    if (nm >= back) return v[static_cast<std::size_t>(count - 1)];
+    const std::size_t k = static_cast<std::size_t>(std::floor(nm - front)) + 1;  // the first wavelength above nm
+    const double t = (nm - (front + static_cast<double>(k - 1))) / ((front + static_cast<double>(k)) - (front + static_cast<double>(k - 1)));
+    return v[k - 1] + t * (v[k] - v[k - 1]);
+  };
+  const auto integral = [&](double lo, double hi) {
+    double sum = 0.0;
+    if (lo < front) sum += v[0] * (std::min(hi, front) - lo);
+    if (hi > back) sum += v[static_cast<std::size_t>(count - 1)] * (hi - std::max(lo, back));
+    const double a = std::max(lo, front), b = std::min(hi, back);
+    if (a >= b) return sum;
+    std::size_t i = static_cast<std::size_t>(std::floor(a - front)) + 1;
+    double x0 = a, f0 = value_at(a);
+    for (; i < static_cast<std::size_t>(count) && front + static_cast<double>(i) < b; ++i) {
+      const double li = front + static_cast<double>(i);
+      sum += 0.5 * (li - x0) * (f0 + v[i]);
+      x0 = li;
+      f0 = v[i];
+    }
+    sum += 0.5 * (b - x0) * (f0 + value_at(b));
+    return sum;
+  };
+  for (std::size_t b = 0; b < nb; ++b) {
+    const double lo = bands.lo(b), hi = bands.hi(b);
+    out[b] = hi == lo ? value_at(lo) : integral(lo, hi) / (hi - lo);
+  }
+}
+
 double ScaledSigmoid::tabulated_at(double nm) const {
   const double x = std::clamp(nm, kLo, kHi) - kLo;
   const double i = std::min(std::floor(x), kHi - kLo - 1.0);

@@ -150,9 +150,7 @@ std::vector<double> palette_band_averages(const TexelSpectra& spectra, const Ban
   const std::size_t entries = spectra.palette.size(), nb = bands.size();
   std::vector<double> values(entries * nb);
   parallel_for(entries, threads, [&](std::size_t i) {
-    const std::vector<double> averages =
-        band_averages(spectra.palette[i].tabulated(bands.min_wavelength(), bands.max_wavelength()), bands);
-    std::copy(averages.begin(), averages.end(), values.begin() + static_cast<std::ptrdiff_t>(i * nb));
+    tabulated_band_averages(spectra.palette[i], bands, values.data() + i * nb);
   });
   return values;
 }

@@ -157,6 +157,31 @@ TEST(RgbToSpectrum, PartialTabulationGivesTheSameBandAverages) {
   }
 }
 
+TEST(RgbToSpectrum, DirectBandAveragesAreThoseOfTheTabulatedSpectrum) {
+  // tabulated_band_averages (a texture palette's band averages) repeats PiecewiseLinearSpectrum's arithmetic on
+  // the 1 nm samples: the same doubles, for colours of every kind and band plans with fractional edges, edges
+  // on the samples, and ranges past the table's ends.
+  const std::vector<Bands> plans = {Bands::parse("400:700:10"), Bands::parse("360:830:47"), Bands::parse("300:900:25"),
+                                    Bands::from_edges({401.3, 402.9, 555.55, 829.5}), Bands::parse("840:900:20"),
+                                    Bands::parse("300:350:10"), Bands::from_edges({359.5, 360.0, 360.25, 830.0, 830.5}),
+                                    Bands::parse("380:780:1")};
+  std::vector<ScaledSigmoid> spectra = {upsample_rgb_unbounded({0.0, 0.0, 0.0}), upsample_rgb_unbounded({2.0, 2.0, 2.0}),
+                                        ScaledSigmoid{1.0, upsample_rgb_reflectance({1.0, 1.0, 1.0})},
+                                        ScaledSigmoid{1.0, upsample_rgb_reflectance({1.0, 0.0, 0.0})}};
+  for (int i = 0; i < 200; ++i) {
+    Random random(9, static_cast<std::uint64_t>(i));
+    const Vec3d rgb = {random.uniform(), random.uniform(), random.uniform()};
+    spectra.push_back(i % 2 ? ScaledSigmoid{1.0, upsample_rgb_reflectance(rgb)}
+                            : upsample_rgb_unbounded({30 * rgb[0], 30 * rgb[1], 30 * rgb[2]}));
+  }
+  for (const Bands& bands : plans)
+    for (const ScaledSigmoid& s : spectra) {
+      std::vector<double> direct(bands.size());
+      tabulated_band_averages(s, bands, direct.data());
+      ASSERT_EQ(direct, band_averages(s.tabulated(), bands)) << bands.min_wavelength() << "-" << bands.max_wavelength();
+    }
+}
+
 TEST(RgbToSpectrum, TableIsTheSameWhateverTheThreadCount) {
   const RgbCoefficientTable one = RgbCoefficientTable::compute(9, 1), two = RgbCoefficientTable::compute(9, 2);
   EXPECT_EQ(one.bytes(), two.bytes());
