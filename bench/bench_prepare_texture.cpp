@@ -1,9 +1,13 @@
 // prepare-texture throughput and cache size against the I/O limit (bench/README.md, "Texture preparation").
 //
-// A synthetic 4096×2048 texture (an 8-bit sRGB PNG reflectance by default; --hdr: a float EXR radiance, every
-// texel its own colour) goes through prepare_texture (core/texture_prep.h) for a band plan. Beside it, in the
-// same process: the image only read with OpenImageIO and written back as float RGB EXRs (ZIP), as many as
-// there are band groups (the I/O limit), and the second, cached call. Times are medians of alternating runs.
+// A synthetic texture (a 4096×4096 8-bit sRGB PNG reflectance by default; --hdr: a 4096×2048 float EXR
+// radiance, every texel its own colour) goes through prepare_texture (core/texture_prep.h) for a band plan.
+// Beside it, in the same process: the image only read with OpenImageIO and written back as float RGB EXRs (ZIP),
+// as many as there are band groups (the I/O limit), and the second, cached call. Times are medians of
+// alternating runs. Then the two stages that depend on the number of distinct colours, timed alone: the
+// upsampling through the coefficient table (upsample_texels) and the band averages (palette_band_averages);
+// and the exact per-colour fit (core/rgb_to_spectrum.h) timed on a sample of the distinct colours, which gives
+// the time the upsampling would take without the table.
 //
 //   bench_prepare_texture [--width W] [--height H] [--bands lo:hi:w] [--runs R] [--threads T] [--noise N] [--levels L]
 //                         [--hdr] [--keep DIR]
@@ -15,6 +19,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -23,6 +28,7 @@
 
 #include "core/parallel.h"
 #include "core/random.h"
+#include "core/rgb_to_spectrum.h"
 #include "core/spectral_exr.h"
 #include "core/texture_prep.h"
 
@@ -94,7 +100,7 @@ std::uintmax_t directory_bytes(const fs::path& dir) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  int width = 4096, height = 2048, runs = 3, threads = 0;
+  int width = 4096, height = 0, runs = 3, threads = 0;
   std::string bands_text = "400:700:10";
   bool hdr = false, keep = false;
   double noise_levels = 0.0;
@@ -118,6 +124,7 @@ int main(int argc, char** argv) {
       return 2;
     }
   }
+  if (height == 0) height = hdr ? 2048 : 4096;
   threads = ct::thread_count(threads);
   ct::set_exr_threads(threads);
   OIIO::attribute("threads", threads);
@@ -154,6 +161,44 @@ int main(int argc, char** argv) {
              static_cast<double>(directory_bytes(dir / "cache")) * mb, median(cold) / median(io));
   fmt::print("| prepare-texture, cached               | {:6.3f} s |           | {:.3f}x |\n", median(cached),
              median(cached) / median(io));
+
+  // The stages that scale with the distinct colours, alone, and the exact fit on a sample of those colours.
+  const ct::ImageTexture texture = ct::read_image_texture(image, image.string(), std::nullopt, request.use, 1.0);
+  ct::TexelSpectra spectra;
+  const double upsample = seconds([&] { spectra = ct::upsample_texels(texture, threads); });
+  const double averages = seconds([&] { ct::palette_band_averages(spectra, request.bands, threads); });
+  std::vector<std::array<double, 3>> sample;
+  const std::size_t distinct = spectra.palette.size(), wanted = std::min<std::size_t>(distinct, 1000);
+  {
+    std::vector<bool> taken(distinct, false);
+    for (std::size_t t = 0; t < texture.texel_count() && sample.size() < wanted; t += texture.texel_count() / wanted + 1)
+      if (!taken[spectra.palette_of[t]]) {
+        taken[spectra.palette_of[t]] = true;
+        sample.push_back(texture.texel(t));
+      }
+  }
+  std::vector<ct::ScaledSigmoid> fitted(sample.size());
+  const double fit = seconds([&] {
+    ct::parallel_for(sample.size(), threads, [&](std::size_t i) {
+      fitted[i] = request.use == ct::TextureUse::Reflectance ? ct::ScaledSigmoid{1.0, ct::fit_rgb_reflectance(sample[i])}
+                                                             : ct::fit_rgb_unbounded(sample[i]);
+    });
+  });
+  // The table lookups alone, over every distinct colour (upsample_texels also finds the distinct colours).
+  std::vector<std::array<double, 3>> colours(distinct);
+  for (std::size_t t = 0; t < texture.texel_count(); ++t) colours[spectra.palette_of[t]] = texture.texel(t);
+  std::vector<ct::ScaledSigmoid> looked_up(distinct);
+  const double lookups = seconds([&] {
+    ct::parallel_for(distinct, threads, [&](std::size_t i) { looked_up[i] = ct::texel_spectrum(colours[i], request.use); });
+  });
+  const double fit_all = fit / static_cast<double>(sample.size()) * static_cast<double>(distinct);
+  fmt::print("\n| stage ({} distinct colours, {} threads)          | time     |\n", distinct, threads);
+  fmt::print("| upsampling through the table (upsample_texels)   | {:6.2f} s |\n", upsample);
+  fmt::print("|   the table lookups alone                        | {:6.2f} s |\n", lookups);
+  fmt::print("| band averages of the palette                     | {:6.2f} s |\n", averages);
+  fmt::print("| exact fit of {:4} of the colours                 | {:6.2f} s |\n", sample.size(), fit);
+  fmt::print("| exact fit of all, extrapolated (no table)        | {:6.0f} s | {:.0f}x the table's lookups, {:.0f}x upsample_texels\n",
+             fit_all, fit_all / lookups, fit_all / upsample);
   if (!keep) fs::remove_all(dir);
   return 0;
 }

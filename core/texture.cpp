@@ -111,8 +111,8 @@ ImageTexture read_image_texture(const std::filesystem::path& path, const std::st
 }
 
 ScaledSigmoid texel_spectrum(const std::array<double, 3>& linear_srgb, TextureUse use) {
-  return use == TextureUse::Reflectance ? ScaledSigmoid{1.0, fit_rgb_reflectance(linear_srgb)}
-                                        : fit_rgb_unbounded(linear_srgb);
+  return use == TextureUse::Reflectance ? ScaledSigmoid{1.0, upsample_rgb_reflectance(linear_srgb)}
+                                        : upsample_rgb_unbounded(linear_srgb);
 }
 
 TexelSpectra upsample_texels(const ImageTexture& texture, int threads) {
@@ -150,8 +150,7 @@ std::vector<double> palette_band_averages(const TexelSpectra& spectra, const Ban
   const std::size_t entries = spectra.palette.size(), nb = bands.size();
   std::vector<double> values(entries * nb);
   parallel_for(entries, threads, [&](std::size_t i) {
-    const std::vector<double> averages = band_averages(spectra.palette[i].tabulated(), bands);
-    std::copy(averages.begin(), averages.end(), values.begin() + static_cast<std::ptrdiff_t>(i * nb));
+    tabulated_band_averages(spectra.palette[i], bands, values.data() + i * nb);
   });
   return values;
 }

@@ -1,8 +1,9 @@
 #pragma once
 // Image textures: a colour input of the scene format (a reflectance, a diffuse colour, an emitter's or the
 // environment's radiance) that varies over a surface's (u, v) or over directions (docs/scene-format.md,
-// "Textures"). Each texel's RGB is decoded to linear sRGB and upsampled to a spectrum by core/rgb_to_spectrum,
-// the code an {"rgb": [...]} spectrum uses, so a texture of one colour is that colour's spectrum.
+// "Textures"). Each texel's RGB is decoded to linear sRGB and upsampled to a spectrum by core/rgb_to_spectrum's
+// coefficient table (upsample_rgb_reflectance / upsample_rgb_unbounded), the code an {"rgb": [...]} spectrum
+// uses, so a texture of one colour is that colour's spectrum.
 //
 // Lookup is nearest-texel (no filtering): the texel that contains (u, v). (u, v) = (0, 0) is the image's
 // bottom-left corner and (1, 1) its top-right (Blender's convention); u and v repeat outside [0, 1).
@@ -20,8 +21,8 @@
 namespace ct {
 
 enum class TextureColourSpace { Srgb, Linear };
-// What the texels mean, which fixes how they are upsampled: a reflectance must lie in [0, 1] and is fitted as
-// an {"rgb"} spectrum is; a radiance may exceed 1 and is fitted in the unbounded form (fit_rgb_unbounded).
+// What the texels mean, which fixes how they are upsampled: a reflectance must lie in [0, 1] and is upsampled as
+// an {"rgb"} spectrum is; a radiance may exceed 1 and is upsampled in the unbounded form (upsample_rgb_unbounded).
 enum class TextureUse { Reflectance, Radiance };
 
 struct ImageTexture {
@@ -53,11 +54,11 @@ ImageTexture read_image_texture(const std::filesystem::path& path, const std::st
 // for an integer one. Reads the header only; errors as read_image_texture's.
 TextureColourSpace default_texture_colour_space(const std::filesystem::path& path);
 
-// The spectra of a texture's texels: each distinct colour is fitted once (on up to `threads` threads; 0: all),
+// The spectra of a texture's texels: each distinct colour is upsampled once (on up to `threads` threads; 0: all),
 // in the order of its first texel, so the result does not depend on the thread count.
 struct TexelSpectra {
   std::vector<std::uint32_t> palette_of;  // per texel: index into palette
-  std::vector<ScaledSigmoid> palette;     // scale · fitted sigmoid, the texture's scale included
+  std::vector<ScaledSigmoid> palette;     // scale · upsampled sigmoid, the texture's scale included
 };
 TexelSpectra upsample_texels(const ImageTexture& texture, int threads = 0);
 // The band averages of each palette entry's spectrum in the form an {"rgb"} spectrum has (1 nm samples):

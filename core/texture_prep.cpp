@@ -22,7 +22,7 @@ namespace ct {
 namespace {
 
 // Bump when the upsampling or the output layout changes, so that old caches are not reused.
-constexpr std::string_view kPrepVersion = "chromatrace-texture-prep/1";
+constexpr std::string_view kPrepVersion = "chromatrace-texture-prep/2";
 constexpr int kRowsPerWrite = 64;
 
 // Two independent 64-bit multiply-xor lanes over 8-byte words (not cryptographic; a content key for a cache).

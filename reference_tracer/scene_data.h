@@ -26,7 +26,7 @@ struct ColourInput {
   explicit operator bool() const { return spectrum || texture >= 0; }
 };
 
-// A texture with the spectrum of each of its texels (each distinct colour fitted once per render).
+// A texture with the spectrum of each of its texels (each distinct colour upsampled once per render).
 struct TracerTexture {
   const ImageTexture* image = nullptr;
   TexelSpectra spectra;

@@ -299,7 +299,7 @@ TEST_F(EnvironmentTest, TexturedEmitterShowsEachTexelsSpectrumExactly) {
     for (int x = 0; x < 32; ++x) {
       const auto [tx, ty] = texel_under(s.camera, x, y);
       const std::vector<double> expected =
-          band_averages(fit_rgb_unbounded(texture.texel(static_cast<std::size_t>(ty * 4 + tx))).tabulated(), image.bands);
+          band_averages(upsample_rgb_unbounded(texture.texel(static_cast<std::size_t>(ty * 4 + tx))).tabulated(), image.bands);
       for (int b = 0; b < 3; ++b) {
         const double e = 6.0 * expected[static_cast<std::size_t>(b)];
         EXPECT_NEAR(value(image, 0, x, y, b), e, 1e-6 * e) << x << ", " << y;
