@@ -1,0 +1,237 @@
+// Automatic segmentation (analyzer/segmentation.h) on synthetic scenes of known masks: dichromatic spheres
+// with shading, highlights and sensor noise, on black and on a shaded wall. Every finding is checked over
+// sizes and noise seeds, not on one image.
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <set>
+
+#include <gtest/gtest.h>
+
+#include "analyzer/segmentation.h"
+#include "tests/analyzer/synthetic.h"
+
+namespace ct::test {
+namespace {
+
+using analyzer::Segmentation;
+
+constexpr int kWall = 5;
+
+// The four spheres (ids 1–4) of `size` pixels each; with a wall, the black background becomes a matte
+// grey-blue wall shaded top to bottom (id 5). Noise: shot noise of full_well electrons at 1 and read noise.
+Scene spheres(int size, bool wall, double full_well, std::uint32_t seed) {
+  Scene scene = dichromatic_scene(Vec3(1, 0.9, 0.75), size);
+  const int w = scene.image.width;
+  if (wall)
+    for (std::size_t p = 0; p < scene.ids.size(); ++p) {
+      if (scene.ids[p] != 0) continue;
+      const double v = static_cast<double>(p / static_cast<std::size_t>(w)) / w;
+      const Vec3 c = (0.25 + 0.3 * v) * Vec3(0.4, 0.45, 0.6);
+      for (std::size_t k = 0; k < 3; ++k) scene.image.rgb[p * 3 + k] = static_cast<float>(c[static_cast<Eigen::Index>(k)]);
+      scene.ids[p] = kWall;
+    }
+  if (full_well > 0) scene.image = add_sensor_noise(scene.image, full_well, 3.0, seed);
+  return scene;
+}
+
+Segmentation segment(const RgbImage& image, const analyzer::SegmentationOptions& options = {}) {
+  return analyzer::segment_image(image, std::nullopt, 1.0, 0.0, options);
+}
+
+struct Match {
+  std::int32_t label = 0;
+  double iou = 0;
+};
+
+// The segment that best covers object `id`, and its intersection over union with the object's mask.
+Match best_segment(const Segmentation& s, const std::vector<std::int32_t>& ids, std::int32_t id) {
+  std::map<std::int32_t, std::size_t> overlap, size;
+  std::size_t object = 0;
+  for (std::size_t p = 0; p < ids.size(); ++p) {
+    if (s.labels[p] > 0) ++size[s.labels[p]];
+    if (ids[p] != id) continue;
+    ++object;
+    if (s.labels[p] > 0) ++overlap[s.labels[p]];
+  }
+  Match m;
+  for (const auto& [label, common] : overlap) {
+    const double iou = double(common) / double(object + size[label] - common);
+    if (iou > m.iou) m = {label, iou};
+  }
+  return m;
+}
+
+// The object's highlight: its pixels whose colour is turned by more than 3° from its body colour (the
+// direction of its darkest lit pixels, where no highlight is), in the noise-free scene.
+std::vector<std::size_t> highlight_pixels(const Scene& clean, std::int32_t id) {
+  std::vector<std::pair<double, std::size_t>> by_brightness;
+  for (std::size_t p = 0; p < clean.ids.size(); ++p)
+    if (clean.ids[p] == id)
+      by_brightness.emplace_back(clean.image.rgb[p * 3] + clean.image.rgb[p * 3 + 1] + clean.image.rgb[p * 3 + 2], p);
+  std::sort(by_brightness.begin(), by_brightness.end());
+  Vec3 body = Vec3::Zero();
+  for (std::size_t k = 0; k < by_brightness.size() / 5; ++k) {
+    const std::size_t p = by_brightness[k].second;
+    body += Vec3(clean.image.rgb[p * 3], clean.image.rgb[p * 3 + 1], clean.image.rgb[p * 3 + 2]).normalized();
+  }
+  std::vector<std::size_t> out;
+  for (const auto& [b, p] : by_brightness) {
+    const Vec3 c(clean.image.rgb[p * 3], clean.image.rgb[p * 3 + 1], clean.image.rgb[p * 3 + 2]);
+    if (std::acos(std::clamp(c.normalized().dot(body.normalized()), -1.0, 1.0)) > 3.0 * M_PI / 180) out.push_back(p);
+  }
+  return out;
+}
+
+// The label map of a segmentation of a size × size image scaled to `to` × `to` (nearest pixel).
+std::vector<std::int32_t> scaled_mask(const Segmentation& s, std::int32_t label, int to) {
+  std::vector<std::int32_t> out(static_cast<std::size_t>(to) * static_cast<std::size_t>(to));
+  for (int y = 0; y < to; ++y)
+    for (int x = 0; x < to; ++x) {
+      const int sx = x * s.width / to, sy = y * s.height / to;
+      out[static_cast<std::size_t>(y) * static_cast<std::size_t>(to) + static_cast<std::size_t>(x)] =
+          s.labels[static_cast<std::size_t>(sy) * static_cast<std::size_t>(s.width) + static_cast<std::size_t>(sx)] == label;
+    }
+  return out;
+}
+
+double iou(const std::vector<std::int32_t>& a, const std::vector<std::int32_t>& b) {
+  std::size_t both = 0, either = 0;
+  for (std::size_t p = 0; p < a.size(); ++p) both += a[p] && b[p], either += a[p] || b[p];
+  return either ? double(both) / double(either) : 0.0;
+}
+
+std::size_t segment_count(const Segmentation& s) {
+  return static_cast<std::size_t>(std::count_if(s.regions.begin(), s.regions.end(), [](const analyzer::Region& r) { return r.source == "segment"; }));
+}
+
+// Every sphere (and the wall) is one segment holding its highlight, over three sizes (the largest is
+// area-averaged to the working size), two noise levels and three noise seeds.
+TEST(Segmentation, EveryObjectIsOneSegmentThatKeepsItsHighlight) {
+  for (const bool wall : {true, false})
+    for (const int size : {96, 192, 384})
+      for (const double full_well : {400.0, 4000.0})
+        for (const std::uint32_t seed : {1u, 2u, 3u}) {
+          SCOPED_TRACE(::testing::Message() << "wall " << wall << ", size " << size << ", full well " << full_well << ", seed " << seed);
+          const Scene clean = spheres(size, wall, 0, 0);
+          const Scene scene = spheres(size, wall, full_well, seed);
+          const Segmentation s = segment(scene.image);
+          std::set<std::int32_t> used;
+          for (std::int32_t id = 1; id <= (wall ? kWall : 4); ++id) {
+            const Match m = best_segment(s, scene.ids, id);
+            EXPECT_GE(m.iou, 0.8) << "object " << id;
+            EXPECT_TRUE(used.insert(m.label).second) << "object " << id << " shares segment " << m.label;
+            if (id == kWall) continue;
+            const std::vector<std::size_t> highlight = highlight_pixels(clean, id);
+            ASSERT_GT(highlight.size(), 20u);
+            const auto kept = std::count_if(highlight.begin(), highlight.end(), [&](std::size_t p) { return s.labels[p] == m.label; });
+            EXPECT_GE(double(kept), 0.9 * double(highlight.size())) << "object " << id << ": highlight of " << highlight.size() << " pixels";
+          }
+          EXPECT_EQ(segment_count(s), wall ? 5u : 4u);
+          // The unassigned pixels are counted and are a region of their own: on black, the background.
+          std::size_t unassigned = 0;
+          for (const std::int32_t l : s.labels) unassigned += l == 0;
+          EXPECT_EQ(s.unassigned_pixels, unassigned);
+          EXPECT_EQ(s.valid_pixels, s.labels.size());
+          if (wall) {
+            EXPECT_LT(s.unassigned_fraction(), 0.1);  // the noisiest shadow sides only
+          } else {
+            // The black background has no colour: all of it is unassigned (and the darkest, noisiest rims of
+            // the spheres' shadow sides may be too).
+            std::size_t black = 0, black_unassigned = 0;
+            for (std::size_t p = 0; p < scene.ids.size(); ++p) black += scene.ids[p] == 0, black_unassigned += scene.ids[p] == 0 && s.labels[p] == 0;
+            EXPECT_GE(double(black_unassigned), 0.99 * double(black));
+            EXPECT_GE(s.unassigned_fraction(), 0.99 * double(black) / double(scene.ids.size()));
+          }
+          ASSERT_FALSE(s.regions.empty());
+          if (unassigned > 0) {
+            EXPECT_EQ(s.regions.back().source, "unassigned");
+            EXPECT_EQ(s.regions.back().pixels.size(), unassigned);
+          }
+        }
+}
+
+// The same objects give the same segments at 1×, 2× and 4× size: rendered at each size with its own noise,
+// and as copies of the 1× image enlarged by interpolation.
+TEST(Segmentation, SameSegmentsAtEverySize) {
+  for (const std::uint32_t seed : {1u, 2u, 3u}) {
+    SCOPED_TRACE(::testing::Message() << "seed " << seed);
+    const Scene one = spheres(96, true, 1000, seed);
+    const Segmentation s1 = segment(one.image);
+    for (const int factor : {2, 4}) {
+      SCOPED_TRACE(::testing::Message() << factor << "x");
+      const Scene rendered = spheres(96 * factor, true, 1000, seed + 100);
+      // Enlarged copy: bilinear interpolation of the 1× image.
+      const int to = 192 * factor;
+      RgbImage enlarged{to, to, std::vector<float>(static_cast<std::size_t>(to) * static_cast<std::size_t>(to) * 3)};
+      for (int y = 0; y < to; ++y)
+        for (int x = 0; x < to; ++x) {
+          const double fx = std::clamp((x + 0.5) / factor - 0.5, 0.0, 191.0), fy = std::clamp((y + 0.5) / factor - 0.5, 0.0, 191.0);
+          const int x0 = std::min(190, static_cast<int>(fx)), y0 = std::min(190, static_cast<int>(fy));
+          const double ax = fx - x0, ay = fy - y0;
+          for (std::size_t k = 0; k < 3; ++k) {
+            auto at = [&](int xx, int yy) { return double(one.image.rgb[(static_cast<std::size_t>(yy) * 192 + static_cast<std::size_t>(xx)) * 3 + k]); };
+            enlarged.rgb[(static_cast<std::size_t>(y) * static_cast<std::size_t>(to) + static_cast<std::size_t>(x)) * 3 + k] = static_cast<float>(
+                (1 - ay) * ((1 - ax) * at(x0, y0) + ax * at(x0 + 1, y0)) + ay * ((1 - ax) * at(x0, y0 + 1) + ax * at(x0 + 1, y0 + 1)));
+          }
+        }
+      for (const RgbImage* image : std::initializer_list<const RgbImage*>{&rendered.image, &enlarged}) {
+        const Segmentation sk = segment(*image);
+        EXPECT_EQ(segment_count(sk), segment_count(s1));
+        for (std::int32_t id = 1; id <= kWall; ++id) {
+          const Match m1 = best_segment(s1, one.ids, id), mk = best_segment(sk, rendered.ids, id);
+          EXPECT_GE(iou(scaled_mask(s1, m1.label, to), scaled_mask(sk, mk.label, to)), 0.8) << "object " << id;
+        }
+      }
+    }
+  }
+}
+
+// The noise is estimated once for the image, from its flat parts: known shot and read noise on a shaded,
+// textured surface (a fine stripe pattern of ±20 % that a within-region spread would count as noise) are
+// found within 25 %, over seeds.
+TEST(Segmentation, NoiseIsTheImagesNotTheTexture) {
+  for (const std::uint32_t seed : {1u, 2u, 3u}) {
+    const int n = 256;
+    RgbImage image{n, n, std::vector<float>(static_cast<std::size_t>(n) * n * 3)};
+    for (int y = 0; y < n; ++y)
+      for (int x = 0; x < n; ++x) {
+        // Left half flat-shaded, right half striped every 2 pixels.
+        const double shade = 0.2 + 0.6 * y / double(n), texture = x >= n / 2 ? (((x / 2) % 2) ? 1.2 : 0.8) : 1.0;
+        for (std::size_t k = 0; k < 3; ++k)
+          image.rgb[(static_cast<std::size_t>(y) * n + static_cast<std::size_t>(x)) * 3 + k] = static_cast<float>(shade * texture * (0.5 + 0.2 * double(k)));
+      }
+    const double full_well = 2000, read = 5;
+    const Segmentation s = segment(add_sensor_noise(image, full_well, read, seed));
+    for (const double level : {0.2, 0.5}) {
+      const double truth = std::sqrt(read * read + level * full_well) / full_well;
+      for (int c = 0; c < 3; ++c) EXPECT_NEAR(s.noise.sigma(c, level), truth, 0.25 * truth) << "seed " << seed << ", level " << level << ", channel " << c;
+    }
+  }
+}
+
+// The same input gives the same labels; segments are numbered by decreasing size.
+TEST(Segmentation, DeterministicAndNumberedBySize) {
+  const Scene scene = spheres(96, true, 1000, 7);
+  const Segmentation a = segment(scene.image), b = segment(scene.image);
+  EXPECT_EQ(a.labels, b.labels);
+  for (std::size_t k = 1; k < a.regions.size(); ++k)
+    if (a.regions[k].source == "segment") {
+      EXPECT_GE(a.regions[k - 1].pixels.size(), a.regions[k].pixels.size());
+    }
+}
+
+// NaN pixels (unreadable, transparent, negative) are in no segment and not counted as valid.
+TEST(Segmentation, InvalidPixelsAreNeitherSegmentedNorCounted) {
+  Scene scene = spheres(96, true, 1000, 3);
+  for (std::size_t p = 0; p < 192 * 20; ++p) scene.image.rgb[p * 3 + 1] = std::nanf("");
+  const Segmentation s = segment(scene.image);
+  EXPECT_EQ(s.valid_pixels, scene.ids.size() - 192 * 20);
+  for (std::size_t p = 0; p < 192 * 20; ++p) ASSERT_EQ(s.labels[p], 0);
+  std::size_t in_regions = 0;
+  for (const auto& r : s.regions) in_regions += r.pixels.size();
+  EXPECT_EQ(in_regions, s.valid_pixels);
+}
+
+}  // namespace
+}  // namespace ct::test
