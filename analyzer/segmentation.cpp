@@ -130,7 +130,7 @@ double quantile(std::vector<double> v, double q) {
 // noise; where the image is flat it holds noise only. Per channel and per band of 16 equal-count brightness
 // bands, the 25th percentile of its magnitude (0.3186 × 6σ for Gaussian noise) weights the flat pixels of the
 // band; σ² = a + b·I is fitted over the bands.
-NoiseModel estimate_noise_at(const Work& work) {
+NoiseModel estimate_noise(const Work& work) {
   NoiseModel model;
   std::vector<double> brightest;
   for (std::size_t q = 0; q < work.size(); ++q)
@@ -187,56 +187,6 @@ NoiseModel estimate_noise_at(const Work& work) {
     if (a < 0) a = 0, b = sxx > 0 ? sxy / sxx : 0;
     model.a[c] = a;
     model.b[c] = b;
-  }
-  return model;
-}
-
-// The working image binned k × k (valid, unclipped pixels averaged; a bin with any other is invalid).
-Work binned(const Work& work, int k) {
-  Work out;
-  out.w = work.w / k, out.h = work.h / k;
-  out.rgb.assign(out.size() * 3, 0.0f);
-  out.state.assign(out.size(), kInvalid);
-  out.clipped.assign(out.size(), 0);
-  for (int y = 0; y < out.h; ++y)
-    for (int x = 0; x < out.w; ++x) {
-      Vec3 sum = Vec3::Zero();
-      bool ok = true;
-      for (int j = 0; j < k && ok; ++j)
-        for (int i = 0; i < k; ++i) {
-          const std::size_t q = static_cast<std::size_t>(y * k + j) * static_cast<std::size_t>(work.w) + static_cast<std::size_t>(x * k + i);
-          if (work.state[q] == kInvalid || work.clipped[q]) {
-            ok = false;
-            break;
-          }
-          sum += Vec3(work.rgb[q * 3], work.rgb[q * 3 + 1], work.rgb[q * 3 + 2]);
-        }
-      if (!ok) continue;
-      const std::size_t p = static_cast<std::size_t>(y) * static_cast<std::size_t>(out.w) + static_cast<std::size_t>(x);
-      out.state[p] = kOk;
-      for (std::size_t c = 0; c < 3; ++c) out.rgb[p * 3 + c] = static_cast<float>(sum[static_cast<Eigen::Index>(c)] / (k * k));
-    }
-  return out;
-}
-
-// Noise that neighbouring pixels share (an enlarged or resampled image, demosaicing, compression) hides from
-// a 3×3 mask at one scale; binned k × k, white noise keeps σ²·k² constant while shared noise shows. Per
-// coefficient, the median over k = 1, 2, 4 (each scaled by k²), so that neither a correlation nor the
-// texture that coarser scales see decides alone.
-NoiseModel estimate_noise(const Work& work) {
-  NoiseModel model = estimate_noise_at(work);
-  std::vector<NoiseModel> scales{model};
-  for (const int k : {2, 4})
-    if (work.w / k >= 16 && work.h / k >= 16) scales.push_back(estimate_noise_at(binned(work, k)));
-  if (scales.size() < 3) return model;
-  for (int c = 0; c < 3; ++c) {
-    double a[3], b[3];
-    for (int i = 0; i < 3; ++i) {
-      const double k2 = std::pow(4.0, i);  // (2^i)²
-      a[i] = scales[static_cast<std::size_t>(i)].a[c] * k2, b[i] = scales[static_cast<std::size_t>(i)].b[c] * k2;
-    }
-    std::sort(a, a + 3), std::sort(b, b + 3);
-    model.a[c] = a[1], model.b[c] = b[1];
   }
   return model;
 }
@@ -329,14 +279,54 @@ PartStats part_stats(const Work& work, const std::vector<std::uint32_t>& pixels,
 // through black: α ≈ 0. The line is fitted to the mean colours of B's rings (pixels at the same distance
 // from B's edge): a highlight grows from its edge to its peak, and the ring means are far less noisy than
 // single pixels.
-bool is_highlight(const Work& work, const std::vector<std::int32_t>& part_of, std::int32_t b_id, const std::vector<std::uint32_t>& b_pixels,
-                  const PartStats& a, const PartStats& b) {
-  if (!(b.brightness > a.brightness) || b.n > a.n) return false;  // a highlight is brighter than its object, and smaller
+// The parts B encloses whole (in holes of B's mask: not reachable from outside B's bounding box without
+// crossing B), e.g. the brighter core of a highlight whose fringe is B. Their pixels are appended to `pixels`.
+std::vector<std::int32_t> enclosed_parts(const Work& work, const std::vector<std::int32_t>& part_of, const std::vector<std::vector<std::uint32_t>>& part_pixels,
+                                         std::int32_t b_id, const std::vector<std::uint32_t>& b_pixels, std::vector<std::uint32_t>& pixels) {
+  const auto w = static_cast<std::size_t>(work.w);
+  std::size_t x0 = w, x1 = 0, y0 = work.size(), y1 = 0;
+  for (const std::uint32_t q : b_pixels) x0 = std::min(x0, q % w), x1 = std::max(x1, q % w), y0 = std::min(y0, q / w), y1 = std::max(y1, q / w);
+  // A box one pixel larger on each side, flooded from its border over everything but B.
+  const std::size_t bx0 = x0 > 0 ? x0 - 1 : 0, by0 = y0 > 0 ? y0 - 1 : 0, bx1 = std::min(w - 1, x1 + 1), by1 = std::min(work.size() / w - 1, y1 + 1);
+  const std::size_t bw = bx1 - bx0 + 1, bh = by1 - by0 + 1;
+  std::vector<std::uint8_t> outside(bw * bh, 0);
+  std::vector<std::size_t> stack;
+  auto global = [&](std::size_t i) { return (by0 + i / bw) * w + bx0 + i % bw; };
+  for (std::size_t i = 0; i < bw * bh; ++i) {
+    const std::size_t bx = i % bw, by = i / bw;
+    if ((bx == 0 || by == 0 || bx + 1 == bw || by + 1 == bh) && part_of[global(i)] != b_id) outside[i] = 1, stack.push_back(i);
+  }
+  while (!stack.empty()) {
+    const std::size_t i = stack.back();
+    stack.pop_back();
+    const std::size_t bx = i % bw, by = i / bw;
+    const std::size_t next[4] = {bx > 0 ? i - 1 : i, bx + 1 < bw ? i + 1 : i, by > 0 ? i - bw : i, by + 1 < bh ? i + bw : i};
+    for (const std::size_t j : next)
+      if (!outside[j] && part_of[global(j)] != b_id) outside[j] = 1, stack.push_back(j);
+  }
+  std::map<std::int32_t, std::size_t> in_holes;
+  for (std::size_t i = 0; i < bw * bh; ++i)
+    if (!outside[i] && part_of[global(i)] != b_id && part_of[global(i)] >= 0) ++in_holes[part_of[global(i)]];
+  std::vector<std::int32_t> parts;
+  for (const auto& [id, count] : in_holes)
+    if (count == part_pixels[static_cast<std::size_t>(id)].size()) {
+      parts.push_back(id);
+      pixels.insert(pixels.end(), part_pixels[static_cast<std::size_t>(id)].begin(), part_pixels[static_cast<std::size_t>(id)].end());
+    }
+  return parts;
+}
+
+// `b_pixels`: B with the parts it encloses (`inside_b`), whose pixels count as B's here.
+bool is_highlight(const Work& work, const std::vector<std::int32_t>& part_of, const std::vector<std::int32_t>& inside_b,
+                  const std::vector<std::uint32_t>& b_pixels, const PartStats& a, const PartStats& b) {
+  // A highlight is brighter than its object and a small part of it (at most a quarter of the object's size).
+  if (std::getenv("CHROMATRACE_SEGMENT_DEBUG")) fmt::print(stderr, "  B with enclosed parts: {} px in {} parts; bright {:.3g} vs {:.3g}\n", b_pixels.size(), inside_b.size(), b.brightness, a.brightness);
+  if (!(b.brightness > a.brightness) || 4 * b_pixels.size() > a.n) return false;
   // Distance from B's edge (4-neighbour steps), by breadth-first search inside B.
   const auto w = static_cast<std::size_t>(work.w);
   std::map<std::uint32_t, int> ring;
   std::vector<std::uint32_t> frontier;
-  auto inside = [&](std::size_t q) { return part_of[q] == b_id; };
+  auto inside = [&](std::size_t q) { return std::find(inside_b.begin(), inside_b.end(), part_of[q]) != inside_b.end(); };
   for (const std::uint32_t q : b_pixels) {
     const std::size_t x = q % w;
     const bool edge = x == 0 || x + 1 == w || q < w || q + w >= work.size() || !inside(q - 1) || !inside(q + 1) || !inside(q - w) || !inside(q + w);
@@ -404,7 +394,7 @@ bool is_highlight(const Work& work, const std::vector<std::int32_t>& part_of, st
                b.n, b.brightness, a.n, a.brightness, a.upper, means.size(), mx, std::sqrt(vxx), x_noise, second, first, alpha, kappa);
   // The highlight must turn the colour measurably and grow along its line, else nothing tells a highlight
   // from a brighter patch of another colour; and it adds one colour: the off-body parts lie along one direction.
-  if (mx < 3 * x_noise || std::sqrt(vxx) < 3 * x_noise) return false;
+  if (mx < 3 * x_noise || std::sqrt(vxx) < 2 * x_noise) return false;
   if (second > 3 * x_noise + 0.15 * first) return false;
   return kappa > -0.2 && alpha >= 0.3 * a.upper && alpha <= 1.5 * a.upper;
 }
@@ -468,8 +458,20 @@ Adjacency adjacency(const Work& work, const Parts& parts) {
 
 }  // namespace
 
+double NoiseModel::quantisation(double value) const {
+  if (!integer) return 0.0;
+  double step = 1.0;
+  if (!codes.empty()) {
+    const auto k = static_cast<std::size_t>(std::upper_bound(codes.begin(), codes.end(), static_cast<float>(value)) - codes.begin());
+    const std::size_t hi = std::min(k, codes.size() - 1), lo = k > 0 ? std::min(k - 1, codes.size() - 2) : 0;
+    step = double(codes[std::max(hi, lo + 1)]) - double(codes[lo]);
+  }
+  return step / std::sqrt(12.0 * averaged);
+}
+
 double NoiseModel::sigma(int channel, double value) const {
-  return std::max(floor, std::sqrt(std::max(0.0, a[channel] + b[channel] * std::max(0.0, value))));
+  const double q = quantisation(value);
+  return std::max(floor, std::sqrt(std::max(0.0, a[channel] + b[channel] * std::max(0.0, value)) + q * q));
 }
 
 void check_segmentation_options(const SegmentationOptions& o) {
@@ -494,6 +496,9 @@ Segmentation segment_image(const RgbImage& image, const std::optional<ToneCurve>
   out.working_width = work.w;
   out.working_height = work.h;
   out.noise = estimate_noise(work);
+  out.noise.integer = full_scale > 1;
+  out.noise.codes = decode.table;
+  out.noise.averaged = static_cast<double>(image.pixel_count()) / static_cast<double>(work.size());
   const NoiseModel& noise = out.noise;
 
   // Each pixel's angular noise; the dark ones are set aside.
@@ -551,22 +556,27 @@ Segmentation segment_image(const RgbImage& image, const std::optional<ToneCurve>
   // than `tolerance` times the noise of the two means plus `angle`: a part is a linear colour cluster, and a
   // gradual drift cannot chain it into its neighbours.
   DisjointSets sets(n);
+  // Quantisation does not average out over a smooth part: its mean colour may be off by half a code step per
+  // channel, an angle of up to 3·σ_q/|c| (σ_q = step/√12), which the comparison of means allows for.
   std::vector<Vec3> unit_sum(n, Vec3::Zero());
-  std::vector<double> precision(n, 0.0);
+  std::vector<double> precision(n, 0.0), bias_sum(n, 0.0);
   for (std::size_t q = 0; q < n; ++q) {
     if (work.state[q] != kOk) continue;
     precision[q] = 1.0 / (double(work.angle_sigma[q]) * work.angle_sigma[q]);
-    unit_sum[q] = colour_at(work, q).normalized() * precision[q];
+    const Vec3 c = colour_at(work, q);
+    unit_sum[q] = c.normalized() * precision[q];
+    bias_sum[q] = precision[q] * 3 * noise.quantisation(c.mean()) * std::sqrt(noise.averaged) / c.norm();
   }
   const double angle_tolerance = options.angle_deg * M_PI / 180;
   auto try_join = [&](std::uint32_t a, std::uint32_t b, double extra) {
     a = sets.find(a), b = sets.find(b);
     if (a == b) return false;
-    const double noise = std::sqrt(1 / precision[a] + 1 / precision[b]);
-    if (angle(unit_sum[a], unit_sum[b]) > options.tolerance * noise + angle_tolerance + extra) return false;
+    const double spread = std::sqrt(1 / precision[a] + 1 / precision[b]), bias = bias_sum[a] / precision[a] + bias_sum[b] / precision[b];
+    if (angle(unit_sum[a], unit_sum[b]) > options.tolerance * spread + bias + angle_tolerance + extra) return false;
     const std::uint32_t root = sets.join(a, b), other = root == a ? b : a;
     unit_sum[root] += unit_sum[other];
     precision[root] += precision[other];
+    bias_sum[root] += bias_sum[other];
     return true;
   };
   for (const Edge& e : edges) try_join(e.a, e.b, 0.0);
@@ -620,14 +630,31 @@ Segmentation segment_image(const RgbImage& image, const std::optional<ToneCurve>
         const PartStats& a = stats[static_cast<std::size_t>(ai)];
         if (touched[static_cast<std::size_t>(ai)] == 2) continue;  // merged away this round
         const double shared = static_cast<double>(adj.between(ai, bi)), perimeter = static_cast<double>(adj.perimeter[static_cast<std::size_t>(bi)]);
+        if (debug) fmt::print(stderr, " candidate B {} (n {}, clipped {:.2f}, perimeter {}) beside A {} (n {}): shared {}\n", bi, b.n, b.clipped, perimeter, ai, a.n, shared);
         if (shared < 0.3 * perimeter) break;  // neighbours are in decreasing order of shared boundary
         bool join = false;
         if (b.clipped >= 0.5) {
           join = shared >= 0.5 * perimeter && b.n <= a.n;
           if (join) ++out.clipped_merges;
-        } else if (is_highlight(work, parts.id, bi, parts.pixels[static_cast<std::size_t>(bi)], a, b)) {
-          join = true;
-          ++out.highlight_merges;
+        } else {
+          std::vector<std::uint32_t> pixels = parts.pixels[static_cast<std::size_t>(bi)];
+          std::vector<std::int32_t> inside = enclosed_parts(work, parts.id, parts.pixels, bi, parts.pixels[static_cast<std::size_t>(bi)], pixels);
+          inside.push_back(bi);
+          if (debug) {
+            fmt::print(stderr, "  encloses:");
+            for (const std::int32_t k : inside) fmt::print(stderr, " {}(t{})", k, touched[static_cast<std::size_t>(k)]);
+            fmt::print(stderr, "\n");
+          }
+          const bool free = std::none_of(inside.begin(), inside.end(), [&](std::int32_t k) { return touched[static_cast<std::size_t>(k)] == 2 || k == ai; });
+          if (free && is_highlight(work, parts.id, inside, pixels, a, b)) {
+            join = true;
+            ++out.highlight_merges;
+            for (const std::int32_t k : inside)
+              if (k != bi) {
+                sets.join(parts.pixels[static_cast<std::size_t>(ai)].front(), parts.pixels[static_cast<std::size_t>(k)].front());
+                touched[static_cast<std::size_t>(k)] = 2;
+              }
+          }
         }
         if (!join) continue;
         sets.join(parts.pixels[static_cast<std::size_t>(ai)].front(), parts.pixels[static_cast<std::size_t>(bi)].front());

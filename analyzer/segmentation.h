@@ -11,7 +11,8 @@
 //     `working_megapixels` (never enlarged), so that the same objects give the same segments at any size.
 //  2. The noise of the working image is estimated once for the whole image (Immerkær 1996, "Fast noise
 //     variance estimation", with a low quantile of |3×3 Laplacian difference| per brightness band so that
-//     flat areas decide it), as σ²(I) = a + b·I per channel (read noise plus shot noise).
+//     flat areas decide it), as σ²(I) = a + b·I per channel (read noise plus shot noise), plus the
+//     quantisation noise of integer files (step/√12 of the stored code, in linear light).
 //  3. Pixels darker than `dark` noise σ have no reliable colour direction and are left unassigned ("dark").
 //  4. Linear colour clusters grow over the pixel graph (8-neighbours, the edges taken in increasing order of
 //     the angle between the two colours in units of its noise σ, as in Felzenszwalb & Huttenlocher's graph
@@ -21,10 +22,13 @@
 //     Parts that a slow drift of one surface's colour split meet along a boundary with no edge (a median step
 //     across it of at most 1.5 σ) and join if their mean directions differ by less than 3 · angle_deg beyond
 //     their noise.
-//  5. Dichromatic extension: a brighter neighbour B of a region A joins A when B's colours are A's body
-//     colour plus one other colour (they lie in a plane with A's body line) and B's line meets A's body line
-//     at a point of A's upper range (a highlight), not at black (another matte surface); a mostly clipped
-//     neighbour that A surrounds joins as a clipped highlight.
+//  5. Dichromatic extension: a brighter neighbour B of a region A, at most a quarter of A's size and bordered
+//     by A on at least 30 % of its boundary, joins A when B's colours are A's body colour plus one other
+//     colour (the mean colours of B's rings, pixels at the same distance from B's edge, lie in a plane with
+//     A's body line), their turn away from A's body colour grows from B's edge inwards, and their line meets
+//     A's body line at a point of A's upper range (30 % to 150 % of its 90th percentile: a highlight), not at
+//     black (another matte surface). A mostly clipped neighbour that A surrounds (half its boundary) joins as
+//     a clipped highlight.
 //  6. Parts smaller than `min_area` of the valid image join a neighbour whose colour they share, else stay
 //     unassigned ("small": mixed edge pixels, texture finer than the working size).
 //  7. Labels are carried back to full size; pixels on a boundary between segments take the segment whose
@@ -55,7 +59,14 @@ struct NoiseModel {
   Vec3 b = Vec3::Zero();
   double floor = 0;
   std::size_t samples = 0;  // pixels the estimate used
+  // Integer files: the linear value of each stored code (empty for float files, and for linear integer files
+  // whose step is 1), and the pixels averaged into one working pixel; the quantisation noise, step/√12 per
+  // stored code, averaged down, is added.
+  std::vector<float> codes;
+  bool integer = false;
+  double averaged = 1;
   double sigma(int channel, double value) const;
+  double quantisation(double value) const;
 };
 
 struct Segmentation {
