@@ -176,7 +176,7 @@ NoiseModel estimate_noise(const Work& work) {
     const double n = kBands;
     const double sx = std::accumulate(level.begin(), level.end(), 0.0), sy = std::accumulate(variance.begin(), variance.end(), 0.0);
     double sxx = 0, sxy = 0;
-    for (int k = 0; k < kBands; ++k) sxx += level[k] * level[k], sxy += level[k] * variance[k];
+    for (std::size_t k = 0; k < level.size(); ++k) sxx += level[k] * level[k], sxy += level[k] * variance[k];
     const double det = n * sxx - sx * sx;
     double a = sy / n, b = 0;
     if (det > 0) {

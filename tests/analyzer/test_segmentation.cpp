@@ -8,8 +8,13 @@
 
 #include <gtest/gtest.h>
 
+#include <nlohmann/json.hpp>
+
 #include "analyzer/segmentation.h"
+#include "core/file_io.h"
 #include "tests/analyzer/synthetic.h"
+#include "tests/cli/run_command.h"
+#include "tests/core/spectral_exr_fixtures.h"
 
 namespace ct::test {
 namespace {
@@ -246,6 +251,70 @@ TEST(Segmentation, InvalidPixelsAreNeitherSegmentedNorCounted) {
   std::size_t in_regions = 0;
   for (const auto& r : s.regions) in_regions += r.pixels.size();
   EXPECT_EQ(in_regions, s.valid_pixels);
+}
+
+// analyze --segment writes labels.png (16-bit, 0 = unassigned, k = segment k), which --labels reads back as
+// the same regions; analysis.json reports the unassigned fraction; plots for the N largest regions only; the
+// same labels with one thread or two.
+TEST(SegmentCommand, WritesLabelsThatLabelsReadsBack) {
+  TempDir dir;
+  write_rgb(dir.file("scene.png"), spheres(96, true, 1000, 5).image, 16);
+  const auto out = dir.file("out"), again = dir.file("again"), one_thread = dir.file("one");
+  const CommandResult r = run_chromatrace({"analyze", dir.file("scene.png").string(), "-o", out.string(), "--segment", "--plots", "2",
+                                           "--no-report", "-q", "--threads", "2", "--input-transfer", "linear"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  ASSERT_TRUE(std::filesystem::is_regular_file(out / "labels.png"));
+  const nlohmann::json a = nlohmann::json::parse(read_file(out / "analysis.json"));
+  const nlohmann::json& seg = a["segmentation"];
+  ASSERT_TRUE(seg.is_object());
+  EXPECT_EQ(seg["labels_file"], "labels.png");
+  EXPECT_EQ(seg["valid_pixels"], 192 * 192);
+  EXPECT_NEAR(seg["unassigned_fraction"].get<double>(), seg["unassigned_pixels"].get<double>() / (192.0 * 192.0), 1e-12);
+  std::map<std::int64_t, std::size_t> segments;
+  std::size_t unassigned = 0, plotted = 0;
+  for (const auto& region : a["regions"]) {
+    if (region["source"] == "segment") segments[region["label"].get<std::int64_t>()] = region["pixels"];
+    if (region["source"] == "unassigned") unassigned = region["pixels"];
+    plotted += !region["files"]["plot"].is_null();
+  }
+  EXPECT_EQ(segments.size(), 5u);  // four spheres and the wall
+  EXPECT_EQ(unassigned, seg["unassigned_pixels"].get<std::size_t>());
+  EXPECT_EQ(plotted, 2u);
+  std::size_t plot_files = 0;
+  for (const auto& f : std::filesystem::directory_iterator(out / "plots")) plot_files += f.path().extension() == ".png";
+  EXPECT_EQ(plot_files, 4u);  // the two largest regions, each with its density plot
+  // Read back: label k is segment k, with the same pixels.
+  const CommandResult back = run_chromatrace({"analyze", dir.file("scene.png").string(), "-o", again.string(), "--labels",
+                                              (out / "labels.png").string(), "--no-plots", "--no-report", "-q", "--input-transfer", "linear"});
+  ASSERT_EQ(back.exit_code, 0) << back.err;
+  const nlohmann::json b = nlohmann::json::parse(read_file(again / "analysis.json"));
+  std::map<std::int64_t, std::size_t> labels;
+  for (const auto& region : b["regions"])
+    if (region["source"] == "labels") labels[region["label"].get<std::int64_t>()] = region["pixels"];
+  EXPECT_EQ(labels, segments);
+  // Deterministic whatever the thread count.
+  const CommandResult single = run_chromatrace({"analyze", dir.file("scene.png").string(), "-o", one_thread.string(), "--segment",
+                                                "--no-plots", "--no-report", "-q", "--threads", "1", "--input-transfer", "linear"});
+  ASSERT_EQ(single.exit_code, 0) << single.err;
+  EXPECT_EQ(read_file(one_thread / "labels.png"), read_file(out / "labels.png"));
+}
+
+// Bad parameters: one line naming the option, exit 2.
+TEST(SegmentCommand, BadParametersAreOneLineErrorsNamingTheOption) {
+  TempDir dir;
+  write_rgb(dir.file("scene.png"), spheres(96, true, 0, 0).image, 8);
+  const std::vector<std::pair<std::vector<std::string>, std::string>> cases = {
+      {{"--segment-min-area", "0"}, "--segment-min-area"}, {{"--segment-size", "-1"}, "--segment-size"},
+      {{"--segment-tolerance", "0"}, "--segment-tolerance"}, {{"--segment-angle", "90"}, "--segment-angle"},
+      {{"--segment-dark", "-2"}, "--segment-dark"}, {{"--plots", "some"}, "--plots"}};
+  for (const auto& [extra, option] : cases) {
+    std::vector<std::string> args{"analyze", dir.file("scene.png").string(), "-o", dir.file("out").string(), "--segment", "-q"};
+    args.insert(args.end(), extra.begin(), extra.end());
+    const CommandResult r = run_chromatrace(args);
+    EXPECT_EQ(r.exit_code, 2) << option;
+    EXPECT_NE(r.err.find(option), std::string::npos) << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  }
 }
 
 }  // namespace
