@@ -1,8 +1,8 @@
 #include "analyzer/segmentation.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
-#include <cstdlib>
 #include <map>
 #include <numeric>
 #include <tuple>
@@ -320,7 +320,6 @@ std::vector<std::int32_t> enclosed_parts(const Work& work, const std::vector<std
 bool is_highlight(const Work& work, const std::vector<std::int32_t>& part_of, const std::vector<std::int32_t>& inside_b,
                   const std::vector<std::uint32_t>& b_pixels, const PartStats& a, const PartStats& b) {
   // A highlight is brighter than its object and a small part of it (at most a quarter of the object's size).
-  if (std::getenv("CHROMATRACE_SEGMENT_DEBUG")) fmt::print(stderr, "  B with enclosed parts: {} px in {} parts; bright {:.3g} vs {:.3g}\n", b_pixels.size(), inside_b.size(), b.brightness, a.brightness);
   if (!(b.brightness > a.brightness) || 4 * b_pixels.size() > a.n) return false;
   // Distance from B's edge (4-neighbour steps), by breadth-first search inside B.
   const auto w = static_cast<std::size_t>(work.w);
@@ -356,18 +355,12 @@ bool is_highlight(const Work& work, const std::vector<std::int32_t>& part_of, co
     if (pooled >= 4) means.push_back(pool / double(pooled)), counts.push_back(double(pooled)), pool.setZero(), pooled = 0;
   }
   if (means.size() < 2) return false;
-  if (std::getenv("CHROMATRACE_SEGMENT_DEBUG")) {
-    fmt::print(stderr, "  A body ({:.3f} {:.3f} {:.3f}); rings inner to outer:", a.body[0], a.body[1], a.body[2]);
-    for (std::size_t k = 0; k < means.size(); ++k) fmt::print(stderr, " [{:.3f} {:.3f} {:.3f} n{}]", means[k][0], means[k][1], means[k][2], counts[k]);
-    fmt::print(stderr, "\n");
-  }
   // A highlight grows from its edge: its most turned ring is turned from A's body colour by more than the
   // outermost one (beyond 3 σ of a ring mean's direction). A whole other object (with a highlight of its
   // own) keeps its own colour out to its edge, and its highlight turns it towards the illuminant, not away
   // from A's body.
   double edge_turn = angle(means.back(), a.body), peak_turn = 0;
   for (const Vec3& m : means) peak_turn = std::max(peak_turn, angle(m, a.body));
-  if (std::getenv("CHROMATRACE_SEGMENT_DEBUG")) fmt::print(stderr, "  turn: edge {:.2f}° peak {:.2f}°\n", edge_turn * 180 / M_PI, peak_turn * 180 / M_PI);
   const double ring_angle_noise = b.noise / std::max(1e-300, b.brightness) / std::sqrt(double(b.n) / double(means.size()));
   if (peak_turn <= edge_turn + 3 * ring_angle_noise) return false;
   double sw = 0, mx = 0, my = 0;
@@ -389,9 +382,6 @@ bool is_highlight(const Work& work, const std::vector<std::int32_t>& part_of, co
   const Eigen::SelfAdjointEigenSolver<Mat3> eigen(off_scatter / sw);
   const double second = std::sqrt(std::max(0.0, eigen.eigenvalues()[1])), first = std::sqrt(std::max(0.0, eigen.eigenvalues()[2]));
   const double kappa = vxx > 0 ? vxy / vxx : 0, alpha = my - kappa * mx;
-  if (std::getenv("CHROMATRACE_SEGMENT_DEBUG"))
-    fmt::print(stderr, "  highlight? B n {} bright {:.3g} vs A n {} bright {:.3g} upper {:.3g}; rings {}; x mean {:.3g} sd {:.3g} ring noise {:.3g}; second {:.3g} first {:.3g}; alpha {:.3g} kappa {:.3g}\n",
-               b.n, b.brightness, a.n, a.brightness, a.upper, means.size(), mx, std::sqrt(vxx), x_noise, second, first, alpha, kappa);
   // The highlight must turn the colour measurably and grow along its line, else nothing tells a highlight
   // from a brighter patch of another colour; and it adds one colour: the off-body parts lie along one direction.
   if (mx < 3 * x_noise || std::sqrt(vxx) < 2 * x_noise) return false;
@@ -487,6 +477,7 @@ void check_segmentation_options(const SegmentationOptions& o) {
 
 Segmentation segment_image(const RgbImage& image, const std::optional<ToneCurve>& curve, double full_scale, double clip_level,
                            const SegmentationOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
   Segmentation out;
   out.options = options;
   out.width = image.width;
@@ -544,13 +535,6 @@ Segmentation segment_image(const RgbImage& image, const std::optional<ToneCurve>
     return x.weight != y.weight ? x.weight < y.weight : (x.a != y.a ? x.a < y.a : x.b < y.b);
   });
   const double min_area = std::max(1.0, options.min_area * static_cast<double>(work.valid));
-  if (std::getenv("CHROMATRACE_SEGMENT_DEBUG")) {
-    std::vector<double> ws, ss;
-    for (const Edge& e : edges) ws.push_back(e.weight);
-    for (std::size_t q = 0; q < n; ++q) if (work.state[q] == kOk) ss.push_back(work.angle_sigma[q]);
-    fmt::print(stderr, "{} edges kept of {} px; weight q50 {:.3g} q90 {:.3g}; angle sigma q10 {:.3g} q50 {:.3g} q90 {:.3g}\n", edges.size(), n,
-               quantile(ws, 0.5), quantile(ws, 0.9), quantile(ss, 0.1), quantile(ss, 0.5), quantile(ss, 0.9));
-  }
   // Each part's colour: its mean colour direction, each pixel's unit colour weighted by the inverse variance
   // of its direction, and that mean's own noise. Two parts join when their mean directions differ by less
   // than `tolerance` times the noise of the two means plus `angle`: a part is a linear colour cluster, and a
@@ -600,18 +584,6 @@ Segmentation segment_image(const RgbImage& image, const std::optional<ToneCurve>
     for (const auto& [median, a, b] : weak) joined += try_join(a, b, 2 * angle_tolerance);
     if (joined == 0) break;
   }
-  const bool debug = std::getenv("CHROMATRACE_SEGMENT_DEBUG") != nullptr;
-  auto report = [&](const char* stage) {
-    if (!debug) return;
-    const Parts p = parts_of(work, sets);
-    std::vector<std::size_t> sizes;
-    for (const auto& px : p.pixels) sizes.push_back(px.size());
-    std::sort(sizes.rbegin(), sizes.rend());
-    fmt::print(stderr, "{}: {} parts, {} >= min area; largest", stage, sizes.size(), std::count_if(sizes.begin(), sizes.end(), [&](std::size_t z) { return double(z) >= min_area; }));
-    for (std::size_t k = 0; k < std::min<std::size_t>(8, sizes.size()); ++k) fmt::print(stderr, " {}", sizes[k]);
-    fmt::print(stderr, "\n");
-  };
-  report("graph merging");
   // Dichromatic extension: highlights (and clipped highlights) join their objects.
   for (int round = 0; round < 4; ++round) {
     const Parts parts = parts_of(work, sets);
@@ -630,7 +602,6 @@ Segmentation segment_image(const RgbImage& image, const std::optional<ToneCurve>
         const PartStats& a = stats[static_cast<std::size_t>(ai)];
         if (touched[static_cast<std::size_t>(ai)] == 2) continue;  // merged away this round
         const double shared = static_cast<double>(adj.between(ai, bi)), perimeter = static_cast<double>(adj.perimeter[static_cast<std::size_t>(bi)]);
-        if (debug) fmt::print(stderr, " candidate B {} (n {}, clipped {:.2f}, perimeter {}) beside A {} (n {}): shared {}\n", bi, b.n, b.clipped, perimeter, ai, a.n, shared);
         if (shared < 0.3 * perimeter) break;  // neighbours are in decreasing order of shared boundary
         bool join = false;
         if (b.clipped >= 0.5) {
@@ -640,11 +611,6 @@ Segmentation segment_image(const RgbImage& image, const std::optional<ToneCurve>
           std::vector<std::uint32_t> pixels = parts.pixels[static_cast<std::size_t>(bi)];
           std::vector<std::int32_t> inside = enclosed_parts(work, parts.id, parts.pixels, bi, parts.pixels[static_cast<std::size_t>(bi)], pixels);
           inside.push_back(bi);
-          if (debug) {
-            fmt::print(stderr, "  encloses:");
-            for (const std::int32_t k : inside) fmt::print(stderr, " {}(t{})", k, touched[static_cast<std::size_t>(k)]);
-            fmt::print(stderr, "\n");
-          }
           const bool free = std::none_of(inside.begin(), inside.end(), [&](std::int32_t k) { return touched[static_cast<std::size_t>(k)] == 2 || k == ai; });
           if (free && is_highlight(work, parts.id, inside, pixels, a, b)) {
             join = true;
@@ -664,7 +630,6 @@ Segmentation segment_image(const RgbImage& image, const std::optional<ToneCurve>
         break;
       }
     }
-    report("dichromatic round");
     if (merges == 0) break;
   }
 
@@ -687,7 +652,6 @@ Segmentation segment_image(const RgbImage& image, const std::optional<ToneCurve>
     }
     parts = parts_of(work, sets);
   }
-  report("small parts");
 
   // Segments by decreasing size; 0 for the rest, with the reason.
   std::vector<std::int32_t> order;
@@ -711,6 +675,20 @@ Segmentation segment_image(const RgbImage& image, const std::optional<ToneCurve>
   std::vector<std::size_t> counts(order.size() + 1, 0);
   const bool same = W == w && H == h;
   const double area_factor = std::sqrt(static_cast<double>(image.pixel_count()) / static_cast<double>(work.size()));
+  // Working pixels with another label among their 8 neighbours: only their full-size pixels need a choice.
+  std::vector<std::uint8_t> work_mixed(n, 0);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const std::size_t q = static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x);
+      for (int j = -1; j <= 1 && !work_mixed[q]; ++j)
+        for (int i = -1; i <= 1; ++i) {
+          const int nx = x + i, ny = y + j;
+          if (nx >= 0 && ny >= 0 && nx < w && ny < h && work_label[static_cast<std::size_t>(ny) * static_cast<std::size_t>(w) + static_cast<std::size_t>(nx)] != work_label[q]) {
+            work_mixed[q] = 1;
+            break;
+          }
+        }
+    }
   for (int y = 0; y < H; ++y) {
     const int wy = same ? y : std::min(h - 1, static_cast<int>((y + 0.5) * h / H));
     for (int x = 0; x < W; ++x) {
@@ -721,7 +699,7 @@ Segmentation segment_image(const RgbImage& image, const std::optional<ToneCurve>
       const int wx = same ? x : std::min(w - 1, static_cast<int>((x + 0.5) * w / W));
       const std::size_t q = static_cast<std::size_t>(wy) * static_cast<std::size_t>(w) + static_cast<std::size_t>(wx);
       std::int32_t label = work_label[q];
-      if (!same) {
+      if (!same && work_mixed[q]) {
         std::int32_t candidates[9];
         int count = 0;
         for (int j = -1; j <= 1; ++j)
@@ -781,6 +759,7 @@ Segmentation segment_image(const RgbImage& image, const std::optional<ToneCurve>
   // A segment that lost every pixel to its neighbours on the boundaries keeps its number but is left out.
   std::erase_if(out.regions, [](const Region& r) { return r.pixels.empty(); });
   if (!unassigned.pixels.empty()) out.regions.push_back(std::move(unassigned));
+  out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return out;
 }
 

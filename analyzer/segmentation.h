@@ -80,6 +80,7 @@ struct Segmentation {
   std::size_t highlight_merges = 0, clipped_merges = 0;  // dichromatic extensions made
   NoiseModel noise;
   SegmentationOptions options;
+  double seconds = 0;  // wall time of the segmentation
 
   double unassigned_fraction() const { return valid_pixels ? double(unassigned_pixels) / double(valid_pixels) : 0.0; }
 };

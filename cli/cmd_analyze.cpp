@@ -110,9 +110,9 @@ Action add_analyze(CLI::App& app) {
     analyzer::ImageAnalysis analysis = analyzer::analyse_image(input, o->layer, std::move(regions), options, known, !o->quiet);
     if (o->regions.segment) {
       if (!o->quiet)
-        fmt::print(stderr, "segmentation: {} segments, {:.1f} % of the valid pixels unassigned ({} dark, {} in parts too small)\n",
+        fmt::print(stderr, "segmentation: {} segments, {:.1f} % of the valid pixels unassigned ({} dark, {} in parts too small), {:.1f} s\n",
                    std::count_if(analysis.regions.begin(), analysis.regions.end(), [](const analyzer::Region& r) { return r.source == "segment"; }),
-                   100 * segmentation.unassigned_fraction(), segmentation.dark_pixels, segmentation.small_pixels);
+                   100 * segmentation.unassigned_fraction(), segmentation.dark_pixels, segmentation.small_pixels, segmentation.seconds);
       analysis.segmentation = std::move(segmentation);
     }
     analyzer::write_analysis(o->output, input, analysis, {!o->no_plots, !o->no_report, o->report_points, plot_limit});
