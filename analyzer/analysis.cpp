@@ -26,7 +26,8 @@ void check_size(const LabelImage& image, const RgbImage& layer, const std::strin
 
 }  // namespace
 
-std::vector<Region> select_regions(const AnalysisImage& input, const RgbImage& layer, const RegionOptions& options) {
+std::vector<Region> select_regions(const AnalysisImage& input, const RgbImage& layer, const RegionOptions& options,
+                                   Segmentation* segmentation) {
   std::vector<Region> regions{whole_image_region(layer.width, layer.height)};
   auto append = [&](std::vector<Region> more) { std::move(more.begin(), more.end(), std::back_inserter(regions)); };
   // Id 0 is "no object" by convention, unless the file gives it a name.
@@ -45,7 +46,18 @@ std::vector<Region> select_regions(const AnalysisImage& input, const RgbImage& l
     regions.push_back(mask_region(mask, fmt::format("mask {}", std::filesystem::path(m).filename().string())));
   }
   for (const Rect& r : options.rects) regions.push_back(rect_region(r, layer.width, layer.height));
-  if (options.segment) append(segment_regions(layer, options.segmentation));
+  if (options.segment) {
+    // In linear light: the final layer's curve is undone (the other layers are linear); clipped pixels are
+    // those at the clipping level of an integer file.
+    const bool final_layer = &layer == &input.image;
+    const ImageEncoding& e = input.encoding;
+    const std::optional<ToneCurve> curve = final_layer ? e.curve : std::nullopt;
+    const double clip = final_layer && e.integer ? e.clipping_level().value_or(e.full_scale) : 0.0;
+    Segmentation s = segment_image(layer, curve, e.integer ? e.full_scale : 1.0, clip, options.segmentation);
+    append(std::move(s.regions));
+    s.regions.clear();
+    if (segmentation) *segmentation = std::move(s);
+  }
   return regions;
 }
 

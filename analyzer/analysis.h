@@ -23,9 +23,12 @@ struct RegionOptions {
 };
 
 // The whole image first, then labels (id 0, "no object", left out unless the file names it), masks,
-// rectangles and segments, in that order. Label and mask images must match the image's size
-// (InputError naming the file otherwise).
-std::vector<Region> select_regions(const AnalysisImage& input, const RgbImage& layer, const RegionOptions& options);
+// rectangles and segments (by decreasing size, then the unassigned pixels as a region of their own), in that
+// order. Label and mask images must match the image's size (InputError naming the file otherwise).
+// With options.segment and `segmentation`, the segmentation's label map and numbers are kept there (its
+// regions are moved into the result).
+std::vector<Region> select_regions(const AnalysisImage& input, const RgbImage& layer, const RegionOptions& options,
+                                   Segmentation* segmentation = nullptr);
 
 struct ImageAnalysis {
   std::string file;
@@ -39,6 +42,7 @@ struct ImageAnalysis {
   std::vector<std::optional<Explanation>> explanations;  // one per region; empty without component layers
   IlluminantAnalysis illuminant;
   std::vector<std::string> notes;  // what a person should know (non-finite pixels, empty regions …)
+  std::optional<Segmentation> segmentation;  // with --segment: the label map and its numbers
 };
 
 // progress: shows a bar on stderr over the regions.

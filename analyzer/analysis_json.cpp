@@ -176,7 +176,28 @@ json shape_to_json(const ClusterShape& s) {
   return j;
 }
 
-json analysis_to_json(const ImageAnalysis& a) {
+static json segmentation_json(const Segmentation& s) {
+  const SegmentationOptions& o = s.options;
+  auto per_channel = [](const Vec3& v) { return json::array({v[0], v[1], v[2]}); };
+  return {{"method", "linear colour clusters extended over dichromatic planes (Klinker, Shafer & Kanade 1990)"},
+          {"labels_file", "labels.png"},
+          {"parameters", {{"working_megapixels", o.working_megapixels}, {"min_area", o.min_area}, {"tolerance", o.tolerance},
+                          {"angle_deg", o.angle_deg}, {"dark", o.dark}}},
+          {"working_size", {s.working_width, s.working_height}},
+          {"noise", {{"model", "sigma_c(I)^2 = a_c + b_c * I in linear light at the working size, never below floor"},
+                     {"estimator", "Immerkaer 1996, lower quartile per brightness band"},
+                     {"a", per_channel(s.noise.a)}, {"b", per_channel(s.noise.b)}, {"floor", s.noise.floor},
+                     {"pixels_used", s.noise.samples}}},
+          {"valid_pixels", s.valid_pixels},
+          {"unassigned_pixels", s.unassigned_pixels},
+          {"unassigned_fraction", s.unassigned_fraction()},
+          {"unassigned_dark_pixels", s.dark_pixels},
+          {"unassigned_small_pixels", s.small_pixels},
+          {"highlight_merges", s.highlight_merges},
+          {"clipped_highlight_merges", s.clipped_merges}};
+}
+
+json analysis_to_json(const ImageAnalysis& a, const std::vector<bool>& plotted) {
   json regions = json::array();
   for (std::size_t i = 0; i < a.results.size(); ++i) {
     const RegionAnalysis& r = a.results[i];
@@ -191,7 +212,8 @@ json analysis_to_json(const ImageAnalysis& a) {
               {"occupied_bins", r.histogram.cells.size()},
               {"shape", shape_to_json(r.shape)},
               {"linear_light", r.linear_light ? shape_to_json(*r.linear_light) : json(nullptr)},
-              {"files", {{"histogram", "histograms/" + stem + ".json"}, {"plot", "plots/" + stem + ".png"}}}};
+              {"files", {{"histogram", "histograms/" + stem + ".json"},
+                         {"plot", plotted.empty() || (i < plotted.size() && plotted[i]) ? json("plots/" + stem + ".png") : json(nullptr)}}}};
     j["explanation"] = i < a.explanations.size() ? optional_json(a.explanations[i], explanation_json) : json(nullptr);
     regions.push_back(std::move(j));
   }
@@ -240,6 +262,7 @@ json analysis_to_json(const ImageAnalysis& a) {
             {"superposed_share", k.superposed_share},
             {"min_mixed_samples", k.min_mixed_samples}}},
           {"regions", regions},
+          {"segmentation", a.segmentation ? segmentation_json(*a.segmentation) : json(nullptr)},
           {"illuminant",
            {{"estimate", estimate_json(il.best())},
             {"choice", il.choice},

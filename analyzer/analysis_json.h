@@ -3,6 +3,7 @@
 // the per-region histogram files it points to.
 
 #include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -13,7 +14,8 @@ namespace ct::analyzer {
 inline constexpr const char* kAnalysisFormat = "chromatrace-analysis/1";
 
 nlohmann::json shape_to_json(const ClusterShape& shape);
-nlohmann::json analysis_to_json(const ImageAnalysis& analysis);
+// `plotted`: which regions have plots (files.plot null for the others); empty: all of them.
+nlohmann::json analysis_to_json(const ImageAnalysis& analysis, const std::vector<bool>& plotted = {});
 // The 3D histogram (sparse cells), its three projections and the rg-chromaticity histogram of a region.
 nlohmann::json histogram_to_json(const Histogram3& histogram, const Histogram2& chromaticity);
 

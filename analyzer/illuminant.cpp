@@ -104,6 +104,7 @@ IlluminantAnalysis estimate_illuminant(const std::vector<RegionAnalysis>& region
   const bool parts = std::any_of(regions.begin(), regions.end(), [](const RegionAnalysis& r) { return r.source != "image"; });
   for (const RegionAnalysis& r : regions) {
     if (parts && r.source == "image") continue;
+    if (r.source == "unassigned") continue;  // the pixels no segment holds: no one surface
     const ClusterShape& s = r.shape;
     // A P too: its highlight line is the line the two-line search found through the broad highlight.
     if ((s.shape == ShapeClass::L || s.shape == ShapeClass::SkewedT || s.shape == ShapeClass::P) && s.two_lines) {

@@ -185,6 +185,7 @@ json region_json(const RgbImage& layer, const ImageAnalysis& a, std::size_t i, c
   if (!dominant.empty()) points["component"] = base64_of(component);
   const std::optional<Explanation> none;
   return {{"name", r.name},
+          {"pixels", r.pixels},
           {"range", {spec.lo[0], spec.hi[0]}},
           {"class", class_name(r.shape.shape)},
           {"reason", r.shape.reason},

@@ -1,77 +1,766 @@
 #include "analyzer/segmentation.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
+#include <map>
+#include <numeric>
+#include <tuple>
 
+#include <Eigen/Eigenvalues>
 #include <fmt/core.h>
-#include <opencv2/imgproc.hpp>
+
+#include "core/error.h"
 
 namespace ct::analyzer {
+namespace {
 
-std::vector<Region> segment_regions(const RgbImage& layer, const SegmentationOptions& options) {
-  const int w = layer.width, h = layer.height;
-  const std::size_t n = layer.pixel_count();
-  std::vector<double> brightness(n);
-  for (std::size_t p = 0; p < n; ++p) {
-    const double s = static_cast<double>(layer.rgb[p * 3]) + layer.rgb[p * 3 + 1] + layer.rgb[p * 3 + 2];
-    brightness[p] = std::isfinite(s) ? s : 0.0;
+constexpr double kMinAngle = 0.002;  // radians: the angular noise never counts as less (noise-free renders)
+constexpr double kWeakBoundary = 1.5;  // the median step (noise σ) across a boundary that is no edge
+constexpr std::uint8_t kInvalid = 0, kOk = 1, kDark = 2;
+
+// The image area-averaged to the working size, in linear light.
+struct Work {
+  int w = 0, h = 0;
+  std::vector<float> rgb;           // [p][channel]
+  std::vector<std::uint8_t> state;  // kInvalid, kOk, kDark
+  std::vector<std::uint8_t> clipped;
+  std::vector<float> angle_sigma;   // the noise σ of the colour's direction, radians
+  std::size_t valid = 0;
+  std::size_t size() const { return static_cast<std::size_t>(w) * static_cast<std::size_t>(h); }
+};
+
+// Each source coordinate's share of the (at most two) working coordinates it overlaps.
+struct Spans {
+  std::vector<int> first;
+  std::vector<float> share_first;  // the rest goes to first + 1
+};
+
+Spans spans(int from, int to) {
+  Spans s{std::vector<int>(static_cast<std::size_t>(from)), std::vector<float>(static_cast<std::size_t>(from))};
+  const double scale = static_cast<double>(to) / from;  // working pixels per source pixel, <= 1
+  for (int i = 0; i < from; ++i) {
+    const double a = i * scale, b = (i + 1) * scale;
+    const int k = std::min(to - 1, static_cast<int>(std::floor(a)));
+    const double edge = k + 1.0;
+    s.first[static_cast<std::size_t>(i)] = k;
+    s.share_first[static_cast<std::size_t>(i)] = b <= edge || k + 1 >= to ? 1.0f : static_cast<float>((edge - a) / (b - a));
   }
-  std::vector<double> sorted = brightness;
-  const auto k = static_cast<std::ptrdiff_t>(0.9 * static_cast<double>(n - 1));
-  std::nth_element(sorted.begin(), sorted.begin() + k, sorted.end());
-  const double dark = options.dark_fraction * sorted[static_cast<std::size_t>(k)];
+  return s;
+}
 
-  // Chromaticity as 8-bit colour, the input pyrMeanShiftFiltering takes.
-  cv::Mat chroma(h, w, CV_8UC3, cv::Scalar::all(0));
-  std::vector<std::uint8_t> lit(n, 0);
-  for (std::size_t p = 0; p < n; ++p) {
-    if (!(brightness[p] > dark) || brightness[p] <= 0) continue;
-    lit[p] = 1;
-    auto* c = chroma.ptr<cv::Vec3b>(static_cast<int>(p / static_cast<std::size_t>(w))) + p % static_cast<std::size_t>(w);
-    for (int i = 0; i < 3; ++i)
-      (*c)[i] = cv::saturate_cast<std::uint8_t>(255.0 * std::clamp(layer.rgb[p * 3 + static_cast<std::size_t>(i)] / brightness[p], 0.0, 1.0));
+// A decoder from stored values to linear light: a table for integer codes, else the curve itself.
+struct Decoder {
+  std::optional<ToneCurve> curve;
+  double full_scale = 1;
+  std::vector<float> table;
+  Decoder(const std::optional<ToneCurve>& c, double fs) : curve(c && !c->linear() ? c : std::nullopt), full_scale(fs) {
+    if (curve && fs >= 1 && fs <= 65535 && fs == std::floor(fs)) {
+      table.resize(static_cast<std::size_t>(fs) + 1);
+      for (std::size_t k = 0; k < table.size(); ++k) table[k] = static_cast<float>(curve->decode(static_cast<double>(k), fs));
+    }
   }
-  cv::Mat filtered;
-  cv::pyrMeanShiftFiltering(chroma, filtered, options.spatial_radius, options.colour_radius * 255.0, 1);
+  float operator()(float v) const {
+    if (!curve) return v;
+    if (!table.empty() && v >= 0 && v == std::floor(v) && v < static_cast<float>(table.size())) return table[static_cast<std::size_t>(v)];
+    return static_cast<float>(curve->decode(v, full_scale));
+  }
+};
 
-  const double tolerance = options.step_tolerance * 255.0;
-  auto close = [&](std::size_t a, std::size_t b) {
-    const auto& ca = filtered.ptr<cv::Vec3b>(static_cast<int>(a / static_cast<std::size_t>(w)))[a % static_cast<std::size_t>(w)];
-    const auto& cb = filtered.ptr<cv::Vec3b>(static_cast<int>(b / static_cast<std::size_t>(w)))[b % static_cast<std::size_t>(w)];
-    double d2 = 0;
-    for (int i = 0; i < 3; ++i) d2 += std::pow(double(ca[i]) - double(cb[i]), 2);
-    return d2 <= tolerance * tolerance;
+Work working_image(const RgbImage& image, const Decoder& decode, double clip_level, double megapixels) {
+  const int W = image.width, H = image.height;
+  const double f = std::sqrt(static_cast<double>(image.pixel_count()) / (megapixels * 1e6));
+  Work work;
+  work.w = f > 1 ? std::max(1, static_cast<int>(std::lround(W / f))) : W;
+  work.h = f > 1 ? std::max(1, static_cast<int>(std::lround(H / f))) : H;
+  const Spans sx = spans(W, work.w), sy = spans(H, work.h);
+  const std::size_t n = work.size();
+  // Per working pixel: weighted sums of valid colour, valid weight, clipped weight, total weight.
+  std::vector<double> colour(n * 3, 0.0), valid(n, 0.0), clip(n, 0.0), total(n, 0.0);
+  for (int y = 0; y < H; ++y) {
+    const int wy = sy.first[static_cast<std::size_t>(y)];
+    const float fy = sy.share_first[static_cast<std::size_t>(y)];
+    for (int x = 0; x < W; ++x) {
+      const std::size_t p = static_cast<std::size_t>(y) * static_cast<std::size_t>(W) + static_cast<std::size_t>(x);
+      const float* v = &image.rgb[p * 3];
+      const bool ok = std::isfinite(v[0]) && std::isfinite(v[1]) && std::isfinite(v[2]);
+      const bool clipped = ok && clip_level > 0 && std::max({v[0], v[1], v[2]}) >= clip_level;
+      float c[3] = {0, 0, 0};
+      if (ok)
+        for (int k = 0; k < 3; ++k) c[k] = decode(v[k]);
+      const int wx = sx.first[static_cast<std::size_t>(x)];
+      const float fx = sx.share_first[static_cast<std::size_t>(x)];
+      for (int dy = 0; dy < 2; ++dy) {
+        const double wyw = dy == 0 ? fy : 1.0 - fy;
+        if (wyw <= 0) continue;
+        for (int dx = 0; dx < 2; ++dx) {
+          const double wgt = wyw * (dx == 0 ? fx : 1.0 - fx);
+          if (wgt <= 0) continue;
+          const std::size_t q = static_cast<std::size_t>(wy + dy) * static_cast<std::size_t>(work.w) + static_cast<std::size_t>(wx + dx);
+          total[q] += wgt;
+          if (!ok) continue;
+          valid[q] += wgt;
+          if (clipped) clip[q] += wgt;
+          for (int k = 0; k < 3; ++k) colour[q * 3 + static_cast<std::size_t>(k)] += wgt * c[k];
+        }
+      }
+    }
+  }
+  work.rgb.assign(n * 3, 0.0f);
+  work.state.assign(n, kInvalid);
+  work.clipped.assign(n, 0);
+  for (std::size_t q = 0; q < n; ++q) {
+    if (!(valid[q] >= 0.5 * total[q]) || valid[q] <= 0) continue;
+    work.state[q] = kOk;
+    ++work.valid;
+    work.clipped[q] = clip[q] >= 0.25 * valid[q];
+    for (std::size_t k = 0; k < 3; ++k) work.rgb[q * 3 + k] = static_cast<float>(colour[q * 3 + k] / valid[q]);
+  }
+  return work;
+}
+
+double quantile(std::vector<double> v, double q) {
+  if (v.empty()) return 0.0;
+  const auto k = static_cast<std::ptrdiff_t>(q * static_cast<double>(v.size() - 1));
+  std::nth_element(v.begin(), v.begin() + k, v.end());
+  return v[static_cast<std::size_t>(k)];
+}
+
+// Immerkær's 3×3 mask [1 −2 1; −2 4 −2; 1 −2 1] cancels any locally planar signal and leaves 6σ of white
+// noise; where the image is flat it holds noise only. Per channel and per band of 16 equal-count brightness
+// bands, the 25th percentile of its magnitude (0.3186 × 6σ for Gaussian noise) weights the flat pixels of the
+// band; σ² = a + b·I is fitted over the bands.
+NoiseModel estimate_noise(const Work& work) {
+  NoiseModel model;
+  std::vector<double> brightest;
+  for (std::size_t q = 0; q < work.size(); ++q)
+    if (work.state[q] == kOk && !work.clipped[q]) {
+      const double m = std::max({work.rgb[q * 3], work.rgb[q * 3 + 1], work.rgb[q * 3 + 2]});
+      if (m > 0) brightest.push_back(m);
+    }
+  model.floor = 1e-3 * quantile(brightest, 0.5);
+  const int w = work.w;
+  const int mask[3][3] = {{1, -2, 1}, {-2, 4, -2}, {1, -2, 1}};
+  for (int c = 0; c < 3; ++c) {
+    std::vector<std::pair<double, double>> samples;  // (value, |mask response|)
+    for (int y = 1; y + 1 < work.h; ++y)
+      for (int x = 1; x + 1 < w; ++x) {
+        double m = 0;
+        bool usable = true;
+        for (int j = -1; j <= 1 && usable; ++j)
+          for (int i = -1; i <= 1; ++i) {
+            const std::size_t q = static_cast<std::size_t>(y + j) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x + i);
+            if (work.state[q] == kInvalid || work.clipped[q]) {
+              usable = false;
+              break;
+            }
+            m += mask[j + 1][i + 1] * static_cast<double>(work.rgb[q * 3 + static_cast<std::size_t>(c)]);
+          }
+        if (usable)
+          samples.emplace_back(work.rgb[(static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x)) * 3 + static_cast<std::size_t>(c)], std::abs(m));
+      }
+    model.samples = std::max(model.samples, samples.size());
+    if (samples.size() < 64) continue;
+    std::sort(samples.begin(), samples.end());
+    constexpr int kBands = 16;
+    std::vector<double> level, variance;
+    for (int band = 0; band < kBands; ++band) {
+      const std::size_t lo = samples.size() * static_cast<std::size_t>(band) / kBands, hi = samples.size() * static_cast<std::size_t>(band + 1) / kBands;
+      std::vector<double> m;
+      for (std::size_t k = lo; k < hi; ++k) m.push_back(samples[k].second);
+      const double sigma = quantile(m, 0.25) / (6 * 0.3186);
+      level.push_back(samples[(lo + hi) / 2].first);
+      variance.push_back(sigma * sigma);
+    }
+    // Least squares σ² = a + b·I with a, b >= 0.
+    const double n = kBands;
+    const double sx = std::accumulate(level.begin(), level.end(), 0.0), sy = std::accumulate(variance.begin(), variance.end(), 0.0);
+    double sxx = 0, sxy = 0;
+    for (std::size_t k = 0; k < level.size(); ++k) sxx += level[k] * level[k], sxy += level[k] * variance[k];
+    const double det = n * sxx - sx * sx;
+    double a = sy / n, b = 0;
+    if (det > 0) {
+      b = (n * sxy - sx * sy) / det;
+      a = (sy - b * sx) / n;
+    }
+    if (b < 0) b = 0, a = sy / n;
+    if (a < 0) a = 0, b = sxx > 0 ? sxy / sxx : 0;
+    model.a[c] = a;
+    model.b[c] = b;
+  }
+  return model;
+}
+
+struct DisjointSets {
+  std::vector<std::uint32_t> parent, size;
+  explicit DisjointSets(std::size_t n) : parent(n), size(n, 1) { std::iota(parent.begin(), parent.end(), 0u); }
+  std::uint32_t find(std::uint32_t a) {
+    while (parent[a] != a) a = parent[a] = parent[parent[a]];
+    return a;
+  }
+  // Joins the two sets; the smaller index stays the root (deterministic, whatever the sizes). Returns it.
+  std::uint32_t join(std::uint32_t a, std::uint32_t b) {
+    a = find(a), b = find(b);
+    if (a == b) return a;
+    if (a > b) std::swap(a, b);
+    parent[b] = a;
+    size[a] += size[b];
+    return a;
+  }
+};
+
+double angle(const float* a, const float* b) {
+  const double d = double(a[0]) * b[0] + double(a[1]) * b[1] + double(a[2]) * b[2];
+  const double na = std::sqrt(double(a[0]) * a[0] + double(a[1]) * a[1] + double(a[2]) * a[2]);
+  const double nb = std::sqrt(double(b[0]) * b[0] + double(b[1]) * b[1] + double(b[2]) * b[2]);
+  return std::acos(std::clamp(d / std::max(1e-300, na * nb), -1.0, 1.0));
+}
+
+double angle(const Vec3& a, const Vec3& b) { return std::acos(std::clamp(a.normalized().dot(b.normalized()), -1.0, 1.0)); }
+
+// What the dichromatic tests need to know of a part of the working image.
+struct PartStats {
+  std::size_t n = 0;
+  Vec3 body = Vec3::Zero();       // the principal direction of Σ c cᵀ: the body colour of a matte line
+  Vec3 direction = Vec3::Zero();  // the mean unit colour
+  double upper = 0;               // the 90th percentile along `body`
+  double brightness = 0;          // the median |c|
+  double spread = 0;              // the 90th percentile angle of its colours from `direction`
+  double clipped = 0;             // the fraction of clipped pixels
+  double noise = 0;               // the noise σ (length of the per-channel vector) at its mean colour
+};
+
+Vec3 colour_at(const Work& work, std::size_t q) { return {work.rgb[q * 3], work.rgb[q * 3 + 1], work.rgb[q * 3 + 2]}; }
+
+PartStats part_stats(const Work& work, const std::vector<std::uint32_t>& pixels, const NoiseModel& noise) {
+  PartStats s;
+  s.n = pixels.size();
+  Mat3 scatter = Mat3::Zero();
+  Vec3 unit_sum = Vec3::Zero(), sum = Vec3::Zero();
+  std::vector<double> lengths;
+  lengths.reserve(pixels.size());
+  std::size_t clipped = 0;
+  for (const std::uint32_t q : pixels) {
+    const Vec3 c = colour_at(work, q);
+    scatter += c * c.transpose();
+    sum += c;
+    const double l = c.norm();
+    lengths.push_back(l);
+    if (l > 0) unit_sum += c / l;
+    clipped += work.clipped[q];
+  }
+  const Eigen::SelfAdjointEigenSolver<Mat3> eigen(scatter);
+  s.body = eigen.eigenvectors().col(2);
+  if (s.body.sum() < 0) s.body = -s.body;
+  s.direction = unit_sum.norm() > 0 ? Vec3(unit_sum.normalized()) : s.body;
+  std::vector<double> along, off;
+  along.reserve(pixels.size());
+  off.reserve(pixels.size());
+  for (const std::uint32_t q : pixels) {
+    const Vec3 c = colour_at(work, q);
+    along.push_back(c.dot(s.body));
+    off.push_back(c.norm() > 0 ? angle(c, s.direction) : 0.0);
+  }
+  s.upper = quantile(along, 0.9);
+  s.brightness = quantile(lengths, 0.5);
+  s.spread = quantile(off, 0.9);
+  s.clipped = s.n ? double(clipped) / double(s.n) : 0.0;
+  const Vec3 mean = s.n ? Vec3(sum / double(s.n)) : Vec3::Zero();
+  double v = 0;
+  for (int c = 0; c < 3; ++c) v += std::pow(noise.sigma(c, mean[c]), 2);
+  s.noise = std::sqrt(v);
+  return s;
+}
+
+// Is B (a brighter neighbour of A) A's highlight? B's colours c = m_b·body_A + m_s·h: their part off A's
+// body line, x = |c − (c·body_A) body_A| = m_s·|h⊥|, grows with the highlight while their part along it,
+// y = c·body_A = m_b + m_s·(h·body_A), starts from the body level where the highlight is: the line
+// y = α + κ·x meets the body line at α, in A's upper range. Another matte surface's colours lie on a line
+// through black: α ≈ 0. The line is fitted to the mean colours of B's rings (pixels at the same distance
+// from B's edge): a highlight grows from its edge to its peak, and the ring means are far less noisy than
+// single pixels.
+// The parts B encloses whole (in holes of B's mask: not reachable from outside B's bounding box without
+// crossing B), e.g. the brighter core of a highlight whose fringe is B. Their pixels are appended to `pixels`.
+std::vector<std::int32_t> enclosed_parts(const Work& work, const std::vector<std::int32_t>& part_of, const std::vector<std::vector<std::uint32_t>>& part_pixels,
+                                         std::int32_t b_id, const std::vector<std::uint32_t>& b_pixels, std::vector<std::uint32_t>& pixels) {
+  const auto w = static_cast<std::size_t>(work.w);
+  std::size_t x0 = w, x1 = 0, y0 = work.size(), y1 = 0;
+  for (const std::uint32_t q : b_pixels) x0 = std::min(x0, q % w), x1 = std::max(x1, q % w), y0 = std::min(y0, q / w), y1 = std::max(y1, q / w);
+  // A box one pixel larger on each side, flooded from its border over everything but B.
+  const std::size_t bx0 = x0 > 0 ? x0 - 1 : 0, by0 = y0 > 0 ? y0 - 1 : 0, bx1 = std::min(w - 1, x1 + 1), by1 = std::min(work.size() / w - 1, y1 + 1);
+  const std::size_t bw = bx1 - bx0 + 1, bh = by1 - by0 + 1;
+  std::vector<std::uint8_t> outside(bw * bh, 0);
+  std::vector<std::size_t> stack;
+  auto global = [&](std::size_t i) { return (by0 + i / bw) * w + bx0 + i % bw; };
+  for (std::size_t i = 0; i < bw * bh; ++i) {
+    const std::size_t bx = i % bw, by = i / bw;
+    if ((bx == 0 || by == 0 || bx + 1 == bw || by + 1 == bh) && part_of[global(i)] != b_id) outside[i] = 1, stack.push_back(i);
+  }
+  while (!stack.empty()) {
+    const std::size_t i = stack.back();
+    stack.pop_back();
+    const std::size_t bx = i % bw, by = i / bw;
+    const std::size_t next[4] = {bx > 0 ? i - 1 : i, bx + 1 < bw ? i + 1 : i, by > 0 ? i - bw : i, by + 1 < bh ? i + bw : i};
+    for (const std::size_t j : next)
+      if (!outside[j] && part_of[global(j)] != b_id) outside[j] = 1, stack.push_back(j);
+  }
+  std::map<std::int32_t, std::size_t> in_holes;
+  for (std::size_t i = 0; i < bw * bh; ++i)
+    if (!outside[i] && part_of[global(i)] != b_id && part_of[global(i)] >= 0) ++in_holes[part_of[global(i)]];
+  std::vector<std::int32_t> parts;
+  for (const auto& [id, count] : in_holes)
+    if (count == part_pixels[static_cast<std::size_t>(id)].size()) {
+      parts.push_back(id);
+      pixels.insert(pixels.end(), part_pixels[static_cast<std::size_t>(id)].begin(), part_pixels[static_cast<std::size_t>(id)].end());
+    }
+  return parts;
+}
+
+// `b_pixels`: B with the parts it encloses (`inside_b`), whose pixels count as B's here.
+bool is_highlight(const Work& work, const std::vector<std::int32_t>& part_of, const std::vector<std::int32_t>& inside_b,
+                  const std::vector<std::uint32_t>& b_pixels, const PartStats& a, const PartStats& b) {
+  // A highlight is brighter than its object and a small part of it (at most a quarter of the object's size).
+  if (!(b.brightness > a.brightness) || 4 * b_pixels.size() > a.n) return false;
+  // Distance from B's edge (4-neighbour steps), by breadth-first search inside B.
+  const auto w = static_cast<std::size_t>(work.w);
+  std::map<std::uint32_t, int> ring;
+  std::vector<std::uint32_t> frontier;
+  auto inside = [&](std::size_t q) { return std::find(inside_b.begin(), inside_b.end(), part_of[q]) != inside_b.end(); };
+  for (const std::uint32_t q : b_pixels) {
+    const std::size_t x = q % w;
+    const bool edge = x == 0 || x + 1 == w || q < w || q + w >= work.size() || !inside(q - 1) || !inside(q + 1) || !inside(q - w) || !inside(q + w);
+    if (edge) ring[q] = 0, frontier.push_back(q);
+  }
+  for (int d = 1; !frontier.empty(); ++d) {
+    std::vector<std::uint32_t> next;
+    for (const std::uint32_t q : frontier)
+      for (const std::size_t r : {std::size_t(q) - 1, std::size_t(q) + 1, std::size_t(q) - w, std::size_t(q) + w})
+        if (r < work.size() && inside(r) && !ring.contains(static_cast<std::uint32_t>(r))) ring[static_cast<std::uint32_t>(r)] = d, next.push_back(static_cast<std::uint32_t>(r));
+    frontier = std::move(next);
+  }
+  std::map<int, std::pair<Vec3, std::size_t>> sums;
+  for (const auto& [q, d] : ring) {
+    if (work.clipped[q]) continue;
+    auto& [sum, count] = sums.try_emplace(d, Vec3::Zero(), 0).first->second;
+    sum += colour_at(work, q);
+    ++count;
+  }
+  // Rings of at least 4 pixels (the innermost ones pooled).
+  std::vector<Vec3> means;
+  std::vector<double> counts;
+  Vec3 pool = Vec3::Zero();
+  std::size_t pooled = 0;
+  for (auto it = sums.rbegin(); it != sums.rend(); ++it) {
+    pool += it->second.first, pooled += it->second.second;
+    if (pooled >= 4) means.push_back(pool / double(pooled)), counts.push_back(double(pooled)), pool.setZero(), pooled = 0;
+  }
+  if (means.size() < 2) return false;
+  // A highlight grows from its edge: its most turned ring is turned from A's body colour by more than the
+  // outermost one (beyond 3 σ of a ring mean's direction). A whole other object (with a highlight of its
+  // own) keeps its own colour out to its edge, and its highlight turns it towards the illuminant, not away
+  // from A's body.
+  double edge_turn = angle(means.back(), a.body), peak_turn = 0;
+  for (const Vec3& m : means) peak_turn = std::max(peak_turn, angle(m, a.body));
+  const double ring_angle_noise = b.noise / std::max(1e-300, b.brightness) / std::sqrt(double(b.n) / double(means.size()));
+  if (peak_turn <= edge_turn + 3 * ring_angle_noise) return false;
+  double sw = 0, mx = 0, my = 0;
+  std::vector<double> xs, ys;
+  Mat3 off_scatter = Mat3::Zero();
+  for (std::size_t k = 0; k < means.size(); ++k) {
+    const double y = means[k].dot(a.body);
+    const Vec3 r = means[k] - y * a.body;
+    xs.push_back(r.norm()), ys.push_back(y);
+    sw += counts[k], mx += counts[k] * xs.back(), my += counts[k] * y;
+    off_scatter += counts[k] * r * r.transpose();
+  }
+  mx /= sw, my /= sw;
+  double vxx = 0, vxy = 0;
+  for (std::size_t k = 0; k < xs.size(); ++k) vxx += counts[k] * (xs[k] - mx) * (xs[k] - mx), vxy += counts[k] * (xs[k] - mx) * (ys[k] - my);
+  vxx /= sw, vxy /= sw;
+  const double mean_count = sw / double(means.size());
+  const double x_noise = b.noise / std::sqrt(mean_count);  // of one ring mean
+  const Eigen::SelfAdjointEigenSolver<Mat3> eigen(off_scatter / sw);
+  const double second = std::sqrt(std::max(0.0, eigen.eigenvalues()[1])), first = std::sqrt(std::max(0.0, eigen.eigenvalues()[2]));
+  const double kappa = vxx > 0 ? vxy / vxx : 0, alpha = my - kappa * mx;
+  // The highlight must turn the colour measurably and grow along its line, else nothing tells a highlight
+  // from a brighter patch of another colour; and it adds one colour: the off-body parts lie along one direction.
+  if (mx < 3 * x_noise || std::sqrt(vxx) < 2 * x_noise) return false;
+  if (second > 3 * x_noise + 0.15 * first) return false;
+  return kappa > -0.2 && alpha >= 0.3 * a.upper && alpha <= 1.5 * a.upper;
+}
+
+struct Parts {
+  std::vector<std::int32_t> id;                   // per working pixel, -1 for none
+  std::vector<std::vector<std::uint32_t>> pixels;  // per part
+};
+
+Parts parts_of(const Work& work, DisjointSets& sets) {
+  Parts parts;
+  parts.id.assign(work.size(), -1);
+  std::map<std::uint32_t, std::int32_t> index;
+  for (std::size_t q = 0; q < work.size(); ++q) {
+    if (work.state[q] != kOk) continue;
+    const std::uint32_t root = sets.find(static_cast<std::uint32_t>(q));
+    auto [it, added] = index.try_emplace(root, static_cast<std::int32_t>(parts.pixels.size()));
+    if (added) parts.pixels.emplace_back();
+    parts.id[q] = it->second;
+    parts.pixels[static_cast<std::size_t>(it->second)].push_back(static_cast<std::uint32_t>(q));
+  }
+  return parts;
+}
+
+// Shared 4-neighbour boundary lengths between parts, and each part's whole boundary (to anything else).
+struct Adjacency {
+  std::map<std::pair<std::int32_t, std::int32_t>, std::size_t> shared;
+  std::vector<std::size_t> perimeter;
+  std::size_t between(std::int32_t a, std::int32_t b) const {
+    const auto it = shared.find({std::min(a, b), std::max(a, b)});
+    return it == shared.end() ? 0 : it->second;
+  }
+  std::vector<std::int32_t> neighbours(std::int32_t a) const {
+    std::vector<std::pair<std::size_t, std::int32_t>> list;
+    for (const auto& [key, count] : shared)
+      if (key.first == a || key.second == a) list.emplace_back(count, key.first == a ? key.second : key.first);
+    std::sort(list.begin(), list.end(), [](const auto& x, const auto& y) { return x.first != y.first ? x.first > y.first : x.second < y.second; });
+    std::vector<std::int32_t> out;
+    for (const auto& [count, b] : list) out.push_back(b);
+    return out;
+  }
+};
+
+Adjacency adjacency(const Work& work, const Parts& parts) {
+  Adjacency adj;
+  adj.perimeter.assign(parts.pixels.size(), 0);
+  auto pair = [&](std::size_t p, std::size_t q) {
+    const std::int32_t a = parts.id[p], b = parts.id[q];
+    if (a == b) return;
+    if (a >= 0) ++adj.perimeter[static_cast<std::size_t>(a)];
+    if (b >= 0) ++adj.perimeter[static_cast<std::size_t>(b)];
+    if (a >= 0 && b >= 0) ++adj.shared[{std::min(a, b), std::max(a, b)}];
   };
-  std::vector<std::int32_t> label(n, -1);
-  std::vector<Region> regions;
-  std::vector<std::uint32_t> stack;
-  for (std::size_t seed = 0; seed < n; ++seed) {
-    if (!lit[seed] || label[seed] >= 0) continue;
-    const auto id = static_cast<std::int32_t>(regions.size());
-    Region r{"", "segment", id, {}};
-    stack.assign(1, static_cast<std::uint32_t>(seed));
-    label[seed] = id;
-    while (!stack.empty()) {
-      const std::uint32_t p = stack.back();
-      stack.pop_back();
-      r.pixels.push_back(p);
-      const std::size_t x = p % static_cast<std::size_t>(w);
-      const std::size_t neighbours[4] = {x > 0 ? p - 1 : n, x + 1 < static_cast<std::size_t>(w) ? p + 1 : n,
-                                         p >= static_cast<std::size_t>(w) ? p - w : n, p + w < n ? p + w : n};
-      for (const std::size_t q : neighbours)
-        if (q < n && lit[q] && label[q] < 0 && close(p, q)) label[q] = id, stack.push_back(static_cast<std::uint32_t>(q));
-    }
-    std::sort(r.pixels.begin(), r.pixels.end());
-    regions.push_back(std::move(r));
+  const auto w = static_cast<std::size_t>(work.w);
+  for (std::size_t q = 0; q < work.size(); ++q) {
+    if (q % w + 1 < w) pair(q, q + 1);
+    if (q + w < work.size()) pair(q, q + w);
   }
-  std::vector<Region> kept;
-  for (Region& r : regions)
-    if (r.pixels.size() >= options.min_pixels) {
-      r.label = static_cast<std::int64_t>(kept.size()) + 1;
-      r.name = fmt::format("segment {}", r.label);
-      kept.push_back(std::move(r));
+  return adj;
+}
+
+}  // namespace
+
+double NoiseModel::quantisation(double value) const {
+  if (!integer) return 0.0;
+  double step = 1.0;
+  if (!codes.empty()) {
+    const auto k = static_cast<std::size_t>(std::upper_bound(codes.begin(), codes.end(), static_cast<float>(value)) - codes.begin());
+    const std::size_t hi = std::min(k, codes.size() - 1), lo = k > 0 ? std::min(k - 1, codes.size() - 2) : 0;
+    step = double(codes[std::max(hi, lo + 1)]) - double(codes[lo]);
+  }
+  return step / std::sqrt(12.0 * averaged);
+}
+
+double NoiseModel::sigma(int channel, double value) const {
+  const double q = quantisation(value);
+  return std::max(floor, std::sqrt(std::max(0.0, a[channel] + b[channel] * std::max(0.0, value)) + q * q));
+}
+
+void check_segmentation_options(const SegmentationOptions& o) {
+  auto check = [](bool ok, const char* option, double value, const char* range) {
+    if (!ok) throw InputError(fmt::format("{}: must be {}, got {}", option, range, value));
+  };
+  check(o.working_megapixels >= 0.01 && o.working_megapixels <= 100, "--segment-size", o.working_megapixels, "in [0.01, 100] megapixels");
+  check(o.min_area >= 2e-5 && o.min_area < 1, "--segment-min-area", o.min_area, "in [2e-5, 1)");
+  check(o.tolerance > 0 && std::isfinite(o.tolerance), "--segment-tolerance", o.tolerance, "> 0");
+  check(o.angle_deg >= 0 && o.angle_deg < 90, "--segment-angle", o.angle_deg, "in [0, 90) degrees");
+  check(o.dark >= 0 && std::isfinite(o.dark), "--segment-dark", o.dark, ">= 0");
+}
+
+Segmentation segment_image(const RgbImage& image, const std::optional<ToneCurve>& curve, double full_scale, double clip_level,
+                           const SegmentationOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  Segmentation out;
+  out.options = options;
+  out.width = image.width;
+  out.height = image.height;
+  const Decoder decode(curve, full_scale);
+  Work work = working_image(image, decode, clip_level, options.working_megapixels);
+  out.working_width = work.w;
+  out.working_height = work.h;
+  out.noise = estimate_noise(work);
+  out.noise.integer = full_scale > 1;
+  out.noise.codes = decode.table;
+  out.noise.averaged = static_cast<double>(image.pixel_count()) / static_cast<double>(work.size());
+  const NoiseModel& noise = out.noise;
+
+  // Each pixel's angular noise; the dark ones are set aside.
+  const std::size_t n = work.size();
+  work.angle_sigma.assign(n, 0.0f);
+  for (std::size_t q = 0; q < n; ++q) {
+    if (work.state[q] != kOk) continue;
+    const float* c = &work.rgb[q * 3];
+    double v = 0;
+    for (int k = 0; k < 3; ++k) v += std::pow(noise.sigma(k, c[k]), 2);
+    const double length = std::sqrt(double(c[0]) * c[0] + double(c[1]) * c[1] + double(c[2]) * c[2]);
+    if (!work.clipped[q] && !(length > options.dark * std::sqrt(v))) {
+      work.state[q] = kDark;
+      continue;
     }
-  return kept;
+    work.angle_sigma[q] = static_cast<float>(std::max(kMinAngle, std::sqrt(v) / length));
+  }
+
+  // Graph merging over 8-neighbour edges, lightest first (ties by position: deterministic).
+  struct Edge {
+    float weight;
+    std::uint32_t a, b;
+  };
+  std::vector<Edge> edges;
+  edges.reserve(n * 4);
+  const int w = work.w, h = work.h;
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const std::size_t p = static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x);
+      if (work.state[p] != kOk) continue;
+      const int offsets[4][2] = {{1, 0}, {0, 1}, {1, 1}, {-1, 1}};
+      for (const auto& o : offsets) {
+        const int nx = x + o[0], ny = y + o[1];
+        if (nx < 0 || nx >= w || ny >= h) continue;
+        const std::size_t q = static_cast<std::size_t>(ny) * static_cast<std::size_t>(w) + static_cast<std::size_t>(nx);
+        if (work.state[q] != kOk) continue;
+        const double sigma = std::hypot(work.angle_sigma[p], work.angle_sigma[q]);
+        const double weight = angle(&work.rgb[p * 3], &work.rgb[q * 3]) / sigma;
+        if (weight <= options.tolerance) edges.push_back({static_cast<float>(weight), static_cast<std::uint32_t>(p), static_cast<std::uint32_t>(q)});
+      }
+    }
+  std::sort(edges.begin(), edges.end(), [](const Edge& x, const Edge& y) {
+    return x.weight != y.weight ? x.weight < y.weight : (x.a != y.a ? x.a < y.a : x.b < y.b);
+  });
+  const double min_area = std::max(1.0, options.min_area * static_cast<double>(work.valid));
+  // Each part's colour: its mean colour direction, each pixel's unit colour weighted by the inverse variance
+  // of its direction, and that mean's own noise. Two parts join when their mean directions differ by less
+  // than `tolerance` times the noise of the two means plus `angle`: a part is a linear colour cluster, and a
+  // gradual drift cannot chain it into its neighbours.
+  DisjointSets sets(n);
+  // Quantisation does not average out over a smooth part: its mean colour may be off by half a code step per
+  // channel, an angle of up to 3·σ_q/|c| (σ_q = step/√12), which the comparison of means allows for.
+  std::vector<Vec3> unit_sum(n, Vec3::Zero());
+  std::vector<double> precision(n, 0.0), bias_sum(n, 0.0);
+  for (std::size_t q = 0; q < n; ++q) {
+    if (work.state[q] != kOk) continue;
+    precision[q] = 1.0 / (double(work.angle_sigma[q]) * work.angle_sigma[q]);
+    const Vec3 c = colour_at(work, q);
+    unit_sum[q] = c.normalized() * precision[q];
+    bias_sum[q] = precision[q] * 3 * noise.quantisation(c.mean()) * std::sqrt(noise.averaged) / c.norm();
+  }
+  const double angle_tolerance = options.angle_deg * M_PI / 180;
+  auto try_join = [&](std::uint32_t a, std::uint32_t b, double extra) {
+    a = sets.find(a), b = sets.find(b);
+    if (a == b) return false;
+    const double spread = std::sqrt(1 / precision[a] + 1 / precision[b]), bias = bias_sum[a] / precision[a] + bias_sum[b] / precision[b];
+    if (angle(unit_sum[a], unit_sum[b]) > options.tolerance * spread + bias + angle_tolerance + extra) return false;
+    const std::uint32_t root = sets.join(a, b), other = root == a ? b : a;
+    unit_sum[root] += unit_sum[other];
+    precision[root] += precision[other];
+    bias_sum[root] += bias_sum[other];
+    return true;
+  };
+  for (const Edge& e : edges) try_join(e.a, e.b, 0.0);
+
+  // Parts of one surface that a slow drift of its colour split (shading by light of two colours, skin)
+  // meet along a boundary without an edge: where the median step across it is at the noise level, they join.
+  for (int round = 0; round < 4; ++round) {
+    std::map<std::pair<std::uint32_t, std::uint32_t>, std::vector<float>> across;
+    for (const Edge& e : edges) {
+      const std::uint32_t a = sets.find(e.a), b = sets.find(e.b);
+      if (a != b) across[{std::min(a, b), std::max(a, b)}].push_back(e.weight);
+    }
+    std::vector<std::tuple<double, std::uint32_t, std::uint32_t>> weak;
+    for (auto& [key, weights] : across) {
+      if (weights.size() < 4) continue;
+      const double median = quantile(std::vector<double>(weights.begin(), weights.end()), 0.5);
+      if (median <= kWeakBoundary) weak.emplace_back(median, key.first, key.second);
+    }
+    std::sort(weak.begin(), weak.end());
+    std::size_t joined = 0;
+    for (const auto& [median, a, b] : weak) joined += try_join(a, b, 2 * angle_tolerance);
+    if (joined == 0) break;
+  }
+  // Dichromatic extension: highlights (and clipped highlights) join their objects.
+  for (int round = 0; round < 4; ++round) {
+    const Parts parts = parts_of(work, sets);
+    const Adjacency adj = adjacency(work, parts);
+    std::vector<PartStats> stats;
+    for (const auto& pixels : parts.pixels) stats.push_back(part_stats(work, pixels, noise));
+    std::vector<std::int32_t> order(parts.pixels.size());
+    std::iota(order.begin(), order.end(), 0);
+    std::stable_sort(order.begin(), order.end(), [&](std::int32_t x, std::int32_t y) { return stats[static_cast<std::size_t>(x)].n < stats[static_cast<std::size_t>(y)].n; });
+    std::vector<std::uint8_t> touched(parts.pixels.size(), 0);
+    std::size_t merges = 0;
+    for (const std::int32_t bi : order) {
+      const PartStats& b = stats[static_cast<std::size_t>(bi)];
+      if (touched[static_cast<std::size_t>(bi)] != 0 || b.n < 2) continue;
+      for (const std::int32_t ai : adj.neighbours(bi)) {
+        const PartStats& a = stats[static_cast<std::size_t>(ai)];
+        if (touched[static_cast<std::size_t>(ai)] == 2) continue;  // merged away this round
+        const double shared = static_cast<double>(adj.between(ai, bi)), perimeter = static_cast<double>(adj.perimeter[static_cast<std::size_t>(bi)]);
+        if (shared < 0.3 * perimeter) break;  // neighbours are in decreasing order of shared boundary
+        bool join = false;
+        if (b.clipped >= 0.5) {
+          join = shared >= 0.5 * perimeter && b.n <= a.n;
+          if (join) ++out.clipped_merges;
+        } else {
+          std::vector<std::uint32_t> pixels = parts.pixels[static_cast<std::size_t>(bi)];
+          std::vector<std::int32_t> inside = enclosed_parts(work, parts.id, parts.pixels, bi, parts.pixels[static_cast<std::size_t>(bi)], pixels);
+          inside.push_back(bi);
+          const bool free = std::none_of(inside.begin(), inside.end(), [&](std::int32_t k) { return touched[static_cast<std::size_t>(k)] == 2 || k == ai; });
+          if (free && is_highlight(work, parts.id, inside, pixels, a, b)) {
+            join = true;
+            ++out.highlight_merges;
+            for (const std::int32_t k : inside)
+              if (k != bi) {
+                sets.join(parts.pixels[static_cast<std::size_t>(ai)].front(), parts.pixels[static_cast<std::size_t>(k)].front());
+                touched[static_cast<std::size_t>(k)] = 2;
+              }
+          }
+        }
+        if (!join) continue;
+        sets.join(parts.pixels[static_cast<std::size_t>(ai)].front(), parts.pixels[static_cast<std::size_t>(bi)].front());
+        touched[static_cast<std::size_t>(bi)] = 2;
+        touched[static_cast<std::size_t>(ai)] = std::max<std::uint8_t>(touched[static_cast<std::size_t>(ai)], 1);
+        ++merges;
+        break;
+      }
+    }
+    if (merges == 0) break;
+  }
+
+  // Small parts: into the neighbour whose colours they share, else unassigned.
+  Parts parts = parts_of(work, sets);
+  {
+    const Adjacency adj = adjacency(work, parts);
+    std::vector<PartStats> stats;
+    for (const auto& pixels : parts.pixels) stats.push_back(part_stats(work, pixels, noise));
+    for (std::size_t bi = 0; bi < parts.pixels.size(); ++bi) {
+      if (static_cast<double>(stats[bi].n) >= min_area) continue;
+      for (const std::int32_t ai : adj.neighbours(static_cast<std::int32_t>(bi))) {
+        const PartStats& a = stats[static_cast<std::size_t>(ai)];
+        if (static_cast<double>(a.n) < min_area) continue;
+        if (angle(stats[bi].direction, a.direction) <= std::max(a.spread, 3 * kMinAngle)) {
+          sets.join(parts.pixels[static_cast<std::size_t>(ai)].front(), parts.pixels[bi].front());
+          break;
+        }
+      }
+    }
+    parts = parts_of(work, sets);
+  }
+
+  // Segments by decreasing size; 0 for the rest, with the reason.
+  std::vector<std::int32_t> order;
+  for (std::size_t k = 0; k < parts.pixels.size(); ++k)
+    if (static_cast<double>(parts.pixels[k].size()) >= min_area) order.push_back(static_cast<std::int32_t>(k));
+  std::stable_sort(order.begin(), order.end(), [&](std::int32_t x, std::int32_t y) { return parts.pixels[static_cast<std::size_t>(x)].size() > parts.pixels[static_cast<std::size_t>(y)].size(); });
+  std::vector<std::int32_t> label_of_part(parts.pixels.size(), 0);
+  for (std::size_t k = 0; k < order.size(); ++k) label_of_part[static_cast<std::size_t>(order[k])] = static_cast<std::int32_t>(k) + 1;
+  std::vector<std::int32_t> work_label(n, 0);
+  for (std::size_t q = 0; q < n; ++q)
+    if (parts.id[q] >= 0) work_label[q] = label_of_part[static_cast<std::size_t>(parts.id[q])];
+  std::vector<Vec3> label_direction(order.size() + 1, Vec3::Zero());
+  for (std::size_t k = 0; k < order.size(); ++k) {
+    const PartStats s = part_stats(work, parts.pixels[static_cast<std::size_t>(order[k])], noise);
+    label_direction[k + 1] = s.direction;
+  }
+
+  // Back to full size; on boundaries, the segment whose colour direction is nearest.
+  const int W = image.width, H = image.height;
+  out.labels.assign(image.pixel_count(), 0);
+  std::vector<std::size_t> counts(order.size() + 1, 0);
+  const bool same = W == w && H == h;
+  const double area_factor = std::sqrt(static_cast<double>(image.pixel_count()) / static_cast<double>(work.size()));
+  // Working pixels with another label among their 8 neighbours: only their full-size pixels need a choice.
+  std::vector<std::uint8_t> work_mixed(n, 0);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const std::size_t q = static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x);
+      for (int j = -1; j <= 1 && !work_mixed[q]; ++j)
+        for (int i = -1; i <= 1; ++i) {
+          const int nx = x + i, ny = y + j;
+          if (nx >= 0 && ny >= 0 && nx < w && ny < h && work_label[static_cast<std::size_t>(ny) * static_cast<std::size_t>(w) + static_cast<std::size_t>(nx)] != work_label[q]) {
+            work_mixed[q] = 1;
+            break;
+          }
+        }
+    }
+  for (int y = 0; y < H; ++y) {
+    const int wy = same ? y : std::min(h - 1, static_cast<int>((y + 0.5) * h / H));
+    for (int x = 0; x < W; ++x) {
+      const std::size_t p = static_cast<std::size_t>(y) * static_cast<std::size_t>(W) + static_cast<std::size_t>(x);
+      const float* v = &image.rgb[p * 3];
+      if (!std::isfinite(v[0]) || !std::isfinite(v[1]) || !std::isfinite(v[2])) continue;
+      ++out.valid_pixels;
+      const int wx = same ? x : std::min(w - 1, static_cast<int>((x + 0.5) * w / W));
+      const std::size_t q = static_cast<std::size_t>(wy) * static_cast<std::size_t>(w) + static_cast<std::size_t>(wx);
+      std::int32_t label = work_label[q];
+      if (!same && work_mixed[q]) {
+        std::int32_t candidates[9];
+        int count = 0;
+        for (int j = -1; j <= 1; ++j)
+          for (int i = -1; i <= 1; ++i) {
+            const int nx = wx + i, ny = wy + j;
+            if (nx < 0 || ny < 0 || nx >= w || ny >= h) continue;
+            const std::int32_t l = work_label[static_cast<std::size_t>(ny) * static_cast<std::size_t>(w) + static_cast<std::size_t>(nx)];
+            if (l > 0 && std::find(candidates, candidates + count, l) == candidates + count) candidates[count++] = l;
+          }
+        bool beside_unassigned = false;
+        for (int j = -1; j <= 1; ++j)
+          for (int i = -1; i <= 1; ++i) {
+            const int nx = wx + i, ny = wy + j;
+            if (nx >= 0 && ny >= 0 && nx < w && ny < h && work_label[static_cast<std::size_t>(ny) * static_cast<std::size_t>(w) + static_cast<std::size_t>(nx)] == 0)
+              beside_unassigned = true;
+          }
+        const Vec3 c(decode(v[0]), decode(v[1]), decode(v[2]));
+        if (label > 0 && beside_unassigned) {
+          // Beside unassigned pixels (dark, mostly): a pixel too dark for a colour at full size is unassigned too;
+          // one full-size pixel has `area_factor` times the noise σ of a working pixel.
+          double variance = 0;
+          for (int k = 0; k < 3; ++k) variance += std::pow(noise.sigma(k, c[k]) * area_factor, 2);
+          if (!(c.norm() > options.dark * std::sqrt(variance))) label = 0;
+        }
+        if (label > 0 && (count > 1 || candidates[0] != label)) {
+          if (c.norm() > 0) {
+            double best = angle(c, label_direction[static_cast<std::size_t>(label)]);
+            for (int k = 0; k < count; ++k) {
+              const double a = angle(c, label_direction[static_cast<std::size_t>(candidates[k])]);
+              if (a < best || (a == best && candidates[k] < label)) best = a, label = candidates[k];
+            }
+          }
+        }
+      }
+      out.labels[p] = label;
+      ++counts[static_cast<std::size_t>(label)];
+      if (label == 0) {
+        ++out.unassigned_pixels;
+        if (work.state[q] == kDark) ++out.dark_pixels;
+        else ++out.small_pixels;
+      }
+    }
+  }
+  for (std::size_t k = 1; k < counts.size(); ++k) {
+    Region r{fmt::format("segment {}", k), "segment", static_cast<std::int64_t>(k), {}};
+    r.pixels.reserve(counts[k]);
+    out.regions.push_back(std::move(r));
+  }
+  Region unassigned{"unassigned", "unassigned", 0, {}};
+  unassigned.pixels.reserve(counts[0]);
+  for (std::size_t p = 0; p < out.labels.size(); ++p) {
+    const std::int32_t l = out.labels[p];
+    if (l > 0) out.regions[static_cast<std::size_t>(l - 1)].pixels.push_back(static_cast<std::uint32_t>(p));
+    else if (std::isfinite(image.rgb[p * 3]) && std::isfinite(image.rgb[p * 3 + 1]) && std::isfinite(image.rgb[p * 3 + 2]))
+      unassigned.pixels.push_back(static_cast<std::uint32_t>(p));
+  }
+  // A segment that lost every pixel to its neighbours on the boundaries keeps its number but is left out.
+  std::erase_if(out.regions, [](const Region& r) { return r.pixels.empty(); });
+  if (!unassigned.pixels.empty()) out.regions.push_back(std::move(unassigned));
+  out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return out;
 }
 
 }  // namespace ct::analyzer

@@ -1,4 +1,5 @@
 // chromatrace analyze IMAGE -o DIR: colour-histogram analysis of image regions (docs/analyze.md).
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
@@ -34,6 +35,7 @@ Action add_analyze(CLI::App& app) {
     std::size_t report_points = 20000;
     std::uint64_t seed = 1;
     bool no_plots = false, no_report = false, quiet = false;
+    std::string plots = "12";
   };
   auto o = std::make_shared<Options>();
   cmd->add_option("image", o->image, "Image: PNG, TIFF, EXR … (the sensor simulator's EXR adds layers and object ids)")->required();
@@ -47,7 +49,19 @@ Action add_analyze(CLI::App& app) {
   cmd->add_flag("--no-labels", o->regions.no_labels, "Ignore the image's object_id channel");
   cmd->add_option("--mask", o->regions.masks, "Mask image (non-zero pixels form a region); repeatable");
   cmd->add_option("--rect", o->rects, "Rectangle x,y,width,height; repeatable");
-  cmd->add_flag("--segment", o->regions.segment, "Add automatic segments (mean-shift on chromaticity)");
+  cmd->add_flag("--segment", o->regions.segment,
+                "Add automatic segments: linear colour clusters extended over dichromatic planes, so that a highlight "
+                "stays with its object; writes labels.png");
+  analyzer::SegmentationOptions& seg = o->regions.segmentation;
+  cmd->add_option("--segment-size", seg.working_megapixels, "Working size of the segmentation in megapixels (larger images are area-averaged to it)")
+      ->capture_default_str();
+  cmd->add_option("--segment-min-area", seg.min_area, "Smallest segment, as a fraction of the image's valid pixels")->capture_default_str();
+  cmd->add_option("--segment-tolerance", seg.tolerance, "Largest colour-angle step between neighbouring pixels of a segment, in noise σ")
+      ->capture_default_str();
+  cmd->add_option("--segment-angle", seg.angle_deg, "How far (degrees) the mean colours of two parts of a segment may differ beyond their noise")
+      ->capture_default_str();
+  cmd->add_option("--segment-dark", seg.dark, "Pixels darker than this many noise σ are left unassigned")->capture_default_str();
+  cmd->add_option("--plots", o->plots, "Plots for the N largest regions, or all")->capture_default_str();
   cmd->add_option("--bins", o->bins, "Histogram bins per channel (2–1024)")->capture_default_str();
   cmd->add_option("--illuminant", o->illuminant, "Known illuminant R,G,B in the layer's units: report angular errors");
   cmd->add_option("--report-points", o->report_points, "Points per region in report.html")->capture_default_str();
@@ -61,6 +75,19 @@ Action add_analyze(CLI::App& app) {
     if (o->bins < 2 || o->bins > 1024) throw InputError(fmt::format("--bins: must be in [2, 1024], got {}", o->bins));
     if (o->threads < 0) throw InputError(fmt::format("--threads: must be >= 0, got {}", o->threads));
     if (o->report_points < 1) throw InputError("--report-points: must be >= 1");
+    std::optional<std::size_t> plot_limit;
+    if (o->plots != "all") {
+      std::size_t used = 0;
+      long long n = -1;
+      try {
+        n = std::stoll(o->plots, &used);
+      } catch (const std::exception&) {
+        used = 0;
+      }
+      if (used != o->plots.size() || n < 0) throw InputError(fmt::format("--plots: expected a number >= 0 or all, got \"{}\"", o->plots));
+      plot_limit = static_cast<std::size_t>(n);
+    }
+    if (o->regions.segment) analyzer::check_segmentation_options(o->regions.segmentation);
     const std::optional<analyzer::Vec3> known = o->illuminant.empty() ? std::nullopt : std::optional(parse_colour(o->illuminant));
     for (const std::string& r : o->rects) o->regions.rects.push_back(analyzer::parse_rect(r, "--rect"));
     const std::filesystem::path parent = std::filesystem::absolute(o->output).parent_path();
@@ -69,7 +96,8 @@ Action add_analyze(CLI::App& app) {
 
     const analyzer::AnalysisImage input = analyzer::read_analysis_image(o->image, o->input_transfer);
     const analyzer::RgbImage& layer = analyzer::select_layer(input, o->layer);
-    std::vector<analyzer::Region> regions = analyzer::select_regions(input, layer, o->regions);
+    analyzer::Segmentation segmentation;
+    std::vector<analyzer::Region> regions = analyzer::select_regions(input, layer, o->regions, &segmentation);
     if (!o->quiet && input.encoding.curve)
       fmt::print(stderr, "{}: R, G, B {} ({})\n", o->image,
                  input.encoding.curve->linear() ? "taken as linear light" : "encoded by " + input.encoding.curve->describe() +
@@ -79,8 +107,15 @@ Action add_analyze(CLI::App& app) {
     options.bins = o->bins;
     options.threads = o->threads;
     options.seed = o->seed;
-    const analyzer::ImageAnalysis analysis = analyzer::analyse_image(input, o->layer, std::move(regions), options, known, !o->quiet);
-    analyzer::write_analysis(o->output, input, analysis, {!o->no_plots, !o->no_report, o->report_points});
+    analyzer::ImageAnalysis analysis = analyzer::analyse_image(input, o->layer, std::move(regions), options, known, !o->quiet);
+    if (o->regions.segment) {
+      if (!o->quiet)
+        fmt::print(stderr, "segmentation: {} segments, {:.1f} % of the valid pixels unassigned ({} dark, {} in parts too small), {:.1f} s\n",
+                   std::count_if(analysis.regions.begin(), analysis.regions.end(), [](const analyzer::Region& r) { return r.source == "segment"; }),
+                   100 * segmentation.unassigned_fraction(), segmentation.dark_pixels, segmentation.small_pixels, segmentation.seconds);
+      analysis.segmentation = std::move(segmentation);
+    }
+    analyzer::write_analysis(o->output, input, analysis, {!o->no_plots, !o->no_report, o->report_points, plot_limit});
     if (!o->quiet) {
       for (const analyzer::RegionAnalysis& r : analysis.results)
         fmt::print(stderr, "{}: {} ({} px){}\n", r.name, analyzer::class_name(r.shape.shape), r.pixels,

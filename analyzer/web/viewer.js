@@ -73,9 +73,11 @@ overlay.addEventListener('click', (event) => {
 
 // ---- region list and details ---------------------------------------------------------------------
 const list = document.getElementById('region-list');
-regions.forEach((r, index) => {
+// Largest first, with pixel counts (ties keep the analysis order).
+const bySize = regions.map((r, index) => [r, index]).sort((a, b) => (b[0].pixels ?? 0) - (a[0].pixels ?? 0) || a[1] - b[1]);
+bySize.forEach(([r, index]) => {
   const button = document.createElement('button');
-  button.textContent = `${r.name} — ${r.class}`;
+  button.textContent = `${r.name} — ${r.class} (${(r.pixels ?? 0).toLocaleString('en')} px)`;
   button.dataset.region = String(index);
   button.addEventListener('click', () => showRegion(index));
   list.appendChild(button);

@@ -7,9 +7,10 @@
     "without three.js from npm). The plots in plots/ and the numbers in analysis.json hold every region.";
   for (const hint of document.querySelectorAll("main .hint")) hint.hidden = true;  // they describe the viewer
   const list = document.getElementById("region-list");
-  for (const region of data.regions || []) {
+  const regions = (data.regions || []).slice().sort(function (a, b) { return (b.pixels || 0) - (a.pixels || 0); });
+  for (const region of regions) {
     const item = document.createElement("div");
-    item.textContent = region.name + " — " + region.class;
+    item.textContent = region.name + " — " + region.class + " (" + (region.pixels || 0) + " px)";
     item.style.width = "100%";
     list.appendChild(item);
   }

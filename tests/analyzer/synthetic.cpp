@@ -119,22 +119,22 @@ struct SceneParts {
   std::map<std::int32_t, std::string> names;
 };
 
-SceneParts sphere_scene(const Vec3& illuminant, double indirect_strength) {
+SceneParts sphere_scene(const Vec3& illuminant, double indirect_strength, int size = 96) {
   const Vec3 bodies[] = {{0.8, 0.3, 0.2}, {0.25, 0.7, 0.3}, {0.2, 0.35, 0.85}, {0.8, 0.75, 0.2}};
   const char* names[] = {"red", "green", "blue", "yellow"};
   const Vec3 wall(0.3, 0.8, 0.35);
-  constexpr int kSize = 96, kWidth = 2 * kSize;
+  const int kSize = size, kWidth = 2 * kSize;
   SceneParts parts;
-  parts.diffuse = RgbImage{kWidth, kWidth, std::vector<float>(kWidth * kWidth * 3, 0.0f)};
+  parts.diffuse = RgbImage{kWidth, kWidth, std::vector<float>(static_cast<std::size_t>(kWidth * kWidth * 3), 0.0f)};
   parts.glossy = parts.indirect = parts.diffuse;
-  parts.ids.assign(kWidth * kWidth, 0);
+  parts.ids.assign(static_cast<std::size_t>(kWidth * kWidth), 0);
   for (int o = 0; o < 4; ++o) {
     parts.names[o + 1] = names[o];
     for (int y = 0; y < kSize; ++y)
       for (int x = 0; x < kSize; ++x) {
         const SphereShading s = sphere(x / double(kSize - 1), y / double(kSize - 1), 20.0 + 15 * o);
         if (!s.inside) continue;
-        const std::size_t p = static_cast<std::size_t>((o / 2) * kSize + y) * kWidth + (o % 2) * kSize + x;
+        const std::size_t p = static_cast<std::size_t>(((o / 2) * kSize + y) * kWidth + (o % 2) * kSize + x);
         const Vec3 body = bodies[o].cwiseProduct(illuminant);
         const Vec3 d = 0.9 * s.body * body, g = 0.9 * s.specular * illuminant;
         const Vec3 i = indirect_strength * (0.3 + x / double(kSize)) * body.cwiseProduct(wall);
@@ -157,8 +157,8 @@ RgbImage sum(const RgbImage& a, const RgbImage& b) {
 
 }  // namespace
 
-Scene dichromatic_scene(const Vec3& illuminant) {
-  SceneParts parts = sphere_scene(illuminant, 0.0);
+Scene dichromatic_scene(const Vec3& illuminant, int size) {
+  SceneParts parts = sphere_scene(illuminant, 0.0, size);
   return {sum(parts.diffuse, parts.glossy), std::move(parts.ids), std::move(parts.names)};
 }
 

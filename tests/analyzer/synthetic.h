@@ -50,13 +50,13 @@ inline const Vec3 kSecondLight = Vec3(0.55, 0.95, 0.5).normalized();  // the for
 inline constexpr double kGamma = 1 / 2.2;
 
 // A scene of several dichromatic objects (different body colours, one illuminant), each a block of pixels
-// with its own object id (1…count); background id 0 is black.
+// with its own object id (1…count); background id 0 is black. Four spheres of `size` pixels in a 2 × 2 grid.
 struct Scene {
   RgbImage image;
   std::vector<std::int32_t> ids;
   std::map<std::int32_t, std::string> names;
 };
-Scene dichromatic_scene(const Vec3& illuminant);
+Scene dichromatic_scene(const Vec3& illuminant, int size = 96);
 
 // Shot noise (Poisson in electrons, full scale = full_well electrons) and Gaussian read noise (read_noise
 // electrons), with a fixed seed; values stay in the image's scale.
