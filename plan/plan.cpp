@@ -542,8 +542,11 @@ std::pair<double, double> Model::evaluate(const std::vector<int>& edges, int max
   return score(t, K);
 }
 
-// Coordinate descent over the candidate positions of each inner edge (indices into grid_edges).
-std::pair<std::vector<std::size_t>, double> descend(const Model& model, std::vector<std::size_t> idx, int bounces) {
+// Coordinate descent over the candidate positions of each inner edge (indices into grid_edges): each edge in
+// turn moves to the best position between its neighbours that is a multiple of `stride` candidates away and at
+// most `window` candidates away, until a sweep changes nothing.
+std::pair<std::vector<std::size_t>, double> descend(const Model& model, std::vector<std::size_t> idx, int bounces,
+                                                    std::size_t stride, std::size_t window) {
   const auto& cand = model.grid_edges();
   auto edges_of = [&](const std::vector<std::size_t>& ix) {
     std::vector<int> e(ix.size());
@@ -554,9 +557,12 @@ std::pair<std::vector<std::size_t>, double> descend(const Model& model, std::vec
   for (int sweep = 0; sweep < 12; ++sweep) {
     bool improved = false;
     for (std::size_t i = 1; i + 1 < idx.size(); ++i) {
-      std::size_t keep = idx[i];
-      for (std::size_t c = idx[i - 1] + 1; c < idx[i + 1]; ++c) {
-        if (c == keep) continue;
+      const std::size_t start = idx[i];
+      std::size_t keep = start;
+      const std::size_t lo = std::max(idx[i - 1] + 1, start > window ? start - window : 0);
+      const std::size_t hi = std::min(idx[i + 1] - 1, start + window);
+      for (std::size_t c = start - ((start - lo) / stride) * stride; c <= hi; c += stride) {
+        if (c == start) continue;
         idx[i] = c;
         const double v = model.evaluate(edges_of(idx), bounces).first;
         if (v < best - 1e-12) {
@@ -570,6 +576,25 @@ std::pair<std::vector<std::size_t>, double> descend(const Model& model, std::vec
     if (!improved) break;
   }
   return {idx, best};
+}
+
+// Coarse to fine: strides of 10, 5, 2 and 1 nm (those that are whole multiples of the edge step), the first over
+// the whole range, each later one within twice the previous stride.
+std::pair<std::vector<std::size_t>, double> fit(const Model& model, const std::vector<std::size_t>& start, int bounces,
+                                                double edge_step) {
+  std::vector<std::size_t> strides;
+  for (double nm : {10.0, 5.0, 2.0}) {
+    const double r = nm / edge_step;
+    if (r > 1 && std::abs(r - std::round(r)) < 1e-9) strides.push_back(static_cast<std::size_t>(std::lround(r)));
+  }
+  strides.push_back(1);
+  std::pair<std::vector<std::size_t>, double> out{start, 0.0};
+  std::size_t window = std::numeric_limits<std::size_t>::max() / 4;
+  for (std::size_t stride : strides) {
+    out = descend(model, out.first, bounces, stride, window);
+    window = 2 * stride;
+  }
+  return out;
 }
 
 // Splits the widest bands (in candidate steps) until there are `bands` bands.
@@ -662,8 +687,8 @@ Plan make_plan(const Scene& scene, const PlanOptions& options) {
     std::vector<std::size_t> uniform(n + 1);
     for (std::size_t i = 0; i <= n; ++i) uniform[i] = (i * cells + n / 2) / n;
     uniform.erase(std::unique(uniform.begin(), uniform.end()), uniform.end());
-    auto [a_idx, a_val] = descend(model, uniform, plan.max_bounces);
-    auto [b_idx, b_val] = descend(model, split_widest(previous, n), plan.max_bounces);
+    auto [a_idx, a_val] = fit(model, uniform, plan.max_bounces, options.edge_step_nm);
+    auto [b_idx, b_val] = fit(model, split_widest(previous, n), plan.max_bounces, options.edge_step_nm);
     if (b_val < a_val) {
       a_idx = b_idx;
       a_val = b_val;

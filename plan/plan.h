@@ -17,8 +17,8 @@
 // ΔE00. measure_delta_e() computes the same statistic between two renders.
 //
 // Band edges for a band count are fitted to that prediction by coordinate descent over a grid of edge
-// positions (a 5 nm grid by default, so that a 5 nm reference nests), from the uniform plan and from the
-// previous count's plan with its widest band split.
+// positions (whole nm by default), coarse to fine, from the uniform plan and from the previous count's plan with
+// its widest bands split.
 
 #include <array>
 #include <cstdint>
@@ -39,7 +39,7 @@ struct PlanOptions {
   double target_de00 = 1.0;
   std::string camera = "cie1931";  // the observer: cie1931 or a shipped camera
   Renderer renderer = Renderer::Cycles;
-  double edge_step_nm = 5.0;  // band edges lie on multiples of this (and on the range's ends)
+  double edge_step_nm = 1.0;  // band edges lie on multiples of this (and on the range's ends)
   int preview_size = 32;      // longer side of the preview render, pixels
   int preview_samples = 16;   // paths per pixel of the preview render
   int threads = 0;            // 0: all cores
