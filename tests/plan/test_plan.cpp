@@ -62,7 +62,7 @@ class Plan : public ::testing::Test {
   };
 
   // Plans `scene` for a mean ΔE00 of 1 and measures the plan against a 5 nm reference at the scene's bounce
-  // limit. The same seed makes most of the noise common to both; what is not (paths part after Russian roulette,
+  // limit. The same seed makes most of the noise common to both; what is not (paths diverge after Russian roulette,
   // whose survival follows the band values) is bounded by rendering 4 nm bands against the same reference,
   // whose own band error is negligible: the "floor".
   Outcome plan_and_measure(const Scene& scene) {
