@@ -159,6 +159,8 @@ TEST_F(Plan, BadInputGetsExitTwoAndOneLineNamingTheField) {
       {{"plan", kBox.string(), "-o", (dir_ / "no/such/dir/plan.json").string()}, "does not exist"},
       {{"render", kBox.string(), "-o", (dir_ / "x.exr").string(), "--plan", bad_plan.string()},
        "bad_plan.json: edges_nm[2]"},
+      {{"render", kBox.string(), "-o", (dir_ / "x.exr").string(), "--plan", bad_plan.string(), "--bands", "400:700:10"},
+       "--plan: give either --bands or --plan"},
   };
   for (const Case& c : cases) {
     const auto r = run_chromatrace(c.args);
