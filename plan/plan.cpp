@@ -247,6 +247,9 @@ class Model {
   int scene_max_bounces() const { return kmax_; }
   const std::vector<Pixel>& pixels() const { return pixels_; }
   double hit_fraction() const { return hit_fraction_; }
+  // Mean ΔE00 of the preview's Monte Carlo noise (one render against the truth) and its paths per pixel.
+  double preview_noise() const { return preview_noise_; }
+  int preview_samples() const { return preview_samples_; }
   double mean_albedo() const { return mean_albedo_; }
 
  private:
@@ -265,7 +268,8 @@ class Model {
   std::vector<Vec3d> lab_exact_;
   Vec3d white_{};
   std::vector<int> grid_edges_;
-  double hit_fraction_ = 0, mean_albedo_ = 0;
+  double hit_fraction_ = 0, mean_albedo_ = 0, preview_noise_ = 0;
+  int preview_samples_ = 0;
   std::size_t pixel_count_ = 0;
 };
 
@@ -488,6 +492,24 @@ Model::Model(const Scene& scene, const PlanOptions& options, std::vector<std::st
   for (double& v : white_) v = std::max(v * ws, 1e-300);
   lab_exact_.resize(pixels_.size());
   for (std::size_t p = 0; p < pixels_.size(); ++p) lab_exact_[p] = xyz_to_lab(xyz[p], white_);
+
+  // Noise: a second preview with the next seed. The two differ by noise alone, of twice the variance of either;
+  // while noise is small against the colour, ΔE00 grows in proportion to its standard deviation, so one render's
+  // noise is the mean ΔE00 between the two / √2 and falls as 1/√(paths per pixel).
+  rt::RenderOptions ro2 = ro;
+  ro2.seed = scene.render.seed + 1;
+  ro2.components = rt::ComponentSelection::parse("none");
+  const rt::RenderedImage img2 = rt::render(preview, ro2);
+  auto colour = [&](const std::vector<float>& l, std::size_t p) {
+    Vec3d x{};
+    for (int c = 0; c < 3; ++c)
+      for (std::size_t b = 0; b < nb; ++b) x[c] += q[c][b] * l[p * nb + b];
+    return xyz_to_lab(x, white_);
+  };
+  double noise = 0;
+  for (std::size_t p = 0; p < N; ++p) noise += delta_e_2000(colour(img.layers[0], p), colour(img2.layers[0], p));
+  preview_noise_ = N ? noise / static_cast<double>(N) / std::sqrt(2.0) : 0.0;
+  preview_samples_ = img.samples;
 }
 
 std::pair<double, double> Model::score(const std::vector<std::vector<std::array<Vec3d, 2>>>& templates,
@@ -652,7 +674,13 @@ Plan make_plan(const Scene& scene, const PlanOptions& options) {
   Plan plan;
   const Model model(scene, options, plan.notes);
   const int kmax = model.scene_max_bounces();
-  plan.samples = scene.render.samples;
+  // Samples: the paths per pixel at which the noise alone is predicted at the target.
+  plan.noise_at_scene_samples = model.preview_noise() * std::sqrt(static_cast<double>(model.preview_samples()) /
+                                                                  std::max(1, scene.render.samples));
+  plan.samples = std::max(1, static_cast<int>(std::ceil(model.preview_samples() *
+                                                        std::pow(model.preview_noise() / options.target_de00, 2))));
+  plan.noise_at_samples =
+      model.preview_noise() * std::sqrt(static_cast<double>(model.preview_samples()) / plan.samples);
 
   // Energy left after k bounces, over the preview's pixels.
   std::vector<double> per_k(static_cast<std::size_t>(kmax) + 1, 0.0);
@@ -771,7 +799,7 @@ Json report_document(const Plan& plan, const Scene& scene, const PlanOptions& op
   s["band_count"] = plan.bands.size();
   s["max_bounces"] = plan.max_bounces;
   s["samples"] = plan.samples;
-  s["samples_from"] = "the scene's render.samples (plan has no noise model)";
+  s["samples_from"] = "tracer paths per pixel for a mean ΔE00 of Monte Carlo noise at the target, at the preview's pixel size";
   j["settings"] = s;
   Json p;
   p["mean_de00"] = plan.predicted_mean;
@@ -780,6 +808,8 @@ Json report_document(const Plan& plan, const Scene& scene, const PlanOptions& op
   p["bounces_only_mean_de00"] = plan.predicted_bounce_only;
   if (std::isfinite(plan.scene_bands_predicted_mean)) p["scene_bands_mean_de00"] = plan.scene_bands_predicted_mean;
   else p["scene_bands_mean_de00"] = nullptr;
+  p["noise_mean_de00_at_planned_samples"] = plan.noise_at_samples;
+  p["noise_mean_de00_at_scene_samples"] = plan.noise_at_scene_samples;
   p["energy_after_bounces"] = plan.energy_after;
   Json trials = Json::array();
   for (const BandTrial& t : plan.trials)

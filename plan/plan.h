@@ -41,7 +41,7 @@ struct PlanOptions {
   Renderer renderer = Renderer::Cycles;
   double edge_step_nm = 1.0;  // band edges lie on multiples of this (and on the range's ends)
   int preview_size = 32;      // longer side of the preview render, pixels
-  int preview_samples = 16;   // paths per pixel of the preview render
+  int preview_samples = 16;   // paths per pixel of the preview renders (two, for the noise)
   int threads = 0;            // 0: all cores
   // Cycles: also render the bounce components separately (each bounce order is a Cycles render of its own).
   bool bounce_components = false;
@@ -57,7 +57,10 @@ struct Plan {
   // Settings.
   Bands bands;
   int max_bounces = 0;
-  int samples = 0;  // the scene's render.samples (no noise model)
+  // Tracer paths per pixel at which Monte Carlo noise alone gives a mean ΔE00 at the target: from two preview
+  // renders with different seeds (the noise of one is their ΔE00 / √2, falling as 1/√samples).
+  int samples = 0;
+  double noise_at_samples = 0, noise_at_scene_samples = 0;  // predicted mean ΔE00 of the noise
   bool target_met = false;
   // Predictions (ΔE00 against the scene's own bounce limit with exact spectra).
   double predicted_mean = 0, predicted_p95 = 0;

@@ -5,6 +5,7 @@
 
 #include <unistd.h>
 
+#include <cmath>
 #include <filesystem>
 
 #include <fmt/core.h>
@@ -116,6 +117,29 @@ TEST_F(Plan, PredictsTheMeasuredErrorUnderF11) {
   doc["spectra"]["lamp"] = Json{{"illuminant", "F11"}};
   const Scene scene = parse_scene(doc, "box-f11", kBox.parent_path());
   check(plan_and_measure(scene), scene, "paper_box_f11");
+}
+
+// The planned samples: two renders at that many paths per pixel and independent seeds differ by a mean ΔE00 of
+// √2 × the noise of one; the noise of one must be the target within a factor 1.5 (the preview at the
+// measurement's pixel size, as the prediction assumes).
+TEST_F(Plan, PlannedSamplesGiveTheTargetNoise) {
+  for (const fs::path& file : {kBox, kCornell}) {
+    SCOPED_TRACE(file.string());
+    const Scene scene = load_scene(file);
+    plan::PlanOptions options;
+    options.threads = 2;
+    options.preview_size = 24;
+    options.target_de00 = 2.0;
+    const plan::Plan p = plan::make_plan(scene, options);
+    const fs::path a = render(scene, p.bands, p.max_bounces, 11, p.samples, "a.exr");
+    const fs::path b = render(scene, p.bands, p.max_bounces, 12, p.samples, "b.exr");
+    const double noise = plan::measure_delta_e(a, b, scene).mean / std::sqrt(2.0);
+    std::fprintf(stderr, "%s: %d paths per pixel, predicted noise %.3f, measured %.3f\n", file.filename().c_str(),
+                 p.samples, p.noise_at_samples, noise);
+    EXPECT_LE(p.noise_at_samples, 2.0);
+    EXPECT_LE(p.noise_at_samples, 1.5 * noise);
+    EXPECT_GE(p.noise_at_samples, noise / 1.5);
+  }
 }
 
 TEST_F(Plan, CommandWritesABandFileThatRenderTakes) {
