@@ -15,6 +15,7 @@
 #include "core/file_io.h"
 #include "core/json_input.h"
 #include "core/scene.h"
+#include "core/spectral_exr.h"
 #include "plan/plan.h"
 #include "reference_tracer/render.h"
 #include "tests/cli/run_command.h"
@@ -163,6 +164,30 @@ TEST_F(Plan, CommandWritesABandFileThatRenderTakes) {
   EXPECT_EQ(read_file(bands), read_file(bands2));
 }
 
+// `series --plan FILE --max-bounces K` renders every variant with the plan's bands and that bounce limit, and
+// the cache key follows them.
+TEST_F(Plan, SeriesTakesThePlan) {
+  const fs::path bands = dir_ / "plan.json", out = dir_ / "out";
+  write_file_atomically(bands, R"({"format": "chromatrace-bands/1", "edges_nm": [380, 430, 480, 530, 580, 630, 780]})");
+  const std::string series = (kSource / "scenes/paper/series.json").string();
+  auto run = [&](std::vector<std::string> extra) {
+    std::vector<std::string> args = {"series", series, "-o", out.string(), "--variant", "2-object-spectra",
+                                     "--resolution", "16x16", "--spp", "2", "--threads", "2", "--quiet"};
+    args.insert(args.end(), extra.begin(), extra.end());
+    const auto r = run_chromatrace(args);
+    EXPECT_EQ(r.exit_code, 0) << r.err;
+    return read_json(out / "series.json")["variants"][0]["render"];
+  };
+  const Json planned = run({"--plan", bands.string(), "--max-bounces", "2"});
+  SpectralExrReader reader(out / planned["file"].get<std::string>());
+  EXPECT_EQ(reader.info().bands.edges(), (std::vector<double>{380, 430, 480, 530, 580, 630, 780}));
+  const Json inputs = read_json(out / "renders" / (planned["key"].get<std::string>() + ".json"));
+  EXPECT_EQ(inputs["max_bounces"].get<int>(), 2);
+  const Json plain = run({});
+  EXPECT_NE(plain["key"], planned["key"]);
+  EXPECT_EQ(SpectralExrReader(out / plain["file"].get<std::string>()).info().bands.size(), 40u);
+}
+
 TEST_F(Plan, BadInputGetsExitTwoAndOneLineNamingTheField) {
   const fs::path bad_scene = dir_ / "bad.json";
   Json doc = read_json(kBox);
@@ -182,6 +207,9 @@ TEST_F(Plan, BadInputGetsExitTwoAndOneLineNamingTheField) {
       {{"plan", kBox.string(), "--camera", "nokia_3310"}, "--camera"},
       {{"plan", kBox.string(), "-o", (dir_ / "no/such/dir/plan.json").string()}, "does not exist"},
       {{"render", kBox.string(), "-o", (dir_ / "x.exr").string(), "--plan", bad_plan.string()},
+       "bad_plan.json: edges_nm[2]"},
+      {{"series", (kSource / "scenes/paper/series.json").string(), "-o", (dir_ / "s").string(), "--plan",
+        bad_plan.string()},
        "bad_plan.json: edges_nm[2]"},
       {{"render", kBox.string(), "-o", (dir_ / "x.exr").string(), "--plan", bad_plan.string(), "--bands", "400:700:10"},
        "--plan: give either --bands or --plan"},
