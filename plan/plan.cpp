@@ -281,7 +281,9 @@ Model::Model(const Scene& scene, const PlanOptions& options, std::vector<std::st
   kmax_ = scene.render.max_bounces;
 
   const sensor::CameraCurves curves = sensor::camera_curves(options.camera, {"r", "g", "b"}, "--camera");
-  sensor::check_band_coverage(sb, curves, scene.source);
+  if (sb.min_wavelength() < curves.min_wavelength() - 1e-9 || sb.max_wavelength() > curves.max_wavelength() + 1e-9)
+    notes.push_back(fmt::format("the camera {} has curves over {:g}-{:g} nm only: it sees nothing of the bands beyond",
+                                curves.name, curves.min_wavelength(), curves.max_wavelength()));
   for (int c = 0; c < 3; ++c) obs_[c] = grid_.sample([&](double nm) { return curves.curves[c](nm); });
 
   // Candidate edges: the range's ends and the multiples of the step inside it.

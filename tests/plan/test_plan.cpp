@@ -162,6 +162,13 @@ TEST_F(Plan, CommandWritesABandFileThatRenderTakes) {
   const fs::path bands2 = dir_ / "plan2.json";
   ASSERT_EQ(run_chromatrace({"plan", kCornell.string(), "-o", bands2.string(), "--threads", "1", "--quiet"}).exit_code, 0);
   EXPECT_EQ(read_file(bands), read_file(bands2));
+  // A shipped camera as the observer; its curves end at 720 nm, short of the paper box's bands: a note says so.
+  const auto cam = run_chromatrace({"plan", kBox.string(), "--camera", "nikon_d850", "--threads", "2", "--quiet"});
+  ASSERT_EQ(cam.exit_code, 0) << cam.err;
+  const Json cj = parse_json(cam.out, "stdout");
+  EXPECT_EQ(cj["camera"], "nikon_d850");
+  ASSERT_EQ(cj["notes"].size(), 1u);
+  EXPECT_NE(cj["notes"][0].get<std::string>().find("380-720 nm"), std::string::npos) << cj["notes"][0];
 }
 
 // `series --plan FILE --max-bounces K` renders every variant with the plan's bands and that bounce limit, and
