@@ -4,17 +4,16 @@
 //
 // The prediction. A low-resolution preview render (bands mode, every component) says, for each pixel, which
 // object it shows and how much luminance arrives after each number k of scattering events (bounce.k; k = 1
-// split into its diffuse and glossy parts). Each pixel's spectrum is then modelled at 1 nm as
-//   S_p(λ) = Σ_k Y_p,k · T_o,k(λ) / Y(T_o,k),
-//   T_o,0 = E_o (an emitter seen directly), T_o,1 = E·R_o (diffuse) or E·G_o (glossy: flat for a dichromatic
-//   lobe, R for a mirror), T_o,k = E·R_o·ρ̄^(k−1) (k ≥ 2),
-// with E the scene's light spectrum (lights weighted by radiance × area), R_o the object's reflectance and ρ̄
-// the area-weighted mean albedo of the scene's surfaces. A band plan renders instead, as the tracer's bands
-// mode and Cycles do, the product of band averages ⟨E⟩·⟨R_o⟩·⟨ρ̄⟩^(k−1) in each band; a bounce limit K drops
-// k > K. Both spectra go through the observer (the CIE 1931 curves or a shipped camera's) to tristimulus
-// values, to CIELAB under the light's white (scaled to the 99th percentile of the non-emitter pixels'
-// luminance, as `compare` scales its white), and the predicted error is the mean over pixels of their
-// ΔE00. measure_delta_e() computes the same statistic between two renders.
+// split into its diffuse and glossy parts). Each object's spectrum after k events comes from radiosity with one
+// patch per object, at 1 nm: transfer factors F_oj (cosine-weighted rays from the object's surface) give the
+// irradiance I_1,o = Σ_l F_ol·E_l from the lights and I_k,o = Σ_j F_oj·ρ_j·I_k−1,j after more events, and the
+// camera sees R_o·I_k,o (a dichromatic lobe: flat; a mirror: its reflectance); k = 0 is an emitter's own
+// spectrum. A pixel's spectrum is Σ_k Y_p,k · (that spectrum scaled to unit luminance). A band plan computes the
+// same recursion on band averages, as the tracer's bands mode and Cycles do, and drops k > K for a bounce limit
+// K. Both go through the observer (the CIE 1931 curves or a shipped camera's) to tristimulus values, to CIELAB
+// under the light's white (scaled to the 99th percentile of the luminance of pixels not on or next to a light),
+// and the predicted error is the mean over pixels of their ΔE00. measure_delta_e() computes the same statistic
+// between two renders. docs/plan.md has the details and the measured accuracy.
 //
 // Band edges for a band count are fitted to that prediction by coordinate descent over a grid of edge
 // positions (whole nm by default), coarse to fine, from the uniform plan and from the previous count's plan with
@@ -94,7 +93,8 @@ struct Measurement {
 };
 // ΔE00 between the totals of two spectral EXR renders of `scene` (same size; any band plans), each turned into
 // tristimulus values through `camera`'s curves over its own bands, in CIELAB under the white of
-// scene_light_spectrum() scaled to the 99th percentile of `reference`'s luminance over pixels not on a light.
+// scene_light_spectrum() scaled to the 99th percentile of `reference`'s luminance over pixels not on or next to a
+// light.
 Measurement measure_delta_e(const std::filesystem::path& test, const std::filesystem::path& reference,
                             const Scene& scene, const std::string& camera = "cie1931");
 
