@@ -7,6 +7,7 @@
 
 #include "cli/command.h"
 #include "cli/options.h"
+#include "core/band_plan.h"
 #include "core/error.h"
 #include "core/parallel.h"
 #include "core/scene.h"
@@ -18,7 +19,7 @@ namespace ct::cli {
 Action add_render(CLI::App& app) {
   auto* cmd = app.add_subcommand("render", "Render a scene with the reference spectral path tracer");
   struct Options {
-    std::string scene, output, bands, mode, resolution, components = "paths,lights";
+    std::string scene, output, bands, plan, mode, resolution, components = "paths,lights";
     std::optional<int> spp, max_bounces;
     std::optional<std::uint64_t> seed;
     int threads = 0;
@@ -32,6 +33,7 @@ Action add_render(CLI::App& app) {
   cmd->add_option("--max-bounces", o->max_bounces, "Scattering events per path: 0 emitters, 1 direct, >= 2 global");
   cmd->add_option("--resolution", o->resolution, "Image size WxH, overriding the scene's camera (e.g. 64x64)");
   cmd->add_option("--bands", o->bands, "Band plan lo:hi:width in nm, e.g. 380:780:10");
+  cmd->add_option("--plan", o->plan, "Band plan file (chromatrace-bands/1), e.g. from chromatrace plan");
   cmd->add_option("--spectral-mode", o->mode, "bands (band averages, as Cycles) or continuous (hero wavelengths)");
   cmd->add_option("--components", o->components,
                   "Component families: paths, lights, bounces, all, none (comma-separated)")
@@ -48,7 +50,9 @@ Action add_render(CLI::App& app) {
     rt::RenderOptions options;
     options.samples = o->spp;
     options.max_bounces = o->max_bounces;
+    if (!o->bands.empty() && !o->plan.empty()) throw InputError("--plan: give either --bands or --plan, not both");
     if (!o->bands.empty()) options.bands = Bands::parse(o->bands, "--bands");
+    if (!o->plan.empty()) options.bands = read_band_plan(o->plan);
     if (!o->mode.empty()) {
       if (o->mode == "bands") options.mode = SpectralMode::Bands;
       else if (o->mode == "continuous") options.mode = SpectralMode::Continuous;

@@ -15,6 +15,7 @@
 
 #include "cli/command.h"
 #include "cli/options.h"
+#include "core/band_plan.h"
 #include "core/error.h"
 #include "core/scene.h"
 #include "series/figure.h"
@@ -25,7 +26,8 @@ namespace {
 namespace fs = std::filesystem;
 
 struct Options {
-  std::string series, output, renderer = "tracer", resolution, components = "paths,lights";
+  std::string series, output, renderer = "tracer", resolution, components = "paths,lights", plan;
+  std::optional<int> max_bounces;
   std::vector<std::string> variants;
   std::optional<int> spp;
   std::optional<std::uint64_t> seed;
@@ -56,6 +58,8 @@ void add_common(CLI::App* cmd, Options& o) {
   cmd->add_option("--resolution", o.resolution, "Image size WxH for every variant (default: the scenes')");
   cmd->add_option("--spp", o.spp, "Paths per pixel (default: the scenes' render.samples)");
   cmd->add_option("--seed", o.seed, "Random seed of the renders (default: the scenes' render.seed)");
+  cmd->add_option("--plan", o.plan, "Band plan file (chromatrace-bands/1, e.g. from chromatrace plan) for every variant");
+  cmd->add_option("--max-bounces", o.max_bounces, "Scattering events per path for every variant (default: the scenes')");
   cmd->add_option("--components", o.components, "Component families rendered: paths, lights, bounces, all")
       ->capture_default_str();
   cmd->add_option("--threads", o.threads, "Worker threads (0: all cores)")->check(CLI::NonNegativeNumber);
@@ -71,6 +75,13 @@ series::RunOptions run_options(const Options& o) {
   if (o.spp && *o.spp < 1) throw InputError(fmt::format("--spp: must be >= 1, got {}", *o.spp));
   r.spp = o.spp;
   r.seed = o.seed;
+  if (o.max_bounces && *o.max_bounces < 0)
+    throw InputError(fmt::format("--max-bounces: must be >= 0, got {}", *o.max_bounces));
+  r.max_bounces = o.max_bounces;
+  if (!o.plan.empty()) {
+    r.bands = read_band_plan(o.plan);
+    r.bands_file = fs::absolute(o.plan);
+  }
   r.components = o.components;
   r.variants = o.variants;
   r.threads = o.threads;

@@ -66,6 +66,8 @@ Json render_inputs(const Scene& scene, const RunOptions& options) {
           {"height", options.height.value_or(scene.camera.height)},
           {"samples", options.spp.value_or(scene.render.samples)},
           {"seed", options.seed.value_or(scene.render.seed)},
+          {"max_bounces", options.max_bounces.value_or(scene.render.max_bounces)},
+          {"bands", options.bands ? options.bands->edges() : scene.render.bands.edges()},
           {"components", options.components}};
 }
 
@@ -79,6 +81,8 @@ void render_with_tracer(Scene scene, const fs::path& out, const RunOptions& opti
   rt::RenderOptions render;
   render.samples = options.spp;
   render.seed = options.seed;
+  render.max_bounces = options.max_bounces;
+  render.bands = options.bands;
   render.components = rt::ComponentSelection::parse(options.components);
   render.threads = options.threads;
   render.progress = options.progress;
@@ -129,6 +133,14 @@ void render_with_cycles(const Scene& scene, const fs::path& scene_file, const fs
   if (options.width || options.height) {
     argv.push_back("--resolution");
     argv.push_back(fmt::format("{}x{}", options.width.value_or(scene.camera.width), options.height.value_or(scene.camera.height)));
+  }
+  if (options.max_bounces) {
+    argv.push_back("--max-bounces");
+    argv.push_back(std::to_string(*options.max_bounces));
+  }
+  if (options.bands) {
+    argv.push_back("--bands-file");
+    argv.push_back(options.bands_file.string());
   }
   if (!options.progress) argv.push_back("--quiet");
   const fs::path log = dir / "renders" / "blender.log";

@@ -37,6 +37,9 @@ struct RunOptions {
   std::optional<int> width, height;   // override the scenes' camera resolution
   std::optional<int> spp;
   std::optional<std::uint64_t> seed;
+  std::optional<int> max_bounces;      // override the scenes' render.max_bounces
+  std::optional<Bands> bands;          // override the scenes' band plan: a chromatrace-bands/1 file's bands
+  std::filesystem::path bands_file;    // that file (handed to the Blender batch as --bands-file), absolute
   std::string components = "paths,lights";
   int threads = 0;
   bool progress = true;

@@ -1,0 +1,66 @@
+// chromatrace plan SCENE.json -o PLAN.json: the fewest bands and bounces for a colour-error target (docs/plan.md).
+#include <filesystem>
+#include <string>
+
+#include <fmt/core.h>
+
+#include "cli/command.h"
+#include "core/error.h"
+#include "core/file_io.h"
+#include "core/scene.h"
+#include "plan/plan.h"
+
+namespace ct::cli {
+
+Action add_plan(CLI::App& app) {
+  auto* cmd = app.add_subcommand("plan", "Choose the fewest bands and bounces that keep a scene within a ΔE00 target");
+  struct Options {
+    std::string scene, output, report, renderer = "cycles";
+    plan::PlanOptions plan;
+    bool quiet = false;
+  };
+  auto o = std::make_shared<Options>();
+  cmd->add_option("scene", o->scene, "Scene file (chromatrace-scene/1)")->required();
+  cmd->add_option("-o,--output", o->output, "Band plan to write (chromatrace-bands/1)");
+  cmd->add_option("--report", o->report, "Settings, predictions and cost as JSON (also printed on stdout)");
+  cmd->add_option("--target-de00", o->plan.target_de00, "Mean ΔE00 to reach")->capture_default_str();
+  cmd->add_option("--camera", o->plan.camera, "Observer: cie1931 or a shipped camera")->capture_default_str();
+  cmd->add_option("--renderer", o->renderer, "cycles (bands in groups of 3) or tracer")->capture_default_str();
+  cmd->add_option("--edge-step", o->plan.edge_step_nm, "Band edges on multiples of this many nm")->capture_default_str();
+  cmd->add_option("--preview-size", o->plan.preview_size, "Longer side of the preview render, pixels")->capture_default_str();
+  cmd->add_option("--preview-spp", o->plan.preview_samples, "Paths per pixel of the preview render")->capture_default_str();
+  cmd->add_flag("--bounce-components", o->plan.bounce_components,
+                "Cost Cycles renders for separate bounce components (one render per bounce order)");
+  cmd->add_option("--threads", o->plan.threads, "Worker threads (0: all cores)")->capture_default_str();
+  cmd->add_flag("-q,--quiet", o->quiet, "No summary on stderr");
+
+  return [o] {
+    if (o->renderer == "cycles") o->plan.renderer = plan::Renderer::Cycles;
+    else if (o->renderer == "tracer") o->plan.renderer = plan::Renderer::Tracer;
+    else throw InputError(fmt::format("--renderer: must be cycles or tracer, got \"{}\"", o->renderer));
+    if (o->plan.preview_size < 1)
+      throw InputError(fmt::format("--preview-size: must be >= 1, got {}", o->plan.preview_size));
+    if (o->plan.preview_samples < 1)
+      throw InputError(fmt::format("--preview-spp: must be >= 1, got {}", o->plan.preview_samples));
+    for (const std::string* out : {&o->output, &o->report}) {
+      if (out->empty()) continue;
+      const std::filesystem::path parent = std::filesystem::absolute(*out).parent_path();
+      if (!std::filesystem::is_directory(parent))
+        throw InputError(fmt::format("{}: directory {} does not exist", *out, parent.string()));
+    }
+    const Scene scene = load_scene(o->scene);
+    const plan::Plan p = plan::make_plan(scene, o->plan);
+    const Json report = plan::report_document(p, scene, o->plan);
+    if (!o->output.empty()) write_file_atomically(o->output, plan::bands_document(p).dump(2) + "\n");
+    if (!o->report.empty()) write_file_atomically(o->report, report.dump(2) + "\n");
+    fmt::print("{}\n", report.dump(2));
+    if (!o->quiet)
+      fmt::print(stderr, "{}: {} bands, max bounces {}, predicted mean ΔE00 {:.2f} (target {:g}{}); Cycles renders {} "
+                         "(scene's settings: {})\n",
+                 o->scene, p.bands.size(), p.max_bounces, p.predicted_mean, o->plan.target_de00,
+                 p.target_met ? "" : ", NOT met", p.cycles_renders, p.scene_cycles_renders);
+    return 0;
+  };
+}
+
+}  // namespace ct::cli

@@ -1,0 +1,101 @@
+#pragma once
+// `chromatrace plan`: the fewest bands and bounces that keep a scene's image within a colour-error target,
+// with the error they are predicted to cause (docs/plan.md).
+//
+// The prediction. A low-resolution preview render (bands mode, every component) says, for each pixel, which
+// object it shows and how much luminance arrives after each number k of scattering events (bounce.k; k = 1
+// split into its diffuse and glossy parts). Each object's spectrum after k events comes from radiosity with one
+// patch per object, at 1 nm: transfer factors F_oj (cosine-weighted rays from the object's surface) give the
+// irradiance I_1,o = Σ_l F_ol·E_l from the lights and I_k,o = Σ_j F_oj·ρ_j·I_k−1,j after more events, and the
+// camera sees R_o·I_k,o (a dichromatic lobe: flat; a mirror: its reflectance); k = 0 is an emitter's own
+// spectrum. A pixel's spectrum is Σ_k Y_p,k · (that spectrum scaled to unit luminance). A band plan computes the
+// same recursion on band averages, as the tracer's bands mode and Cycles do, and drops k > K for a bounce limit
+// K. Both go through the observer (the CIE 1931 curves or a shipped camera's) to tristimulus values, to CIELAB
+// under the light's white (scaled to the 99th percentile of the luminance of pixels not on or next to a light),
+// and the predicted error is the mean over pixels of their ΔE00. measure_delta_e() computes the same statistic
+// between two renders. docs/plan.md has the details and the measured accuracy.
+//
+// Band edges for a band count are fitted to that prediction by coordinate descent over a grid of edge
+// positions (whole nm by default), coarse to fine, from the uniform plan and from the previous count's plan with
+// its widest bands split.
+
+#include <array>
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/json_input.h"
+#include "core/scene.h"
+#include "core/spectrum.h"
+
+namespace ct::plan {
+
+enum class Renderer { Cycles, Tracer };
+
+struct PlanOptions {
+  double target_de00 = 1.0;
+  std::string camera = "cie1931";  // the observer: cie1931 or a shipped camera
+  Renderer renderer = Renderer::Cycles;
+  double edge_step_nm = 1.0;  // band edges lie on multiples of this (and on the range's ends)
+  int preview_size = 32;      // longer side of the preview render, pixels
+  int preview_samples = 16;   // paths per pixel of the preview renders (two, for the noise)
+  int threads = 0;            // 0: all cores
+  // Cycles: also render the bounce components separately (each bounce order is a Cycles render of its own).
+  bool bounce_components = false;
+};
+
+struct BandTrial {
+  int bands = 0;
+  double predicted_mean = 0;
+  std::vector<double> edges_nm;
+};
+
+struct Plan {
+  // Settings.
+  Bands bands;
+  int max_bounces = 0;
+  // Tracer paths per pixel at which Monte Carlo noise alone gives a mean ΔE00 at the target: from two preview
+  // renders with different seeds (the noise of one is their ΔE00 / √2, falling as 1/√samples).
+  int samples = 0;
+  double noise_at_samples = 0, noise_at_scene_samples = 0;  // predicted mean ΔE00 of the noise
+  bool target_met = false;
+  // Predictions (ΔE00 against the scene's own bounce limit with exact spectra).
+  double predicted_mean = 0, predicted_p95 = 0;
+  double predicted_band_only = 0;    // the plan's bands at the scene's bounce limit
+  double predicted_bounce_only = 0;  // exact spectra, the plan's bounce limit
+  double scene_bands_predicted_mean = 0;  // the scene's own band plan, for comparison
+  std::vector<BandTrial> trials;          // every band count tried, fewest first
+  std::vector<double> energy_after;       // luminance fraction beyond k bounces, k = 0 .. scene max - 1
+  // Cost.
+  int cycles_band_groups = 0;    // ceil(bands / 3)
+  int cycles_bounce_variants = 1;
+  int cycles_renders = 0;        // groups × variants + 1 (the object-id render)
+  int scene_cycles_renders = 0;  // the same for the scene's own settings
+  double tracer_relative_time = 0;  // the plan's tracer time / the scene's settings' (model, see docs/plan.md)
+  std::vector<std::string> notes;
+};
+
+Plan make_plan(const Scene& scene, const PlanOptions& options);
+
+// The chromatrace-bands/1 document of the plan's bands, and the full report (settings, predictions, cost).
+Json bands_document(const Plan& plan);
+Json report_document(const Plan& plan, const Scene& scene, const PlanOptions& options);
+
+// The light spectrum the plan adapts to: the scene's lights weighted by mean radiance × area (and a
+// uniform environment by 4π·R², R the scene's bounding radius), as a 1 nm table.
+PiecewiseLinearSpectrum scene_light_spectrum(const Scene& scene);
+
+struct Measurement {
+  double mean = 0, p95 = 0, max = 0;
+  std::size_t pixels = 0;
+};
+// ΔE00 between the totals of two spectral EXR renders of `scene` (same size; any band plans), each turned into
+// tristimulus values through `camera`'s curves over its own bands, in CIELAB under the white of
+// scene_light_spectrum() scaled to the 99th percentile of `reference`'s luminance over pixels not on or next to a
+// light.
+Measurement measure_delta_e(const std::filesystem::path& test, const std::filesystem::path& reference,
+                            const Scene& scene, const std::string& camera = "cie1931");
+
+}  // namespace ct::plan

@@ -1,0 +1,233 @@
+// `chromatrace plan`: its predicted ΔE00 against the ΔE00 measured between a render with the planned bands and
+// bounce limit and a 5 nm reference at the scene's own bounce limit (same seed, so most of the Monte Carlo
+// noise is common to both); the band counts; bad input.
+#include <gtest/gtest.h>
+
+#include <unistd.h>
+
+#include <cmath>
+#include <filesystem>
+
+#include <fmt/core.h>
+
+#include "core/band_plan.h"
+#include "core/error.h"
+#include "core/file_io.h"
+#include "core/json_input.h"
+#include "core/scene.h"
+#include "core/spectral_exr.h"
+#include "plan/plan.h"
+#include "reference_tracer/render.h"
+#include "tests/cli/run_command.h"
+
+namespace ct {
+namespace {
+
+namespace fs = std::filesystem;
+using test::run_chromatrace;
+
+const fs::path kSource = CHROMATRACE_SOURCE_DIR;
+const fs::path kBox = kSource / "scenes/paper/box.json";
+const fs::path kCornell = kSource / "scenes/cornell_box/cornell_box.json";
+
+class Plan : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / fmt::format("ct-plan-{}-{}", ::getpid(), counter_++);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  // Renders `scene` at 24×24 into `name` with the given bands and bounce limit.
+  fs::path render(const Scene& scene, const Bands& bands, int max_bounces, std::uint64_t seed, int spp,
+                  const std::string& name) {
+    Scene s = scene;
+    s.camera.width = s.camera.height = 24;
+    rt::RenderOptions o;
+    o.samples = spp;
+    o.max_bounces = max_bounces;
+    o.bands = bands;
+    o.mode = SpectralMode::Bands;
+    o.seed = seed;
+    o.components = rt::ComponentSelection::parse("none");
+    o.threads = 2;
+    o.progress = false;
+    const fs::path out = dir_ / name;
+    rt::write_render(out, s, rt::render(s, o));
+    return out;
+  }
+
+  struct Outcome {
+    plan::Plan plan;
+    double measured = 0;  // the plan against the 5 nm reference
+    double floor = 0;     // a 4 nm render against the 5 nm reference: Monte Carlo noise, little else
+  };
+
+  // Plans `scene` for a mean ΔE00 of 1 and measures the plan against a 5 nm reference at the scene's bounce
+  // limit. The same seed makes most of the noise common to both; what is not (paths diverge after Russian roulette,
+  // whose survival follows the band values) is bounded by rendering 4 nm bands against the same reference,
+  // whose own band error is negligible: the "floor".
+  Outcome plan_and_measure(const Scene& scene) {
+    plan::PlanOptions options;
+    options.threads = 2;
+    Outcome out;
+    out.plan = plan::make_plan(scene, options);
+    const double lo = scene.render.bands.min_wavelength(), hi = scene.render.bands.max_wavelength();
+    const int kmax = scene.render.max_bounces;
+    const fs::path a = render(scene, out.plan.bands, out.plan.max_bounces, 1, kSpp, "plan.exr");
+    const fs::path b = render(scene, Bands::uniform(lo, hi, 5.0), kmax, 1, kSpp, "ref.exr");
+    const fs::path c = render(scene, Bands::uniform(lo, hi, 4.0), kmax, 1, kSpp, "floor.exr");
+    out.measured = plan::measure_delta_e(a, b, scene).mean;
+    out.floor = plan::measure_delta_e(c, b, scene).mean;
+    return out;
+  }
+
+  // Known answers: the prediction within a factor 1.5 of the measurement, whose Monte Carlo part is small (the
+  // floor at most a third of it); the target reached with at most half the scenes' own bands.
+  void check(const Outcome& o, const Scene& scene, const std::string& what) {
+    SCOPED_TRACE(what);
+    std::fprintf(stderr, "%s: %zu bands (scene: %zu), max bounces %d (scene: %d), predicted %.3f, measured %.3f, "
+                 "noise floor %.3f\n",
+                 what.c_str(), o.plan.bands.size(), scene.render.bands.size(), o.plan.max_bounces,
+                 scene.render.max_bounces, o.plan.predicted_mean, o.measured, o.floor);
+    EXPECT_TRUE(o.plan.target_met);
+    EXPECT_LE(o.plan.predicted_mean, 1.0);
+    EXPECT_LE(o.plan.bands.size(), scene.render.bands.size() / 2);
+    EXPECT_LE(o.floor, o.measured / 3);
+    EXPECT_LE(o.plan.predicted_mean, 1.5 * o.measured);
+    EXPECT_GE(o.plan.predicted_mean, o.measured / 1.5);
+  }
+
+  fs::path dir_;
+  static inline int counter_ = 0;
+  static constexpr int kSpp = 512;
+};
+
+TEST_F(Plan, PredictsTheMeasuredErrorOnThePaperBox) {
+  const Scene scene = load_scene(kBox);
+  check(plan_and_measure(scene), scene, "paper_box");
+}
+
+TEST_F(Plan, PredictsTheMeasuredErrorOnTheCornellBox) {
+  const Scene scene = load_scene(kCornell);
+  check(plan_and_measure(scene), scene, "cornell_box");
+}
+
+TEST_F(Plan, PredictsTheMeasuredErrorUnderF11) {
+  Json doc = read_json(kBox);
+  doc["spectra"]["lamp"] = Json{{"illuminant", "F11"}};
+  const Scene scene = parse_scene(doc, "box-f11", kBox.parent_path());
+  check(plan_and_measure(scene), scene, "paper_box_f11");
+}
+
+// The planned samples: two renders at that many paths per pixel and independent seeds differ by a mean ΔE00 of
+// √2 × the noise of one; the noise of one must be the target within a factor 1.5 (the preview at the
+// measurement's pixel size, as the prediction assumes).
+TEST_F(Plan, PlannedSamplesGiveTheTargetNoise) {
+  for (const fs::path& file : {kBox, kCornell}) {
+    SCOPED_TRACE(file.string());
+    const Scene scene = load_scene(file);
+    plan::PlanOptions options;
+    options.threads = 2;
+    options.preview_size = 24;
+    options.target_de00 = 2.0;
+    const plan::Plan p = plan::make_plan(scene, options);
+    const fs::path a = render(scene, p.bands, p.max_bounces, 11, p.samples, "a.exr");
+    const fs::path b = render(scene, p.bands, p.max_bounces, 12, p.samples, "b.exr");
+    const double noise = plan::measure_delta_e(a, b, scene).mean / std::sqrt(2.0);
+    std::fprintf(stderr, "%s: %d paths per pixel, predicted noise %.3f, measured %.3f\n", file.filename().c_str(),
+                 p.samples, p.noise_at_samples, noise);
+    EXPECT_LE(p.noise_at_samples, 2.0);
+    EXPECT_LE(p.noise_at_samples, 1.5 * noise);
+    EXPECT_GE(p.noise_at_samples, noise / 1.5);
+  }
+}
+
+TEST_F(Plan, CommandWritesABandFileThatRenderTakes) {
+  const fs::path bands = dir_ / "plan.json", report = dir_ / "report.json", exr = dir_ / "out.exr";
+  const auto r = run_chromatrace({"plan", kCornell.string(), "-o", bands.string(), "--report", report.string(),
+                                  "--threads", "2", "--quiet"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const Bands b = read_band_plan(bands);
+  const Json j = read_json(report);
+  EXPECT_EQ(j["settings"]["band_count"].get<std::size_t>(), b.size());
+  EXPECT_EQ(j["cost"]["cycles_band_groups"].get<int>(), static_cast<int>((b.size() + 2) / 3));
+  EXPECT_EQ(j["cost"]["cycles_renders"].get<int>(), static_cast<int>((b.size() + 2) / 3) + 1);
+  EXPECT_EQ(b.size() % 3, 0u);  // Cycles: whole groups of three bands
+  EXPECT_EQ(parse_json(r.out, "stdout"), j);
+  const auto rr = run_chromatrace({"render", kCornell.string(), "-o", exr.string(), "--plan", bands.string(),
+                                   "--spp", "1", "--resolution", "8x8", "--quiet"});
+  ASSERT_EQ(rr.exit_code, 0) << rr.err;
+  // Same inputs, same bytes.
+  const fs::path bands2 = dir_ / "plan2.json";
+  ASSERT_EQ(run_chromatrace({"plan", kCornell.string(), "-o", bands2.string(), "--threads", "1", "--quiet"}).exit_code, 0);
+  EXPECT_EQ(read_file(bands), read_file(bands2));
+  // A shipped camera as the observer; its curves end at 720 nm, short of the paper box's bands: a note says so.
+  const auto cam = run_chromatrace({"plan", kBox.string(), "--camera", "nikon_d850", "--threads", "2", "--quiet"});
+  ASSERT_EQ(cam.exit_code, 0) << cam.err;
+  const Json cj = parse_json(cam.out, "stdout");
+  EXPECT_EQ(cj["camera"], "nikon_d850");
+  ASSERT_EQ(cj["notes"].size(), 1u);
+  EXPECT_NE(cj["notes"][0].get<std::string>().find("380-720 nm"), std::string::npos) << cj["notes"][0];
+}
+
+// `series --plan FILE --max-bounces K` renders every variant with the plan's bands and that bounce limit, and
+// the cache key follows them.
+TEST_F(Plan, SeriesTakesThePlan) {
+  const fs::path bands = dir_ / "plan.json", out = dir_ / "out";
+  write_file_atomically(bands, R"({"format": "chromatrace-bands/1", "edges_nm": [380, 430, 480, 530, 580, 630, 780]})");
+  const std::string series = (kSource / "scenes/paper/series.json").string();
+  auto run = [&](std::vector<std::string> extra) {
+    std::vector<std::string> args = {"series", series, "-o", out.string(), "--variant", "2-object-spectra",
+                                     "--resolution", "16x16", "--spp", "2", "--threads", "2", "--quiet"};
+    args.insert(args.end(), extra.begin(), extra.end());
+    const auto r = run_chromatrace(args);
+    EXPECT_EQ(r.exit_code, 0) << r.err;
+    return read_json(out / "series.json")["variants"][0]["render"];
+  };
+  const Json planned = run({"--plan", bands.string(), "--max-bounces", "2"});
+  SpectralExrReader reader(out / planned["file"].get<std::string>());
+  EXPECT_EQ(reader.info().bands.edges(), (std::vector<double>{380, 430, 480, 530, 580, 630, 780}));
+  const Json inputs = read_json(out / "renders" / (planned["key"].get<std::string>() + ".json"));
+  EXPECT_EQ(inputs["max_bounces"].get<int>(), 2);
+  const Json plain = run({});
+  EXPECT_NE(plain["key"], planned["key"]);
+  EXPECT_EQ(SpectralExrReader(out / plain["file"].get<std::string>()).info().bands.size(), 40u);
+}
+
+TEST_F(Plan, BadInputGetsExitTwoAndOneLineNamingTheField) {
+  const fs::path bad_scene = dir_ / "bad.json";
+  Json doc = read_json(kBox);
+  doc["render"]["max_bounces"] = "eight";
+  write_file_atomically(bad_scene, rebase_scene_paths(doc, kBox.parent_path(), dir_).dump());
+  const fs::path bad_plan = dir_ / "bad_plan.json";
+  write_file_atomically(bad_plan, R"({"format": "chromatrace-bands/1", "edges_nm": [400, 500, 450]})");
+  struct Case {
+    std::vector<std::string> args;
+    std::string must_mention;
+  };
+  const std::vector<Case> cases = {
+      {{"plan", bad_scene.string()}, "bad.json: render.max_bounces"},
+      {{"plan", (dir_ / "missing.json").string()}, "missing.json"},
+      {{"plan", kBox.string(), "--target-de00", "0"}, "--target-de00"},
+      {{"plan", kBox.string(), "--renderer", "eevee"}, "--renderer"},
+      {{"plan", kBox.string(), "--camera", "nokia_3310"}, "--camera"},
+      {{"plan", kBox.string(), "-o", (dir_ / "no/such/dir/plan.json").string()}, "does not exist"},
+      {{"render", kBox.string(), "-o", (dir_ / "x.exr").string(), "--plan", bad_plan.string()},
+       "bad_plan.json: edges_nm[2]"},
+      {{"series", (kSource / "scenes/paper/series.json").string(), "-o", (dir_ / "s").string(), "--plan",
+        bad_plan.string()},
+       "bad_plan.json: edges_nm[2]"},
+      {{"render", kBox.string(), "-o", (dir_ / "x.exr").string(), "--plan", bad_plan.string(), "--bands", "400:700:10"},
+       "--plan: give either --bands or --plan"},
+  };
+  for (const Case& c : cases) {
+    const auto r = run_chromatrace(c.args);
+    EXPECT_EQ(r.exit_code, 2) << c.args[1] << ": " << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    EXPECT_NE(r.err.find(c.must_mention), std::string::npos) << r.err;
+  }
+}
+
+}  // namespace
+}  // namespace ct
