@@ -208,6 +208,37 @@ TEST_F(Outputs, ExportMeshesAndPrepareTextureKeepTheirInputs) {
                     png, png.string());
 }
 
+TEST_F(Outputs, SeriesKeepsItsFileAndScenes) {
+  const fs::path data = fs::path(CHROMATRACE_TEST_DATA) / "scenes";
+  const fs::path run = dir_.file("run");
+  fs::create_directories(run / "a");
+  fs::copy_file(data / "series_merge.json", run / "series.json");
+  fs::copy_file(data / "minimal.json", run / "minimal.json");
+  fs::copy_file(data / "series_merge.json", run / "a" / "s.json");
+  fs::copy_file(data / "minimal.json", run / "a" / "minimal.json");
+  const std::string series = bytes_of(run / "series.json"), scene = bytes_of(run / "minimal.json");
+  const struct {
+    fs::path file;
+    std::string says;
+  } cases[] = {
+      // The run writes series.json at the top of its directory, and everything of variant "a" under a/.
+      {run / "series.json",
+       (run / "series.json").string() + ": is the same file as the input " + (run / "series.json").string()},
+      {run / "a" / "s.json", run.string() + ": the input " + (run / "a" / "minimal.json").string() + " is in " +
+                                 (run / "a").string() + ", which the series writes"},
+  };
+  for (const auto& c : cases) {
+    const auto r = run_chromatrace({"series", c.file.string(), "-o", run.string(), "--quiet"});
+    EXPECT_EQ(r.exit_code, 2) << r.err;
+    EXPECT_EQ(line_count(r.err), 1) << r.err;
+    EXPECT_NE(r.err.find(c.says), std::string::npos) << "expected \"" << c.says << "\" in " << r.err;
+  }
+  EXPECT_EQ(bytes_of(run / "series.json"), series);
+  EXPECT_EQ(bytes_of(run / "a" / "s.json"), series);
+  EXPECT_EQ(bytes_of(run / "minimal.json"), scene);
+  EXPECT_EQ(bytes_of(run / "a" / "minimal.json"), scene);
+}
+
 // ---- special files -------------------------------------------------------------------------------
 
 TEST_F(Outputs, FifosLinksToThemAndDirectoriesAreRefusedBeforeAnyWork) {
