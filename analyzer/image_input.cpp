@@ -13,6 +13,7 @@
 #include "core/colour.h"
 #include "core/error.h"
 #include "core/exr_vocabulary.h"
+#include "core/limits.h"
 
 namespace ct::analyzer {
 namespace {
@@ -94,6 +95,7 @@ RawImage read_raw(const std::filesystem::path& file) {
   raw.colour_space = spec.get_string_attribute("oiio:ColorSpace");
   raw.display_gamma = spec.get_float_attribute("oiio:Gamma", 0.0f);
   if (raw.width < 1 || raw.height < 1) throw InputError(fmt::format("{}: image has no pixels", name));
+  check_image_size(name, raw.width, raw.height, raw.channels);
   raw.values.resize(static_cast<std::size_t>(raw.width) * static_cast<std::size_t>(raw.height) *
                     static_cast<std::size_t>(raw.channels));
   // OpenImageIO hands integer samples over as fractions of full scale; scaling back keeps digital numbers.

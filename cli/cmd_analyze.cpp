@@ -11,6 +11,7 @@
 #include "analyzer/output.h"
 #include "cli/command.h"
 #include "core/error.h"
+#include "core/file_io.h"
 
 namespace ct::cli {
 namespace {
@@ -21,6 +22,20 @@ analyzer::Vec3 parse_colour(const std::string& text) {
   if (std::sscanf(text.c_str(), "%lf,%lf,%lf%c", &v[0], &v[1], &v[2], &extra) != 3 || !v.allFinite() || v.minCoeff() < 0 || v.sum() <= 0)
     throw InputError(fmt::format("--illuminant: expected R,G,B with non-negative numbers, not all 0, got \"{}\"", text));
   return v;
+}
+
+// Before any work: the output directory is no input, and no input is among the files written into it.
+void check_output(const std::filesystem::path& dir, const std::string& image, const analyzer::RegionOptions& regions) {
+  std::vector<std::filesystem::path> inputs = {image};
+  if (std::filesystem::is_regular_file(regions.labels)) inputs.push_back(regions.labels);
+  for (const std::string& mask : regions.masks) inputs.push_back(mask);
+  check_output_directory(dir, inputs);
+  for (const char* written : {"analysis.json", "report.html"}) check_not_an_input(dir / written, inputs);
+  for (const std::filesystem::path& input : inputs)
+    for (const char* sub : {"histograms", "plots"})
+      if (same_file(input.parent_path().empty() ? std::filesystem::path(".") : input.parent_path(), dir / sub))
+        throw InputError(fmt::format("{}: the input {} is in the directory {} that analyze writes", dir.string(),
+                                     input.string(), (dir / sub).string()));
 }
 
 }  // namespace
@@ -90,9 +105,7 @@ Action add_analyze(CLI::App& app) {
     if (o->regions.segment) analyzer::check_segmentation_options(o->regions.segmentation);
     const std::optional<analyzer::Vec3> known = o->illuminant.empty() ? std::nullopt : std::optional(parse_colour(o->illuminant));
     for (const std::string& r : o->rects) o->regions.rects.push_back(analyzer::parse_rect(r, "--rect"));
-    const std::filesystem::path parent = std::filesystem::absolute(o->output).parent_path();
-    if (!std::filesystem::is_directory(parent))
-      throw InputError(fmt::format("{}: directory {} does not exist", o->output, parent.string()));
+    check_output(o->output, o->image, o->regions);
 
     const analyzer::AnalysisImage input = analyzer::read_analysis_image(o->image, o->input_transfer);
     const analyzer::RgbImage& layer = analyzer::select_layer(input, o->layer);

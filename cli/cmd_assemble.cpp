@@ -1,12 +1,14 @@
 // chromatrace assemble MANIFEST.json -o OUT.exr: builds a spectral EXR from band-multiplexed RGB renders (the
 // Blender add-on's Cycles renders). The manifest format and the assembly are in core/assembly.h.
 #include <filesystem>
+#include <vector>
 
 #include <fmt/core.h>
 
 #include "cli/command.h"
 #include "core/assembly.h"
 #include "core/error.h"
+#include "core/file_io.h"
 #include "core/parallel.h"
 #include "core/spectral_exr.h"
 
@@ -29,9 +31,9 @@ Action add_assemble(CLI::App& app) {
   return [o] {
     const AssemblyManifest manifest = read_assembly_manifest(o->manifest);
     if (o->output.empty()) throw InputError("--output: no file name");
-    const std::filesystem::path parent = std::filesystem::absolute(o->output).parent_path();
-    if (!std::filesystem::is_directory(parent))
-      throw InputError(fmt::format("{}: directory {} does not exist", o->output, parent.string()));
+    std::vector<std::filesystem::path> inputs = {o->manifest};
+    for (const AssemblyInput& input : manifest.inputs) inputs.push_back(input.path);
+    check_output_file(o->output, inputs);
     set_exr_threads(thread_count(o->threads));
     assemble(manifest, o->output, !o->quiet);
     return 0;

@@ -159,6 +159,10 @@ void print_variant(const Json& v) {
 // settings as a chromatrace-sensor/1 file, so it can be rendered with `render` or the Blender batch by hand.
 void emit_variant(const Options& options, const Series& series) {
   const SeriesVariant* variant = &series.variant(options.variant, "--variant");
+  std::vector<std::filesystem::path> inputs = series.base_scene.files;
+  inputs.push_back(options.file);
+  for (const std::string& output : {options.emit, options.emit_sensor})
+    if (!output.empty()) check_output_file(output, inputs);
   if (!options.emit.empty()) {
     const std::filesystem::path out = std::filesystem::absolute(options.emit);
     const Json scene = rebase_scene_paths(variant->scene.json, {}, out.parent_path());

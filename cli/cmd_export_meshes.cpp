@@ -11,6 +11,7 @@
 
 #include "cli/command.h"
 #include "core/error.h"
+#include "core/file_io.h"
 #include "core/geometry.h"
 #include "core/json_input.h"
 #include "core/ply.h"
@@ -37,24 +38,26 @@ std::string mesh_file_name(int id, const std::string& name) {
 int run(const Options& o) {
   const Scene scene = load_scene(o.scene);
   const fs::path dir(o.directory);
-  std::error_code error;
-  if (fs::exists(dir, error) && !fs::is_directory(dir, error))
-    throw InputError(fmt::format("{}: exists and is not a directory", o.directory));
-  fs::path absolute = fs::absolute(dir);
-  if (!absolute.has_filename()) absolute = absolute.parent_path();  // "meshes/"
-  if (!fs::is_directory(absolute.parent_path()))
-    throw InputError(fmt::format("{}: directory {} does not exist", o.directory, absolute.parent_path().string()));
+  check_output_directory(dir, scene.files);
+  const std::vector<TriangleMesh> meshes = scene_meshes(scene);
+  // Every file name first: a mesh the scene reads must not be replaced by its own export.
+  std::vector<std::string> files;
+  for (std::size_t i = 0; i < meshes.size(); ++i) {
+    const bool is_light = i >= scene.objects.size();
+    const std::string& name = is_light ? scene.lights[i - scene.objects.size()].name : scene.objects[i].name;
+    files.push_back(mesh_file_name(static_cast<int>(i) + 1, name));
+    if (fs::is_directory(dir)) check_output_file(dir / files.back(), scene.files);
+  }
   fs::create_directories(dir);
 
   const PlyFormat format = o.ascii ? PlyFormat::Ascii : PlyFormat::BinaryLittleEndian;
-  const std::vector<TriangleMesh> meshes = scene_meshes(scene);
   Json objects = Json::array(), lights = Json::array();
   std::size_t triangles = 0;
   for (std::size_t i = 0; i < meshes.size(); ++i) {
     const bool is_light = i >= scene.objects.size();
     const std::string& name = is_light ? scene.lights[i - scene.objects.size()].name : scene.objects[i].name;
     const int id = static_cast<int>(i) + 1;
-    const std::string file = mesh_file_name(id, name);
+    const std::string& file = files[i];
     if (o.uvs) {
       const std::vector<std::array<Vec2, 3>> uvs =
           is_light ? std::visit([](const auto& shape) { return corner_uvs(Shape(shape)); }, scene.lights[i - scene.objects.size()].shape)

@@ -1,14 +1,17 @@
 // chromatrace prepare-texture IMAGE -o DIR: per-band-group textures for Cycles (the Blender add-on), upsampled
 // per texel exactly as the tracer upsamples the original texture (core/texture_prep.h).
 #include <cmath>
+#include <filesystem>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include <fmt/core.h>
 
 #include "cli/command.h"
 #include "core/band_plan.h"
 #include "core/error.h"
+#include "core/file_io.h"
 #include "core/json_input.h"
 #include "core/texture_prep.h"
 
@@ -47,6 +50,11 @@ int run(const Options& o) {
     throw InputError(fmt::format("--scale: must be a finite number >= 0, got {}", o.scale));
   request.scale = o.scale;
   request.threads = o.threads;
+  std::vector<std::filesystem::path> inputs = {o.image};
+  if (!o.bands_file.empty()) inputs.push_back(o.bands_file);
+  check_not_an_input(o.output, inputs);  // the cache directory is created with its parents, if need be
+  if (std::filesystem::exists(o.output) && !std::filesystem::is_directory(o.output))
+    throw InputError(fmt::format("{}: exists and is not a directory", o.output));
 
   const TexturePrepResult r = prepare_texture(request, o.output);
   const char* space = r.colour_space == TextureColourSpace::Srgb ? "sRGB" : "linear";

@@ -9,6 +9,7 @@
 #include "cli/options.h"
 #include "core/band_plan.h"
 #include "core/error.h"
+#include "core/file_io.h"
 #include "core/parallel.h"
 #include "core/scene.h"
 #include "core/spectral_exr.h"
@@ -65,9 +66,7 @@ Action add_render(CLI::App& app) {
     options.progress = !o->quiet;
     if (o->output.empty()) throw InputError("--output: no file name");
     // Fail before a long render, not after it.
-    const std::filesystem::path parent = std::filesystem::absolute(o->output).parent_path();
-    if (!std::filesystem::is_directory(parent))
-      throw InputError(fmt::format("{}: directory {} does not exist", o->output, parent.string()));
+    check_output_file(o->output, scene.files);
     set_exr_threads(thread_count(o->threads));
     const rt::RenderedImage image = rt::render(scene, options);
     rt::write_render(o->output, scene, image);

@@ -1,6 +1,7 @@
 // chromatrace sensor IN.exr -o OUT.{exr,tif,png}: the camera simulator (docs/sensor.md).
 #include <chrono>
 #include <cstdio>
+#include <filesystem>
 #include <memory>
 #include <optional>
 #include <string>
@@ -97,7 +98,10 @@ int run(const Options& o) {
   }
   if (o.input.empty()) throw InputError("input: no spectral EXR given");
   if (o.output.empty()) throw InputError("--output: no file name given");
-  sensor::check_output_path(o.output);
+  std::vector<std::filesystem::path> inputs = {o.input};
+  if (!o.config.empty()) inputs.push_back(o.config);
+  if (std::filesystem::is_regular_file(config.response.camera)) inputs.push_back(config.response.camera);
+  sensor::check_output_path(o.output, inputs);
   set_exr_threads(thread_count(o.threads));
 
   const auto start = std::chrono::steady_clock::now();

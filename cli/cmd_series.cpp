@@ -17,6 +17,7 @@
 #include "cli/options.h"
 #include "core/band_plan.h"
 #include "core/error.h"
+#include "core/file_io.h"
 #include "core/scene.h"
 #include "series/figure.h"
 #include "series/runner.h"
@@ -118,6 +119,23 @@ void print_summary(const series::SeriesResult& result, const fs::path& dir) {
   fmt::print("{} of {} expectations met; {}\n", met, total, (dir / "index.html").string());
 }
 
+// The series file and the scene files it reads must not be among what the run writes: series.json and
+// index.html at the top of the output directory, and everything under renders/ and each variant's directory.
+void check_inputs_outside(const fs::path& dir, const Series& series, const fs::path& series_file) {
+  std::vector<fs::path> inputs = series.base_scene.files;
+  inputs.push_back(series_file);
+  check_output_directory(dir, inputs);
+  for (const char* top : {"series.json", "index.html"}) check_not_an_input(dir / top, inputs);
+  std::vector<fs::path> written = {dir / "renders"};
+  for (const SeriesVariant& v : series.variants) written.push_back(dir / v.name);
+  for (const fs::path& input : inputs)
+    for (fs::path up = fs::absolute(input).parent_path(); up.has_relative_path(); up = up.parent_path())
+      for (const fs::path& w : written)
+        if (same_file(up, w))
+          throw InputError(fmt::format("{}: the input {} is in {}, which the series writes", dir.string(),
+                                       input.string(), w.string()));
+}
+
 int run(const Options& o, const fs::path& series_file) {
   series::RunOptions options = run_options(o);
   if (o.output.empty()) throw InputError("--output: no directory given");
@@ -128,6 +146,7 @@ int run(const Options& o, const fs::path& series_file) {
     throw InputError(fmt::format("{}: exists and is not a directory", o.output));
   series::check_renderer(options);
   const Series series = load_series(series_file, o.threads);
+  check_inputs_outside(o.output, series, series_file);
   // run_series checks the variants and their sensor settings before it writes anything.
   const series::SeriesResult result = series::run_series(series, o.output, options);
   series::write_figure_page(o.output, series::result_json(result));

@@ -1,19 +1,30 @@
 #include "cli/options.h"
 
-#include <cstdio>
+#include <charconv>
 
 #include <fmt/core.h>
 
 #include "core/error.h"
+#include "core/limits.h"
 
 namespace ct::cli {
 
 std::pair<int, int> parse_resolution(const std::string& text, std::string_view option) {
-  int w = 0, h = 0;
-  char x = 0, extra = 0;
-  if (std::sscanf(text.c_str(), "%d%c%d%c", &w, &x, &h, &extra) != 3 || x != 'x' || w < 1 || h < 1)
+  const auto fail = [&] {
     throw InputError(fmt::format("{}: expected WxH with positive integers, got \"{}\"", option, text));
-  return {w, h};
+  };
+  const std::size_t x = text.find('x');
+  if (x == std::string::npos) fail();
+  long long size[2] = {0, 0};
+  const std::string_view parts[2] = {std::string_view(text).substr(0, x), std::string_view(text).substr(x + 1)};
+  for (int i = 0; i < 2; ++i) {
+    const auto [end, ec] = std::from_chars(parts[i].data(), parts[i].data() + parts[i].size(), size[i]);
+    if (parts[i].empty() || end != parts[i].data() + parts[i].size()) fail();
+    if (ec == std::errc::result_out_of_range || (ec == std::errc() && size[i] > kMaxImageSide))
+      throw InputError(fmt::format("{}: {} is larger than the limit of {} pixels a side", option, text, kMaxImageSide));
+    if (ec != std::errc() || size[i] < 1) fail();
+  }
+  return {static_cast<int>(size[0]), static_cast<int>(size[1])};
 }
 
 }  // namespace ct::cli

@@ -1,6 +1,7 @@
 #include "core/file_io.h"
 
 #include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -18,18 +19,97 @@ namespace ct {
 
 namespace fs = std::filesystem;
 
+namespace {
+
+// "a FIFO", "a character device", …: what a path is when it is not a regular file.
+std::string kind_of(mode_t mode) {
+  if (S_ISDIR(mode)) return "a directory";
+  if (S_ISFIFO(mode)) return "a FIFO";
+  if (S_ISCHR(mode)) return "a character device";
+  if (S_ISBLK(mode)) return "a block device";
+  if (S_ISSOCK(mode)) return "a socket";
+  return "not a regular file";
+}
+
+// The refusal to replace `resolved` (which `output` is or links to) by a regular file.
+std::string not_a_regular_file(const fs::path& output, const fs::path& resolved, mode_t mode) {
+  if (S_ISDIR(mode) && output == resolved)
+    return fmt::format("{}: is a directory; the output must be a file name", output.string());
+  const std::string what = output == resolved ? fmt::format("is {}", kind_of(mode))
+                                              : fmt::format("links to {}, which is {}", resolved.string(), kind_of(mode));
+  return fmt::format("{}: {}; outputs are written only as regular files, never in place of {}", output.string(), what,
+                     S_ISDIR(mode) ? "a directory" : "a special file");
+}
+
+}  // namespace
+
 std::string read_file(const fs::path& file) {
+  std::error_code error;
+  if (fs::is_directory(file, error)) throw InputError(fmt::format("{}: is a directory, not a file", file.string()));
   std::ifstream in(file, std::ios::binary);
   if (!in) throw InputError(fmt::format("{}: cannot open file", file.string()));
   std::ostringstream bytes;
   bytes << in.rdbuf();
+  if (in.bad()) throw InputError(fmt::format("{}: cannot read file", file.string()));
   return bytes.str();
 }
 
-AtomicFile::AtomicFile(fs::path target) : target_(std::move(target)) {
-  const fs::path directory = target_.has_parent_path() ? target_.parent_path() : fs::path(".");
+bool same_file(const fs::path& a, const fs::path& b) {
+  struct stat sa{}, sb{};
+  if (::stat(a.c_str(), &sa) != 0 || ::stat(b.c_str(), &sb) != 0) return false;
+  return sa.st_dev == sb.st_dev && sa.st_ino == sb.st_ino;
+}
+
+void check_not_an_input(const fs::path& output, const std::vector<fs::path>& inputs) {
+  for (const fs::path& input : inputs)
+    if (!input.empty() && same_file(output, input))
+      throw InputError(fmt::format("{}: is the same file as the input {}; writing the output would destroy the input",
+                                   output.string(), input.string()));
+}
+
+fs::path follow_links(const fs::path& path) {
+  fs::path current = path;
+  for (int hops = 0; hops < 40; ++hops) {
+    std::error_code error;
+    if (!fs::is_symlink(fs::symlink_status(current, error))) return current;
+    const fs::path next = fs::read_symlink(current, error);
+    if (error) return current;
+    current = next.is_absolute() ? next : (current.parent_path() / next).lexically_normal();
+  }
+  throw InputError(fmt::format("{}: too many levels of symbolic links", path.string()));
+}
+
+void check_output_file(const fs::path& output, const std::vector<fs::path>& inputs) {
+  check_not_an_input(output, inputs);
+  const fs::path resolved = follow_links(output);
+  struct stat st{};
+  if (::stat(resolved.c_str(), &st) == 0 && !S_ISREG(st.st_mode))
+    throw InputError(not_a_regular_file(output, resolved, st.st_mode));
+  if (output.filename().empty()) throw InputError(fmt::format("{}: no file name", output.string()));
+  const fs::path parent = fs::absolute(resolved).parent_path();
+  if (!fs::is_directory(parent))
+    throw InputError(fmt::format("{}: directory {} does not exist", output.string(), parent.string()));
+}
+
+void check_output_directory(const fs::path& directory, const std::vector<fs::path>& inputs) {
+  check_not_an_input(directory, inputs);
+  std::error_code error;
+  if (fs::exists(directory, error) && !fs::is_directory(directory, error))
+    throw InputError(fmt::format("{}: exists and is not a directory", directory.string()));
+  fs::path absolute = fs::absolute(directory);
+  if (!absolute.has_filename()) absolute = absolute.parent_path();  // "out/"
+  if (!fs::is_directory(absolute.parent_path()))
+    throw InputError(
+        fmt::format("{}: directory {} does not exist", directory.string(), absolute.parent_path().string()));
+}
+
+AtomicFile::AtomicFile(fs::path target) : target_(std::move(target)), destination_(follow_links(target_)) {
+  struct stat st{};
+  if (::stat(destination_.c_str(), &st) == 0 && !S_ISREG(st.st_mode))
+    throw InputError(not_a_regular_file(target_, destination_, st.st_mode));
+  const fs::path directory = destination_.has_parent_path() ? destination_.parent_path() : fs::path(".");
   for (int attempt = 0;; ++attempt) {
-    temporary_ = directory / fmt::format(".{}.{}-{}.tmp", target_.filename().string(), static_cast<long>(::getpid()), attempt);
+    temporary_ = directory / fmt::format(".{}.{}-{}.tmp", destination_.filename().string(), static_cast<long>(::getpid()), attempt);
     fd_ = ::open(temporary_.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
     if (fd_ >= 0) return;
     if (errno != EEXIST || attempt >= 1000) {
@@ -51,8 +131,13 @@ void AtomicFile::commit() {
   // On disk before it gets the final name, so that a crash cannot leave a renamed but empty file.
   if (::fsync(fd_) != 0 || ::close(std::exchange(fd_, -1)) != 0)
     throw std::runtime_error(fmt::format("{}: cannot write: {}", target_.string(), std::strerror(errno)));
+  // What was checked when this file was started may have changed since (a long render): a special file or
+  // a directory that has appeared under the name is still not replaced.
+  struct stat st{};
+  if (::lstat(destination_.c_str(), &st) == 0 && !S_ISREG(st.st_mode))
+    throw InputError(not_a_regular_file(target_, destination_, st.st_mode));
   std::error_code error;
-  fs::rename(temporary_, target_, error);
+  fs::rename(temporary_, destination_, error);
   if (error)
     throw std::runtime_error(
         fmt::format("{}: cannot rename the finished file into place: {}", target_.string(), error.message()));

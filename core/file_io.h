@@ -4,18 +4,52 @@
 #include <filesystem>
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace ct {
 
-// The file's bytes; an unreadable file is an InputError "<file>: cannot open file".
+// The file's bytes; an unreadable file is an InputError "<file>: cannot open file", a directory
+// "<file>: is a directory, not a file".
 std::string read_file(const std::filesystem::path& file);
+
+// ---- Outputs that never destroy inputs or replace special files ----------------------------------------
+//
+// Each command checks its outputs with these before any work, so that a mistyped output name is refused
+// at once (exit 2) instead of after an hour's render, and never costs an input.
+
+// Whether `a` and `b` name one existing file: the same device and inode, following symbolic links, so that
+// hard links, "./x" spellings and links to the file all count. False when either does not exist.
+bool same_file(const std::filesystem::path& a, const std::filesystem::path& b);
+
+// InputError "<output>: is the same file as the input <input>; …" when `output` names one of `inputs`.
+void check_not_an_input(const std::filesystem::path& output, const std::vector<std::filesystem::path>& inputs);
+
+// What a file output may be: nothing yet, or a regular file (through any symbolic links). InputError naming
+// `output` when its directory does not exist, when it is (or links to) a directory, a FIFO, a device or a
+// socket, or when it is one of `inputs`.
+void check_output_file(const std::filesystem::path& output, const std::vector<std::filesystem::path>& inputs = {});
+
+// What an output directory may be: nothing yet (its parent must exist) or a directory. InputError naming
+// `directory` otherwise, or when it is one of `inputs`.
+void check_output_directory(const std::filesystem::path& directory,
+                            const std::vector<std::filesystem::path>& inputs = {});
+
+// The file a write to `path` lands in: `path` with the symbolic links of its last component followed (a
+// link's target relative to the link's directory); `path` itself when it is not a link. InputError on a
+// loop of links.
+std::filesystem::path follow_links(const std::filesystem::path& path);
 
 // A temporary file beside `target` (so the final rename stays on one file system and is atomic), created
 // with O_EXCL and the permissions a plain new file gets. commit() flushes it to disk and renames it to
 // `target`; destroyed without commit(), it removes the temporary. Nothing half-written is ever left behind.
+//
+// A `target` that is a symbolic link is followed: the file it points to is replaced (atomically, the
+// temporary file beside it) and the link stays. A target that is a directory, FIFO, device or socket is
+// never replaced by a regular file: the constructor refuses it.
 class AtomicFile {
  public:
-  // InputError naming the target when no temporary file can be created there.
+  // InputError naming the target when it is not a regular file (see above) or no temporary file can be
+  // created there.
   explicit AtomicFile(std::filesystem::path target);
   ~AtomicFile();
   AtomicFile(const AtomicFile&) = delete;
@@ -29,6 +63,7 @@ class AtomicFile {
 
  private:
   std::filesystem::path target_;
+  std::filesystem::path destination_;  // target_ with its links followed: what commit() replaces
   std::filesystem::path temporary_;
   int fd_ = -1;
 };

@@ -1,5 +1,6 @@
 #include "core/json_input.h"
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <iterator>
@@ -28,11 +29,20 @@ std::string quoted_list(std::initializer_list<std::string_view> items) {
   return text;
 }
 
-// Tracks where the parser is (object keys and array indices) so that a repeated key can be reported by
-// its JSON path; nlohmann's parser callback reports structure events but not positions.
+// Tracks where the parser is (object keys and array indices) so that a repeated key, or a value the parser
+// refuses, can be reported by its JSON path; nlohmann's parser callback reports structure events but not
+// positions. The parser copies its callback: this is the state, the callback refers to it.
 class DuplicateKeyCheck {
  public:
   explicit DuplicateKeyCheck(std::string source) : source_(std::move(source)) {}
+
+  // The JSON path of the value being parsed: after a key, the key's; in an array, the next element's.
+  std::string current_path() const {
+    std::string path;
+    for (const Frame& frame : frames_)
+      path = frame.array ? element_path(path, frame.index) : child_path(path, frame.key);
+    return path;
+  }
 
   bool operator()(int /*depth*/, Json::parse_event_t event, Json& parsed) {
     switch (event) {
@@ -67,22 +77,78 @@ class DuplicateKeyCheck {
     if (!frames_.empty() && frames_.back().array) ++frames_.back().index;
   }
 
-  std::string current_path() const {
-    std::string path;
-    for (const Frame& frame : frames_)
-      path = frame.array ? element_path(path, frame.index) : child_path(path, frame.key);
-    return path;
-  }
-
   std::string source_;
   std::vector<Frame> frames_;
 };
 
+// Where nlohmann's parser stopped: it tells a SAX handler the byte offset of an error, but leaves it out of
+// the exceptions of its DOM parser for values it refuses (a number beyond the range of a double).
+class ErrorOffset final : public nlohmann::json_sax<Json> {
+ public:
+  std::optional<std::size_t> offset;
+  std::string token;
+
+  bool null() override { return true; }
+  bool boolean(bool) override { return true; }
+  bool number_integer(number_integer_t) override { return true; }
+  bool number_unsigned(number_unsigned_t) override { return true; }
+  bool number_float(number_float_t, const string_t&) override { return true; }
+  bool string(string_t&) override { return true; }
+  bool binary(binary_t&) override { return true; }
+  bool start_object(std::size_t) override { return true; }
+  bool key(string_t&) override { return true; }
+  bool end_object() override { return true; }
+  bool start_array(std::size_t) override { return true; }
+  bool end_array() override { return true; }
+  bool parse_error(std::size_t position, const std::string& last_token, const nlohmann::detail::exception&) override {
+    offset = position;
+    token = last_token;
+    return false;
+  }
+};
+
+// "line L, column C" of the start of the token the parser refused, or "" if it cannot be found.
+std::string error_position(std::string_view text) {
+  ErrorOffset handler;
+  try {
+    Json::sax_parse(text.begin(), text.end(), &handler);
+  } catch (const std::exception&) {
+    return "";
+  }
+  if (!handler.offset || *handler.offset > text.size()) return "";
+  const std::size_t start = *handler.offset >= handler.token.size() ? *handler.offset - handler.token.size() : 0;
+  const std::string_view before = text.substr(0, start);
+  const std::size_t line = 1 + static_cast<std::size_t>(std::count(before.begin(), before.end(), '\n'));
+  const std::size_t line_start = before.rfind('\n');
+  const std::size_t column = line_start == std::string_view::npos ? start + 1 : start - line_start;
+  return fmt::format("line {}, column {}: ", line, column);
+}
+
+// nlohmann's message without its "[json.exception.out_of_range.406] " prefix.
+std::string without_prefix(const std::string& what) {
+  if (!what.starts_with("[json.exception.")) return what;
+  const std::size_t end = what.find("] ");
+  return end == std::string::npos ? what : what.substr(end + 2);
+}
+
 }  // namespace
 
 Json parse_json(std::string_view text, const std::string& source) {
+  DuplicateKeyCheck where(source);
   try {
-    return Json::parse(text.begin(), text.end(), DuplicateKeyCheck(source));
+    return Json::parse(text.begin(), text.end(),
+                       [&where](int depth, Json::parse_event_t event, Json& parsed) { return where(depth, event, parsed); });
+  } catch (const Json::out_of_range& e) {
+    // 406: a number the parser read but that no double holds, e.g. 1e999.
+    const std::string path = where.current_path();
+    std::string reason = without_prefix(e.what());
+    if (e.id == 406) {
+      const std::size_t first = reason.find('\''), last = reason.rfind('\'');
+      std::string number = first < last ? reason.substr(first + 1, last - first - 1) : "";
+      if (number.size() > 40) number = number.substr(0, 40) + "...";  // a 400-digit integer, say
+      reason = fmt::format("number {} is out of range (a finite number of magnitude below 1.8e308 is needed)", number);
+    }
+    throw InputError(fmt::format("{}: {}{}{}", source, error_position(text), path.empty() ? "" : path + ": ", reason));
   } catch (const Json::parse_error& e) {
     // nlohmann says "[json.exception.parse_error.101] parse error at line 3, column 14: <reason>"; keep
     // the position and the reason.
@@ -90,6 +156,8 @@ Json parse_json(std::string_view text, const std::string& source) {
     const std::string marker = "parse error at ";
     const std::size_t at = what.find(marker);
     throw InputError(fmt::format("{}: {}", source, at == std::string::npos ? what : what.substr(at + marker.size())));
+  } catch (const Json::exception& e) {
+    throw InputError(fmt::format("{}: {}", source, without_prefix(e.what())));
   }
 }
 

@@ -41,6 +41,22 @@ std::optional<ScalarType> scalar_type(std::string_view name) {
   return std::nullopt;
 }
 
+// Bytes one value takes at the least: its size in binary, a character and a separator in ASCII.
+std::size_t min_bytes(ScalarType type, PlyFormat format) {
+  if (format == PlyFormat::Ascii) return 2;
+  switch (type) {
+    case ScalarType::Int8:
+    case ScalarType::UInt8: return 1;
+    case ScalarType::Int16:
+    case ScalarType::UInt16: return 2;
+    case ScalarType::Int32:
+    case ScalarType::UInt32:
+    case ScalarType::Float32: return 4;
+    case ScalarType::Float64: return 8;
+  }
+  return 1;
+}
+
 struct Property {
   std::string name;
   ScalarType type;                       // the item type for a list
@@ -144,6 +160,11 @@ class BodyReader {
   double read(ScalarType type, const std::string& where) {
     return format_ == PlyFormat::Ascii ? read_text(where) : read_binary(type, where);
   }
+  std::size_t remaining() const { return body_.size() - pos_; }
+  // At most how many values of `type` the rest of the file can hold (the last ASCII value needs no separator).
+  std::size_t capacity(ScalarType type) const {
+    return (body_.size() - pos_ + (format_ == PlyFormat::Ascii ? 1 : 0)) / min_bytes(type, format_);
+  }
 
  private:
   double read_text(const std::string& where) {
@@ -211,6 +232,9 @@ Record read_record(BodyReader& reader, const Element& element, std::optional<std
     const double n = reader.read(*property.list_count, where);
     if (n < 0 || n != std::floor(n))
       throw InputError(fmt::format("{}: {}: list length {} is not a count", source, where, n));
+    // Before allocating the items: a length the rest of the file cannot hold is a lie (or a cut file).
+    if (n > static_cast<double>(reader.capacity(property.type)))
+      throw InputError(fmt::format("{}: {}: list length {} is more than the rest of the file holds", source, where, n));
     std::vector<double> items(static_cast<std::size_t>(n));
     for (double& item : items) item = reader.read(property.type, where);
     if (list && p == *list) record.list = std::move(items);
@@ -255,6 +279,16 @@ TriangleMesh parse_ply(std::string_view bytes, const std::string& source) {
         throw InputError(fmt::format("{}: face element has no list property vertex_indices", source));
     }
 
+    // Before reading: a count the rest of the file cannot hold (4e9 elements in 200 bytes) is refused at
+    // once instead of read value by value; an element with no properties holds nothing to read.
+    if (element.properties.empty()) continue;
+    std::size_t record_bytes = 0;
+    for (const Property& property : element.properties)
+      record_bytes += min_bytes(property.list_count ? *property.list_count : property.type, header.format);
+    const std::size_t room = (reader.remaining() + (header.format == PlyFormat::Ascii ? 1 : 0)) / record_bytes;
+    if (element.count > room)
+      throw InputError(fmt::format("{}: element {} declares {} entries, more than the {} that the rest of the file can hold",
+                                   source, element.name, element.count, room));
     for (std::size_t i = 0; i < element.count; ++i) {
       const std::string where = fmt::format("{} {}", element.name, i);
       Record record = read_record(reader, element, face_list, source, where);

@@ -285,6 +285,7 @@ PiecewiseLinearSpectrum SceneReader::csv_spectrum(const JsonNode& node) {
   auto cached = csv_tables_.find(path);
   if (cached == csv_tables_.end()) {
     try {
+      scene_.files.emplace_back(path);
       cached = csv_tables_.emplace(path, read_csv(path)).first;
     } catch (const InputError& e) {
       csv.fail(e.what());
@@ -375,6 +376,7 @@ SpectrumRef SceneReader::texture_ref(const JsonNode& node, TextureUse use) {
   const auto key = std::make_tuple(path, colour_space ? static_cast<int>(*colour_space) : -1, static_cast<int>(use), scale);
   auto cached = textures_.find(key);
   if (cached == textures_.end()) {
+    scene_.files.emplace_back(path);
     try {
       cached = textures_
                    .emplace(key, std::make_shared<const ImageTexture>(
@@ -461,6 +463,15 @@ Shape SceneReader::object_shape(const JsonNode& node) const {
   if (type == "cylinder") return read_cylinder(node, defaults);
   if (type == "box") return read_box(node);
   return read_mesh(node, directory_);
+}
+
+// The mesh files the objects read, in object order.
+std::vector<std::filesystem::path> mesh_files(const Scene& scene) {
+  std::vector<std::filesystem::path> files;
+  for (const Object& object : scene.objects)
+    if (const auto* mesh = std::get_if<MeshShape>(&object.shape))
+      files.push_back((scene.directory / mesh->file).lexically_normal());
+  return files;
 }
 
 LightShape SceneReader::light_shape(const JsonNode& node) const {
@@ -600,12 +611,14 @@ Scene parse_scene(const Json& document, const std::string& source, const std::fi
   scene.source = source;
   scene.directory = directory;
   scene.json = document;
+  for (std::filesystem::path& mesh : mesh_files(scene)) scene.files.push_back(std::move(mesh));
   return scene;
 }
 
 Scene load_scene(const std::filesystem::path& file) {
   Scene scene = parse_scene(read_json(file), file.string(), file.parent_path());
   if (scene.name.empty()) scene.name = file.stem().string();
+  scene.files.insert(scene.files.begin(), file);
   return scene;
 }
 

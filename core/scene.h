@@ -170,6 +170,9 @@ struct Scene {
   std::optional<Environment> environment;
   Camera camera;
   RenderSettings render;
+  // The files it was read from: the scene file (when loaded from one), then the CSV tables, textures and
+  // meshes it reads. An output must never be one of them.
+  std::vector<std::filesystem::path> files;
 
   const Material* find_material(std::string_view name) const;
   const NamedSpectrum* find_spectrum(std::string_view name) const;

@@ -8,6 +8,7 @@
 #include <fmt/core.h>
 
 #include "core/error.h"
+#include "core/limits.h"
 
 namespace ct {
 
@@ -78,6 +79,8 @@ PiecewiseLinearSpectrum PiecewiseLinearSpectrum::scaled(double factor) const {
 
 Bands Bands::from_edges(std::vector<double> edges, const std::string& what) {
   if (edges.size() < 2) throw InputError(fmt::format("{}: need at least two band edges, got {}", what, edges.size()));
+  if (edges.size() - 1 > kMaxBands)
+    throw InputError(fmt::format("{}: {} bands, more than the limit of {}", what, edges.size() - 1, kMaxBands));
   for (std::size_t i = 0; i < edges.size(); ++i) {
     if (!std::isfinite(edges[i]) || edges[i] <= 0)
       throw InputError(fmt::format("{}: band edge {} must be a positive wavelength, got {}", what, i, edges[i]));
@@ -97,6 +100,9 @@ Bands Bands::uniform(double lo, double hi, double width, const std::string& what
   const double n = std::round(count);
   if (std::abs(count - n) * width > 1e-9)
     throw InputError(fmt::format("{}: range {}–{} nm is not a whole number of {} nm bands", what, lo, hi, width));
+  if (n > static_cast<double>(kMaxBands))  // before allocating the edges
+    throw InputError(fmt::format("{}: {} nm bands over {}–{} nm are {:.0f} bands, more than the limit of {}", what,
+                                 width, lo, hi, n, kMaxBands));
   std::vector<double> edges(static_cast<std::size_t>(n) + 1);
   for (std::size_t i = 0; i < edges.size(); ++i) edges[i] = lo + width * static_cast<double>(i);
   edges.back() = hi;

@@ -11,6 +11,7 @@
 
 #include "core/colour.h"
 #include "core/error.h"
+#include "core/limits.h"
 #include "core/parallel.h"
 
 namespace ct {
@@ -40,6 +41,7 @@ std::unique_ptr<OIIO::ImageInput> open_image(const std::filesystem::path& path) 
   const OIIO::ImageSpec& spec = in->spec();
   if (spec.width < 1 || spec.height < 1 || spec.nchannels < 1)
     throw InputError(fmt::format("{}: image has no pixels", name));
+  check_image_size(name, spec.width, spec.height, spec.nchannels);
   return in;
 }
 

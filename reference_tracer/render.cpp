@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/error.h"
+#include "core/limits.h"
 #include "core/parallel.h"
 #include "core/progress.h"
 #include "core/spectral_exr.h"
@@ -51,6 +52,10 @@ RenderedImage render(const Scene& scene, const RenderOptions& options) {
   image.settings = settings;
   const int w = image.width, h = image.height, nb = static_cast<int>(settings.bands.size());
   const std::size_t layer_size = static_cast<std::size_t>(w) * h * nb;
+  // Before allocating: an image of 10^9 x 10^9 pixels or of 10^6 bands is bad input, not a process to kill.
+  check_memory((static_cast<double>(plan.layer_count()) * nb * sizeof(float) + sizeof(std::int32_t)) * w * h,
+               fmt::format("the image ({}x{} pixels, {} bands, {} layers: the resolution, --bands and --components)",
+                           w, h, nb, plan.layer_count()));
   image.layers.assign(static_cast<std::size_t>(plan.layer_count()), std::vector<float>(layer_size, 0.0f));
   image.object_ids.resize(static_cast<std::size_t>(w) * h);
   for (const Object& o : scene.objects) image.object_names[o.id] = o.name;

@@ -14,6 +14,7 @@
 #include "core/cie.h"
 #include "core/colour.h"
 #include "core/error.h"
+#include "core/file_io.h"
 #include "core/parallel.h"
 #include "core/progress.h"
 #include "core/spectral_exr.h"
@@ -608,17 +609,14 @@ void display_pixels(const DisplayRendering& display, const float* linear, std::s
 
 }  // namespace
 
-void check_output_path(const fs::path& output) {
+void check_output_path(const fs::path& output, const std::vector<fs::path>& inputs) {
+  check_output_file(output, inputs);  // first: "/dev/null: is a character device" says more than its format
   output_format(output);
-  if (output.filename().empty()) throw InputError(fmt::format("{}: no file name", output.string()));
-  const fs::path parent = fs::absolute(output).parent_path();
-  if (!fs::is_directory(parent))
-    throw InputError(fmt::format("{}: directory {} does not exist", output.string(), parent.string()));
 }
 
 RunReport simulate_sensor(const fs::path& input, const fs::path& output, SensorConfig config,
                           const RunOptions& options) {
-  check_output_path(output);
+  check_output_path(output, {input});
   SpectralExrReader reader(input);
   const SpectralExrInfo& info = reader.info();
   const SpectralLayer* total = &total_radiance(info, config);

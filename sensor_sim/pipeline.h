@@ -32,8 +32,9 @@ struct RunReport {
   Json effective_config;           // as written to chromatrace.sensor
 };
 
-// Checks what can be checked before any work: the output's format and directory. InputError naming the file.
-void check_output_path(const std::filesystem::path& output);
+// Checks what can be checked before any work: the output's format and directory, that it is no special file
+// and none of `inputs` (core/file_io.h). InputError naming the file.
+void check_output_path(const std::filesystem::path& output, const std::vector<std::filesystem::path>& inputs = {});
 
 // Runs the sensor on `input` (an emissive spectral EXR) and writes `output` (.exr, .tif/.tiff, .png).
 // Bad input is an InputError naming the file and the field; the output then does not exist.

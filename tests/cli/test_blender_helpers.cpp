@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <limits>
 #include <fstream>
+#include <iterator>
 #include <string>
 #include <vector>
 
@@ -28,6 +29,11 @@ const std::string kBox = std::string(CHROMATRACE_SOURCE_DIR) + "/scenes/paper/bo
 int line_count(const std::string& s) { return static_cast<int>(std::count(s.begin(), s.end(), '\n')); }
 
 void write_text(const fs::path& path, const std::string& text) { std::ofstream(path) << text; }
+
+std::string read_bytes(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
 
 struct BadCase {
   std::vector<std::string> args;
@@ -350,6 +356,29 @@ TEST_F(Assemble, BadManifestGetsExitTwoAndOneLineNamingTheField) {
           {{"assemble", (dir_.path() / "missing.json").string(), "-o", out.string()}, "missing.json"},
       },
       out);
+}
+
+TEST_F(Assemble, NeverWritesOverItsManifestOrARenderItReads) {
+  const fs::path manifest = write_manifest(manifest_);
+  fs::create_symlink(manifest, dir_.file("link.json"));
+  fs::create_hard_link(dir_.file("g1.exr"), dir_.file("hard.exr"));
+  const struct {
+    fs::path output;
+    fs::path input;
+  } cases[] = {{manifest, manifest},
+               {dir_.path() / "." / "manifest.json", manifest},
+               {dir_.file("link.json"), manifest},
+               {dir_.file("g0.exr"), dir_.file("g0.exr")},
+               {dir_.file("hard.exr"), dir_.file("g1.exr")}};
+  for (const auto& c : cases) {
+    const std::string before = read_bytes(c.input);
+    const auto r = run_chromatrace({"assemble", manifest.string(), "-o", c.output.string(), "--quiet"});
+    EXPECT_EQ(r.exit_code, 2) << r.err;
+    EXPECT_EQ(line_count(r.err), 1) << r.err;
+    EXPECT_NE(r.err.find(c.output.string() + ": is the same file as the input " + c.input.string()), std::string::npos)
+        << r.err;
+    EXPECT_EQ(read_bytes(c.input), before) << c.output;
+  }
 }
 
 }  // namespace

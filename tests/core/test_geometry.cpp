@@ -244,5 +244,44 @@ TEST_F(Ply, BadFilesNameTheFileAndThePlace) {
   EXPECT_THROW(read_ply(dir_ / "absent.ply"), InputError);
 }
 
+TEST_F(Ply, CountsTheFileCannotHoldAreRefusedBeforeAllocating) {
+  auto message = [](const std::string& text) {
+    try {
+      parse_ply(text, "m.ply");
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  // 4e9 vertices declared in a small file: a vertex of 3 ASCII values takes at least 6 bytes (the last one 5),
+  // so the 18 bytes after the header hold 3.
+  EXPECT_EQ(message("ply\nformat ascii 1.0\nelement vertex 4000000000\nproperty float x\nproperty float y\n"
+                    "property float z\nend_header\n0 0 0\n1 0 0\n0 1 0\n"),
+            "m.ply: element vertex declares 4000000000 entries, more than the 3 that the rest of the file can hold");
+  const std::string vertices =
+      "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+      "element face 1\nproperty list uint int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n";
+  // A face list of 10^9 or 10^300 indices: refused before a vector of that length is made.
+  EXPECT_EQ(message(vertices + "1000000000 0 1 2\n"),
+            "m.ply: face 0: list length 1000000000 is more than the rest of the file holds");
+  EXPECT_EQ(message(vertices + "1e300 0 1 2\n"), "m.ply: face 0: list length 1e+300 is more than the rest of the file holds");
+  // Binary: a uint32 count of 4294967295 items of 4 bytes in a 12-byte rest.
+  std::string binary =
+      "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+      "property float z\nelement face 1\nproperty list uint int vertex_indices\nend_header\n";
+  auto put = [&](auto value) { binary.append(reinterpret_cast<const char*>(&value), sizeof value); };
+  for (float x : {0.f, 0.f, 0.f, 1.f, 0.f, 0.f, 0.f, 1.f, 0.f}) put(x);
+  put(std::uint32_t{4294967295u});
+  for (std::int32_t i : {0, 1, 2}) put(i);
+  EXPECT_EQ(message(binary), "m.ply: face 0: list length 4294967295 is more than the rest of the file holds");
+  // An element without properties holds nothing, however many it declares: skipped, not counted through.
+  const TriangleMesh mesh = parse_ply(
+      "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+      "element nothing 4000000000000\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n"
+      "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n",
+      "m.ply");
+  EXPECT_EQ(mesh.triangles.size(), 1u);
+}
+
 }  // namespace
 }  // namespace ct
