@@ -123,9 +123,10 @@ ImageAnalysis analyse_image(const AnalysisImage& input, const std::string& layer
     std::vector<RegionAnalysis> light = a.results;
     for (RegionAnalysis& r : light) r.shape = *r.linear_light;
     a.illuminant = estimate_illuminant(light, linear.rgb, known_illuminant, known_levels(linear_context));
-    a.notes.push_back(fmt::format("R, G, B were encoded by {} (the file's chromatrace.curve_*): classes are of the "
+    a.notes.push_back(fmt::format("R, G, B were encoded by {} ({}): classes are of the "
                                   "values as stored, each region's class in linear light is given beside it, and "
-                                  "the illuminant is estimated in linear light", curve->describe()));
+                                  "the illuminant is estimated in linear light", curve->describe(),
+                                  a.encoding.curve_source.empty() ? "the file's chromatrace.curve_*" : a.encoding.curve_source));
   } else {
     a.illuminant = estimate_illuminant(a.results, pixels.rgb, known_illuminant, known_levels(a.context));
   }
