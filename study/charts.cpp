@@ -78,6 +78,7 @@ double value_of(const SettingResult& r, ChartValue value) {
     case ChartValue::MeanDe00: return r.mean;
     case ChartValue::P95De00: return r.p95;
     case ChartValue::DirectionDeg: return r.max_direction_deg.value_or(0.0);
+    case ChartValue::SystematicRms: return r.systematic_rms;
   }
   return 0;
 }
@@ -115,9 +116,10 @@ std::vector<double> log_ticks(double lo, double hi) {
 cv::Mat chart(const StudyResult& result, ChartValue value) {
   const int W = 980, H = 640, left = 96, right = 236, top = 64, bottom = 78;
   cv::Mat img(H, W, CV_8UC3, kWhite);
-  const char* title = value == ChartValue::MeanDe00 ? "Mean colour error against render cost"
-                      : value == ChartValue::P95De00 ? "95th-percentile colour error against render cost"
-                                                     : "Largest turn of an object's principal direction against render cost";
+  const char* title = value == ChartValue::MeanDe00        ? "Mean colour error against render cost"
+                      : value == ChartValue::P95De00       ? "95th-percentile colour error against render cost"
+                      : value == ChartValue::SystematicRms ? "Systematic colour error (bands, bounces, mode) against render cost"
+                                                           : "Largest turn of an object's principal direction against render cost";
   put_text(img, title, {left, 30}, 0.62, kInk, Align::Left, 1);
   put_text(img, fmt::format("{}: each setting against the reference ({})", fs::path(result.scene).filename().string(),
                             result.reference.value),
@@ -127,10 +129,11 @@ cv::Mat chart(const StudyResult& result, ChartValue value) {
   for (const SettingResult& r : result.settings)
     if (r.ok && r.cpu_s > 0) shown.push_back(&r);
   std::vector<double> xs, ys;
-  const double floor = value == ChartValue::DirectionDeg ? 0.01 : 1e-3;
+  const double floor = value == ChartValue::DirectionDeg ? 0.01 : value == ChartValue::SystematicRms ? 0.05 : 1e-3;
   for (const SettingResult* r : shown) {
     xs.push_back(r->cpu_s);
     ys.push_back(value_of(*r, value));
+    if (value == ChartValue::SystematicRms) ys.push_back(std::max(r->systematic_rms_hi, floor));
   }
   if (value != ChartValue::DirectionDeg) ys.push_back(1.0);  // the ΔE00 = 1 line is always in view
   const auto [xlo, xhi] = log_range(xs, 1e-3);
@@ -152,9 +155,10 @@ cv::Mat chart(const StudyResult& result, ChartValue value) {
   }
   cv::rectangle(img, {left, top}, {W - right, H - bottom}, kInk, 1);
   put_text(img, "render CPU time (seconds, log scale)", {(left + W - right) / 2, H - 24}, 0.5, kInk, Align::Centre);
-  const std::string ylabel = value == ChartValue::MeanDe00 ? "mean dE00 (log scale)"
-                             : value == ChartValue::P95De00 ? "95th-percentile dE00 (log scale)"
-                                                            : "largest direction change (degrees, log scale)";
+  const std::string ylabel = value == ChartValue::MeanDe00        ? "mean dE00 (log scale)"
+                             : value == ChartValue::P95De00       ? "95th-percentile dE00 (log scale)"
+                             : value == ChartValue::SystematicRms ? "systematic rms dE00 (log scale)"
+                                                                  : "largest direction change (degrees, log scale)";
   cv::Mat label(24, H - top - bottom, CV_8UC3, kWhite);
   put_text(label, ylabel, {label.cols / 2, 17}, 0.5, kInk, Align::Centre);
   cv::rotate(label, label, cv::ROTATE_90_COUNTERCLOCKWISE);
@@ -181,16 +185,39 @@ cv::Mat chart(const StudyResult& result, ChartValue value) {
       cv::line(plot, a, {b.x, a.y}, cv::Scalar(150, 150, 150), 2, cv::LINE_AA);
       cv::line(plot, {b.x, a.y}, b, cv::Scalar(150, 150, 150), 2, cv::LINE_AA);
     }
+  if (value == ChartValue::SystematicRms)
+    for (const SettingResult* r : shown) {
+      const int px = point(*r).x - origin.x;
+      const int lo = static_cast<int>(std::lround(y.at(std::max(r->systematic_rms_lo, floor)))) - origin.y;
+      const int hi = static_cast<int>(std::lround(y.at(std::max(r->systematic_rms_hi, floor)))) - origin.y;
+      cv::line(plot, {px, lo}, {px, hi}, colour_of(r->setting.knob), 1, cv::LINE_AA);
+      for (int e : {lo, hi}) cv::line(plot, {px - 4, e}, {px + 4, e}, colour_of(r->setting.knob), 1, cv::LINE_AA);
+    }
+  std::vector<cv::Rect> taken;  // markers and labels placed so far
+  for (const SettingResult* r : shown) taken.emplace_back(point(*r) - origin - cv::Point(7, 7), cv::Size(14, 14));
   for (const SettingResult* r : shown) {
     const cv::Point p = point(*r) - origin;
     const bool changed = r->classes_kept < static_cast<int>(r->objects.size());
     if (r->pareto) cv::circle(plot, p, 11, kInk, 1, cv::LINE_AA);
     draw_marker(plot, p, colour_of(r->setting.knob), r->setting.renderer == series::Renderer::Cycles,
                 value == ChartValue::DirectionDeg && changed, 6);
-    // The label right of its marker, or left of it where it would leave the plot.
+    // The label in the first free place of: right, left, above right, below right, above left, below left; in
+    // none, right of the marker anyway.
     const std::string text = short_label(r->setting);
-    const bool room = p.x + 12 + series::text_width(text, 0.4) < plot.cols;
-    put_text(plot, text, p + cv::Point(room ? 10 : -10, -6), 0.4, kInk, room ? Align::Left : Align::Right);
+    const int w = series::text_width(text, 0.4), h = 12;
+    const cv::Point offsets[] = {{10, 4}, {-10 - w, 4}, {8, -10}, {8, 18}, {-8 - w, -10}, {-8 - w, 18}};
+    cv::Rect place(p + offsets[0] - cv::Point(0, h), cv::Size(w, h));
+    for (const cv::Point& o : offsets) {
+      const cv::Rect candidate(p + o - cv::Point(0, h), cv::Size(w, h));
+      const bool inside = candidate.x >= 0 && candidate.y >= 0 && candidate.br().x < plot.cols && candidate.br().y < plot.rows;
+      const bool free = std::none_of(taken.begin(), taken.end(), [&](const cv::Rect& t) { return (t & candidate).area() > 0; });
+      if (inside && free) {
+        place = candidate;
+        break;
+      }
+    }
+    taken.push_back(place);
+    put_text(plot, text, {place.x, place.y + h}, 0.4, kInk);
   }
 
   // Legend.
@@ -227,6 +254,7 @@ cv::Mat chart(const StudyResult& result, ChartValue value) {
 void write_charts(const fs::path& dir, const StudyResult& result) {
   const std::pair<const char*, ChartValue> charts[] = {{"error_vs_cost.png", ChartValue::MeanDe00},
                                                        {"p95_vs_cost.png", ChartValue::P95De00},
+                                                       {"systematic_vs_cost.png", ChartValue::SystematicRms},
                                                        {"structure_vs_cost.png", ChartValue::DirectionDeg}};
   for (const auto& [name, value] : charts) write_file_atomically(dir / name, series::encode_png(chart(result, value)));
 }

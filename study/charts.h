@@ -5,6 +5,8 @@
 //
 //   error_vs_cost.png      mean ΔE00 against CPU seconds
 //   p95_vs_cost.png        95th-percentile ΔE00 against CPU seconds
+//   systematic_vs_cost.png the systematic rms ΔE00 (bands, bounces, mode, renderer) with its ±2 standard-error
+//                          interval as a bar, against CPU seconds
 //   structure_vs_cost.png  the largest turn of an object's principal direction (degrees) against CPU seconds;
 //                          a setting that changes any object's class is drawn as a cross
 
@@ -16,7 +18,7 @@
 
 namespace ct::study {
 
-enum class ChartValue { MeanDe00, P95De00, DirectionDeg };
+enum class ChartValue { MeanDe00, P95De00, SystematicRms, DirectionDeg };
 
 // 8-bit BGR.
 cv::Mat chart(const StudyResult& result, ChartValue value);

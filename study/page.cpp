@@ -45,6 +45,7 @@ void write_page(const fs::path& file, const StudyResult& result) {
        "cheaper and more accurate.</p>\n";
   h << image_tag(result, ChartValue::MeanDe00, "mean ΔE00 against CPU seconds") << "\n";
   h << image_tag(result, ChartValue::P95De00, "95th-percentile ΔE00 against CPU seconds") << "\n";
+  h << image_tag(result, ChartValue::SystematicRms, "systematic rms ΔE00 against CPU seconds") << "\n";
   h << image_tag(result, ChartValue::DirectionDeg, "largest direction change against CPU seconds") << "\n";
   h << "<table><tr><th class=l>setting</th><th class=l>knob</th><th class=l>value</th><th>bands</th><th>samples</th>"
        "<th>bounces</th><th>CPU s</th><th>wall s</th><th>renders</th><th>mean ΔE00</th><th>p95 ΔE00</th>"

@@ -299,6 +299,16 @@ StudyResult run_study(const fs::path& scene_file, const fs::path& dir, const Stu
     series::SeriesResult sr = series::run_series(series, runs, ro);
     series::VariantResult v = std::move(sr.variants.at(0));
     if (!v.ok) throw std::runtime_error(fmt::format("{}: {}", variant, v.error));
+    // What the render cost, kept beside it: a render taken from the cache (a study run again) keeps its cost.
+    const fs::path cost = runs / "renders" / (v.render_key + ".cost.json");
+    if (!v.render_reused) {
+      write_file_atomically(cost, Json{{"wall_seconds", v.render_s}, {"cpu_seconds", v.render_cpu_s}}.dump() + "\n");
+    } else if (fs::exists(cost)) {
+      std::ifstream in(cost);
+      const Json c = Json::parse(in);
+      v.render_s = c.at("wall_seconds").get<double>();
+      v.render_cpu_s = c.at("cpu_seconds").get<double>();
+    }
     return v;
   };
   auto render_of = [&](const series::VariantResult& v) { return runs / "renders" / (v.render_key + ".exr"); };

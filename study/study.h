@@ -109,7 +109,7 @@ struct StudyResult {
 std::vector<Setting> make_settings(const Scene& scene, const StudyOptions& options);
 
 // Runs the study into `dir` (created; its parent must exist): runs/ holds the series variants (renders, camera
-// images, analyses), plans/ the band plans; then study.json, error_vs_cost.png, p95_vs_cost.png,
+// images, analyses), plans/ the band plans; then study.json, error_vs_cost.png, p95_vs_cost.png, systematic_vs_cost.png,
 // structure_vs_cost.png and index.html.
 StudyResult run_study(const std::filesystem::path& scene_file, const std::filesystem::path& dir,
                       const StudyOptions& options);

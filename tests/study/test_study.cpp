@@ -57,7 +57,7 @@ void check_files(const fs::path& dir, const Json& study) {
   EXPECT_EQ(names, (std::vector<std::string>{"tracer-base", "tracer-bands-3", "tracer-bands-12", "tracer-fitted-1",
                                              "tracer-samples-16", "tracer-bounces-1", "tracer-mode-continuous"}));
   EXPECT_EQ(study.at("reference").at("band_count"), 80);  // 380–780 nm in 5 nm bands
-  for (const char* chart : {"error_vs_cost.png", "p95_vs_cost.png", "structure_vs_cost.png"}) {
+  for (const char* chart : {"error_vs_cost.png", "p95_vs_cost.png", "systematic_vs_cost.png", "structure_vs_cost.png"}) {
     const cv::Mat png = cv::imread((dir / chart).string());
     ASSERT_FALSE(png.empty()) << chart;
     EXPECT_EQ(png.cols, 980);
