@@ -86,8 +86,9 @@ void print_summary(const study::StudyResult& result, const fs::path& dir) {
       fmt::print("{:<26} failed: {}\n", r.setting.name, r.error);
       continue;
     }
-    fmt::print("{:<26} {:<34} {:>8.2f} {:>9.2f} {:>8.2f} {:>9.2f} {:>10.2f} {:>5}/{:<2} {}\n", r.setting.name,
-               r.setting.value.substr(0, 34), r.cpu_s, r.mean, r.p95, r.noise_rms, r.systematic_rms, r.classes_kept,
+    fmt::print("{:<26} {:<34} {:>8.2f} {:>9.2f} {:>8.2f} {:>9.2f} {:>10} {:>5}/{:<2} {}\n", r.setting.name,
+               r.setting.value.substr(0, 34), r.cpu_s, r.mean, r.p95, r.noise_rms,
+               r.systematic_measurable ? fmt::format("{:.2f}", r.systematic_rms) : "-", r.classes_kept,
                r.objects.size(), r.pareto ? "pareto" : "");
   }
   fmt::print("{}\n", (dir / "index.html").string());

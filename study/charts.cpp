@@ -127,7 +127,7 @@ cv::Mat chart(const StudyResult& result, ChartValue value) {
 
   std::vector<const SettingResult*> shown;
   for (const SettingResult& r : result.settings)
-    if (r.ok && r.cpu_s > 0) shown.push_back(&r);
+    if (r.ok && r.cpu_s > 0 && (value != ChartValue::SystematicRms || r.systematic_measurable)) shown.push_back(&r);
   std::vector<double> xs, ys;
   const double floor = value == ChartValue::DirectionDeg ? 0.01 : value == ChartValue::SystematicRms ? 0.05 : 1e-3;
   for (const SettingResult* r : shown) {

@@ -64,9 +64,13 @@ void write_page(const fs::path& file, const StudyResult& result) {
     for (const ObjectFinding& f : r.objects)
       if (!f.same) changed += fmt::format("{}{}: {} (reference {})", changed.empty() ? "" : "; ", f.object, f.cls, f.reference_cls);
     h << fmt::format("<td>{}</td><td>{}</td><td>{}</td><td>{:.2f}</td><td>{:.2f}</td><td>{}</td><td>{:.2f}</td>"
-                     "<td>{:.2f}</td><td>{:.2f}</td><td>{:.2f} <small>({:.2f}–{:.2f})</small></td>",
+                     "<td>{:.2f}</td><td>{:.2f}</td>{}",
                      s.bands.size(), s.samples, s.max_bounces, r.cpu_s, r.wall_s, r.renders, r.mean, r.p95,
-                     r.noise_rms, r.systematic_rms, r.systematic_rms_lo, r.systematic_rms_hi);
+                     r.noise_rms,
+                     r.systematic_measurable
+                         ? fmt::format("<td>{:.2f} <small>({:.2f}–{:.2f})</small></td>", r.systematic_rms,
+                                       r.systematic_rms_lo, r.systematic_rms_hi)
+                         : std::string("<td title=\"the noise is too large to split the error\">–</td>"));
     h << "<td class=" << (all_kept ? "ok" : "bad") << " title=\"" << escape_html(changed) << "\">" << r.classes_kept
       << " of " << r.objects.size() << "</td><td>" << optional_deg(r.max_direction_deg) << "</td><td>"
       << optional_deg(r.illuminant_deg)

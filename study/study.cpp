@@ -381,6 +381,9 @@ StudyResult run_study(const fs::path& scene_file, const fs::path& dir, const Stu
     r.systematic_rms = std::sqrt(std::max(0.0, s2));
     r.systematic_rms_lo = std::sqrt(std::max(0.0, s2 - 2 * r.systematic_sq_se));
     r.systematic_rms_hi = std::sqrt(std::max(0.0, s2 + 2 * r.systematic_sq_se));
+    // Below zero by more than its own uncertainty: the split's first-order assumption fails (noise so large that
+    // ΔE00 is no longer a quadratic form of it), and the systematic part cannot be told.
+    r.systematic_measurable = s2 + 2 * r.systematic_sq_se >= 0;
   }
   if (base_samples == 0)
     result.notes.push_back("no tracer base setting: the reference's own noise is not subtracted from the systematic part");
@@ -422,8 +425,9 @@ Json result_json(const StudyResult& result) {
                   {"noise_rms_de00", r.noise_rms},
                   {"noise_rms_de00_se", r.noise_rms_se},
                   {"reference_noise_rms_de00", r.reference_noise_rms},
-                  {"systematic_rms_de00", r.systematic_rms},
-                  {"systematic_rms_de00_interval", {r.systematic_rms_lo, r.systematic_rms_hi}}};
+                  {"systematic_rms_de00", r.systematic_measurable ? Json(r.systematic_rms) : Json()},
+                  {"systematic_rms_de00_interval",
+                   r.systematic_measurable ? Json{r.systematic_rms_lo, r.systematic_rms_hi} : Json()}};
     Json objects = Json::array();
     for (const ObjectFinding& f : r.objects)
       objects.push_back({{"object", f.object},

@@ -87,6 +87,7 @@ struct SettingResult {
   // images and few samples the noise hides a small systematic error; the interval says how much could hide).
   double systematic_rms = 0, systematic_rms_lo = 0, systematic_rms_hi = 0;
   double systematic_sq = 0, systematic_sq_se = 0;  // mean over pixels of |s|² + |n_r|², and its standard error
+  bool systematic_measurable = true;  // false: the estimate fell below zero beyond its uncertainty (noise too large)
   // Structure against the reference's.
   std::vector<ObjectFinding> objects;
   int classes_kept = 0;
