@@ -172,6 +172,57 @@ TEST_F(CameraRaw, DngMosaicIsTheSimulatorsNumbersInThreeReaders) {
   }
 }
 
+// The half-size reading keeps each tile's red, first green and blue exactly: the whole image's mean is the mean of
+// those digital numbers less the black level. info reads the file's pattern and levels.
+TEST_F(CameraRaw, HalfSizeKeepsTheCapturedNumbersAndInfoReadsTheLevels) {
+  const fs::path dng = dir_.file("capture.dng"), tif = dir_.file("every_channel.tif");
+  ASSERT_EQ(capture(dng).exit_code, 0);
+  ASSERT_EQ(capture(tif, {"--cfa", "none"}).exit_code, 0);
+  int w = 0, h = 0, c = 0;
+  const std::vector<float> every = read_pixels(tif, w, h, c);
+  ASSERT_EQ(c, 3);
+  std::array<double, 3> sum{};
+  for (int y = 0; y < kHeight; y += 2)
+    for (int x = 0; x < kWidth; x += 2)
+      for (const auto& [dx, dy] : {std::pair{0, 0}, std::pair{1, 0}, std::pair{1, 1}}) {  // R, first G, B of RGGB
+        const int channel = rggb_channel(x + dx, y + dy);
+        sum[static_cast<std::size_t>(channel)] +=
+            std::round(every[static_cast<std::size_t>(((y + dy) * kWidth + x + dx) * 3 + channel)] * 65535.0) - 2048.0;
+      }
+  const fs::path out = dir_.file("half");
+  const test::CommandResult r =
+      run_chromatrace({"analyze", dng.string(), "-o", out.string(), "--raw-half-size", "--no-plots", "--no-report", "--quiet"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  std::ifstream in(out / "analysis.json");
+  const nlohmann::json j = nlohmann::json::parse(in);
+  EXPECT_EQ(j["image"]["width"], kWidth / 2);
+  EXPECT_EQ(j["image"]["height"], kHeight / 2);
+  EXPECT_EQ(j["input"]["clipping_level"], 16383 - 2048);
+  const nlohmann::json& whole = j["regions"][0];
+  ASSERT_EQ(whole["source"], "image");
+  const double tiles = double(kWidth / 2 * (kHeight / 2));
+  for (std::size_t k = 0; k < 3; ++k)  // whole numbers summed exactly; the mean's rounding is ~1e-12 DN
+    EXPECT_NEAR(whole["shape"]["mean"][k].get<double>(), sum[k] / tiles, 1e-6) << "channel " << k;
+
+  const test::CommandResult info = run_chromatrace({"info", "--json", dng.string()});
+  ASSERT_EQ(info.exit_code, 0) << info.err;
+  const nlohmann::json i = nlohmann::json::parse(info.out);
+  EXPECT_EQ(i["format"], "DNG 1.4.0.0");
+  EXPECT_EQ(i["camera"], "chromatrace canon_eos_5d_mkiii");
+  EXPECT_EQ(i["cfa"], "RGGB");
+  EXPECT_EQ(i["black_level"], "2048");
+  EXPECT_EQ(i["white_level"], "16383");
+  EXPECT_EQ(i["f_number"], "4");
+}
+
+// The same capture gives the same DNG bytes whatever the thread count and block size.
+TEST_F(CameraRaw, DngBytesDoNotDependOnThreads) {
+  const fs::path one = dir_.file("one.dng"), two = dir_.file("two.dng");
+  ASSERT_EQ(capture(one, {"--threads", "1", "--block-rows", "1"}).exit_code, 0);
+  ASSERT_EQ(capture(two, {"--threads", "2"}).exit_code, 0);
+  EXPECT_EQ(test::read_bytes(one), test::read_bytes(two));
+}
+
 TEST_F(CameraRaw, DngConvertsInRawTherapee) {
   const std::string rt = find_program("rawtherapee-cli");
   if (rt.empty()) GTEST_SKIP() << "rawtherapee-cli is not installed (Debian package rawtherapee): conversion not checked";
