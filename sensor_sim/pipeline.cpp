@@ -676,7 +676,8 @@ RunReport simulate_sensor(const fs::path& input, const fs::path& output, SensorC
   const int k = config.pixel.supersample;
   const std::optional<FieldOfView> fov = cos4_field_of_view(info, config);
 
-  const auto component_list = component_layers_of(info);
+  // A lit reflectance image is one layer of light; emissive layers a file may hold beside it are not its light.
+  const auto component_list = lit ? decltype(component_layers_of(info)){} : component_layers_of(info);
   const std::vector<std::string>& components = component_list.first;
   const std::vector<const SpectralLayer*>& component_layers = component_list.second;
 
@@ -706,7 +707,7 @@ RunReport simulate_sensor(const fs::path& input, const fs::path& output, SensorC
   const bool picture = display_png(output, config);  // the PNG holds the display rendering
   const bool want_display = (exr && config.display.enabled) || picture;
   const bool want_light = want_display || dng;  // a DNG's as-shot neutral is the scene illuminant's
-  const SpectralLayer* emission = info.find_layer("emission", SpectralQuantity::S0);
+  const SpectralLayer* emission = lit ? nullptr : info.find_layer("emission", SpectralQuantity::S0);
   const std::set<std::int32_t> lights = light_object_ids(info);
   const std::vector<RowRange> surveyed =
       auto_time || want_light || config.optics.flare > 0 ? survey_rows(auto_time, k, height, rows_per_block)

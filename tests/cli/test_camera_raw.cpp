@@ -399,6 +399,25 @@ TEST(ReflectanceLit, BadInputIsOneLineAndExitTwo) {
       run_chromatrace({"sensor", kMacbeth.string(), "--illuminant", negative.string(), "-o", out.string(), "--quiet"}),
       "negative.csv", "value -0.5 at 560 nm");
   EXPECT_FALSE(fs::exists(out));
+
+  // A fluorescent file's re-radiation is not supported: said so, whether lit or not.
+  const fs::path fluorescent = dir.file("fluorescent.exr");
+  std::vector<test::RawChannel> channels;
+  for (const char* name : {"T.400,0nm", "T.500,0nm", "T.600,0nm", "T.400,0nm.500,0nm"})
+    channels.push_back(test::constant_channel(name, 4, 4, 0.25f));
+  test::write_raw_exr(fluorescent, 4, 4, channels);
+  for (const bool lit : {true, false}) {
+    std::vector<std::string> args = {"sensor", fluorescent.string(), "-o", out.string(), "--quiet"};
+    if (lit) args.insert(args.end(), {"--illuminant", "D65"});
+    expect_bad_input(run_chromatrace(args), "fluorescent.exr", "bi-spectral (fluorescent) file");
+  }
+}
+
+TEST_F(CameraRaw, DngNeedsARawMosaic) {
+  const fs::path out = dir_.file("ideal.dng");
+  expect_bad_input(run_chromatrace({"sensor", input_.string(), "-o", out.string(), "--quiet"}), "ideal.dng",
+                   "a DNG holds a Bayer mosaic of at most 16-bit digital numbers");
+  EXPECT_FALSE(fs::exists(out));
 }
 
 }  // namespace
