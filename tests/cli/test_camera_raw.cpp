@@ -13,8 +13,10 @@
 #include <OpenImageIO/imagebufalgo.h>
 #include <OpenImageIO/imageio.h>
 #include <nlohmann/json.hpp>
+#include <tiffio.h>
 
 #include "core/cie.h"
+#include "core/colour.h"
 #include "core/spectral_exr.h"
 #include "core/spectrum.h"
 #include "tests/cli/run_command.h"
@@ -170,6 +172,61 @@ TEST_F(CameraRaw, DngMosaicIsTheSimulatorsNumbersInThreeReaders) {
     EXPECT_NE(id.out.find("Filter pattern: RGGBRGGBRGGBRGGB"), std::string::npos) << id.out;
     EXPECT_NE(id.out.find("black: 2048"), std::string::npos) << id.out;
   }
+}
+
+// The DNG's colour fields for the ideal colorimetric camera (the CIE 1931 observer as its curves), whose camera
+// RGB is CIE XYZ: a D65 white's neutral is D65's white point (0.95047, 1, 1.08883) over its largest value, and
+// the XYZ → camera matrix is the identity over that value. Tolerance 10⁻³: the D65 table's white through the
+// 5 nm bands differs from the standard's white point by about 10⁻⁴.
+TEST(CameraRawDng, ColourFieldsOfTheCieCameraAndTheExposure) {
+  test::TempDir dir;
+  const Bands bands = Bands::uniform(380, 780, 5);
+  const std::vector<double> d65 = band_averages(cie::illuminant("D65"), bands);
+  constexpr int kSide = 8;
+  std::vector<float> total;
+  for (int p = 0; p < kSide * kSide; ++p)
+    for (double v : d65) total.push_back(static_cast<float>(v * 0.01));
+  SpectralExrLayout layout;
+  layout.width = layout.height = kSide;
+  layout.bands = bands;
+  const fs::path input = dir.file("d65.exr"), dng = dir.file("d65.dng");
+  {
+    SpectralExrWriter writer(input, layout);
+    SpectralRowBlock block;
+    block.rows = kSide;
+    block.total = total;
+    writer.write_rows(block);
+    writer.finish();
+  }
+  const test::CommandResult r =
+      run_chromatrace({"sensor", input.string(), "-o", dng.string(), "--preset", "canon_eos_5d_mkiii", "--camera",
+                       "cie1931", "--exposure-s", "0.004", "--f-number", "5.6", "--no-noise", "--quiet"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+
+  TIFF* tif = TIFFOpen(dng.c_str(), "r");
+  ASSERT_NE(tif, nullptr);
+  const Vec3d white = d65_white();
+  const double top = std::max({white[0], white[1], white[2]});
+  std::uint16_t count = 0;
+  float* values = nullptr;
+  ASSERT_TRUE(TIFFGetField(tif, TIFFTAG_ASSHOTNEUTRAL, &count, &values));
+  ASSERT_EQ(count, 3);
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(values[c], white[c] / top, 1e-3) << "AsShotNeutral " << c;
+  ASSERT_TRUE(TIFFGetField(tif, TIFFTAG_COLORMATRIX1, &count, &values));
+  ASSERT_EQ(count, 9);
+  for (int i = 0; i < 9; ++i) EXPECT_NEAR(values[i], i % 4 == 0 ? 1.0 / top : 0.0, 1e-3) << "ColorMatrix1 " << i;
+  std::uint16_t illuminant = 0;
+  ASSERT_TRUE(TIFFGetField(tif, TIFFTAG_CALIBRATIONILLUMINANT1, &illuminant));
+  EXPECT_EQ(illuminant, 21);  // D65
+  std::uint64_t exif = 0;
+  ASSERT_TRUE(TIFFGetField(tif, TIFFTAG_EXIFIFD, &exif));
+  ASSERT_TRUE(TIFFReadEXIFDirectory(tif, exif));
+  float exposure = 0, f_number = 0;  // rationals, which libtiff hands back as floats
+  ASSERT_TRUE(TIFFGetField(tif, EXIFTAG_EXPOSURETIME, &exposure));
+  ASSERT_TRUE(TIFFGetField(tif, EXIFTAG_FNUMBER, &f_number));
+  EXPECT_NEAR(exposure, 0.004, 0.004 * 1e-6);
+  EXPECT_NEAR(f_number, 5.6, 5.6 * 1e-6);
+  TIFFClose(tif);
 }
 
 // The half-size reading keeps each tile's red, first green and blue exactly: the whole image's mean is the mean of
