@@ -438,6 +438,10 @@ TEST_F(CameraRaw, BadRawInputIsOneLineAndExitTwo) {
                    "the file is truncated");
   expect_bad_input(run_chromatrace({"info", truncated.string()}), "truncated.dng", "the file is truncated");
 
+  expect_bad_input(
+      run_chromatrace({"analyze", dng.string(), "-o", out.string(), "--raw-demosaic", "amaze", "--quiet"}),
+      "--raw-demosaic", "unknown method \"amaze\" (methods: linear, vng, ppg, ahd, dcb, dht, aahd)");
+
   const fs::path junk = dir_.file("junk.nef");
   std::ofstream(junk) << "this is no camera raw, only text that ends early\n";
   expect_bad_input(run_chromatrace({"analyze", junk.string(), "-o", out.string(), "--quiet"}), "junk.nef",
