@@ -21,6 +21,7 @@
 #include "core/spectrum.h"
 #include "tests/cli/run_command.h"
 #include "tests/core/spectral_exr_fixtures.h"
+#include "tests/sensor_sim/sensor_test_util.h"
 
 namespace ct {
 namespace {
@@ -182,22 +183,8 @@ TEST(CameraRawDng, ColourFieldsOfTheCieCameraAndTheExposure) {
   test::TempDir dir;
   const Bands bands = Bands::uniform(380, 780, 5);
   const std::vector<double> d65 = band_averages(cie::illuminant("D65"), bands);
-  constexpr int kSide = 8;
-  std::vector<float> total;
-  for (int p = 0; p < kSide * kSide; ++p)
-    for (double v : d65) total.push_back(static_cast<float>(v * 0.01));
-  SpectralExrLayout layout;
-  layout.width = layout.height = kSide;
-  layout.bands = bands;
   const fs::path input = dir.file("d65.exr"), dng = dir.file("d65.dng");
-  {
-    SpectralExrWriter writer(input, layout);
-    SpectralRowBlock block;
-    block.rows = kSide;
-    block.total = total;
-    writer.write_rows(block);
-    writer.finish();
-  }
+  test::write_radiance(input, bands, 8, 8, [&](int, int, std::size_t b) { return static_cast<float>(d65[b] * 0.01); }, {});
   const test::CommandResult r =
       run_chromatrace({"sensor", input.string(), "-o", dng.string(), "--preset", "canon_eos_5d_mkiii", "--camera",
                        "cie1931", "--exposure-s", "0.004", "--f-number", "5.6", "--no-noise", "--quiet"});
@@ -365,23 +352,16 @@ TEST(CameraRawAnalysis, DngGivesTheClassesAndDirectionsOfTheSensorsExr) {
 void write_lit_by_d50(const fs::path& target) {
   SpectralExrReader reader(kMacbeth);
   const SpectralExrInfo& info = reader.info();
-  std::vector<float> values = reader.read_layer(info.layer("", SpectralQuantity::T));
+  const std::vector<float> values = reader.read_layer(info.layer("", SpectralQuantity::T));
   const PiecewiseLinearSpectrum& d50 = cie::illuminant("D50");
   std::vector<double> scaled = d50.values();
   for (double& v : scaled) v /= d50(560.0);
   const std::vector<double> light =
       band_averages(PiecewiseLinearSpectrum(d50.wavelengths(), scaled, d50.extrapolation()), info.bands);
-  for (std::size_t i = 0; i < values.size(); ++i) values[i] = static_cast<float>(values[i] * light[i % light.size()]);
-  SpectralExrLayout layout;
-  layout.width = info.width;
-  layout.height = info.height;
-  layout.bands = info.bands;
-  SpectralExrWriter writer(target, layout);
-  SpectralRowBlock block;
-  block.rows = info.height;
-  block.total = values;
-  writer.write_rows(block);
-  writer.finish();
+  const std::size_t n = light.size(), w = static_cast<std::size_t>(info.width);
+  test::write_radiance(target, info.bands, info.width, info.height, [&](int x, int y, std::size_t b) {
+    return static_cast<float>(values[(static_cast<std::size_t>(y) * w + static_cast<std::size_t>(x)) * n + b] * light[b]);
+  }, {});
 }
 
 TEST(ReflectanceLit, EqualsTheSameImagePremultipliedByTheIlluminant) {
