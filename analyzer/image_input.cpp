@@ -1,4 +1,5 @@
 #include "analyzer/image_input.h"
+#include "analyzer/raw_input.h"
 
 #include <algorithm>
 #include <cmath>
@@ -303,8 +304,17 @@ RgbImage linear_light(const AnalysisImage& input) {
   return out;
 }
 
-AnalysisImage read_analysis_image(const std::filesystem::path& file, const std::string& input_transfer) {
+AnalysisImage read_analysis_image(const std::filesystem::path& file, const std::string& input_transfer,
+                                  const RawOptions& raw_options) {
   const std::optional<ToneCurve> declared = parse_input_transfer(input_transfer);
+  if (is_camera_raw(file)) {
+    AnalysisImage capture = read_camera_raw(file, raw_options);
+    if (declared) {
+      capture.encoding.curve = declared;
+      capture.encoding.curve_source = fmt::format("--input-transfer {}", input_transfer);
+    }
+    return capture;
+  }
   const std::string name = file.string();
   RawImage raw = read_raw(file);
   AnalysisImage out;

@@ -103,12 +103,21 @@ RgbImage linear_light(const AnalysisImage& input);
 // oiio:Gamma); else a float file is linear and an integer file is sRGB, as cameras, phones and browsers store it.
 std::optional<ToneCurve> parse_input_transfer(const std::string& text);
 
+// How a camera raw file is read (raw_input.h): demosaiced by LibRaw's `demosaic` method, or, with
+// `half_size`, not demosaiced (each 2×2 tile's own red, green and blue, as captured).
+struct RawOptions {
+  std::string demosaic = "linear";
+  bool half_size = false;
+};
+
 // Reads R, G, B (or a grey-free file's first three channels) and whatever extra layers are present.
 // When the file says what the camera's black level was (chromatrace.black_level, as an attribute or in the
 // ImageDescription JSON of a TIFF/PNG), it is subtracted from R, G, B, so that black is 0 for every fit
 // through black. An unreadable file, fewer than three channels or a malformed object_id /
 // chromatrace.objects is an InputError naming the file.
-AnalysisImage read_analysis_image(const std::filesystem::path& file, const std::string& input_transfer = "auto");
+// A camera raw (DNG, CR2, NEF, …: raw_input.h) is read as linear camera RGB as `raw` says.
+AnalysisImage read_analysis_image(const std::filesystem::path& file, const std::string& input_transfer = "auto",
+                                  const RawOptions& raw = {});
 
 // The RGB layer the histograms are made of: "" or "final" for R,G,B, "linear", or a component's name.
 // An unknown name is an InputError listing the layers the file has.

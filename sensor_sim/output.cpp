@@ -59,7 +59,8 @@ OutputFormat output_format(const fs::path& file) {
   if (ext == ".exr") return OutputFormat::Exr;
   if (ext == ".tif" || ext == ".tiff") return OutputFormat::Tiff;
   if (ext == ".png") return OutputFormat::Png;
-  throw InputError(fmt::format("{}: unknown output format \"{}\" (the name must end in .exr, .tif, .tiff or .png)",
+  if (ext == ".dng") return OutputFormat::Dng;
+  throw InputError(fmt::format("{}: unknown output format \"{}\" (the name must end in .exr, .tif, .tiff, .png or .dng)",
                                file.string(), ext));
 }
 
@@ -71,6 +72,8 @@ struct SensorImageWriter::File {
   // TIFF / PNG
   std::unique_ptr<AtomicFile> output;  // declared before the image writer: destroyed after it lets go of the file
   std::unique_ptr<OIIO::ImageOutput> image;
+  // DNG
+  std::unique_ptr<DngWriter> dng;
 };
 
 SensorImageWriter::SensorImageWriter(const fs::path& path, OutputLayout layout)
@@ -100,6 +103,8 @@ SensorImageWriter::SensorImageWriter(const fs::path& path, OutputLayout layout)
     for (const auto& [key, value] : layout_.number_attributes) header.insert(key, Imf::DoubleAttribute(value));
     for (const auto& [key, value] : layout_.integer_attributes) header.insert(key, Imf::IntAttribute(value));
     file->exr = std::make_unique<AtomicExrOutput>(path_, header);
+  } else if (layout_.format == OutputFormat::Dng) {
+    file->dng = std::make_unique<DngWriter>(path_, layout_.width, layout_.height, layout_.dng);
   } else {
     file->output = std::make_unique<AtomicFile>(path_);
     const std::string temporary = file->output->temporary().string();
@@ -131,7 +136,7 @@ SensorImageWriter::~SensorImageWriter() = default;
 void SensorImageWriter::write_rows(const OutputRows& block) {
   if (!file_) throw std::logic_error(fmt::format("{}: write_rows after finish", path_.string()));
   const std::size_t width = static_cast<std::size_t>(layout_.width);
-  const std::size_t values = static_cast<std::size_t>(block.rows) * width * 3;
+  const std::size_t values = static_cast<std::size_t>(block.rows) * width * (layout_.format == OutputFormat::Dng ? 1 : 3);
   if (block.rows < 0 || rows_written_ + block.rows > layout_.height || block.image.size() != values)
     throw std::invalid_argument(fmt::format("{}: row block does not fit the layout", path_.string()));
   if (block.rows == 0) return;
@@ -164,6 +169,8 @@ void SensorImageWriter::write_rows(const OutputRows& block) {
                    Imf::Slice::Make(Imf::FLOAT, file_->ids.data(), window, sizeof(float), sizeof(float) * width));
     }
     file_->exr->write_rows(frame, y0, block.rows);
+  } else if (file_->dng) {
+    file_->dng->write_rows(y0, block.rows, block.image);
   } else {
     const double top = std::ldexp(1.0, layout_.bits) - 1.0;
     const auto code = [&](float v) { return std::clamp(std::round(v * layout_.code_scale), 0.0, top); };
@@ -191,6 +198,8 @@ void SensorImageWriter::finish() {
         fmt::format("{}: finish after {} of {} rows", path_.string(), rows_written_, layout_.height));
   if (file_->exr) {
     file_->exr->finish();
+  } else if (file_->dng) {
+    file_->dng->finish();
   } else {
     if (!file_->image->close())
       throw std::runtime_error(fmt::format("{}: cannot complete the file: {}", path_.string(), file_->image->geterror()));
