@@ -112,7 +112,7 @@ std::vector<SpectralWarning> check_band_plan(const Scene& scene, const Bands& ba
                      fmt::format("material \"{}\" lit by \"{}\": {} give its colour a ΔE00 of {:.1f} ({}); use bands "
                                  "fitted to the scene (chromatrace plan) or narrower ones, or --spectral-mode continuous",
                                  m.name, light, describe(bands), de,
-                                 reflectance_cause ? "its reflectance is narrow-band"
+                                 reflectance_cause ? "its reflectance changes faster than the bands"
                                                    : "the light's spectrum has narrow peaks the bands average away")});
     }
   }

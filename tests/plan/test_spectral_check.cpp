@@ -63,7 +63,7 @@ TEST(SpectralCheck, NarrowBandReflectanceIsNamedAsTheCause) {
   const auto it = std::find_if(wide.begin(), wide.end(), [](const auto& w) { return w.material == "back_wall"; });
   ASSERT_NE(it, wide.end());
   EXPECT_FALSE(it->light_is_cause);
-  EXPECT_NE(it->message.find("reflectance is narrow-band"), std::string::npos) << it->message;
+  EXPECT_NE(it->message.find("reflectance changes faster than the bands"), std::string::npos) << it->message;
   EXPECT_TRUE(plan::check_band_plan(s, Bands::parse("380:780:1"), SpectralMode::Bands).empty());
 }
 
