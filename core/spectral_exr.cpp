@@ -405,19 +405,43 @@ double largest_expansion(std::uint8_t compression) {
   }
 }
 
+// OpenEXR's C reader (OpenEXRCore) checks a header strictly and at once, where the C++ reader can spend
+// seconds and a gigabyte on a corrupt one (found by fuzzing); and it reads the chunk table without the pixels.
+// InputError "<file>: unreadable OpenEXR header: <its first complaint>".
+struct CoreReader {
+  explicit CoreReader(const std::string& file) {
+    exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
+    init.user_data = &first_error;
+    init.error_handler_fn = [](exr_const_context_t context, exr_result_t, const char* message) {
+      void* user = nullptr;
+      if (exr_get_user_data(context, &user) == EXR_ERR_SUCCESS && user != nullptr) {
+        std::string& first = *static_cast<std::string*>(user);
+        if (first.empty()) first = message;
+      }
+    };
+    const exr_result_t result = exr_start_read(&context, file.c_str(), &init);
+    // A complaint it recovers from (an attribute whose size runs past the file, which it skips) would cost the
+    // C++ reader the allocation the size claims: it is refused as well.
+    if (result != EXR_ERR_SUCCESS || !first_error.empty()) {
+      exr_finish(&context);
+      throw InputError(fmt::format("{}: unreadable OpenEXR header: {}", file,
+                                   one_line(first_error.empty() ? exr_get_default_error_message(result) : first_error)));
+    }
+  }
+  ~CoreReader() { exr_finish(&context); }
+  CoreReader(const CoreReader&) = delete;
+  CoreReader& operator=(const CoreReader&) = delete;
+
+  std::string first_error;  // before context: the error handler writes it while exr_start_read runs
+  exr_context_t context = nullptr;
+};
+
 // OpenEXR's C++ reader fills rows that a chunk lacks with zeros instead of failing, so a data window patched
 // to 100 000 pixels over 4 stored ones reads as an image. Each chunk of a scanline file is checked against the
 // rows it must hold, from the chunk table alone: it must be there, hold exactly their bytes if uncompressed,
 // and no fewer than its compression can expand to them.
-void check_chunks_hold_the_data_window(const std::string& file) {
-  exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
-  init.error_handler_fn = [](exr_const_context_t, exr_result_t, const char*) {};  // reported below, on one line
-  exr_context_t context = nullptr;
-  if (exr_start_read(&context, file.c_str(), &init) != EXR_ERR_SUCCESS) {
-    exr_finish(&context);
-    return;  // a header the C++ reader took but this one does not: the pixel reads report what is wrong
-  }
-  const std::unique_ptr<exr_context_t, void (*)(exr_context_t*)> finish(&context, [](exr_context_t* c) { exr_finish(c); });
+void check_chunks_hold_the_data_window(const CoreReader& reader, const std::string& file) {
+  const exr_context_t context = reader.context;
   exr_storage_t storage{};
   std::int32_t lines = 0;
   exr_attr_box2i_t window{};
@@ -584,6 +608,11 @@ struct SpectralExrReader::File {
 SpectralExrReader::SpectralExrReader(const fs::path& path) : file_(std::make_unique<File>()) {
   const std::string file = path.string();
   check_openable_exr(path, file);
+  {
+    // Before the C++ reader, which allocates row buffers for the whole data window it is told of.
+    const CoreReader core(file);
+    check_chunks_hold_the_data_window(core, file);
+  }
   try {
     file_->exr = std::make_unique<Imf::InputFile>(file.c_str(), Imf::globalThreadCount());
   } catch (const std::exception& e) {
@@ -592,7 +621,6 @@ SpectralExrReader::SpectralExrReader(const fs::path& path) : file_(std::make_uni
   std::error_code error;
   const std::uintmax_t bytes = fs::file_size(path, error);
   info_ = describe(file_->exr->header(), file, error ? 0 : bytes);
-  check_chunks_hold_the_data_window(file);
   if (Imf::isMultiPart(file_->exr->version())) info_.notes.push_back("multi-part file: only the first part is read");
 }
 

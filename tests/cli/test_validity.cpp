@@ -140,8 +140,8 @@ TEST(Validity, FilesThatClaimMoreThanTheyHoldAreRefused) {
       {{"info", wide.string()},
        wide.string() + ": pixel data, rows 0-1: 15 stored bytes, which cannot hold their 800000 bytes; the data "
                        "window (50000x2 pixels) claims more than the file holds"},
-      // Here the chunk table itself runs past the end of the file, which OpenEXR's reader finds.
-      {{"info", tall.string()}, tall.string() + ": unreadable OpenEXR header"},
+      // Here the chunk table itself runs past the end of the file: 3125 chunks claimed, 1 stored.
+      {{"info", tall.string()}, tall.string() + ": pixel data, rows 0-15: no chunk for them"},
       {{"info", "--check", ids.string()},
        ids.string() + ": channel object_id: value 1.5 at pixel (1, 1) is not an object id (a whole number in [0, 16777216])"},
       {{"check-scene", dir.file("one_row.json").string()},
@@ -157,6 +157,37 @@ TEST(Validity, FilesThatClaimMoreThanTheyHoldAreRefused) {
   const auto far = run_chromatrace({"analyze", image.string(), "-o", out, "--rect", "2147483647,2147483647,10,10"});
   ASSERT_EQ(far.exit_code, 0) << far.err;
   EXPECT_NE(read_text(dir.file("analysis") / "analysis.json").find("the region is empty"), std::string::npos);
+}
+
+// Found by fuzz_spectral_exr: a header with a channel of pixel type -3070 and no data window kept OpenEXR's C++
+// reader busy for 15 s and 1.2 GB before it gave up; OpenEXR's C reader refuses it at once, naming the channel.
+TEST(Validity, ACorruptExrHeaderIsRefusedByItsFirstFault) {
+  const fs::path file = fs::path(CHROMATRACE_SOURCE_DIR) / "tests" / "fuzz" / "regressions" / "spectral_exr" /
+                        "timeout-invalid-pixel-type-header.exr";
+  // And a string attribute that claims 1 GB in a file of 6 kB: the C++ reader allocated it.
+  const fs::path big = file.parent_path() / "timeout-string-attribute-of-1-gb.exr";
+  expect_refused({{{"info", file.string()},
+                   file.string() + ": unreadable OpenEXR header: Invalid pixel type specified (-3070) adding channel "
+                                   "'S0.435,000000nm' to list"},
+                  {{"info", big.string()},
+                   big.string() + ": unreadable OpenEXR header: Attribute 'renderTime', type 'string': Invalid size "
+                                  "1073741825"}});
+}
+
+// A negative radiance was called "the image is black" by the automatic exposure, and the default preset took it.
+TEST(Validity, NegativeRadianceIsNamedNotTakenForABlackImage) {
+  test::TempDir dir;
+  const fs::path image = dir.file("negative.exr");
+  std::vector<test::RawChannel> channels = {test::constant_channel("S0.500,000000nm", 4, 4, 1),
+                                            test::constant_channel("S0.600,000000nm", 4, 4, 1)};
+  channels[1].values[7] = -1.0f;
+  test::write_raw_exr(image, 4, 4, channels);
+  const std::string out = dir.file("out.exr").string();
+  const std::string says =
+      image.string() + ": channel S0.600,000000nm: value -1 at pixel (3, 1) is negative: a radiance is >= 0";
+  expect_refused({{{"sensor", image.string(), "-o", out, "--quiet"}, says},
+                  {{"sensor", image.string(), "-o", out, "--quiet", "--exposure-s", "auto"}, says}});
+  EXPECT_FALSE(fs::exists(out));
 }
 
 }  // namespace
