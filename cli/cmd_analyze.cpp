@@ -136,7 +136,10 @@ Action add_analyze(CLI::App& app) {
                    100 * segmentation.unassigned_fraction(), segmentation.dark_pixels, segmentation.small_pixels, segmentation.seconds);
       analysis.segmentation = std::move(segmentation);
     }
-    analyzer::write_analysis(o->output, input, analysis, {!o->no_plots, !o->no_report, o->report_points, plot_limit});
+    // Written aside and moved into place when complete: a full disk leaves no partial analysis behind.
+    StagedDirectory output(o->output);
+    analyzer::write_analysis(output.path(), input, analysis, {!o->no_plots, !o->no_report, o->report_points, plot_limit});
+    output.commit();
     if (!o->quiet) {
       for (const analyzer::RegionAnalysis& r : analysis.results)
         fmt::print(stderr, "{}: {} ({} px){}\n", r.name, analyzer::class_name(r.shape.shape), r.pixels,

@@ -4,6 +4,7 @@
 #include <cctype>
 #include <cmath>
 #include <fstream>
+#include <iterator>
 #include <stdexcept>
 
 #include <fmt/core.h>
@@ -50,6 +51,40 @@ void insert_rgb(Imf::FrameBuffer& frame, const std::string& layer, const float* 
   for (int c = 0; c < 3; ++c)
     frame.insert(layer_channel(layer, c), Imf::Slice::Make(Imf::FLOAT, block + c, window, 3 * sizeof(float),
                                                            3 * sizeof(float) * static_cast<std::size_t>(width)));
+}
+
+// OpenImageIO writes TIFF and PNG through its own buffered file and does not report a write that failed for
+// want of space (its close() returns true over a truncated file), so the finished file is checked before it
+// gets its name. A PNG must run chunk by chunk to its IEND chunk at the end of the file (read without decoding,
+// whose errors libpng would print); a TIFF must decode row by row.
+void check_complete_png(const fs::path& file, const fs::path& target) {
+  std::ifstream in(file, std::ios::binary);
+  std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const auto byte = [&](std::size_t i) { return static_cast<std::uint32_t>(static_cast<unsigned char>(bytes[i])); };
+  std::size_t at = 8;  // the signature
+  while (at + 12 <= bytes.size()) {
+    const std::uint64_t length = byte(at) << 24 | byte(at + 1) << 16 | byte(at + 2) << 8 | byte(at + 3);
+    const bool end = bytes.compare(at + 4, 4, "IEND") == 0;
+    at += 12 + length;  // length, type, data, CRC
+    if (end && at == bytes.size()) return;
+  }
+  throw std::runtime_error(
+      fmt::format("{}: cannot complete the file: the PNG written is cut short at {} bytes", target.string(), bytes.size()));
+}
+
+void check_complete_tiff(const fs::path& file, const fs::path& target, int width, int height) {
+  const auto fail = [&](std::string why) {
+    std::replace(why.begin(), why.end(), '\n', ' ');
+    return std::runtime_error(fmt::format("{}: cannot complete the file: the TIFF written does not read back ({})",
+                                          target.string(), why));
+  };
+  auto input = OIIO::ImageInput::create("tiff");
+  OIIO::ImageSpec spec;
+  if (!input || !input->open(file.string(), spec)) throw fail(input ? input->geterror() : OIIO::geterror());
+  if (spec.width != width || spec.height != height) throw fail("wrong size");
+  std::vector<std::uint16_t> row(static_cast<std::size_t>(width) * static_cast<std::size_t>(spec.nchannels));
+  for (int y = 0; y < height; ++y)
+    if (!input->read_scanline(y, 0, OIIO::TypeDesc::UINT16, row.data())) throw fail(input->geterror());
 }
 
 }  // namespace
@@ -203,6 +238,10 @@ void SensorImageWriter::finish() {
   } else {
     if (!file_->image->close())
       throw std::runtime_error(fmt::format("{}: cannot complete the file: {}", path_.string(), file_->image->geterror()));
+    if (layout_.format == OutputFormat::Png)
+      check_complete_png(file_->output->temporary(), path_);
+    else
+      check_complete_tiff(file_->output->temporary(), path_, layout_.width, layout_.height);
     file_->output->commit();
   }
   file_.reset();

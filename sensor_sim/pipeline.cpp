@@ -55,20 +55,24 @@ struct Run {
 };
 
 // Rows [y0, y1) of a layer read for sensor rows: the rendered rows [k·y0, k·y1). A NaN or infinite radiance
-// has no photon count: it is bad input, named by channel and pixel. A reflectance image is lit: each band's
-// value times the illuminant's band average `lighting` (illumination.h).
+// has no photon count, and no surface emits or reflects a negative total radiance: both are bad input, named by
+// channel and pixel. (A component may dip below zero by rounding where it was taken as a difference.) A
+// reflectance image is lit: each band's value times the illuminant's band average `lighting` (illumination.h).
 std::vector<float> read_sensor_rows(SpectralExrReader& reader, const SpectralLayer& layer, int k, int y0, int y1,
                                     const std::vector<double>& lighting) {
   const SpectralExrInfo& info = reader.info();
   std::vector<float> values(to_size(k * (y1 - y0)) * to_size(info.width) * layer.channels.size());
   reader.read_rows(layer, k * y0, k * y1, values);
-  const auto bad = std::find_if(values.begin(), values.end(), [](float v) { return !std::isfinite(v); });
+  const bool total = layer.component.empty();
+  const auto bad = std::find_if(values.begin(), values.end(),
+                                [total](float v) { return !std::isfinite(v) || (total && v < 0.0f); });
   if (bad != values.end()) {
     const std::size_t i = static_cast<std::size_t>(bad - values.begin()), bands = layer.channels.size();
     const std::size_t pixel = i / bands;
-    throw InputError(fmt::format("{}: channel {}: value {} at pixel ({}, {}) is not finite", info.file,
+    throw InputError(fmt::format("{}: channel {}: value {} at pixel ({}, {}) is {}", info.file,
                                  layer.channels[i % bands], *bad, pixel % to_size(info.width),
-                                 to_size(k * y0) + pixel / to_size(info.width)));
+                                 to_size(k * y0) + pixel / to_size(info.width),
+                                 std::isfinite(*bad) ? "negative: a radiance is >= 0" : "not finite"));
   }
   if (!lighting.empty())
     for (std::size_t i = 0; i < values.size(); ++i)
