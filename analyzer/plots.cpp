@@ -16,6 +16,8 @@ constexpr int kPanel = 390, kTitle = 48;
 // Each projection's frame: a square `kInner` wide, with room on the left for the vertical axis's tick values,
 // above it for that axis's name, below it for the horizontal axis's ticks and name, right of it for a colour scale.
 constexpr int kLeft = 58, kTop = 46, kInner = 280;
+constexpr int kCaption = 24;  // the 3D view's caption line at the bottom of its panel
+constexpr int k3dTicks = 2;   // tick intervals along each edge of the 3D view (its edges are short)
 constexpr std::size_t kMaxPoints = 40000;
 const cv::Scalar kBackground(28, 28, 28), kFrame(90, 90, 90), kText(225, 225, 225), kDim(160, 160, 160);
 const cv::Scalar kBodyColour(255, 255, 255), kHighlightColour(0, 220, 255), kCurveColour(255, 255, 0), kPlaneColour(255, 0, 255);
@@ -27,14 +29,16 @@ cv::Point panel_origin(int panel) { return {(panel % 2) * kPanel, kTitle + (pane
 // Where overlays of a panel may go: a projection's frame, the 3D view's whole panel.
 cv::Rect clip_rect(int panel) {
   const cv::Point o = panel_origin(panel);
-  return panel < 3 ? cv::Rect(o.x + kLeft, o.y + kTop, kInner + 1, kInner + 1) : cv::Rect(o.x, o.y, kPanel, kPanel);
+  return panel < 3 ? cv::Rect(o.x + kLeft, o.y + kTop, kInner + 1, kInner + 1) : cv::Rect(o.x, o.y, kPanel, kPanel - kCaption);
 }
 
-void text(cv::Mat& img, const std::string& s, cv::Point at, double scale, const cv::Scalar& colour, int align = -1) {
+// `align`: −1 left, 0 centred, 1 right of `at`; `boxed`: on a patch of background, readable over points.
+void text(cv::Mat& img, const std::string& s, cv::Point at, double scale, const cv::Scalar& colour, int align = -1, bool boxed = false) {
   int baseline = 0;
   const cv::Size size = cv::getTextSize(s, cv::FONT_HERSHEY_SIMPLEX, scale, 1, &baseline);
   if (align == 0) at.x -= size.width / 2;
   if (align == 1) at.x -= size.width;
+  if (boxed) cv::rectangle(img, at + cv::Point(-2, baseline), at + cv::Point(size.width + 2, -size.height - 2), kBackground, cv::FILLED);
   cv::putText(img, s, at, cv::FONT_HERSHEY_SIMPLEX, scale, colour, 1, cv::LINE_AA);
 }
 
@@ -109,9 +113,15 @@ void draw_axes(cv::Mat& img, const Frame& frame, const HistogramSpec& spec, cons
       const cv::Scalar colour = a == 0 ? cv::Scalar(bit == 2 ? 255 : 60, bit == 1 ? 220 : 60, bit == 0 ? 255 : 60) : kFrame;
       cv::line(img, frame.at(corner(a), 3), frame.at(corner(b), 3), colour, 1, cv::LINE_AA);
     }
+}
+
+// The 3D view's tick values and axis names, drawn over the points.
+void draw_3d_labels(cv::Mat& img, const Frame& frame, const HistogramSpec& spec, const std::string& unit) {
+  const Vec3 lo(spec.lo[0], spec.lo[1], spec.lo[2]), hi(spec.hi[0], spec.hi[1], spec.hi[2]);
+  auto corner = [&](int bits) { return Vec3(bits & 1 ? hi[0] : lo[0], bits & 2 ? hi[1] : lo[1], bits & 4 ? hi[2] : lo[2]); };
   const cv::Point2f centre = frame.at(0.5 * (lo + hi), 3);
   for (int c = 0; c < 3; ++c) {
-    for (const double t : axis_ticks(lo[c], hi[c], 4)) {
+    for (const double t : axis_ticks(lo[c], hi[c], k3dTicks)) {
       // Black's own value is written once, at the red edge.
       if (c > 0 && t - lo[c] < 0.08 * (hi[c] - lo[c])) continue;
       Vec3 x = lo;
@@ -120,14 +130,14 @@ void draw_axes(cv::Mat& img, const Frame& frame, const HistogramSpec& spec, cons
       const cv::Point2f out = away * (1.0f / std::max(1.0f, std::hypot(away.x, away.y)));
       cv::line(img, at, at + 4 * out, kDim, 1, cv::LINE_AA);
       const cv::Point2f label = at + 16 * out;
-      text(img, tick_label(t, lo[c], hi[c], 4), cv::Point(cvRound(label.x), cvRound(label.y) + 4), 0.33, kDim, 0);
+      text(img, tick_label(t, lo[c], hi[c], k3dTicks), cv::Point(cvRound(label.x), cvRound(label.y) + 4), 0.33, kDim, 0, true);
     }
     const cv::Point2f end = frame.at(corner(1 << c), 3), away = end - centre;
     const cv::Point2f name = end + away * (34.0f / std::max(1.0f, std::hypot(away.x, away.y)));
-    text(img, kChannel[c], cv::Point(cvRound(name.x), cvRound(name.y) + 4), 0.5, kText, 0);
+    text(img, kChannel[c], cv::Point(cvRound(name.x), cvRound(name.y) + 4), 0.5, kText, 0, true);
   }
   const cv::Point o = panel_origin(3);
-  text(img, fmt::format("3D view, axes in {}", unit), cv::Point(o.x + kPanel / 2, o.y + kPanel - 8), 0.38, kDim, 0);
+  text(img, fmt::format("3D view; axes: {}", unit), cv::Point(o.x + kPanel / 2, o.y + kPanel - 8), 0.38, kDim, 0);
 }
 
 // Drawn into each panel's own view of the image (clip_rect), so that fits reaching past the range are cut at a
@@ -189,7 +199,10 @@ cv::Scalar viridis(double f) {
 // none, 255 for the largest.
 double density_index(double d, double top) { return 40 + 215 * d / std::max(1e-9, top); }
 
-std::string count_label(double count) { return count < 1e5 ? fmt::format("{:.0f}", count) : fmt::format("{:.0e}", count); }
+std::string count_label(double count) {
+  if (count < 1e4) return fmt::format("{:.0f}", count);
+  return count < 1e6 ? fmt::format("{:.0f}k", count / 1e3) : fmt::format("{:.1f}M", count / 1e6);
+}
 
 // The scale of a density panel: the colour of 1 … max_count pixels per cell, on log10(1 + count) as drawn.
 void draw_colour_bar(cv::Mat& img, cv::Point at, int height, std::uint32_t max_count) {
@@ -252,14 +265,10 @@ cv::Scalar component_colour(std::size_t k) {
 std::vector<double> axis_ticks(double lo, double hi, int target) {
   std::vector<double> ticks;
   if (!(hi > lo) || !std::isfinite(lo) || !std::isfinite(hi) || target < 1) return ticks;
-  // The step: 1, 2 or 5 × a power of ten, the smallest that gives at most `target` + 1 ticks.
-  const double raw = (hi - lo) / target, power = std::pow(10.0, std::floor(std::log10(raw)));
-  double step = 10 * power;
-  for (const double m : {1.0, 2.0, 5.0})
-    if (m * power >= raw * (1 - 1e-9)) {
-      step = m * power;
-      break;
-    }
+  // The step: (hi − lo) / target rounded to 1, 2, 5 or 10 × a power of ten (Heckbert's nice numbers, Graphics
+  // Gems, 1990: below 1.5 → 1, 3 → 2, 7 → 5, else 10).
+  const double raw = (hi - lo) / target, power = std::pow(10.0, std::floor(std::log10(raw))), f = raw / power;
+  const double step = (f < 1.5 ? 1 : f < 3 ? 2 : f < 7 ? 5 : 10) * power;
   const double slack = 1e-9 * (hi - lo);
   for (double k = std::ceil((lo - slack) / step); k * step <= hi + slack; k += 1) ticks.push_back(k * step == 0 ? 0.0 : k * step);
   return ticks;
@@ -344,6 +353,7 @@ cv::Mat plot_region(const RgbImage& layer, const ImageAnalysis& analysis, std::s
     }
   }
   draw_fits(img, frame, r.shape);
+  draw_3d_labels(img, frame, spec, unit.axis);
 
   if (colouring == PlotColouring::Density)  // the 3D view's points: the density of their 3D cell
     draw_colour_bar(img, panel_origin(3) + cv::Point(kPanel - 44, 70), 200, std::max<std::uint32_t>(1, histogram.max_count));

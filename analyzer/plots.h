@@ -30,8 +30,8 @@ struct ComponentMap {
 // set by a bright emitter elsewhere in the image.
 HistogramSpec display_range(const ImageAnalysis& analysis, const RegionSamples& samples);
 
-// Tick values for an axis from lo to hi: multiples of a step of 1, 2 or 5 × a power of ten, the smallest step
-// that gives at most `target` intervals, inside [lo, hi]. Empty for an empty or non-finite range.
+// Tick values for an axis from lo to hi: the multiples inside [lo, hi] of (hi − lo) / target rounded to 1, 2, 5
+// or 10 × a power of ten (about `target` intervals). Empty for an empty or non-finite range.
 std::vector<double> axis_ticks(double lo, double hi, int target = 5);
 // A tick value written with as many decimals as the step of axis_ticks(lo, hi, target) needs.
 std::string tick_label(double value, double lo, double hi, int target = 5);

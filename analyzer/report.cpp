@@ -192,8 +192,8 @@ json region_json(const RgbImage& layer, const ImageAnalysis& a, std::size_t i, c
   json ticks = json::array();
   for (int c = 0; c < 3; ++c) {
     json channel = json::array();
-    for (const double t : axis_ticks(spec.lo[c], spec.hi[c], 4))
-      channel.push_back({(t - spec.lo[c]) / (spec.hi[c] - spec.lo[c]), tick_label(t, spec.lo[c], spec.hi[c], 4)});
+    for (const double t : axis_ticks(spec.lo[c], spec.hi[c], 2))
+      channel.push_back({(t - spec.lo[c]) / (spec.hi[c] - spec.lo[c]), tick_label(t, spec.lo[c], spec.hi[c], 2)});
     ticks.push_back(std::move(channel));
   }
   return {{"name", r.name},
