@@ -47,25 +47,30 @@ double ImageNoise::band_sigma(std::size_t band, const Vec3& u) const {
   return sigma;
 }
 
-ImageNoise estimate_image_noise(const RgbImage& image, const std::array<double, 3>& high_levels, double floor,
-                                std::size_t max_pixels) {
+ImageNoise estimate_image_noise(const RgbImage& image, const std::array<double, 3>& low_levels, const std::array<double, 3>& high_levels,
+                                double floor, std::size_t max_pixels) {
   ImageNoise noise;
   noise.floor = floor;
   const std::size_t w = static_cast<std::size_t>(std::max(0, image.width)), h = static_cast<std::size_t>(std::max(0, image.height));
   if (w < 3 || h < 3) return noise;
-  // Whether each pixel may enter a neighbourhood: finite and below every clipping level.
+  // Whether each pixel may enter a neighbourhood: finite and strictly between every channel's limits.
   std::vector<std::uint8_t> usable(w * h);
   for (std::size_t p = 0; p < w * h; ++p) {
     bool ok = true;
-    for (std::size_t c = 0; c < 3; ++c) ok = ok && std::isfinite(image.rgb[p * 3 + c]) && image.rgb[p * 3 + c] < high_levels[c];
+    for (std::size_t c = 0; c < 3; ++c) ok = ok && std::isfinite(image.rgb[p * 3 + c]) && image.rgb[p * 3 + c] > low_levels[c] && image.rgb[p * 3 + c] < high_levels[c];
     usable[p] = ok;
   }
   const std::size_t interior = (w - 2) * (h - 2);
   const std::size_t stride = std::max<std::size_t>(1, interior / std::max<std::size_t>(1, max_pixels));
   const int mask[3][3] = {{1, -2, 1}, {-2, 4, -2}, {1, -2, 1}};
   std::vector<std::pair<double, std::array<float, 3>>> found;  // (brightness, residual / 6)
+  std::vector<double> brightness;  // of every finite pixel visited: the bands are its quantiles
   for (std::size_t i = 0; i < interior; i += stride) {
     const std::size_t x = 1 + i % (w - 2), y = 1 + i / (w - 2);
+    const float* centre = &image.rgb[(y * w + x) * 3];
+    const double level = (double(centre[0]) + centre[1] + centre[2]) / 3.0;
+    if (!std::isfinite(level)) continue;
+    brightness.push_back(level);
     std::array<double, 3> r{};
     bool ok = true;
     for (int j = -1; j <= 1 && ok; ++j)
@@ -74,23 +79,40 @@ ImageNoise estimate_image_noise(const RgbImage& image, const std::array<double, 
         ok = usable[q] != 0;
         for (std::size_t c = 0; c < 3 && ok; ++c) r[c] += mask[j + 1][k + 1] * static_cast<double>(image.rgb[q * 3 + c]);
       }
-    if (!ok) continue;
-    const float* centre = &image.rgb[(y * w + x) * 3];
-    found.push_back({(double(centre[0]) + centre[1] + centre[2]) / 3.0,
-                     {static_cast<float>(r[0] / 6), static_cast<float>(r[1] / 6), static_cast<float>(r[2] / 6)}});
+    if (ok) found.push_back({level, {static_cast<float>(r[0] / 6), static_cast<float>(r[1] / 6), static_cast<float>(r[2] / 6)}});
   }
   noise.pixels = found.size();
   if (found.size() < static_cast<std::size_t>(kBands) * 16) return noise;
-  std::stable_sort(found.begin(), found.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+  // The bands are brightness quantiles of every finite pixel, so that which pixels have a residual (clamped or
+  // clipped ones have none) does not move them.
+  std::sort(brightness.begin(), brightness.end());
+  noise.bands.resize(kBands);
   for (int band = 0; band < kBands; ++band) {
-    const std::size_t lo = found.size() * static_cast<std::size_t>(band) / kBands;
-    const std::size_t hi = found.size() * static_cast<std::size_t>(band + 1) / kBands;
-    ImageNoise::Band b;
-    b.lo = found[lo].first;
-    b.hi = found[hi - 1].first;
-    const std::size_t step = std::max<std::size_t>(1, (hi - lo) / kPerBand);
-    for (std::size_t k = lo; k < hi; k += step) b.residuals.insert(b.residuals.end(), found[k].second.begin(), found[k].second.end());
-    noise.bands.push_back(std::move(b));
+    noise.bands[static_cast<std::size_t>(band)].lo = brightness[brightness.size() * static_cast<std::size_t>(band) / kBands];
+    noise.bands[static_cast<std::size_t>(band)].hi = brightness[(brightness.size() * static_cast<std::size_t>(band + 1) - 1) / kBands];
+  }
+  std::stable_sort(found.begin(), found.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+  std::vector<std::vector<std::size_t>> members(kBands);
+  for (std::size_t i = 0; i < found.size(); ++i) members[noise.band_of(found[i].first)].push_back(i);
+  for (std::size_t band = 0; band < members.size(); ++band) {
+    const std::size_t step = std::max<std::size_t>(1, members[band].size() / kPerBand);
+    for (std::size_t k = 0; k < members[band].size(); k += step)
+      noise.bands[band].residuals.insert(noise.bands[band].residuals.end(), found[members[band][k]].second.begin(), found[members[band][k]].second.end());
+  }
+  // A band with too few residuals (its pixels clamped, clipped or all of one brightness) takes the nearest band's.
+  const std::vector<ImageNoise::Band> measured = noise.bands;
+  for (std::size_t band = 0; band < noise.bands.size(); ++band) {
+    if (measured[band].residuals.size() >= 16 * 3) continue;
+    for (std::size_t d = 1; d < measured.size(); ++d) {
+      if (band >= d && measured[band - d].residuals.size() >= 16 * 3) {
+        noise.bands[band].residuals = measured[band - d].residuals;
+        break;
+      }
+      if (band + d < measured.size() && measured[band + d].residuals.size() >= 16 * 3) {
+        noise.bands[band].residuals = measured[band + d].residuals;
+        break;
+      }
+    }
   }
   return noise;
 }

@@ -26,7 +26,9 @@ struct ImageNoise {
     double lo = 0, hi = 0;         // the brightness (mean of R, G, B) of its pixels
     std::vector<float> residuals;  // Immerkær residuals / 6, [i][channel]
   };
-  std::vector<Band> bands;  // by increasing brightness, equal counts; empty when too few pixels were usable
+  // By increasing brightness, each holding a sixteenth of the image's finite pixels (a band whose pixels have too
+  // few residuals takes the nearest band's); empty when too few pixels were usable.
+  std::vector<Band> bands;
   std::size_t pixels = 0;   // pixels with a residual: finite, unclipped 3×3 neighbourhoods (at an even stride)
   double floor = 0;         // never below: the quantisation noise of integer images (step/√12), else 0
 
@@ -36,11 +38,12 @@ struct ImageNoise {
   double band_sigma(std::size_t band, const Vec3& u) const;
 };
 
-// Pixels whose 3×3 neighbourhood holds a non-finite value or a value at or above a channel's clipping level
-// (`high_levels`, +∞ for none) have no residual. At most `max_pixels` pixels are used, at an even stride;
-// deterministic.
-ImageNoise estimate_image_noise(const RgbImage& image, const std::array<double, 3>& high_levels, double floor,
-                                std::size_t max_pixels = std::size_t{1} << 18);
+// Pixels whose 3×3 neighbourhood holds a non-finite value, a value at or below a channel's lower limit
+// (`low_levels`: the lowest code, where a converter clamps) or at or above its clipping level (`high_levels`,
+// +∞ for none) have no residual: clamped values carry no noise. At most `max_pixels` pixels are used, at an
+// even stride; deterministic.
+ImageNoise estimate_image_noise(const RgbImage& image, const std::array<double, 3>& low_levels, const std::array<double, 3>& high_levels,
+                                double floor, std::size_t max_pixels = std::size_t{1} << 18);
 
 // The share of samples [i][channel] in each band of `noise`.
 std::vector<double> band_weights(const ImageNoise& noise, std::span<const float> rgb);

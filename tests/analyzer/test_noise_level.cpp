@@ -68,7 +68,7 @@ TEST(ImageNoise, BandsFollowTheNoiseOfTheirBrightness) {
     const double level = 0.05 + 0.9 * static_cast<double>(p % 256) / 255.0;
     for (std::size_t c = 0; c < 3; ++c) image.rgb[p * 3 + c] = static_cast<float>(level + 0.01 * std::sqrt(level) * unit(rng));
   }
-  const ImageNoise noise = estimate_image_noise(image, {kNoLevel, kNoLevel, kNoLevel}, 0.0);
+  const ImageNoise noise = estimate_image_noise(image, {-kNoLevel, -kNoLevel, -kNoLevel}, {kNoLevel, kNoLevel, kNoLevel}, 0.0);
   ASSERT_EQ(noise.bands.size(), 16u);
   for (std::size_t k = 0; k < noise.bands.size(); ++k) {
     const double level = 0.5 * (noise.bands[k].lo + noise.bands[k].hi);
