@@ -87,10 +87,12 @@ ImageAnalysis analyse_image(const AnalysisImage& input, const std::string& layer
       a.encoding.curve && !a.encoding.curve->linear() ? a.encoding.curve : std::nullopt;
   const double full_scale = a.encoding.integer ? a.encoding.full_scale : 1.0;
   const RgbImage linear = curve ? linear_light(input) : RgbImage{};
-  const LayerContext linear_context = curve ? linear_light_context(a.context, *curve, full_scale) : LayerContext{};
+  const LayerContext linear_context = curve ? linear_light_context(a.context, linear, *curve, full_scale) : LayerContext{};
   Progress bar("analyze", a.regions.size(), progress);
   for (const Region& r : a.regions) {
     a.results.push_back(analyse_region(pixels, a.context, r, options));
+    if (const ClusterShape& s = a.results.back().shape; a.encoding.curve && s.gamma)
+      a.results.back().declared_gamma = compare_gamma(*s.gamma, *a.encoding.curve, full_scale);
     if (curve) {
       ClusterShape light = analyse_region(linear, linear_context, r, options).shape;
       // The whole image mixes every cluster: its class only describes; the curve's bend is judged per object.

@@ -124,6 +124,8 @@ Action add_analyze(CLI::App& app) {
                  input.encoding.curve->linear() ? "taken as linear light" : "encoded by " + input.encoding.curve->describe() +
                                                                                ": undone for the linear-light analysis",
                  input.encoding.curve_source);
+    if (!o->quiet)
+      for (const std::string& note : input.notes) fmt::print(stderr, "{}: note: {}\n", o->image, note);
     analyzer::AnalyzeOptions options;
     options.bins = o->bins;
     options.threads = o->threads;

@@ -1,0 +1,82 @@
+// The noise a cluster is judged against is the image's, measured where the image is flat: a surface whose
+// shading varies from pixel to pixel (texture along its body colour) is a line, not "a single colour", and a
+// flat noisy patch is still a point.
+#include <cmath>
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include "analyzer/region_analysis.h"
+
+namespace ct::test {
+namespace {
+
+using namespace ct::analyzer;
+
+constexpr double kNoise = 0.004;  // the Gaussian noise σ of every channel
+const Vec3 kColour{0.6, 0.45, 0.3};
+
+// 256 × 128: the left half a smooth shading ramp s = 0.2 … 0.8 of kColour (planar: Immerkær's mask cancels it),
+// the top right quarter the same colour with s drawn afresh for every pixel in [0.2, 0.8] (texture), the bottom
+// right quarter s = 0.5 everywhere; kNoise on every channel of every pixel.
+RgbImage textured_and_flat() {
+  RgbImage image{256, 128, std::vector<float>(256 * 128 * 3)};
+  std::mt19937 rng(17);
+  std::normal_distribution<double> noise(0.0, kNoise);
+  std::uniform_real_distribution<double> shading(0.2, 0.8);
+  for (int y = 0; y < image.height; ++y)
+    for (int x = 0; x < image.width; ++x) {
+      const double s = x < 128 ? 0.2 + 0.6 * x / 127.0 : y < 64 ? shading(rng) : 0.5;
+      for (int c = 0; c < 3; ++c)
+        image.rgb[(static_cast<std::size_t>(y) * 256 + static_cast<std::size_t>(x)) * 3 + static_cast<std::size_t>(c)] =
+            static_cast<float>(s * kColour[c] + noise(rng));
+    }
+  return image;
+}
+
+// The noise along any direction is kNoise (independent channels of equal σ). Each band's estimate is a clipped
+// median of about 2,000 residuals, relative standard error 1.17/√n ≈ 3 % (doubled for the overlap of
+// neighbouring masks), and the textured pixels inside the clip shift it by about 1 %; a region averages several
+// bands. 10 % is beyond four standard errors.
+constexpr double kRelativeTolerance = 0.10;
+
+TEST(ImageNoise, TexturedLineIsALineAndAFlatPatchAPoint) {
+  const RgbImage image = textured_and_flat();
+  const LayerContext context = layer_context(image, {}, 64);
+  ASSERT_FALSE(context.noise.bands.empty());
+  const AnalyzeOptions options;
+
+  const ClusterShape textured = analyse_region(image, context, rect_region({128, 0, 128, 64}, 256, 128), options).shape;
+  EXPECT_EQ(textured.shape, ShapeClass::Linear) << textured.reason;
+  ASSERT_TRUE(textured.line);
+  const double cosine = std::abs(textured.line->direction.normalized().dot(kColour.normalized()));
+  EXPECT_GT(cosine, std::cos(1.0 * M_PI / 180.0));  // along the body colour within 1°
+  for (int a = 0; a < 3; ++a) EXPECT_NEAR(textured.noise_sigma[a] / kNoise, 1.0, kRelativeTolerance) << "axis " << a;
+
+  const ClusterShape flat = analyse_region(image, context, rect_region({128, 64, 128, 64}, 256, 128), options).shape;
+  EXPECT_EQ(flat.shape, ShapeClass::Point) << flat.reason;
+  for (int a = 0; a < 3; ++a) EXPECT_NEAR(flat.noise_sigma[a] / kNoise, 1.0, kRelativeTolerance) << "axis " << a;
+}
+
+// Shot noise grows with the signal: the bands follow it. Pure noise of σ = k·√I on a ramp of I gives each band
+// the σ of its brightness.
+TEST(ImageNoise, BandsFollowTheNoiseOfTheirBrightness) {
+  RgbImage image{256, 256, std::vector<float>(256 * 256 * 3)};
+  std::mt19937 rng(5);
+  std::normal_distribution<double> unit(0.0, 1.0);
+  for (std::size_t p = 0; p < image.pixel_count(); ++p) {
+    const double level = 0.05 + 0.9 * static_cast<double>(p % 256) / 255.0;
+    for (std::size_t c = 0; c < 3; ++c) image.rgb[p * 3 + c] = static_cast<float>(level + 0.01 * std::sqrt(level) * unit(rng));
+  }
+  const ImageNoise noise = estimate_image_noise(image, {-kNoLevel, -kNoLevel, -kNoLevel}, {kNoLevel, kNoLevel, kNoLevel}, 0.0);
+  ASSERT_EQ(noise.bands.size(), 16u);
+  for (std::size_t k = 0; k < noise.bands.size(); ++k) {
+    const double level = 0.5 * (noise.bands[k].lo + noise.bands[k].hi);
+    // ~4,000 residuals per band: relative standard error ≈ 2 % (4 % with overlapping masks), plus the band's
+    // spread of brightness (σ varies by √(hi/lo) across it).
+    EXPECT_NEAR(noise.band_sigma(k, Vec3(1, 1, 1).normalized()) / (0.01 * std::sqrt(level)), 1.0, 0.12) << "band " << k;
+  }
+}
+
+}  // namespace
+}  // namespace ct::test
