@@ -61,7 +61,7 @@ const SpectrumRef* diffuse_of(const Material& m) {
 std::string describe(const Bands& bands) {
   bool uniform = true;
   for (std::size_t b = 1; b < bands.size(); ++b) uniform = uniform && std::abs(bands.width(b) - bands.width(0)) < 1e-6;
-  return uniform ? fmt::format("{} bands of {:g} nm", bands.size(), bands.width(0)) : fmt::format("{} bands", bands.size());
+  return uniform ? fmt::format("{} bands of {:.3g} nm", bands.size(), bands.width(0)) : fmt::format("{} bands", bands.size());
 }
 
 }  // namespace
