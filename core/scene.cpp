@@ -104,10 +104,12 @@ void check_within_reach(const JsonNode& node, const Shape& shape) {
 
 // The peak of radiance · scale within kMaxRadiance; `node` is the scale if given, else the radiance.
 void check_radiance_range(const JsonNode& node, const SpectrumRef& radiance, double scale) {
-  double peak = extreme_sample(radiance.spectrum, true).value;
-  if (radiance.texture) {
+  double peak = 0;
+  if (radiance.texture) {  // a texture has no spectrum of its own: its texels' largest value
     const std::vector<float>& rgb = radiance.texture->rgb;
     peak = radiance.texture->scale * (rgb.empty() ? 0.0 : *std::max_element(rgb.begin(), rgb.end()));
+  } else {
+    peak = extreme_sample(radiance.spectrum, true).value;
   }
   const double emitted = peak * scale;
   if (!(emitted <= kMaxRadiance))
