@@ -7,11 +7,15 @@ cd "$(dirname "$0")"
 packages=(
   build-essential cmake ninja-build pkg-config
   libopenexr-dev libopenimageio-dev openimageio-tools libopencv-dev
+  libtiff-dev libraw-dev  # DNG output (libtiff) and camera raw input (LibRaw)
+  dcraw libraw-bin rawtherapee  # independent raw readers the DNG test checks against (tests/cli/test_camera_raw.cpp)
   libembree-dev libtbb-dev libeigen3-dev
   nlohmann-json3-dev libcli11-dev libfmt-dev libgtest-dev
   chromium  # the browser test of analyze's report.html (tests/browser)
   blender  # the Blender add-on (blender_addon/) and its headless tests (tests/blender)
   xvfb xauth  # a display for the add-on's test in a real Blender window (tests/blender/test_gui.py)
+  clang libclang-rt-14-dev  # libFuzzer and the sanitisers (.ci/sanitize, tests/fuzz)
+  python-matplotlib-data python3-skimage rawtran-doc  # real photographs the analyzer is tested on (tests/data/photos/masks.json)
 )
 # The report viewer is bundled from npm packages (package.json): node and npm from Debian unless a node
 # with its own npm (e.g. NodeSource's) is already there.

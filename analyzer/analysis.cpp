@@ -88,13 +88,15 @@ ImageAnalysis analyse_image(const AnalysisImage& input, const std::string& layer
       a.encoding.curve && !a.encoding.curve->linear() ? a.encoding.curve : std::nullopt;
   const double full_scale = a.encoding.integer ? a.encoding.full_scale : 1.0;
   const RgbImage linear = curve ? linear_light(input) : RgbImage{};
-  const LayerContext linear_context = curve ? linear_light_context(a.context, *curve, full_scale) : LayerContext{};
+  const LayerContext linear_context = curve ? linear_light_context(a.context, linear, *curve, full_scale) : LayerContext{};
   Progress bar("analyze", a.regions.size(), progress);
   a.results.resize(a.regions.size());
   if (!input.components.empty()) a.explanations.resize(a.regions.size());
   auto analyse = [&](std::size_t i, const AnalyzeOptions& opts) {
     const Region& r = a.regions[i];
     RegionAnalysis result = analyse_region(pixels, a.context, r, opts);
+    if (const ClusterShape& s = result.shape; a.encoding.curve && s.gamma)
+      result.declared_gamma = compare_gamma(*s.gamma, *a.encoding.curve, full_scale);
     if (curve) {
       ClusterShape light = analyse_region(linear, linear_context, r, opts).shape;
       // The whole image mixes every cluster: its class only describes; the curve's bend is judged per object.

@@ -197,6 +197,24 @@ static json segmentation_json(const Segmentation& s) {
           {"clipped_highlight_merges", s.clipped_merges}};
 }
 
+// The noise every region's shape is judged against: per brightness band, σ along R, G and B.
+static json image_noise_json(const ImageNoise& noise) {
+  json bands = json::array();
+  for (std::size_t k = 0; k < noise.bands.size(); ++k)
+    bands.push_back({{"brightness", {noise.bands[k].lo, noise.bands[k].hi}},
+                     {"sigma", {std::max(noise.floor, noise.band_sigma(k, Vec3::UnitX())), std::max(noise.floor, noise.band_sigma(k, Vec3::UnitY())),
+                                std::max(noise.floor, noise.band_sigma(k, Vec3::UnitZ()))}}});
+  return {{"estimator", "Immerkaer 1996 over the whole image: 3x3 residuals of R, G, B, per brightness band the 3-sigma clipped "
+                        "median of their projection (flat areas decide, not texture)"},
+          {"spacing", noise.spacing},
+          {"spacing_reason", noise.spacing == 1 ? "the file says each pixel's three values were measured at it (chromatrace.cfa 0, or raw half size)"
+                                                : "the pixels may be demosaiced (interpolated from neighbouring photosites, so sharing their noise): the mask's taps are 3 pixels apart"},
+          {"brightness", "(R + G + B) / 3 in the analysed layer's units"},
+          {"pixels_used", noise.pixels},
+          {"floor", noise.floor},
+          {"bands", bands}};
+}
+
 json analysis_to_json(const ImageAnalysis& a, const std::vector<bool>& plotted) {
   json regions = json::array();
   for (std::size_t i = 0; i < a.results.size(); ++i) {
@@ -212,6 +230,11 @@ json analysis_to_json(const ImageAnalysis& a, const std::vector<bool>& plotted) 
               {"occupied_bins", r.histogram.cells.size()},
               {"shape", shape_to_json(r.shape)},
               {"linear_light", r.linear_light ? shape_to_json(*r.linear_light) : json(nullptr)},
+              {"gamma_against_declared", optional_json(r.declared_gamma, [](const GammaComparison& c) {
+                 return json{{"declared_curve", c.declared}, {"declared_gamma", c.declared_gamma}, {"fitted_gamma", c.fitted},
+                             {"gamma_se", c.se}, {"difference_in_se", c.difference_in_se}, {"agree", c.agree},
+                             {"rule", fmt::format("agree when |fitted - declared| <= {} gamma_se", kGammaAgreement)}};
+               })},
               {"files", {{"histogram", "histograms/" + stem + ".json"},
                          {"plot", plotted.empty() || (i < plotted.size() && plotted[i]) ? json("plots/" + stem + ".png") : json(nullptr)}}}};
     j["explanation"] = i < a.explanations.size() ? optional_json(a.explanations[i], explanation_json) : json(nullptr);
@@ -234,6 +257,7 @@ json analysis_to_json(const ImageAnalysis& a, const std::vector<bool>& plotted) 
           {"clipping_levels", a.context.high_levels},
           {"clipping_levels_source", a.context.high_levels_source},
           {"quantisation_sigma", a.context.quantisation_sigma},
+          {"image_noise", image_noise_json(a.context.noise)},
           {"criteria",
            {{"min_samples", k.min_samples},
             {"max_points", k.max_points},
@@ -262,6 +286,7 @@ json analysis_to_json(const ImageAnalysis& a, const std::vector<bool>& plotted) 
             {"superposed_share", k.superposed_share},
             {"min_mixed_samples", k.min_mixed_samples}}},
           {"regions", regions},
+          {"regions_by_size", regions_by_size(a.results)},
           {"segmentation", a.segmentation ? segmentation_json(*a.segmentation) : json(nullptr)},
           {"illuminant",
            {{"estimate", estimate_json(il.best())},

@@ -143,8 +143,9 @@ class ShapeDecision {
 
   // The noise along each principal axis, the dimensionality features, the fit points and the planes.
   void measure() {
+    const std::vector<double> weights = context_.noise ? band_weights(*context_.noise, rgb_) : std::vector<double>{};
     for (int a = 0; a < 3; ++a)
-      s_.noise_sigma[a] = noise_sigma(context_.differences, s_.moments.axes.col(a), context_.quantisation_sigma);
+      s_.noise_sigma[a] = context_.noise ? noise_sigma(*context_.noise, weights, s_.moments.axes.col(a)) : context_.quantisation_sigma;
     s1_ = s_.sigma[0];
     if (s1_ > 0) {
       s_.linearity = (s_.sigma[0] - s_.sigma[1]) / s1_;

@@ -35,6 +35,7 @@
 #include "analyzer/gamma_fit.h"
 #include "analyzer/line_fit.h"
 #include "analyzer/moments.h"
+#include "analyzer/noise_level.h"
 #include "analyzer/principal_curve.h"
 
 namespace ct::analyzer {
@@ -125,9 +126,9 @@ inline constexpr double kNoLevel = std::numeric_limits<double>::infinity();
 
 // What the cluster is judged against.
 struct ShapeContext {
-  // Differences of neighbouring pixels of the region (analyzer/noise_level.h), [pair][channel].
-  std::span<const float> differences;
-  double quantisation_sigma = 0;  // step / √12 for integer images
+  // The image's noise (analyzer/noise_level.h); none: only the floor.
+  const ImageNoise* noise = nullptr;
+  double quantisation_sigma = 0;  // step / √12 for integer images: the floor without an image noise
   std::array<double, 3> high_levels{kNoLevel, kNoLevel, kNoLevel};  // clipping levels (analyzer/clipping.h); none known: +∞
   ClippingRules clipping;               // whether they are known, and the lower limits
   std::uint64_t seed = 1;

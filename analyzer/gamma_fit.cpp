@@ -5,6 +5,8 @@
 #include <cstdint>
 #include <limits>
 
+#include "core/colour.h"
+
 namespace ct::analyzer {
 namespace {
 
@@ -66,6 +68,16 @@ std::optional<GammaFit> fit_gamma(const std::vector<Vec3>& points) {
   const std::vector<Vec3> sample = gamma_sample(points, fit.used);
   if (fit.used < 10) return std::nullopt;
   fit.gamma = best_gamma(sample);
+  std::vector<double> values;
+  for (const Vec3& p : points)
+    if (p.minCoeff() > 0) values.insert(values.end(), {p[0], p[1], p[2]});
+  auto percentile = [&](double q) {
+    const auto k = static_cast<std::ptrdiff_t>(q * static_cast<double>(values.size() - 1));
+    std::nth_element(values.begin(), values.begin() + k, values.end());
+    return values[static_cast<std::size_t>(k)];
+  };
+  fit.lo = percentile(0.02);
+  fit.hi = percentile(0.98);
   fit.straightness_as_is = straightness(sample, 1.0);
   fit.straightness_linearised = straightness(sample, 1.0 / fit.gamma);
   return fit;
@@ -96,6 +108,31 @@ double gamma_standard_error(const std::vector<Vec3>& points, std::uint64_t seed)
   for (const double g : gammas) var += (g - mean) * (g - mean) / (kReplicates - 1);
   // Resamples of m points spread as √(1/m); the fit used all of the sample's n points.
   return std::sqrt(var) * std::sqrt(static_cast<double>(m) / static_cast<double>(sample.size()));
+}
+
+double srgb_effective_gamma(double lo, double hi) {
+  constexpr int kSteps = 64;
+  double sx = 0, sy = 0, sxx = 0, sxy = 0;
+  for (int k = 0; k <= kSteps; ++k) {
+    const double y = std::log(lo) + (std::log(hi) - std::log(lo)) * k / kSteps;  // ln I'
+    const double x = std::log(srgb_decode(std::exp(y)));                          // ln I
+    sx += x, sy += y, sxx += x * x, sxy += x * y;
+  }
+  const double n = kSteps + 1;
+  return (n * sxy - sx * sy) / (n * sxx - sx * sx);
+}
+
+std::optional<GammaComparison> compare_gamma(const GammaFit& fit, const ToneCurve& declared, double full_scale) {
+  if (!fit.gamma_se || !(*fit.gamma_se > 0)) return std::nullopt;
+  GammaComparison c;
+  c.declared = declared.describe();
+  const double lo = std::clamp(fit.lo / full_scale, 1e-6, 1.0), hi = std::clamp(fit.hi / full_scale, 1e-6, 1.0);
+  c.declared_gamma = declared.srgb ? (hi > lo ? srgb_effective_gamma(lo, hi) : 1 / 2.2) : declared.gamma;
+  c.fitted = fit.gamma;
+  c.se = *fit.gamma_se;
+  c.difference_in_se = std::abs(c.fitted - c.declared_gamma) / c.se;
+  c.agree = c.difference_in_se <= kGammaAgreement;
+  return c;
 }
 
 }  // namespace ct::analyzer

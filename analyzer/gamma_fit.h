@@ -9,8 +9,10 @@
 
 #include <cstdint>
 #include <optional>
+#include <string>
 #include <vector>
 
+#include "analyzer/image_input.h"
 #include "analyzer/moments.h"
 
 namespace ct::analyzer {
@@ -21,6 +23,7 @@ struct GammaFit {
   double straightness_linearised = 0;  // the same after x ↦ x^(1/γ)
   std::size_t used = 0;              // samples with all three channels > 0
   std::optional<double> gamma_se;    // its standard error (gamma_standard_error), when measured
+  double lo = 0, hi = 0;             // the 2nd and 98th percentiles of the used samples' values, as stored
 };
 
 // Searches γ in [0.2, 5]; nullopt with fewer than 10 positive samples.
@@ -30,5 +33,23 @@ std::optional<GammaFit> fit_gamma(const std::vector<Vec3>& points);
 // replacement, a fixed seed, up to 1000 points each, the spread scaled by √(m / n) to the n points the fit used)
 // — the spread the pixels' noise and the cluster's own scatter give the fit.
 double gamma_standard_error(const std::vector<Vec3>& points, std::uint64_t seed = 1);
+
+// The fitted γ against the curve the input declared (--input-transfer, or what the file said): they agree when
+// they differ by at most 3 standard errors (the bootstrap's coverage, tests/analyzer/test_cluster_shape.cpp).
+struct GammaComparison {
+  std::string declared;        // the declared curve, described
+  double declared_gamma = 1;   // its encoding exponent; the sRGB curve's effective one over the fit's values
+  double fitted = 1, se = 0;
+  double difference_in_se = 0;  // |fitted − declared_gamma| / se
+  bool agree = false;
+};
+inline constexpr double kGammaAgreement = 3;  // standard errors
+
+// nullopt without a standard error. `full_scale`: the stored value of full scale (1 for float files).
+std::optional<GammaComparison> compare_gamma(const GammaFit& fit, const ToneCurve& declared, double full_scale);
+
+// The exponent γ of the pure power I' = I^γ nearest the sRGB curve for stored values between lo and hi (fractions
+// of full scale, 0 < lo < hi): the slope of ln I' against ln I, least squares over I' spaced evenly in ln I'.
+double srgb_effective_gamma(double lo, double hi);
 
 }  // namespace ct::analyzer

@@ -1,12 +1,17 @@
 #include "analyzer/image_input.h"
+#include "analyzer/raw_input.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdlib>
+#include <fstream>
 #include <limits>
 #include <sstream>
+#include <string_view>
 
 #include <OpenImageIO/imageio.h>
+#include <OpenImageIO/strutil.h>
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
@@ -30,11 +35,12 @@ struct RawImage {
   int alpha = -1;            // the alpha channel's index, −1 without one
   std::string colour_space;  // oiio:ColorSpace
   float display_gamma = 0;   // oiio:Gamma (0: not given)
+  std::string conversion;    // what OpenImageIO did to give R, G, B from other stored values ("" for nothing)
 };
 
 constexpr const char* kCameraKeys[] = {"chromatrace.black_level", "chromatrace.white_level", "chromatrace.dark_signal",
                                        "chromatrace.read_noise",  "chromatrace.bits",        "chromatrace.noise",
-                                       "chromatrace.adc",         "chromatrace.pixel_area",
+                                       "chromatrace.adc",         "chromatrace.pixel_area",      "chromatrace.cfa",
                                        "chromatrace.curve_gamma", "chromatrace.curve_k",     "chromatrace.curve_srgb"};
 
 // The camera's numbers: numeric attributes (EXR), numbers spelled as text (PNG keeps attributes as text), or
@@ -66,6 +72,30 @@ void read_camera_metadata(const OIIO::ImageSpec& spec, RawImage& raw) {
   if (!raw.camera.empty()) raw.camera_source = "ImageDescription";
 }
 
+// Whether a PNG file stores indices into a palette (IHDR colour type 3; OpenImageIO reports no attribute for it).
+bool png_palette(const std::filesystem::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  std::array<unsigned char, 26> head{};
+  in.read(reinterpret_cast<char*>(head.data()), head.size());
+  return in && std::string_view(reinterpret_cast<const char*>(head.data()) + 12, 4) == "IHDR" && head[25] == 3;
+}
+
+// What OpenImageIO did to give R, G, B from a file that stores something else: CMYK inks, or indices into a palette.
+std::string conversion_note(const OIIO::ImageSpec& spec, const std::string& format, const std::filesystem::path& file) {
+  const std::string tiff_space = spec.get_string_attribute("tiff:ColorSpace"), jpeg_space = spec.get_string_attribute("jpeg:ColorSpace");
+  for (const auto& [attribute, space] : {std::pair{"tiff:ColorSpace", tiff_space}, std::pair{"jpeg:ColorSpace", jpeg_space}})
+    if (OIIO::Strutil::iequals(space, "CMYK") || OIIO::Strutil::iequals(space, "YCCK"))
+      return fmt::format("the file stores CMYK ink values ({} {}): OpenImageIO converted them to R, G, B without a colour "
+                         "profile, so the values analysed are not those of a calibrated conversion", attribute, space);
+  const bool palette = format == "gif" || (format == "tiff" && spec.get_int_attribute("tiff:PhotometricInterpretation", -1) == 3) ||
+                       (format == "png" && png_palette(file));
+  if (palette)
+    return fmt::format("the file stores indices into a palette ({}): OpenImageIO expanded them to the palette's R, G, B, so "
+                       "the image holds at most 256 distinct colours and its clusters are sets of a few points",
+                       format == "png" ? "PNG colour type 3" : format == "gif" ? "GIF" : "TIFF photometric palette");
+  return "";
+}
+
 RawImage read_raw(const std::filesystem::path& file) {
   const std::string name = file.string();
   if (!std::filesystem::is_regular_file(file)) throw InputError(fmt::format("{}: cannot open file", name));
@@ -94,6 +124,7 @@ RawImage read_raw(const std::filesystem::path& file) {
   raw.alpha = spec.alpha_channel;
   raw.colour_space = spec.get_string_attribute("oiio:ColorSpace");
   raw.display_gamma = spec.get_float_attribute("oiio:Gamma", 0.0f);
+  raw.conversion = conversion_note(spec, in->format_name(), file);
   if (raw.width < 1 || raw.height < 1) throw InputError(fmt::format("{}: image has no pixels", name));
   check_image_size(name, raw.width, raw.height, raw.channels);
   raw.values.resize(static_cast<std::size_t>(raw.width) * static_cast<std::size_t>(raw.height) *
@@ -180,6 +211,7 @@ void apply_camera_metadata(const RawImage& raw, AnalysisImage& out) {
   if (const auto noise = camera_number(raw, "chromatrace.noise")) e.noise = *noise != 0;
   if (const auto adc = camera_number(raw, "chromatrace.adc")) e.adc = *adc != 0;
   if (const auto area = camera_number(raw, "chromatrace.pixel_area")) e.pixel_area = *area != 0;
+  if (const auto cfa = camera_number(raw, "chromatrace.cfa")) e.demosaiced = *cfa != 0;
   if (e.black_level && *e.black_level != 0) {
     const auto black = static_cast<float>(*e.black_level);
     for (float& v : out.image.rgb) v -= black;
@@ -303,8 +335,17 @@ RgbImage linear_light(const AnalysisImage& input) {
   return out;
 }
 
-AnalysisImage read_analysis_image(const std::filesystem::path& file, const std::string& input_transfer) {
+AnalysisImage read_analysis_image(const std::filesystem::path& file, const std::string& input_transfer,
+                                  const RawOptions& raw_options) {
   const std::optional<ToneCurve> declared = parse_input_transfer(input_transfer);
+  if (is_camera_raw(file)) {
+    AnalysisImage capture = read_camera_raw(file, raw_options);
+    if (declared) {
+      capture.encoding.curve = declared;
+      capture.encoding.curve_source = fmt::format("--input-transfer {}", input_transfer);
+    }
+    return capture;
+  }
   const std::string name = file.string();
   RawImage raw = read_raw(file);
   AnalysisImage out;
@@ -325,6 +366,7 @@ AnalysisImage read_analysis_image(const std::filesystem::path& file, const std::
   out.linear = extract_rgb(raw, "linear");
   out.display = extract_rgb(raw, "display");
   apply_camera_metadata(raw, out);
+  if (!raw.conversion.empty()) out.notes.push_back(raw.conversion);
   set_aside_invalid_pixels(raw, out);
   if (declared) {
     out.encoding.curve = declared;

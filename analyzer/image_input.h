@@ -56,12 +56,19 @@ struct ImageEncoding {
   std::optional<bool> noise = std::nullopt;  // whether noise was on
   std::optional<bool> adc = std::nullopt;    // whether the ADC was on
   std::optional<bool> pixel_area = std::nullopt;  // whether pixels integrate an area (false: point samples)
+  // Whether R, G, B were interpolated from a colour filter array's photosites (chromatrace.cfa, or a raw file
+  // read through LibRaw's demosaicing), so that neighbouring pixels share their noise; unknown for a
+  // photograph, whose camera almost surely did.
+  std::optional<bool> demosaiced = std::nullopt;
   std::optional<ToneCurve> curve = std::nullopt;   // the response curve R, G, B were encoded with
   std::string curve_source = "";                   // why that curve: the metadata or rule it came from
 
   // The value R, G, B hold for black: −black_level once subtracted, else 0 (the ADC's code 0 lies at
   // −black_level after subtraction).
   double lowest_code() const { return black_subtracted && black_level ? -*black_level : 0.0; }
+  // Whether each pixel's noise is its own, so that adjacent pixels measure it (analyzer/noise_level.h): only
+  // when the file says no colour filter array was demosaiced.
+  bool independent_pixel_noise() const { return demosaiced == false; }
   // The level at which the analysed R, G, B clip: the white level less the subtracted black level.
   std::optional<double> clipping_level() const {
     if (!white_level) return std::nullopt;
@@ -103,12 +110,21 @@ RgbImage linear_light(const AnalysisImage& input);
 // oiio:Gamma); else a float file is linear and an integer file is sRGB, as cameras, phones and browsers store it.
 std::optional<ToneCurve> parse_input_transfer(const std::string& text);
 
+// How a camera raw file is read (raw_input.h): demosaiced by LibRaw's `demosaic` method, or, with
+// `half_size`, not demosaiced (each 2×2 tile's own red, green and blue, as captured).
+struct RawOptions {
+  std::string demosaic = "linear";
+  bool half_size = false;
+};
+
 // Reads R, G, B (or a grey-free file's first three channels) and whatever extra layers are present.
 // When the file says what the camera's black level was (chromatrace.black_level, as an attribute or in the
 // ImageDescription JSON of a TIFF/PNG), it is subtracted from R, G, B, so that black is 0 for every fit
 // through black. An unreadable file, fewer than three channels or a malformed object_id /
 // chromatrace.objects is an InputError naming the file.
-AnalysisImage read_analysis_image(const std::filesystem::path& file, const std::string& input_transfer = "auto");
+// A camera raw (DNG, CR2, NEF, …: raw_input.h) is read as linear camera RGB as `raw` says.
+AnalysisImage read_analysis_image(const std::filesystem::path& file, const std::string& input_transfer = "auto",
+                                  const RawOptions& raw = {});
 
 // The RGB layer the histograms are made of: "" or "final" for R,G,B, "linear", or a component's name.
 // An unknown name is an InputError listing the layers the file has.

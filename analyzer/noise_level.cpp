@@ -2,35 +2,138 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numeric>
 
 namespace ct::analyzer {
+namespace {
 
-std::vector<float> neighbour_differences(const RgbImage& image, const RegionSamples& samples, std::size_t max_pairs) {
-  std::vector<std::uint8_t> inside(image.pixel_count(), 0);
-  for (const std::uint32_t p : samples.pixels) inside[p] = 1;
-  const auto w = static_cast<std::size_t>(image.width);
-  // Each sample has up to two pairs (right, down); a stride keeps the count bounded on huge regions.
-  const std::size_t stride = std::max<std::size_t>(1, 2 * samples.pixels.size() / std::max<std::size_t>(1, max_pairs));
-  std::vector<float> d;
-  auto add = [&](std::size_t a, std::size_t b) {
-    for (std::size_t c = 0; c < 3; ++c) d.push_back(image.rgb[b * 3 + c] - image.rgb[a * 3 + c]);
-  };
-  for (std::size_t i = 0; i < samples.pixels.size(); i += stride) {
-    const std::size_t p = samples.pixels[i];
-    if ((p + 1) % w != 0 && inside[p + 1]) add(p, p + 1);
-    if (p + w < inside.size() && inside[p + w]) add(p, p + w);
-  }
-  return d;
+constexpr int kBands = 16;
+constexpr std::size_t kPerBand = 4096;         // residuals kept per band, at an even stride
+constexpr double kQuartileAbs = 0.3186;        // the 25th percentile of |N(0, 1)|
+constexpr double kClip = 3;                    // the clip, in σ
+constexpr double kTruncatedMedianAbs = 0.6727;  // the median of |N(0, 1)| given |N| < 3
+
+double quantile(std::vector<double>& v, double q) {
+  const auto k = static_cast<std::ptrdiff_t>(q * static_cast<double>(v.size() - 1));
+  std::nth_element(v.begin(), v.begin() + k, v.end());
+  return v[static_cast<std::size_t>(k)];
 }
 
-double noise_sigma(std::span<const float> differences, const Vec3& u, double floor) {
-  const std::size_t n = differences.size() / 3;
-  if (n == 0) return floor;
-  std::vector<double> a(n);
+}  // namespace
+
+std::size_t ImageNoise::band_of(double brightness) const {
+  std::size_t k = 0;
+  while (k + 1 < bands.size() && brightness > bands[k].hi) ++k;
+  return k;
+}
+
+double ImageNoise::band_sigma(std::size_t band, const Vec3& u) const {
+  const std::vector<float>& r = bands[band].residuals;
+  std::vector<double> a(r.size() / 3);
+  for (std::size_t i = 0; i < a.size(); ++i) a[i] = std::abs(r[i * 3] * u[0] + r[i * 3 + 1] * u[1] + r[i * 3 + 2] * u[2]);
+  if (a.empty()) return 0.0;
+  double sigma = quantile(a, 0.25) / kQuartileAbs;
+  std::vector<double> inside;
+  for (int iteration = 0; iteration < 50 && sigma > 0; ++iteration) {
+    inside.clear();
+    for (const double x : a)
+      if (x <= kClip * sigma) inside.push_back(x);
+    if (inside.size() < 8) break;
+    const double next = quantile(inside, 0.5) / kTruncatedMedianAbs;
+    const bool settled = std::abs(next - sigma) <= 1e-4 * sigma;
+    sigma = next;
+    if (settled) break;
+  }
+  return sigma;
+}
+
+ImageNoise estimate_image_noise(const RgbImage& image, const std::array<double, 3>& low_levels, const std::array<double, 3>& high_levels,
+                                double floor, int spacing, std::size_t max_pixels) {
+  ImageNoise noise;
+  noise.floor = floor;
+  noise.spacing = std::max(1, spacing);
+  const std::size_t w = static_cast<std::size_t>(std::max(0, image.width)), h = static_cast<std::size_t>(std::max(0, image.height));
+  const std::size_t s = static_cast<std::size_t>(noise.spacing);
+  if (w < 2 * s + 1 || h < 2 * s + 1) return noise;
+  // Whether each pixel may enter a neighbourhood: finite and strictly between every channel's limits.
+  std::vector<std::uint8_t> usable(w * h);
+  for (std::size_t p = 0; p < w * h; ++p) {
+    bool ok = true;
+    for (std::size_t c = 0; c < 3; ++c) ok = ok && std::isfinite(image.rgb[p * 3 + c]) && image.rgb[p * 3 + c] > low_levels[c] && image.rgb[p * 3 + c] < high_levels[c];
+    usable[p] = ok;
+  }
+  const std::size_t interior = (w - 2 * s) * (h - 2 * s);
+  const std::size_t stride = std::max<std::size_t>(1, interior / std::max<std::size_t>(1, max_pixels));
+  const int mask[3][3] = {{1, -2, 1}, {-2, 4, -2}, {1, -2, 1}};
+  std::vector<std::pair<double, std::array<float, 3>>> found;  // (brightness, residual / 6)
+  std::vector<double> brightness;  // of every finite pixel visited: the bands are its quantiles
+  for (std::size_t i = 0; i < interior; i += stride) {
+    const std::size_t x = s + i % (w - 2 * s), y = s + i / (w - 2 * s);
+    const float* centre = &image.rgb[(y * w + x) * 3];
+    const double level = (double(centre[0]) + centre[1] + centre[2]) / 3.0;
+    if (!std::isfinite(level)) continue;
+    brightness.push_back(level);
+    std::array<double, 3> r{};
+    bool ok = true;
+    for (int j = -1; j <= 1 && ok; ++j)
+      for (int k = -1; k <= 1 && ok; ++k) {
+        const std::size_t q = static_cast<std::size_t>(static_cast<std::ptrdiff_t>((y * w + x)) +
+                                                       static_cast<std::ptrdiff_t>(s) * (j * static_cast<std::ptrdiff_t>(w) + k));
+        ok = usable[q] != 0;
+        for (std::size_t c = 0; c < 3 && ok; ++c) r[c] += mask[j + 1][k + 1] * static_cast<double>(image.rgb[q * 3 + c]);
+      }
+    if (ok) found.push_back({level, {static_cast<float>(r[0] / 6), static_cast<float>(r[1] / 6), static_cast<float>(r[2] / 6)}});
+  }
+  noise.pixels = found.size();
+  if (found.size() < static_cast<std::size_t>(kBands) * 16) return noise;
+  // The bands are brightness quantiles of every finite pixel, so that which pixels have a residual (clamped or
+  // clipped ones have none) does not move them.
+  std::sort(brightness.begin(), brightness.end());
+  noise.bands.resize(kBands);
+  for (int band = 0; band < kBands; ++band) {
+    noise.bands[static_cast<std::size_t>(band)].lo = brightness[brightness.size() * static_cast<std::size_t>(band) / kBands];
+    noise.bands[static_cast<std::size_t>(band)].hi = brightness[(brightness.size() * static_cast<std::size_t>(band + 1) - 1) / kBands];
+  }
+  std::stable_sort(found.begin(), found.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+  std::vector<std::vector<std::size_t>> members(kBands);
+  for (std::size_t i = 0; i < found.size(); ++i) members[noise.band_of(found[i].first)].push_back(i);
+  for (std::size_t band = 0; band < members.size(); ++band) {
+    const std::size_t step = std::max<std::size_t>(1, members[band].size() / kPerBand);
+    for (std::size_t k = 0; k < members[band].size(); k += step)
+      noise.bands[band].residuals.insert(noise.bands[band].residuals.end(), found[members[band][k]].second.begin(), found[members[band][k]].second.end());
+  }
+  // A band with too few residuals (its pixels clamped, clipped or all of one brightness) takes the nearest band's.
+  const std::vector<ImageNoise::Band> measured = noise.bands;
+  for (std::size_t band = 0; band < noise.bands.size(); ++band) {
+    if (measured[band].residuals.size() >= 16 * 3) continue;
+    for (std::size_t d = 1; d < measured.size(); ++d) {
+      if (band >= d && measured[band - d].residuals.size() >= 16 * 3) {
+        noise.bands[band].residuals = measured[band - d].residuals;
+        break;
+      }
+      if (band + d < measured.size() && measured[band + d].residuals.size() >= 16 * 3) {
+        noise.bands[band].residuals = measured[band + d].residuals;
+        break;
+      }
+    }
+  }
+  return noise;
+}
+
+std::vector<double> band_weights(const ImageNoise& noise, std::span<const float> rgb) {
+  std::vector<double> weights(noise.bands.size(), 0.0);
+  const std::size_t n = rgb.size() / 3;
+  if (n == 0 || weights.empty()) return weights;
   for (std::size_t i = 0; i < n; ++i)
-    a[i] = std::abs(differences[i * 3] * u[0] + differences[i * 3 + 1] * u[1] + differences[i * 3 + 2] * u[2]);
-  std::nth_element(a.begin(), a.begin() + static_cast<std::ptrdiff_t>(n / 2), a.end());
-  return std::max(floor, 1.4826 * a[n / 2] / std::sqrt(2.0));
+    weights[noise.band_of((double(rgb[i * 3]) + rgb[i * 3 + 1] + rgb[i * 3 + 2]) / 3.0)] += 1.0 / static_cast<double>(n);
+  return weights;
+}
+
+double noise_sigma(const ImageNoise& noise, std::span<const double> weights, const Vec3& u) {
+  double variance = 0;
+  for (std::size_t k = 0; k < weights.size() && k < noise.bands.size(); ++k)
+    if (weights[k] > 0) variance += weights[k] * std::pow(noise.band_sigma(k, u), 2);
+  return std::max(noise.floor, std::sqrt(variance));
 }
 
 }  // namespace ct::analyzer

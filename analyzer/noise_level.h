@@ -1,28 +1,64 @@
 #pragma once
-// The noise level a cluster's extent is judged against.
+// The noise level a cluster's extent is judged against, estimated once for the whole image.
 //
-// Sensor noise is independent from pixel to pixel, while real colour structure (shading, highlights,
-// interreflection) varies smoothly over the image. So the spread of differences between neighbouring
-// pixels of a region, projected on a direction of colour space, measures the noise along that direction
-// without being fooled by the structure itself: σ = 1.4826 · median |d·u| / √2 (the MAD of a difference
-// of two independent samples). Edges between objects are rare within a region; the median ignores them.
+// Immerkær's 3×3 mask [1 −2 1; −2 4 −2; 1 −2 1] (Fast noise variance estimation, CVIU 64, 1996) cancels any
+// locally planar signal, such as smooth shading, and leaves 6σ of white noise. Applied to R, G, B together it
+// gives a residual vector r per pixel whose projection on a unit vector u has 6 × the noise σ along u, whatever
+// the correlation of the channels. Texture is not cancelled, so the flat areas of the image decide, per band of
+// brightness (shot noise grows with the signal): a start from the 25th percentile of |r·u| (0.3186 × 6σ for
+// Gaussian noise), then a clip iterated to its fixed point, the median of the |r·u| within 3 × 6σ (0.6727 × 6σ
+// for a Gaussian truncated there), which leaves out the textured pixels whose residuals lie far beyond the
+// noise. A region's noise along u is the root of the bands' variances averaged over its samples' brightness:
+// the noise of a textured surface is the image's noise at its brightness, not the spread of its texture.
+//
+// The mask assumes noise independent from pixel to pixel. Demosaicing (and a camera's further processing)
+// interpolates each channel from neighbouring photosites, so neighbouring pixels share their noise and the
+// mask on adjacent pixels sees almost none of it: on bilinear-demosaiced white noise, red and blue residuals
+// vanish at three pixels of four and the estimate falls to 0, green's to a third. With its taps `spacing`
+// pixels apart (3: beyond the reach of a 3×3 interpolation, so the taps' noise is independent again) the mask
+// still cancels a planar signal, and gives each pixel's own noise σ for white and for interpolated noise alike.
 
-#include <cstdint>
+#include <array>
+#include <cstddef>
 #include <span>
 #include <vector>
 
 #include "analyzer/image_input.h"
 #include "analyzer/moments.h"
-#include "analyzer/regions.h"
 
 namespace ct::analyzer {
 
-// Colour differences of pairs of horizontally and vertically adjacent pixels that both belong to the
-// samples, as [pair][channel]; at most `max_pairs`, taken at an even stride over the image.
-std::vector<float> neighbour_differences(const RgbImage& image, const RegionSamples& samples, std::size_t max_pairs);
+struct ImageNoise {
+  struct Band {
+    double lo = 0, hi = 0;         // the brightness (mean of R, G, B) of its pixels
+    std::vector<float> residuals;  // Immerkær residuals / 6, [i][channel]
+  };
+  // By increasing brightness, each holding a sixteenth of the image's finite pixels (a band whose pixels have too
+  // few residuals takes the nearest band's); empty when too few pixels were usable.
+  std::vector<Band> bands;
+  std::size_t pixels = 0;   // pixels with a residual: finite, unclipped 3×3 neighbourhoods (at an even stride)
+  double floor = 0;         // never below: the quantisation noise of integer images (step/√12), else 0
+  int spacing = 1;          // pixels between the mask's taps
 
-// The noise standard deviation along the unit vector u; never below `floor` (the quantisation noise of
-// integer images, step/√12). With no pairs, just the floor.
-double noise_sigma(std::span<const float> differences, const Vec3& u, double floor);
+  // The band a brightness falls into (the nearest at the ends).
+  std::size_t band_of(double brightness) const;
+  // The noise σ along the unit vector u in one band (not floored).
+  double band_sigma(std::size_t band, const Vec3& u) const;
+};
+
+// Pixels whose 3×3 neighbourhood holds a non-finite value, a value at or below a channel's lower limit
+// (`low_levels`: the lowest code, where a converter clamps) or at or above its clipping level (`high_levels`,
+// +∞ for none) have no residual: clamped values carry no noise. At most `max_pixels` pixels are used, at an
+// even stride; deterministic. `spacing`: 1 when the image says each pixel's noise is its own, else
+// kInterpolatedNoiseSpacing.
+inline constexpr int kInterpolatedNoiseSpacing = 3;
+ImageNoise estimate_image_noise(const RgbImage& image, const std::array<double, 3>& low_levels, const std::array<double, 3>& high_levels,
+                                double floor, int spacing = 1, std::size_t max_pixels = std::size_t{1} << 18);
+
+// The share of samples [i][channel] in each band of `noise`.
+std::vector<double> band_weights(const ImageNoise& noise, std::span<const float> rgb);
+
+// The noise standard deviation along the unit vector u for samples with those band weights; never below the floor.
+double noise_sigma(const ImageNoise& noise, std::span<const double> weights, const Vec3& u);
 
 }  // namespace ct::analyzer

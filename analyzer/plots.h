@@ -30,7 +30,21 @@ struct ComponentMap {
 // set by a bright emitter elsewhere in the image.
 HistogramSpec display_range(const ImageAnalysis& analysis, const RegionSamples& samples);
 
-// An 8-bit BGR image, 2 × 2 panels under a title line.
+// Tick values for an axis from lo to hi: the multiples inside [lo, hi] of (hi − lo) / target rounded to 1, 2, 5
+// or 10 × a power of ten (about `target` intervals). Empty for an empty or non-finite range.
+std::vector<double> axis_ticks(double lo, double hi, int target = 5);
+// A tick value written with as many decimals as the step of axis_ticks(lo, hi, target) needs.
+std::string tick_label(double value, double lo, double hi, int target = 5);
+
+// What the plotted values are, short (an axis's unit) and in full (the plot's subtitle, the report): codes or
+// values as stored, linear or encoded by a named curve.
+struct ValueUnit {
+  std::string axis;
+  std::string description;
+};
+ValueUnit value_unit(const ImageAnalysis& analysis);
+
+// An 8-bit BGR image, 2 × 2 panels under a title and a line saying the axes' unit; every axis has tick values.
 cv::Mat plot_region(const RgbImage& layer, const ImageAnalysis& analysis, std::size_t region, PlotColouring colouring,
                     const ComponentMap& components);
 

@@ -2,10 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numeric>
 
 #include <fmt/core.h>
 
-#include "analyzer/noise_level.h"
 
 namespace ct::analyzer {
 
@@ -41,10 +41,12 @@ LayerContext layer_context(const RgbImage& layer, const ImageEncoding& encoding,
     for (double& level : c.high_levels)
       if (!(level > 0)) level = std::numeric_limits<double>::infinity();
   }
+  c.noise = estimate_image_noise(layer, c.clipping.low, c.high_levels, c.quantisation_sigma,
+                                 encoding.independent_pixel_noise() ? 1 : kInterpolatedNoiseSpacing);
   return c;
 }
 
-LayerContext linear_light_context(const LayerContext& stored, const ToneCurve& curve, double full_scale) {
+LayerContext linear_light_context(const LayerContext& stored, const RgbImage& linear, const ToneCurve& curve, double full_scale) {
   LayerContext c = stored;
   for (double& level : c.high_levels)
     if (std::isfinite(level)) level = curve.decode(level, full_scale);
@@ -54,6 +56,7 @@ LayerContext linear_light_context(const LayerContext& stored, const ToneCurve& c
   }
   c.clipping.low.fill(curve.decode(stored.clipping.low[0], full_scale));
   c.quantisation_sigma = 0;
+  c.noise = estimate_image_noise(linear, c.clipping.low, c.high_levels, 0.0, stored.noise.spacing);
   return c;
 }
 
@@ -91,6 +94,13 @@ void apply_tone_curve(RegionAnalysis& stored, ClusterShape linear, const ToneCur
   stored.linear_light = std::move(linear);
 }
 
+std::vector<std::size_t> regions_by_size(const std::vector<RegionAnalysis>& regions) {
+  std::vector<std::size_t> order(regions.size());
+  std::iota(order.begin(), order.end(), std::size_t{0});
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return regions[a].pixels > regions[b].pixels; });
+  return order;
+}
+
 RegionAnalysis analyse_region(const RgbImage& layer, const LayerContext& context, const Region& region,
                               const AnalyzeOptions& options) {
   RegionAnalysis a;
@@ -101,8 +111,7 @@ RegionAnalysis analyse_region(const RgbImage& layer, const LayerContext& context
   const RegionSamples samples = gather_samples(layer, region);
   a.non_finite = samples.non_finite;
   a.histogram = histogram_3d(samples.rgb, context.spec, options.threads);
-  const std::vector<float> differences = neighbour_differences(layer, samples, options.max_noise_pairs);
-  ShapeContext shape{differences, context.quantisation_sigma, context.high_levels, context.clipping, options.seed, options.threads,
+  ShapeContext shape{&context.noise, context.quantisation_sigma, context.high_levels, context.clipping, options.seed, options.threads,
                      options.criteria};
   a.shape = analyse_shape(samples.rgb, shape);
   if (a.pixels == 0) a.shape.reason = "the region is empty: no shape measured";

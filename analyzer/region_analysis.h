@@ -10,6 +10,7 @@
 #include "analyzer/cluster_shape.h"
 #include "analyzer/histogram.h"
 #include "analyzer/image_input.h"
+#include "analyzer/noise_level.h"
 #include "analyzer/regions.h"
 
 namespace ct::analyzer {
@@ -18,7 +19,6 @@ struct AnalyzeOptions {
   int bins = 64;
   int threads = 0;
   std::uint64_t seed = 1;
-  std::size_t max_noise_pairs = 200000;
   ShapeCriteria criteria;
 };
 
@@ -32,6 +32,7 @@ struct LayerContext {
   std::string high_levels_source = "";  // "white level", "full scale" or "channel maxima"
   ClippingRules clipping = {};          // known_high for the first two; the lower limits
   double quantisation_sigma = 0;   // 1/√12 digital numbers for integer files, else 0
+  ImageNoise noise;                // the layer's noise, once for every region (analyzer/noise_level.h)
 };
 // `encoding` is the file's for the final image; pass a default (float) encoding for the linear and
 // component layers.
@@ -47,17 +48,23 @@ struct RegionAnalysis {
   // The cluster in linear light, when the analysed values were encoded by a known non-linear response curve
   // (ImageEncoding::curve): the class the light itself gives, before the curve bent it.
   std::optional<ClusterShape> linear_light;
+  // The γ fitted to the values as stored against the curve the input declared (when both are known).
+  std::optional<GammaComparison> declared_gamma;
 };
 
-// The context of the same layer with its response curve undone (linear_light()): the clipping levels go
-// through the curve's inverse, and the quantisation step, uneven in linear light, is left to the measured noise.
-LayerContext linear_light_context(const LayerContext& stored, const ToneCurve& curve, double full_scale);
+// The context of the same layer with its response curve undone (`linear`, from linear_light()): the clipping
+// levels go through the curve's inverse, the noise is measured on `linear`, and the quantisation step, uneven in
+// linear light, is left to the measured noise.
+LayerContext linear_light_context(const LayerContext& stored, const RgbImage& linear, const ToneCurve& curve, double full_scale);
 
 // Compares the region's cluster as stored with its cluster in linear light: where the light's cluster is a line
 // or a plane, and as stored it spreads off that flat by more than the noise, a spread that undoing the curve
 // removes (its variance relative to the cluster's length falls to gamma_straightening), the structure the
 // histogram shows is the curve's bend, and the class becomes gamma (docs/analyze.md).
 void apply_tone_curve(RegionAnalysis& stored, ClusterShape linear, const ToneCurve& curve, const ShapeCriteria& criteria);
+
+// The regions' indices by decreasing pixel count (equal counts in their order): the order a person reads them in.
+std::vector<std::size_t> regions_by_size(const std::vector<RegionAnalysis>& regions);
 
 RegionAnalysis analyse_region(const RgbImage& layer, const LayerContext& context, const Region& region,
                               const AnalyzeOptions& options);

@@ -2,7 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
+#include <charconv>
 #include <numeric>
 
 #include <fmt/core.h>
@@ -42,18 +42,32 @@ Region mask_region(const LabelImage& mask, const std::string& name) {
 
 Region rect_region(const Rect& rect, int width, int height) {
   Region r{fmt::format("rect {},{} {}x{}", rect.x, rect.y, rect.width, rect.height), "rect", -1, {}};
+  // In 64 bits: x + width may pass INT_MAX (--rect 2147483647,0,10,10).
   const int x0 = std::max(rect.x, 0), y0 = std::max(rect.y, 0);
-  const int x1 = std::min(rect.x + rect.width, width), y1 = std::min(rect.y + rect.height, height);
+  const int x1 = static_cast<int>(std::min<long long>(static_cast<long long>(rect.x) + rect.width, width));
+  const int y1 = static_cast<int>(std::min<long long>(static_cast<long long>(rect.y) + rect.height, height));
   for (int y = y0; y < y1; ++y)
     for (int x = x0; x < x1; ++x) r.pixels.push_back(static_cast<std::uint32_t>(y) * static_cast<std::uint32_t>(width) + static_cast<std::uint32_t>(x));
   return r;
 }
 
 Rect parse_rect(const std::string& text, const std::string& option) {
-  Rect r;
-  char extra = 0;
-  if (std::sscanf(text.c_str(), "%d,%d,%d,%d%c", &r.x, &r.y, &r.width, &r.height, &extra) != 4 || r.width < 0 || r.height < 0)
-    throw InputError(fmt::format("{}: expected x,y,width,height with width, height >= 0, got \"{}\"", option, text));
+  const auto bad = [&] {
+    return InputError(fmt::format("{}: expected x,y,width,height (whole numbers within ±2147483647) with width, "
+                                  "height >= 0, got \"{}\"",
+                                  option, text));
+  };
+  int fields[4] = {};
+  const char* p = text.data();
+  const char* const end = text.data() + text.size();
+  for (int i = 0; i < 4; ++i) {
+    if (i > 0 && (p == end || *p++ != ',')) throw bad();
+    const auto [next, error] = std::from_chars(p, end, fields[i]);
+    if (error != std::errc()) throw bad();  // not a number, or beyond an int
+    p = next;
+  }
+  const Rect r{fields[0], fields[1], fields[2], fields[3]};
+  if (p != end || r.width < 0 || r.height < 0) throw bad();
   return r;
 }
 

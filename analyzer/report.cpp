@@ -151,6 +151,10 @@ json summary(const RegionAnalysis& r, const std::optional<Explanation>& e) {
   if (s.gamma && s.shape == ShapeClass::Gamma)
     row("γ", s.gamma->gamma_se ? fmt::format("{:.3f} ± {:.3f}", s.gamma->gamma, *s.gamma->gamma_se)
                                : fmt::format("{:.3f}", s.gamma->gamma));
+  if (const auto& c = r.declared_gamma)
+    row("γ against the declared curve", fmt::format("{}: fitted {:.3f}, declared {} ≈ {:.3f}, {:.1f} standard errors apart (agreement: at most {:g})",
+                                                    c->agree ? "agree" : "disagree", c->fitted, c->declared, c->declared_gamma,
+                                                    c->difference_in_se, kGammaAgreement));
   if (!s.clipping.faces.empty()) row("clipped", percent(s.clipping.fraction));
   if (r.linear_light) row("class in linear light (curve undone)", std::string(class_name(r.linear_light->shape)));
   if (e) {
@@ -184,9 +188,19 @@ json region_json(const RgbImage& layer, const ImageAnalysis& a, std::size_t i, c
   json points = {{"rgb", base64_of(rgb)}, {"pixels", base64_of(pixels)}};
   if (!dominant.empty()) points["component"] = base64_of(component);
   const std::optional<Explanation> none;
+  // Tick values along each channel's edge from black: the position in the shown cube (0 … 1) and the value.
+  json ticks = json::array();
+  for (int c = 0; c < 3; ++c) {
+    json channel = json::array();
+    for (const double t : axis_ticks(spec.lo[c], spec.hi[c], 2))
+      channel.push_back({(t - spec.lo[c]) / (spec.hi[c] - spec.lo[c]), tick_label(t, spec.lo[c], spec.hi[c], 2)});
+    ticks.push_back(std::move(channel));
+  }
   return {{"name", r.name},
           {"pixels", r.pixels},
           {"range", {spec.lo[0], spec.hi[0]}},
+          {"ranges", {{spec.lo[0], spec.hi[0]}, {spec.lo[1], spec.hi[1]}, {spec.lo[2], spec.hi[2]}}},
+          {"ticks", ticks},
           {"class", class_name(r.shape.shape)},
           {"reason", r.shape.reason},
           {"points", points},
@@ -210,6 +224,9 @@ main { display: flex; gap: 16px; padding: 12px 16px; flex-wrap: wrap; }
 #region-list button { background: #222; color: #ddd; border: 1px solid #444; padding: 3px 8px; cursor: pointer; }
 #region-list button.current { border-color: #f0f; color: #fff; }
 #details table, #illuminant table { border-collapse: collapse; }
+#region-table { border-collapse: collapse; font-size: 13px; }
+#region-table th, #region-table td { text-align: left; padding: 1px 10px 1px 0; font-weight: normal; }
+#region-table th { color: #999; }
 #details th, #details td, #illuminant th, #illuminant td { text-align: left; padding: 1px 10px 1px 0; font-weight: normal; }
 #details th, #illuminant th { color: #999; }
 .class { font-size: 18px; color: #fff; margin: 0; }
@@ -229,7 +246,18 @@ std::string report_html(const AnalysisImage& input, const ImageAnalysis& a, std:
     const cv::Scalar c = component_colour(k);
     colours.push_back({c[0], c[1], c[2]});
   }
+  const ValueUnit unit = value_unit(a);
+  // The regions by size, with their pixel counts: readable without the viewer.
+  std::string region_table = "<table id=\"region-table\"><tr><th>region</th><th>class</th><th>pixels</th><th>share of the image</th></tr>";
+  for (const std::size_t i : regions_by_size(a.results)) {
+    const RegionAnalysis& r = a.results[i];
+    region_table += fmt::format("<tr data-region=\"{}\"><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>", i, escape_html(r.name),
+                                class_name(r.shape.shape), r.pixels,
+                                percent(static_cast<double>(r.pixels) / std::max(1.0, static_cast<double>(a.width) * a.height)));
+  }
+  region_table += "</table>";
   const json data = {{"display", {{"width", d.width}, {"height", d.height}}},
+                     {"unit", unit.axis},
                      {"encodeSrgb", !a.encoding.integer},
                      {"labels", base64_of(label_map(a, d))},
                      {"componentColours", colours},
@@ -268,6 +296,7 @@ std::string report_html(const AnalysisImage& input, const ImageAnalysis& a, std:
 <header>
 <h1>chromatrace analysis — {title}</h1>
 <div>{width}×{height}, layer {layer}, {regions} region{plural}. Numbers: <a href="analysis.json">analysis.json</a>, plots in <a href="plots/">plots/</a>.</div>
+<div class="hint">Values: {unit}.</div>
 {notes}
 </header>
 <main>
@@ -275,6 +304,8 @@ std::string report_html(const AnalysisImage& input, const ImageAnalysis& a, std:
 <div id="image-wrap" data-selected-pixels="0"><img id="image" alt="analysed image" src="{image}"><canvas id="overlay"></canvas></div>
 <p class="hint">Click a region in the image, or pick one below.</p>
 <div id="region-list"></div>
+<h2>Regions by size</h2>
+{region_table}
 <h2>Illuminant</h2>
 <div id="illuminant">{illuminant}</div>
 </section>
@@ -294,6 +325,7 @@ Colour: <select id="colour-mode"><option value="own">own colour</option><option 
       fmt::arg("width", a.width), fmt::arg("height", a.height), fmt::arg("layer", escape_html(a.layer)),
       fmt::arg("regions", a.results.size()), fmt::arg("plural", a.results.size() == 1 ? "" : "s"), fmt::arg("notes", notes),
       fmt::arg("image", image_png(input, layer, a, d)), fmt::arg("illuminant", illuminant), fmt::arg("legend", legend),
+      fmt::arg("unit", escape_html(unit.description)), fmt::arg("region_table", region_table),
       fmt::arg("data", script_safe(data.dump())), fmt::arg("bundle", script_safe(std::string(viewer_bundle()))));
 }
 

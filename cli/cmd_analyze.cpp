@@ -45,6 +45,7 @@ Action add_analyze(CLI::App& app) {
   struct Options {
     std::string image, output, layer, illuminant, input_transfer = "auto";
     analyzer::RegionOptions regions;
+    analyzer::RawOptions raw;
     std::vector<std::string> rects;
     int bins = 64, threads = 0;
     std::size_t report_points = 20000;
@@ -53,13 +54,20 @@ Action add_analyze(CLI::App& app) {
     std::string plots = "12";
   };
   auto o = std::make_shared<Options>();
-  cmd->add_option("image", o->image, "Image: PNG, TIFF, EXR … (the sensor simulator's EXR adds layers and object ids)")->required();
+  cmd->add_option("image", o->image,
+                  "Image: PNG, TIFF, EXR, camera raw (DNG, CR2, NEF, …) (the sensor simulator's EXR adds layers and object ids)")
+      ->required();
   cmd->add_option("-o,--output", o->output, "Output directory (created; its parent must exist)")->required();
   cmd->add_option("--layer", o->layer, "RGB layer to analyse: final (R,G,B), linear, or a component name")->default_str("final");
   cmd->add_option("--input-transfer", o->input_transfer,
                   "What R, G, B hold: auto (from the file's metadata and type), linear, srgb, or gamma=G (a display gamma, "
                   "e.g. 2.2)")
       ->capture_default_str();
+  cmd->add_option("--raw-demosaic", o->raw.demosaic,
+                  "Camera raw: LibRaw's demosaicing, linear, vng, ppg, ahd, dcb, dht or aahd")
+      ->capture_default_str();
+  cmd->add_flag("--raw-half-size", o->raw.half_size,
+                "Camera raw: no demosaicing; each 2x2 Bayer tile gives its own red, green and blue (half size)");
   cmd->add_option("--labels", o->regions.labels, "Label regions: an id channel of the image (object_id) or a label image file");
   cmd->add_flag("--no-labels", o->regions.no_labels, "Ignore the image's object_id channel");
   cmd->add_option("--mask", o->regions.masks, "Mask image (non-zero pixels form a region); repeatable");
@@ -107,7 +115,7 @@ Action add_analyze(CLI::App& app) {
     for (const std::string& r : o->rects) o->regions.rects.push_back(analyzer::parse_rect(r, "--rect"));
     check_output(o->output, o->image, o->regions);
 
-    const analyzer::AnalysisImage input = analyzer::read_analysis_image(o->image, o->input_transfer);
+    const analyzer::AnalysisImage input = analyzer::read_analysis_image(o->image, o->input_transfer, o->raw);
     const analyzer::RgbImage& layer = analyzer::select_layer(input, o->layer);
     analyzer::Segmentation segmentation;
     std::vector<analyzer::Region> regions = analyzer::select_regions(input, layer, o->regions, &segmentation);
@@ -116,6 +124,8 @@ Action add_analyze(CLI::App& app) {
                  input.encoding.curve->linear() ? "taken as linear light" : "encoded by " + input.encoding.curve->describe() +
                                                                                ": undone for the linear-light analysis",
                  input.encoding.curve_source);
+    if (!o->quiet)
+      for (const std::string& note : input.notes) fmt::print(stderr, "{}: note: {}\n", o->image, note);
     analyzer::AnalyzeOptions options;
     options.bins = o->bins;
     options.threads = o->threads;
@@ -128,7 +138,10 @@ Action add_analyze(CLI::App& app) {
                    100 * segmentation.unassigned_fraction(), segmentation.dark_pixels, segmentation.small_pixels, segmentation.seconds);
       analysis.segmentation = std::move(segmentation);
     }
-    analyzer::write_analysis(o->output, input, analysis, {!o->no_plots, !o->no_report, o->report_points, plot_limit});
+    // Written aside and moved into place when complete: a full disk leaves no partial analysis behind.
+    StagedDirectory output(o->output);
+    analyzer::write_analysis(output.path(), input, analysis, {!o->no_plots, !o->no_report, o->report_points, plot_limit});
+    output.commit();
     if (!o->quiet) {
       for (const analyzer::RegionAnalysis& r : analysis.results)
         fmt::print(stderr, "{}: {} ({} px){}\n", r.name, analyzer::class_name(r.shape.shape), r.pixels,

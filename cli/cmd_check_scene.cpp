@@ -14,6 +14,7 @@
 #include "core/file_io.h"
 #include "core/geometry.h"
 #include "core/json_input.h"
+#include "plan/spectral_check.h"
 #include "core/scene.h"
 #include "sensor_sim/config.h"
 
@@ -59,7 +60,10 @@ Json scene_summary(const Scene& scene) {
 
   const Camera& c = scene.camera;
   const RenderSettings& r = scene.render;
+  std::vector<std::string> warnings;
+  for (const plan::SpectralWarning& w : plan::check_band_plan(scene, r.bands, r.spectral_mode)) warnings.push_back(w.message);
   return {
+      {"warnings", warnings},
       {"name", scene.name},
       {"spectra", scene.spectra.size()},
       {"materials", materials},
@@ -132,6 +136,7 @@ void print_scene(const Json& s) {
       r["pixel_filter"].get<std::string>(), r["spectral_mode"].get<std::string>(), r["bands"]["count"].get<int>(),
       r["bands"]["lo_nm"].get<double>(), r["bands"]["hi_nm"].get<double>(), r["tessellation"]["segments"].get<int>(),
       r["tessellation"]["rings"].get<int>());
+  for (const Json& w : s["warnings"]) fmt::print("  warning    {}\n", w.get<std::string>());
 }
 
 Json expect_json(const std::vector<Expectation>& expect) {

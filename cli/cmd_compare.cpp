@@ -50,7 +50,7 @@ Action add_compare(CLI::App& app) {
   auto* cmd = app.add_subcommand(
       "compare", "Cross-validate two spectral renders of one scene: per object, band and component, and ΔE00");
   struct Options {
-    std::string a, b, output, tolerance, pixels = "matched", camera = "cie1931";
+    std::string a, b, output, tolerance, pixels = "matched", camera = "cie1931", colour = "common";
     double sigmas = 4.0;
     bool quiet = false;
   };
@@ -65,6 +65,10 @@ Action add_compare(CLI::App& app) {
                   "An object's pixels: matched (same id in both) or interior (and all 8 neighbours)")
       ->capture_default_str();
   cmd->add_option("--camera", o->camera, "Camera for ΔE00: cie1931 or a shipped camera")->capture_default_str();
+  cmd->add_option("--colour", o->colour,
+                  "Image-level colours: common (both on the coarser band plan: what the renderers do differently) or "
+                  "own (each over its own bands: a coarser plan's colour error counts too)")
+      ->capture_default_str();
   cmd->add_flag("-q,--quiet", o->quiet, "No verdict on stderr");
 
   return [o] {
@@ -75,6 +79,7 @@ Action add_compare(CLI::App& app) {
     options.sigmas = o->sigmas;
     options.pixels = o->pixels;
     options.camera = o->camera;
+    options.colour = o->colour;
     if (o->output.empty()) throw InputError("--output: no directory name");
     const cmp::Comparison c = cmp::compare(options);
     cmp::write_outputs(c, o->output);

@@ -48,7 +48,8 @@ int run(const Options& o) {
     files.push_back(mesh_file_name(static_cast<int>(i) + 1, name));
     if (fs::is_directory(dir)) check_output_file(dir / files.back(), scene.files);
   }
-  fs::create_directories(dir);
+  // Written aside and moved into place when complete: a full disk leaves no partial set of meshes behind.
+  StagedDirectory staged(dir);
 
   const PlyFormat format = o.ascii ? PlyFormat::Ascii : PlyFormat::BinaryLittleEndian;
   Json objects = Json::array(), lights = Json::array();
@@ -62,9 +63,9 @@ int run(const Options& o) {
       const std::vector<std::array<Vec2, 3>> uvs =
           is_light ? std::visit([](const auto& shape) { return corner_uvs(Shape(shape)); }, scene.lights[i - scene.objects.size()].shape)
                    : corner_uvs(scene.objects[i].shape);
-      write_ply(dir / file, with_vertex_uvs(meshes[i], uvs), format);
+      write_ply(staged.path() / file, with_vertex_uvs(meshes[i], uvs), format);
     } else {
-      write_ply(dir / file, meshes[i], format);
+      write_ply(staged.path() / file, meshes[i], format);
     }
     triangles += meshes[i].triangles.size();
     (is_light ? lights : objects)
@@ -74,6 +75,7 @@ int run(const Options& o) {
                     {"triangles", meshes[i].triangles.size()},
                     {"smooth", !meshes[i].normals.empty()}});
   }
+  staged.commit();
   if (o.json)
     fmt::print("{}\n", Json({{"scene", o.scene}, {"directory", o.directory}, {"objects", objects}, {"lights", lights}}).dump(1));
   else if (!o.quiet)

@@ -1,4 +1,5 @@
-// chromatrace info FILE: describes an image (spectral EXR or any other EXR), like `oiiotool --info -v`.
+// chromatrace info FILE: describes an image (spectral EXR or any other EXR, or a camera raw), like
+// `oiiotool --info -v`.
 #include <cmath>
 #include <cstdint>
 #include <memory>
@@ -9,6 +10,7 @@
 #include <fmt/core.h>
 #include <nlohmann/json.hpp>
 
+#include "analyzer/raw_input.h"
 #include "cli/command.h"
 #include "core/error.h"
 #include "core/parallel.h"
@@ -239,7 +241,23 @@ void fail_on_bad_pixels(const SpectralExrInfo& info, const SpectralExrScan& scan
                       std::abs(check.sum - check.total), check.tolerance));
 }
 
+// A camera raw (DNG, CR2, NEF, …): what LibRaw reads of it, as text or JSON.
+int run_raw_info(const InfoOptions& options) {
+  const auto items = analyzer::describe_camera_raw(options.file);
+  if (options.json) {
+    nlohmann::json j = {{"file", options.file}, {"kind", "camera raw"}};
+    for (const auto& [key, value] : items) j[key] = value;
+    fmt::print("{}\n", j.dump(2));
+  } else {
+    fmt::print("{:<16}{}\n", "file", options.file);
+    fmt::print("{:<16}{}\n", "kind", "camera raw");
+    for (const auto& [key, value] : items) fmt::print("{:<16}{}\n", key, value);
+  }
+  return 0;
+}
+
 int run_info(const InfoOptions& options) {
+  if (analyzer::is_camera_raw(options.file)) return run_raw_info(options);
   set_exr_threads(thread_count(options.threads));
   SpectralExrReader reader(options.file);
   const SpectralExrInfo& info = reader.info();
@@ -273,7 +291,7 @@ Action add_info(CLI::App& app) {
   auto options = std::make_shared<InfoOptions>();
   CLI::App* sub = app.add_subcommand(
       "info", "Describe an image: kind, size, bands, layers, components, object ids, metadata, per-band statistics");
-  sub->add_option("file", options->file, "OpenEXR file (spectral or not)")->required();
+  sub->add_option("file", options->file, "OpenEXR file (spectral or not), or a camera raw (DNG, CR2, NEF, …)")->required();
   sub->add_flag("--json", options->json, "Print one JSON object instead of text");
   sub->add_flag("--check", options->check,
                 "Also verify that each family of component layers sums to the total within float rounding "

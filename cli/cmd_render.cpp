@@ -6,6 +6,7 @@
 #include <fmt/core.h>
 
 #include "cli/command.h"
+#include "plan/spectral_check.h"
 #include "cli/options.h"
 #include "core/band_plan.h"
 #include "core/error.h"
@@ -67,6 +68,10 @@ Action add_render(CLI::App& app) {
     if (o->output.empty()) throw InputError("--output: no file name");
     // Fail before a long render, not after it.
     check_output_file(o->output, scene.files);
+    // Where the bands cannot hold the scene's colours: said before the render, not found after it.
+    for (const plan::SpectralWarning& w : plan::check_band_plan(scene, options.bands.value_or(scene.render.bands),
+                                                                options.mode.value_or(scene.render.spectral_mode)))
+      fmt::print(stderr, "chromatrace render: warning: {}\n", w.message);
     set_exr_threads(thread_count(o->threads));
     const rt::RenderedImage image = rt::render(scene, options);
     rt::write_render(o->output, scene, image);

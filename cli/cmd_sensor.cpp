@@ -1,4 +1,4 @@
-// chromatrace sensor IN.exr -o OUT.{exr,tif,png}: the camera simulator (docs/sensor.md).
+// chromatrace sensor IN.exr -o OUT.{exr,tif,png,dng}: the camera simulator (docs/sensor.md).
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -20,7 +20,7 @@ namespace ct::cli {
 namespace {
 
 struct Options {
-  std::string input, output, config, preset, camera, exposure, outside_curve, cfa;
+  std::string input, output, config, preset, camera, exposure, outside_curve, cfa, illuminant;
   std::optional<double> exposure_scale, f_number, fov_deg;
   std::optional<int> supersample;
   std::optional<std::uint64_t> seed;
@@ -101,6 +101,7 @@ int run(const Options& o) {
   std::vector<std::filesystem::path> inputs = {o.input};
   if (!o.config.empty()) inputs.push_back(o.config);
   if (std::filesystem::is_regular_file(config.response.camera)) inputs.push_back(config.response.camera);
+  if (std::filesystem::is_regular_file(o.illuminant)) inputs.push_back(o.illuminant);
   sensor::check_output_path(o.output, inputs);
   set_exr_threads(thread_count(o.threads));
 
@@ -109,6 +110,7 @@ int run(const Options& o) {
   options.threads = o.threads;
   options.block_rows = o.block_rows;
   options.progress = !o.quiet;
+  options.illuminant = o.illuminant;
   const sensor::RunReport report = sensor::simulate_sensor(o.input, o.output, config, options);
   if (!o.quiet) {
     for (const std::string& note : report.notes) fmt::print(stderr, "note: {}\n", note);
@@ -124,8 +126,11 @@ int run(const Options& o) {
 Action add_sensor(CLI::App& app) {
   auto* cmd = app.add_subcommand("sensor", "Simulate a camera: spectral radiance to the numbers a sensor records");
   auto o = std::make_shared<Options>();
-  cmd->add_option("input", o->input, "Spectral EXR (emitted radiance, S0 channels)");
-  cmd->add_option("-o,--output", o->output, "Output image: .exr (all layers), .tif/.tiff or .png (final image)");
+  cmd->add_option("input", o->input, "Spectral EXR (emitted radiance, S0 channels; or reflectance with --illuminant)");
+  cmd->add_option("-o,--output", o->output,
+                  "Output image: .exr (all layers), .tif/.tiff or .png (final image), .dng (the Bayer mosaic)");
+  cmd->add_option("--illuminant", o->illuminant,
+                  "Light a spectral reflectance EXR (T channels): a CIE illuminant (A, D50, D65, F1..F12) or a CSV file");
   cmd->add_option("--config", o->config, "Sensor settings (chromatrace-sensor/1 JSON), applied over the preset");
   cmd->add_option("--preset", o->preset,
                   "Starting settings: ideal, canon_eos_5d_mkiii, machine_vision_ccd, smartphone");

@@ -36,20 +36,6 @@ struct Options {
   bool quiet = false;
 };
 
-fs::path own_executable() {
-  std::error_code error;
-  const fs::path exe = fs::read_symlink("/proc/self/exe", error);
-  return error ? fs::path("chromatrace") : exe;
-}
-
-// A file shipped with chromatrace: installed beside the executable (../share/chromatrace/...), else in the
-// source tree it was built from.
-fs::path shipped_file(const fs::path& relative) {
-  const fs::path installed = own_executable().parent_path().parent_path() / "share" / "chromatrace" / relative;
-  if (fs::exists(installed)) return installed;
-  return fs::path(CHROMATRACE_SOURCE_DIR) / relative;
-}
-
 void add_common(CLI::App* cmd, Options& o) {
   cmd->add_option("-o,--output", o.output, "Output directory (created; its parent must exist)")->required();
   cmd->add_option("--variant", o.variants, "Run only this variant (repeatable)");
@@ -88,8 +74,7 @@ series::RunOptions run_options(const Options& o) {
   r.threads = o.threads;
   r.progress = !o.quiet;
   r.executable = own_executable();
-  const char* addon = std::getenv("CHROMATRACE_BLENDER_ADDON");
-  r.batch_script = (addon && *addon) ? fs::path(addon) / "batch.py" : shipped_file("blender_addon/batch.py");
+  r.batch_script = blender_batch_script();
   return r;
 }
 

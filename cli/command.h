@@ -21,6 +21,7 @@ Action add_sensor(CLI::App& app);
 Action add_series(CLI::App& app);
 Action add_paper(CLI::App& app);
 Action add_plan(CLI::App& app);
+Action add_study(CLI::App& app);
 // Helpers of the Blender add-on (blender_addon/): spectra, meshes and the final file come from core.
 Action add_scene_bands(CLI::App& app);
 Action add_export_meshes(CLI::App& app);

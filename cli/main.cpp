@@ -28,6 +28,7 @@ int main(int argc, char** argv) {
   add(ct::cli::add_series(app));
   add(ct::cli::add_paper(app));
   add(ct::cli::add_plan(app));
+  add(ct::cli::add_study(app));
   add(ct::cli::add_scene_bands(app));
   add(ct::cli::add_export_meshes(app));
   add(ct::cli::add_assemble(app));

@@ -1,6 +1,7 @@
 #include "cli/options.h"
 
 #include <charconv>
+#include <cstdlib>
 
 #include <fmt/core.h>
 
@@ -25,6 +26,25 @@ std::pair<int, int> parse_resolution(const std::string& text, std::string_view o
     if (ec != std::errc() || size[i] < 1) fail();
   }
   return {static_cast<int>(size[0]), static_cast<int>(size[1])};
+}
+
+namespace fs = std::filesystem;
+
+fs::path own_executable() {
+  std::error_code error;
+  const fs::path exe = fs::read_symlink("/proc/self/exe", error);
+  return error ? fs::path("chromatrace") : exe;
+}
+
+fs::path shipped_file(const fs::path& relative) {
+  const fs::path installed = own_executable().parent_path().parent_path() / "share" / "chromatrace" / relative;
+  if (fs::exists(installed)) return installed;
+  return fs::path(CHROMATRACE_SOURCE_DIR) / relative;
+}
+
+fs::path blender_batch_script() {
+  const char* addon = std::getenv("CHROMATRACE_BLENDER_ADDON");
+  return (addon && *addon) ? fs::path(addon) / "batch.py" : shipped_file("blender_addon/batch.py");
 }
 
 }  // namespace ct::cli

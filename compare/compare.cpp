@@ -314,7 +314,36 @@ Comparison compare(const CompareOptions& options) {
   check_side(B);
   check_comparable(A.front(), B.front());
 
+  if (options.colour != "common" && options.colour != "own")
+    throw InputError(fmt::format("--colour: must be common or own, got \"{}\"", options.colour));
+  // The image level's colours, with --colour own: each side through the camera over its own bands, before the
+  // finer side is averaged into the coarser (so the coarser plan's colour error counts).
+  auto own_responses = [&](const std::vector<Render>& side) {
+    const Bands& bands = side.front().info.bands;
+    const auto q = sensor::photon_response(bands, curves, sensor::ResponseBasis::Energy, 1.0,
+                                           PiecewiseLinearSpectrum::constant(1.0));
+    const std::size_t nb = bands.size(), n = static_cast<std::size_t>(side.front().info.width) * side.front().info.height;
+    std::vector<Vec3d> out(n, Vec3d{0, 0, 0});
+    for (const Render& r : side) {
+      const auto& v = r.layers.at("total");
+      for (std::size_t p = 0; p < n; ++p)
+        for (int k = 0; k < 3; ++k) {
+          double sum = 0;
+          for (std::size_t b = 0; b < nb; ++b) sum += q[k][b] * v[p * nb + b];
+          out[p][k] += sum / static_cast<double>(side.size());
+        }
+    }
+    return out;
+  };
+  std::vector<Vec3d> own_a, own_b;
+  if (options.colour == "own") {
+    own_a = own_responses(A);
+    own_b = own_responses(B);
+  }
+  const Bands own_bands_b = B.front().info.bands;
+
   Comparison c;
+  c.colour = options.colour;
   c.a = summary(A);
   c.b = summary(B);
   c.sigmas = options.sigmas;
@@ -487,7 +516,7 @@ Comparison compare(const CompareOptions& options) {
       }
     return out;
   };
-  const auto xa = responses(average(A)), xb = responses(average(B));
+  const auto xa = own_a.empty() ? responses(average(A)) : own_a, xb = own_b.empty() ? responses(average(B)) : own_b;
   // White: the camera's response to D65, scaled to the 99th percentile of A's second channel over pixels not
   // on an emitter (emitters would set it otherwise).
   std::set<std::int32_t> emitters;
@@ -502,10 +531,18 @@ Comparison compare(const CompareOptions& options) {
     for (const auto& v : xa) yw = std::max(yw, v[1]);
   }
   if (!(yw > 0)) yw = 1;
-  const std::vector<double> d65 = band_averages(cie::illuminant("D65"), c.bands);
   Vec3d white{};
-  for (int k = 0; k < 3; ++k)
-    for (std::size_t b = 0; b < nb; ++b) white[k] += q[k][b] * d65[b];
+  if (own_b.empty()) {
+    const std::vector<double> d65 = band_averages(cie::illuminant("D65"), c.bands);
+    for (int k = 0; k < 3; ++k)
+      for (std::size_t b = 0; b < nb; ++b) white[k] += q[k][b] * d65[b];
+  } else {
+    const auto qb = sensor::photon_response(own_bands_b, curves, sensor::ResponseBasis::Energy, 1.0,
+                                            PiecewiseLinearSpectrum::constant(1.0));
+    const std::vector<double> d65 = band_averages(cie::illuminant("D65"), own_bands_b);
+    for (int k = 0; k < 3; ++k)
+      for (std::size_t b = 0; b < own_bands_b.size(); ++b) white[k] += qb[k][b] * d65[b];
+  }
   const double wscale = white[1] > 0 ? yw / white[1] : 1.0;
   for (double& v : white) v = std::max(v * wscale, 1e-300);
   c.delta_e.resize(N);

@@ -36,6 +36,10 @@ struct CompareOptions {
   // 8-neighbour has that id in both).
   std::string pixels = "matched";
   std::string camera = "cie1931";  // for ΔE00: the CIE observer, or a camera the sensor simulator ships
+  // The image level's colours: "common" — both sides on the common (coarser) band plan, so that only what the
+  // renderers do differently counts; "own" — each side through the camera over its own bands, so that a coarser
+  // plan's colour error counts too (how far a cheap render's colours are from a fine reference's).
+  std::string colour = "common";
 };
 
 struct Cell {
@@ -64,6 +68,7 @@ struct Comparison {
   std::string scene_name;
   int width = 0, height = 0;
   Bands bands;  // the common (coarser) plan
+  std::string colour = "common";  // how the image level's colours were made (CompareOptions::colour)
   std::vector<std::string> components;  // compared: "total" and the components both have
   std::vector<std::string> only_a, only_b;
   std::size_t id_mismatch_pixels = 0;  // pixels whose object id differs between A and B

@@ -59,6 +59,10 @@ PiecewiseLinearSpectrum CsvTable::spectrum(std::string_view column) const {
     value.push_back(col[r]);
   }
   if (lambda.empty()) throw InputError(fmt::format("{}: column \"{}\" has no values", source, column));
+  // As for "samples" in a scene: one value is no spectrum (the line through two is; {"constant": v} is flat).
+  if (lambda.size() < 2)
+    throw InputError(fmt::format("{}: column \"{}\" has 1 value, at {} nm; a spectrum needs at least 2", source,
+                                 column, lambda[0]));
   return PiecewiseLinearSpectrum(std::move(lambda), std::move(value), Extrapolation::Zero,
                                  fmt::format("{}: column \"{}\"", source, column));
 }

@@ -12,6 +12,13 @@ namespace ct::exr {
 
 bool is_object_id(double value) { return value >= 0 && value <= kMaxObjectId && value == std::floor(value); }
 
+void check_object_id(double value, const std::string& file, std::size_t x, std::size_t y) {
+  if (!is_object_id(value))
+    throw InputError(fmt::format("{}: channel {}: value {} at pixel ({}, {}) is not an object id (a whole number in "
+                                 "[0, {}])",
+                                 file, kObjectIdChannel, value, x, y, kMaxObjectId));
+}
+
 std::string object_names_text(const std::map<std::int32_t, std::string>& names) {
   nlohmann::json json = nlohmann::json::object();
   for (const auto& [id, name] : names) json[std::to_string(id)] = name;

@@ -4,6 +4,7 @@
 // uses these, so a file one part writes is the file the next part reads (docs/spectral-exr.md,
 // docs/sensor.md "Output").
 
+#include <cstddef>
 #include <cstdint>
 #include <map>
 #include <string>
@@ -23,6 +24,9 @@ inline constexpr const char* kComponentsAttribute = "chromatrace.components";
 
 // Whether a stored object_id sample is an id: a whole number in [0, kMaxObjectId].
 bool is_object_id(double value);
+// Throws InputError "<file>: channel object_id: value <v> at pixel (x, y) is not an object id (…)" unless
+// is_object_id(value).
+void check_object_id(double value, const std::string& file, std::size_t x, std::size_t y);
 
 // kObjectsAttribute's text from names, and back. InputError "<where>: …" for text that is not a JSON object
 // from whole numbers in [0, kMaxObjectId] to strings.

@@ -10,6 +10,7 @@
 #include <sstream>
 #include <stdexcept>
 #include <utility>
+#include <vector>
 
 #include <fmt/core.h>
 
@@ -39,6 +40,14 @@ std::string not_a_regular_file(const fs::path& output, const fs::path& resolved,
                                               : fmt::format("links to {}, which is {}", resolved.string(), kind_of(mode));
   return fmt::format("{}: {}; outputs are written only as regular files, never in place of {}", output.string(), what,
                      S_ISDIR(mode) ? "a directory" : "a special file");
+}
+
+// InputError "<output>: cannot write in directory <directory>: <reason>" unless files can be created there: an
+// unwritable output location is the user's to change, like a missing one.
+void check_writable_directory(const fs::path& output, const fs::path& directory) {
+  if (::access(directory.c_str(), W_OK | X_OK) != 0)
+    throw InputError(
+        fmt::format("{}: cannot write in directory {}: {}", output.string(), directory.string(), std::strerror(errno)));
 }
 
 }  // namespace
@@ -89,6 +98,7 @@ void check_output_file(const fs::path& output, const std::vector<fs::path>& inpu
   const fs::path parent = fs::absolute(resolved).parent_path();
   if (!fs::is_directory(parent))
     throw InputError(fmt::format("{}: directory {} does not exist", output.string(), parent.string()));
+  check_writable_directory(output, parent);
 }
 
 void check_output_directory(const fs::path& directory, const std::vector<fs::path>& inputs) {
@@ -101,6 +111,7 @@ void check_output_directory(const fs::path& directory, const std::vector<fs::pat
   if (!fs::is_directory(absolute.parent_path()))
     throw InputError(
         fmt::format("{}: directory {} does not exist", directory.string(), absolute.parent_path().string()));
+  check_writable_directory(directory, fs::is_directory(absolute) ? absolute : absolute.parent_path());
 }
 
 AtomicFile::AtomicFile(fs::path target) : target_(std::move(target)), destination_(follow_links(target_)) {
@@ -142,6 +153,60 @@ void AtomicFile::commit() {
     throw std::runtime_error(
         fmt::format("{}: cannot rename the finished file into place: {}", target_.string(), error.message()));
   temporary_.clear();
+}
+
+StagedDirectory::StagedDirectory(fs::path target) : target_(std::move(target)) {
+  fs::path absolute = fs::absolute(target_);
+  if (!absolute.has_filename()) absolute = absolute.parent_path();  // "out/"
+  for (int attempt = 0;; ++attempt) {
+    staging_ = absolute.parent_path() /
+               fmt::format(".{}.{}-{}.tmp", absolute.filename().string(), static_cast<long>(::getpid()), attempt);
+    if (::mkdir(staging_.c_str(), 0777) == 0) return;
+    if (errno != EEXIST || attempt >= 1000) {
+      const int error = errno;
+      staging_.clear();
+      throw InputError(fmt::format("{}: cannot create a directory in {}: {}", target_.string(),
+                                   absolute.parent_path().string(), std::strerror(error)));
+    }
+  }
+}
+
+StagedDirectory::~StagedDirectory() {
+  std::error_code ignored;
+  if (!staging_.empty()) fs::remove_all(staging_, ignored);
+}
+
+void StagedDirectory::commit() {
+  std::error_code error;
+  if (!fs::exists(fs::symlink_status(target_, error))) {
+    fs::rename(staging_, target_, error);
+    if (error)
+      throw std::runtime_error(
+          fmt::format("{}: cannot rename the finished directory into place: {}", target_.string(), error.message()));
+    staging_.clear();
+    return;
+  }
+  // Listed first, then moved; directories come before the files in them.
+  const std::vector<fs::directory_entry> entries(fs::recursive_directory_iterator(staging_), {});
+  for (const fs::directory_entry& entry : entries) {
+    const fs::path relative = entry.path().lexically_relative(staging_);
+    const fs::path destination = target_ / relative;
+    if (entry.is_directory()) {
+      if (!fs::is_directory(destination)) {
+        fs::create_directory(destination, error);
+        if (error) throw InputError(fmt::format("{}: cannot create the directory: {}", destination.string(), error.message()));
+      }
+      continue;
+    }
+    const fs::path resolved = follow_links(destination);
+    struct stat st{};
+    if (::stat(resolved.c_str(), &st) == 0 && !S_ISREG(st.st_mode))
+      throw InputError(not_a_regular_file(destination, resolved, st.st_mode));
+    fs::rename(entry.path(), resolved, error);
+    if (error)
+      throw std::runtime_error(
+          fmt::format("{}: cannot rename the finished file into place: {}", destination.string(), error.message()));
+  }
 }
 
 void write_file_atomically(const fs::path& file, std::string_view bytes) {

@@ -68,6 +68,28 @@ class AtomicFile {
   int fd_ = -1;
 };
 
+// A directory of outputs that appears complete or not at all. The files are written under path(), a fresh
+// directory beside `target` (".<name>.<pid>-<n>.tmp"); commit() moves them into `target`: the whole
+// directory is renamed when `target` does not exist yet, else each file is renamed over its namesake there
+// (following a symbolic link as AtomicFile does; a special file or directory in the way is an InputError).
+// Destroyed without commit() (a full disk, bad input found late), the staging directory and everything in it
+// are removed and `target` is left as it was.
+class StagedDirectory {
+ public:
+  // InputError naming `target` when no directory can be created beside it.
+  explicit StagedDirectory(std::filesystem::path target);
+  ~StagedDirectory();
+  StagedDirectory(const StagedDirectory&) = delete;
+  StagedDirectory& operator=(const StagedDirectory&) = delete;
+
+  const std::filesystem::path& path() const { return staging_; }
+  void commit();
+
+ private:
+  std::filesystem::path target_;
+  std::filesystem::path staging_;
+};
+
 // Writes `bytes` to `file` through an AtomicFile.
 void write_file_atomically(const std::filesystem::path& file, std::string_view bytes);
 

@@ -74,6 +74,30 @@ Bounds bounds(const TriangleMesh& mesh) {
   return b;
 }
 
+Bounds bounds(const Shape& shape) {
+  Bounds b;
+  if (const auto* quad = std::get_if<QuadShape>(&shape)) {
+    for (int i = 0; i < 4; ++i)
+      b.extend(quad->corner + double(i & 1) * quad->edge1 + double((i >> 1) & 1) * quad->edge2);
+  } else if (const auto* box = std::get_if<BoxShape>(&shape)) {
+    for (int i = 0; i < 8; ++i)
+      b.extend(box->corner + double(i & 1) * box->edge1 + double((i >> 1) & 1) * box->edge2 +
+               double((i >> 2) & 1) * box->edge3);
+  } else if (const auto* sphere = std::get_if<SphereShape>(&shape)) {
+    b.extend(sphere->center - Vec3::Constant(sphere->radius));
+    b.extend(sphere->center + Vec3::Constant(sphere->radius));
+  } else if (const auto* cylinder = std::get_if<CylinderShape>(&shape)) {
+    const Vec3 r = Vec3::Constant(cylinder->radius);
+    for (const Vec3& end : {cylinder->base, Vec3(cylinder->base + cylinder->height * cylinder->axis)}) {
+      b.extend(end - r);
+      b.extend(end + r);
+    }
+  } else {
+    b = bounds(std::get<MeshShape>(shape).mesh);
+  }
+  return b;
+}
+
 std::array<Vec3, 2> orthonormal_frame(const Vec3& axis) {
   // Cross with the world axis least aligned with `axis`, so the result is never near zero.
   const Vec3 a = axis.cwiseAbs();

@@ -120,6 +120,10 @@ double surface_area(const BoxShape& box);
 double surface_area(const MeshShape& mesh);
 double surface_area(const Shape& shape);
 
+// An axis-aligned box that holds the whole shape (exact for quads, boxes and meshes, conservative for the
+// round shapes), without tessellating it.
+Bounds bounds(const Shape& shape);
+
 // Name of the shape type as the scene format spells it ("quad", "sphere", ...).
 const char* shape_type_name(const Shape& shape);
 

@@ -80,21 +80,61 @@ Vec3 nonzero_vec3(const JsonNode& node) {
   return v;
 }
 
+std::string beyond_reach(double distance) {
+  return fmt::format("reaches {} m from the origin, beyond the ±{} m the renderers represent (32-bit floats)",
+                     distance, kMaxCoordinateM);
+}
+
+double farthest_coordinate(const Bounds& b) { return std::max(b.lo.cwiseAbs().maxCoeff(), b.hi.cwiseAbs().maxCoeff()); }
+
+// A position: each coordinate within ±kMaxCoordinateM.
+Vec3 point_vec3(const JsonNode& node) {
+  const Vec3 p = node.vec3();
+  const double distance = p.cwiseAbs().maxCoeff();
+  if (distance > kMaxCoordinateM) node.fail(beyond_reach(distance));
+  return p;
+}
+
+// The whole shape within ±kMaxCoordinateM (its edges, radius or mesh vertices may carry it beyond); `node` is
+// the shape, or a mesh's "file".
+void check_within_reach(const JsonNode& node, const Shape& shape) {
+  const double distance = farthest_coordinate(bounds(shape));
+  if (!(distance <= kMaxCoordinateM)) node.fail(beyond_reach(distance));
+}
+
+// The peak of radiance · scale within kMaxRadiance; `node` is the scale if given, else the radiance.
+void check_radiance_range(const JsonNode& node, const SpectrumRef& radiance, double scale) {
+  double peak = 0;
+  if (radiance.texture) {  // a texture has no spectrum of its own: its texels' largest value
+    const std::vector<float>& rgb = radiance.texture->rgb;
+    peak = radiance.texture->scale * (rgb.empty() ? 0.0 : *std::max_element(rgb.begin(), rgb.end()));
+  } else {
+    peak = extreme_sample(radiance.spectrum, true).value;
+  }
+  const double emitted = peak * scale;
+  if (!(emitted <= kMaxRadiance))
+    node.fail(fmt::format("the peak radiance {} times the scale {} is {} W m⁻² sr⁻¹ nm⁻¹, beyond the {} the "
+                          "renderers represent (32-bit floats)",
+                          peak, scale, emitted, kMaxRadiance));
+}
+
 int segments_setting(const JsonNode& node) { return static_cast<int>(node.integer_in(3, kMaxSegments)); }
 int rings_setting(const JsonNode& node) { return static_cast<int>(node.integer_in(2, kMaxSegments)); }
 
 QuadShape read_quad(const JsonNode& node) {
   node.expect_object({"type", "corner", "edge1", "edge2"});
-  const QuadShape quad{node["corner"].vec3(), node["edge1"].vec3(), node["edge2"].vec3()};
+  const QuadShape quad{point_vec3(node["corner"]), node["edge1"].vec3(), node["edge2"].vec3()};
   if (!(surface_area(quad) > 0.0)) node.fail("edge1 and edge2 are parallel or zero, so the quad has no area");
+  check_within_reach(node, quad);
   return quad;
 }
 
 SphereShape read_sphere(const JsonNode& node, const Tessellation& defaults) {
   node.expect_object({"type", "center", "radius", "segments", "rings"});
   SphereShape sphere;
-  sphere.center = node["center"].vec3();
+  sphere.center = point_vec3(node["center"]);
   sphere.radius = node["radius"].number_above(0.0);
+  check_within_reach(node, sphere);
   const auto segments = node.find("segments");
   const auto rings = node.find("rings");
   sphere.segments = segments ? segments_setting(*segments) : defaults.segments;
@@ -105,10 +145,11 @@ SphereShape read_sphere(const JsonNode& node, const Tessellation& defaults) {
 CylinderShape read_cylinder(const JsonNode& node, const Tessellation& defaults) {
   node.expect_object({"type", "base", "axis", "radius", "height", "caps", "segments"});
   CylinderShape cylinder;
-  cylinder.base = node["base"].vec3();
+  cylinder.base = point_vec3(node["base"]);
   cylinder.axis = nonzero_vec3(node["axis"]).normalized();
   cylinder.radius = node["radius"].number_above(0.0);
   cylinder.height = node["height"].number_above(0.0);
+  check_within_reach(node, cylinder);
   const auto caps = node.find("caps");
   cylinder.caps = caps ? caps->boolean() : true;
   const auto segments = node.find("segments");
@@ -118,9 +159,10 @@ CylinderShape read_cylinder(const JsonNode& node, const Tessellation& defaults) 
 
 BoxShape read_box(const JsonNode& node) {
   node.expect_object({"type", "corner", "edge1", "edge2", "edge3"});
-  const BoxShape box{node["corner"].vec3(), node["edge1"].vec3(), node["edge2"].vec3(), node["edge3"].vec3()};
+  const BoxShape box{point_vec3(node["corner"]), node["edge1"].vec3(), node["edge2"].vec3(), node["edge3"].vec3()};
   if (!(std::abs(box.edge1.cross(box.edge2).dot(box.edge3)) > 0.0))
     node.fail("edge1, edge2 and edge3 are coplanar, so the box has no volume");
+  check_within_reach(node, box);
   return box;
 }
 
@@ -136,14 +178,16 @@ MeshShape read_mesh(const JsonNode& node, const std::filesystem::path& directory
     file.fail(e.what());
   }
   if (mesh.mesh.triangles.empty()) file.fail(fmt::format("{}: has no faces", path.string()));
+  const double distance = farthest_coordinate(bounds(mesh.mesh));
+  if (!(distance <= kMaxCoordinateM)) file.fail(fmt::format("{}: a vertex {}", path.string(), beyond_reach(distance)));
   return mesh;
 }
 
 Camera read_camera(const JsonNode& node) {
   node.expect_object({"position", "look_at", "up", "fov_deg", "fov_axis", "resolution", "sensor_width_mm"});
   Camera camera;
-  camera.position = node["position"].vec3();
-  camera.look_at = node["look_at"].vec3();
+  camera.position = point_vec3(node["position"]);
+  camera.look_at = point_vec3(node["look_at"]);
   if (!((camera.look_at - camera.position).norm() > 0.0)) node["look_at"].fail("must differ from position");
   const auto up = node.find("up");
   camera.up = up ? nonzero_vec3(*up) : Vec3(Vec3::UnitZ());
@@ -485,7 +529,9 @@ Light SceneReader::light(const JsonNode& node) {
   light.name = node["name"].non_empty_string();
   light.shape = light_shape(node["shape"]);
   light.radiance = radiance(node["radiance"]);
-  if (const auto scale = node.find("scale")) light.scale = scale->number_at_least(0.0);
+  const auto scale = node.find("scale");
+  if (scale) light.scale = scale->number_at_least(0.0);
+  check_radiance_range(scale ? *scale : node["radiance"], light.radiance, light.scale);
   if (const auto group = node.find("group")) {
     light.group = group->string();
     if (!valid_group_name(light.group))
@@ -508,7 +554,9 @@ Environment SceneReader::environment(const JsonNode& node) {
   node.expect_object({"radiance", "scale", "rotation_deg", "group"});
   Environment environment;
   environment.radiance = radiance(node["radiance"]);
-  if (const auto scale = node.find("scale")) environment.scale = scale->number_at_least(0.0);
+  const auto scale = node.find("scale");
+  if (scale) environment.scale = scale->number_at_least(0.0);
+  check_radiance_range(scale ? *scale : node["radiance"], environment.radiance, environment.scale);
   if (const auto rotation = node.find("rotation_deg")) {
     if (!environment.radiance.texture) rotation->fail("applies only to a texture radiance");
     environment.rotation_deg = rotation->number_in(-360.0, 360.0);

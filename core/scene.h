@@ -92,6 +92,13 @@ const char* material_type_name(const Material& material);
 
 using LightShape = std::variant<QuadShape, SphereShape>;
 
+// What both renderers can represent (docs/scene-format.md, "Ranges the renderers represent"). They trace in
+// 32-bit floats: at 10^6 m from the origin a float coordinate steps by 6 cm, and Embree refuses rays from
+// beyond about 1.8e18; a radiance of 10^20 W m⁻² sr⁻¹ nm⁻¹ (10^16 times the Sun's) still leaves a factor of
+// 10^18 before a sum of samples overflows a float.
+inline constexpr double kMaxCoordinateM = 1e6;
+inline constexpr double kMaxRadiance = 1e20;
+
 struct Light {
   std::string name;
   int id = 0;  // object id: the lights follow the objects (see Object::id)

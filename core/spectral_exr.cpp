@@ -30,6 +30,7 @@
 #include <ImfThreading.h>
 #include <ImfVecAttribute.h>
 #include <ImfVersion.h>
+#include <openexr.h>
 
 #include "core/cie.h"
 #include "core/colour.h"
@@ -391,6 +392,85 @@ SpectralExrInfo describe(const Imf::Header& header, const std::string& file, std
   return info;
 }
 
+// How many times its stored size a chunk of each compression can expand to; 0 where no bound is practical
+// (PIZ's run-length codes, B44's uncompressed float channels, DWA).
+double largest_expansion(std::uint8_t compression) {
+  switch (compression) {
+    case EXR_COMPRESSION_NONE: return 1.0;
+    case EXR_COMPRESSION_RLE: return 64.0;  // a run of up to 128 bytes in 2
+    case EXR_COMPRESSION_ZIPS:
+    case EXR_COMPRESSION_ZIP:
+    case EXR_COMPRESSION_PXR24: return 1032.0;  // deflate's largest ratio
+    default: return 0.0;
+  }
+}
+
+// OpenEXR's C reader (OpenEXRCore) checks a header strictly and at once, where the C++ reader can spend
+// seconds and a gigabyte on a corrupt one (found by fuzzing); and it reads the chunk table without the pixels.
+// InputError "<file>: unreadable OpenEXR header: <its first complaint>".
+struct CoreReader {
+  explicit CoreReader(const std::string& file) {
+    exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
+    init.user_data = &first_error;
+    init.error_handler_fn = [](exr_const_context_t context, exr_result_t, const char* message) {
+      void* user = nullptr;
+      if (exr_get_user_data(context, &user) == EXR_ERR_SUCCESS && user != nullptr) {
+        std::string& first = *static_cast<std::string*>(user);
+        if (first.empty()) first = message;
+      }
+    };
+    const exr_result_t result = exr_start_read(&context, file.c_str(), &init);
+    // A complaint it recovers from (an attribute whose size runs past the file, which it skips) would cost the
+    // C++ reader the allocation the size claims: it is refused as well.
+    if (result != EXR_ERR_SUCCESS || !first_error.empty()) {
+      exr_finish(&context);
+      throw InputError(fmt::format("{}: unreadable OpenEXR header: {}", file,
+                                   one_line(first_error.empty() ? exr_get_default_error_message(result) : first_error)));
+    }
+  }
+  ~CoreReader() { exr_finish(&context); }
+  CoreReader(const CoreReader&) = delete;
+  CoreReader& operator=(const CoreReader&) = delete;
+
+  std::string first_error;  // before context: the error handler writes it while exr_start_read runs
+  exr_context_t context = nullptr;
+};
+
+// OpenEXR's C++ reader fills rows that a chunk lacks with zeros instead of failing, so a data window patched
+// to 100 000 pixels over 4 stored ones reads as an image. Each chunk of a scanline file is checked against the
+// rows it must hold, from the chunk table alone: it must be there, hold exactly their bytes if uncompressed,
+// and no fewer than its compression can expand to them.
+void check_chunks_hold_the_data_window(const CoreReader& reader, const std::string& file) {
+  const exr_context_t context = reader.context;
+  exr_storage_t storage{};
+  std::int32_t lines = 0;
+  exr_attr_box2i_t window{};
+  if (exr_get_storage(context, 0, &storage) != EXR_ERR_SUCCESS || storage != EXR_STORAGE_SCANLINE ||
+      exr_get_scanlines_per_chunk(context, 0, &lines) != EXR_ERR_SUCCESS || lines < 1 ||
+      exr_get_data_window(context, 0, &window) != EXR_ERR_SUCCESS)
+    return;
+  const long long width = static_cast<long long>(window.max.x) - window.min.x + 1;
+  const long long height = static_cast<long long>(window.max.y) - window.min.y + 1;
+  const auto claims = [&](long long first, long long last, const std::string& what) {
+    return InputError(fmt::format("{}: pixel data, rows {}-{}: {}; the data window ({}x{} pixels) claims more "
+                                  "than the file holds",
+                                  file, first, last, what, width, height));
+  };
+  for (long long y = window.min.y; y <= window.max.y; y += lines) {
+    const long long first = y - window.min.y, last = std::min(first + lines, height) - 1;
+    exr_chunk_info_t chunk{};
+    const exr_result_t result = exr_read_scanline_chunk_info(context, 0, static_cast<int>(y), &chunk);
+    if (result != EXR_ERR_SUCCESS)
+      throw claims(first, last, fmt::format("no chunk for them ({})", exr_get_default_error_message(result)));
+    const double expansion = largest_expansion(chunk.compression);
+    if (expansion == 1.0 ? chunk.packed_size != chunk.unpacked_size
+                         : expansion > 0 && static_cast<double>(chunk.packed_size) * expansion <
+                                                static_cast<double>(chunk.unpacked_size))
+      throw claims(first, last,
+                   fmt::format("{} stored bytes, which cannot hold their {} bytes", chunk.packed_size, chunk.unpacked_size));
+  }
+}
+
 [[noreturn]] void throw_not_spectral(const SpectralExrInfo& info) {
   std::vector<std::string> names;
   for (const ExrChannel& channel : info.channels) names.push_back(channel.name);
@@ -528,6 +608,11 @@ struct SpectralExrReader::File {
 SpectralExrReader::SpectralExrReader(const fs::path& path) : file_(std::make_unique<File>()) {
   const std::string file = path.string();
   check_openable_exr(path, file);
+  {
+    // Before the C++ reader, which allocates row buffers for the whole data window it is told of.
+    const CoreReader core(file);
+    check_chunks_hold_the_data_window(core, file);
+  }
   try {
     file_->exr = std::make_unique<Imf::InputFile>(file.c_str(), Imf::globalThreadCount());
   } catch (const std::exception& e) {
@@ -584,15 +669,10 @@ void SpectralExrReader::read_object_ids(int y0, int y1, std::span<std::int32_t> 
   if (!info_.has_object_ids) throw InputError(fmt::format("{}: no channel {}", info_.file, kObjectIdChannel));
   std::vector<float> values(out.size());
   read_channels({kObjectIdChannel}, y0, y1, values);
+  const std::size_t width = static_cast<std::size_t>(info_.width);
   for (std::size_t i = 0; i < values.size(); ++i) {
     const float v = values[i];
-    if (!exr::is_object_id(v)) {
-      const std::size_t width = static_cast<std::size_t>(info_.width);
-      throw InputError(fmt::format(
-          "{}: channel {}: value {} at pixel ({}, {}) is not an object id (a whole number in "
-          "[0, {}])",
-          info_.file, kObjectIdChannel, v, i % width, static_cast<std::size_t>(y0) + i / width, kMaxObjectId));
-    }
+    exr::check_object_id(v, info_.file, i % width, static_cast<std::size_t>(y0) + i / width);
     out[i] = static_cast<std::int32_t>(v);
   }
 }

@@ -6,6 +6,8 @@
 #include <span>
 #include <tuple>
 
+#include "core/exr_vocabulary.h"
+
 namespace ct {
 namespace {
 
@@ -144,6 +146,9 @@ SpectralExrScan scan_spectral_exr(SpectralExrReader& reader, const ScanOptions& 
       const int y = y0 + static_cast<int>(p / width);
       for (std::size_t c = 0; c < channels.size(); ++c)
         if (!std::isfinite(pixel[c]) && non_finite[c]++ == 0) first_non_finite[c] = {x, y};
+      if (info.has_object_ids && std::isfinite(pixel[channels.size() - 1]))  // a NaN is counted as non-finite
+        exr::check_object_id(pixel[channels.size() - 1], info.file, static_cast<std::size_t>(x),
+                             static_cast<std::size_t>(y));
       for (std::size_t i = 0; i < bands; ++i) {
         const double value = pixel[total_offset + i];
         if (!std::isfinite(value)) continue;

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <numeric>
+#include <optional>
 #include <set>
 
 #include <fmt/core.h>
@@ -832,13 +833,17 @@ Json report_document(const Plan& plan, const Scene& scene, const PlanOptions& op
 }
 
 Measurement measure_delta_e(const std::filesystem::path& test, const std::filesystem::path& reference,
-                            const Scene& scene, const std::string& camera) {
+                            const Scene& scene, const std::string& camera, const std::filesystem::path& white_from) {
   const sensor::CameraCurves curves = sensor::camera_curves(camera, {"r", "g", "b"}, "--camera");
   SpectralExrReader ra(test), rb(reference);
-  const SpectralExrInfo &ia = ra.info(), &ib = rb.info();
-  if (ia.width != ib.width || ia.height != ib.height)
-    throw InputError(fmt::format("{}: {}x{} pixels but {} has {}x{}", test.string(), ia.width, ia.height,
-                                 reference.string(), ib.width, ib.height));
+  std::optional<SpectralExrReader> rw;
+  if (!white_from.empty()) rw.emplace(white_from);
+  SpectralExrReader& white_reader = rw ? *rw : rb;
+  const SpectralExrInfo &ia = ra.info(), &ib = rb.info(), &iw = white_reader.info();
+  for (const auto& [info, file] : {std::pair{&ia, &test}, std::pair{&iw, &white_from}})
+    if (info->width != ib.width || info->height != ib.height)
+      throw InputError(fmt::format("{}: {}x{} pixels but {} has {}x{}", file->string(), info->width, info->height,
+                                   reference.string(), ib.width, ib.height));
   auto tristimuli = [&](SpectralExrReader& r) {
     const auto q = sensor::photon_response(r.info().bands, curves, sensor::ResponseBasis::Energy, 1.0,
                                            PiecewiseLinearSpectrum::constant(1.0));
@@ -854,19 +859,20 @@ Measurement measure_delta_e(const std::filesystem::path& test, const std::filesy
     return out;
   };
   const std::vector<Vec3d> xa = tristimuli(ra), xb = tristimuli(rb);
+  const std::vector<Vec3d> xw = rw ? tristimuli(*rw) : xb;
   const std::size_t N = xa.size();
   std::vector<std::int32_t> ids(N, 0);
-  if (ib.has_object_ids) rb.read_object_ids(0, ib.height, ids);
+  if (iw.has_object_ids) white_reader.read_object_ids(0, iw.height, ids);
   const auto first_light = static_cast<std::int32_t>(scene.objects.size()) + 1;
   std::vector<double> ys;
   for (std::size_t p = 0; p < N; ++p)
-    if (!near_light(ids, ib.width, ib.height, p, first_light)) ys.push_back(xb[p][1]);
+    if (!near_light(ids, iw.width, iw.height, p, first_light)) ys.push_back(xw[p][1]);
   double yw = percentile(ys, 0.99);
   if (!(yw > 0)) yw = 1;
-  // The white: the light through the observer over the reference's band range.
+  // The white: the light through the observer over the white reference's band range.
   const PiecewiseLinearSpectrum light = scene_light_spectrum(scene);
   Vec3d white{};
-  const double lo = ib.bands.min_wavelength(), hi = ib.bands.max_wavelength();
+  const double lo = iw.bands.min_wavelength(), hi = iw.bands.max_wavelength();
   for (int c = 0; c < 3; ++c) white[c] = integral_of_product(light, curves.curves[c], lo, hi);
   const double ws = white[1] > 0 ? yw / white[1] : 1.0;
   for (double& v : white) v = std::max(v * ws, 1e-300);
@@ -876,7 +882,9 @@ Measurement measure_delta_e(const std::filesystem::path& test, const std::filesy
   m.pixels = N;
   m.mean = std::accumulate(de.begin(), de.end(), 0.0) / static_cast<double>(std::max<std::size_t>(N, 1));
   m.max = de.empty() ? 0 : *std::max_element(de.begin(), de.end());
+  m.rms = std::sqrt(std::inner_product(de.begin(), de.end(), de.begin(), 0.0) / static_cast<double>(std::max<std::size_t>(N, 1)));
   m.p95 = percentile(de, 0.95);
+  m.per_pixel = std::move(de);
   return m;
 }
 

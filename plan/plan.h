@@ -89,13 +89,17 @@ PiecewiseLinearSpectrum scene_light_spectrum(const Scene& scene);
 
 struct Measurement {
   double mean = 0, p95 = 0, max = 0;
+  double rms = 0;  // root mean square: independent errors add in it as squares (to first order)
   std::size_t pixels = 0;
+  std::vector<double> per_pixel;  // ΔE00 of each pixel, row by row
 };
 // ΔE00 between the totals of two spectral EXR renders of `scene` (same size; any band plans), each turned into
 // tristimulus values through `camera`'s curves over its own bands, in CIELAB under the white of
 // scene_light_spectrum() scaled to the 99th percentile of `reference`'s luminance over pixels not on or next to a
-// light.
+// light. With `white_from`, the white is that render's instead (so that two noisy renders compare on the scale of
+// a third, converged one).
 Measurement measure_delta_e(const std::filesystem::path& test, const std::filesystem::path& reference,
-                            const Scene& scene, const std::string& camera = "cie1931");
+                            const Scene& scene, const std::string& camera = "cie1931",
+                            const std::filesystem::path& white_from = {});
 
 }  // namespace ct::plan

@@ -4,6 +4,7 @@
 #include <cctype>
 #include <cmath>
 #include <fstream>
+#include <iterator>
 #include <stdexcept>
 
 #include <fmt/core.h>
@@ -52,6 +53,40 @@ void insert_rgb(Imf::FrameBuffer& frame, const std::string& layer, const float* 
                                                            3 * sizeof(float) * static_cast<std::size_t>(width)));
 }
 
+// OpenImageIO writes TIFF and PNG through its own buffered file and does not report a write that failed for
+// want of space (its close() returns true over a truncated file), so the finished file is checked before it
+// gets its name. A PNG must run chunk by chunk to its IEND chunk at the end of the file (read without decoding,
+// whose errors libpng would print); a TIFF must decode row by row.
+void check_complete_png(const fs::path& file, const fs::path& target) {
+  std::ifstream in(file, std::ios::binary);
+  std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const auto byte = [&](std::size_t i) { return static_cast<std::uint32_t>(static_cast<unsigned char>(bytes[i])); };
+  std::size_t at = 8;  // the signature
+  while (at + 12 <= bytes.size()) {
+    const std::uint64_t length = byte(at) << 24 | byte(at + 1) << 16 | byte(at + 2) << 8 | byte(at + 3);
+    const bool end = bytes.compare(at + 4, 4, "IEND") == 0;
+    at += 12 + length;  // length, type, data, CRC
+    if (end && at == bytes.size()) return;
+  }
+  throw std::runtime_error(
+      fmt::format("{}: cannot complete the file: the PNG written is cut short at {} bytes", target.string(), bytes.size()));
+}
+
+void check_complete_tiff(const fs::path& file, const fs::path& target, int width, int height) {
+  const auto fail = [&](std::string why) {
+    std::replace(why.begin(), why.end(), '\n', ' ');
+    return std::runtime_error(fmt::format("{}: cannot complete the file: the TIFF written does not read back ({})",
+                                          target.string(), why));
+  };
+  auto input = OIIO::ImageInput::create("tiff");
+  OIIO::ImageSpec spec;
+  if (!input || !input->open(file.string(), spec)) throw fail(input ? input->geterror() : OIIO::geterror());
+  if (spec.width != width || spec.height != height) throw fail("wrong size");
+  std::vector<std::uint16_t> row(static_cast<std::size_t>(width) * static_cast<std::size_t>(spec.nchannels));
+  for (int y = 0; y < height; ++y)
+    if (!input->read_scanline(y, 0, OIIO::TypeDesc::UINT16, row.data())) throw fail(input->geterror());
+}
+
 }  // namespace
 
 OutputFormat output_format(const fs::path& file) {
@@ -59,7 +94,8 @@ OutputFormat output_format(const fs::path& file) {
   if (ext == ".exr") return OutputFormat::Exr;
   if (ext == ".tif" || ext == ".tiff") return OutputFormat::Tiff;
   if (ext == ".png") return OutputFormat::Png;
-  throw InputError(fmt::format("{}: unknown output format \"{}\" (the name must end in .exr, .tif, .tiff or .png)",
+  if (ext == ".dng") return OutputFormat::Dng;
+  throw InputError(fmt::format("{}: unknown output format \"{}\" (the name must end in .exr, .tif, .tiff, .png or .dng)",
                                file.string(), ext));
 }
 
@@ -71,6 +107,8 @@ struct SensorImageWriter::File {
   // TIFF / PNG
   std::unique_ptr<AtomicFile> output;  // declared before the image writer: destroyed after it lets go of the file
   std::unique_ptr<OIIO::ImageOutput> image;
+  // DNG
+  std::unique_ptr<DngWriter> dng;
 };
 
 SensorImageWriter::SensorImageWriter(const fs::path& path, OutputLayout layout)
@@ -100,6 +138,8 @@ SensorImageWriter::SensorImageWriter(const fs::path& path, OutputLayout layout)
     for (const auto& [key, value] : layout_.number_attributes) header.insert(key, Imf::DoubleAttribute(value));
     for (const auto& [key, value] : layout_.integer_attributes) header.insert(key, Imf::IntAttribute(value));
     file->exr = std::make_unique<AtomicExrOutput>(path_, header);
+  } else if (layout_.format == OutputFormat::Dng) {
+    file->dng = std::make_unique<DngWriter>(path_, layout_.width, layout_.height, layout_.dng);
   } else {
     file->output = std::make_unique<AtomicFile>(path_);
     const std::string temporary = file->output->temporary().string();
@@ -131,7 +171,7 @@ SensorImageWriter::~SensorImageWriter() = default;
 void SensorImageWriter::write_rows(const OutputRows& block) {
   if (!file_) throw std::logic_error(fmt::format("{}: write_rows after finish", path_.string()));
   const std::size_t width = static_cast<std::size_t>(layout_.width);
-  const std::size_t values = static_cast<std::size_t>(block.rows) * width * 3;
+  const std::size_t values = static_cast<std::size_t>(block.rows) * width * (layout_.format == OutputFormat::Dng ? 1 : 3);
   if (block.rows < 0 || rows_written_ + block.rows > layout_.height || block.image.size() != values)
     throw std::invalid_argument(fmt::format("{}: row block does not fit the layout", path_.string()));
   if (block.rows == 0) return;
@@ -164,6 +204,8 @@ void SensorImageWriter::write_rows(const OutputRows& block) {
                    Imf::Slice::Make(Imf::FLOAT, file_->ids.data(), window, sizeof(float), sizeof(float) * width));
     }
     file_->exr->write_rows(frame, y0, block.rows);
+  } else if (file_->dng) {
+    file_->dng->write_rows(y0, block.rows, block.image);
   } else {
     const double top = std::ldexp(1.0, layout_.bits) - 1.0;
     const auto code = [&](float v) { return std::clamp(std::round(v * layout_.code_scale), 0.0, top); };
@@ -191,9 +233,15 @@ void SensorImageWriter::finish() {
         fmt::format("{}: finish after {} of {} rows", path_.string(), rows_written_, layout_.height));
   if (file_->exr) {
     file_->exr->finish();
+  } else if (file_->dng) {
+    file_->dng->finish();
   } else {
     if (!file_->image->close())
       throw std::runtime_error(fmt::format("{}: cannot complete the file: {}", path_.string(), file_->image->geterror()));
+    if (layout_.format == OutputFormat::Png)
+      check_complete_png(file_->output->temporary(), path_);
+    else
+      check_complete_tiff(file_->output->temporary(), path_, layout_.width, layout_.height);
     file_->output->commit();
   }
   file_.reset();

@@ -7,7 +7,8 @@
 // total), <component>.R/G/B per path component, display.R/G/B (the picture for people), object_id, string
 // attributes and numeric ones (the camera's black and white levels …). TIFF and PNG (OpenImageIO, 8 or 16
 // bits): the final image only, with the numeric attributes as OpenImageIO attributes and, since TIFF keeps
-// no attributes of its own, as JSON in ImageDescription.
+// no attributes of its own, as JSON in ImageDescription. DNG (libtiff, dng_writer.h): the Bayer mosaic's digital
+// numbers, one per pixel, before demosaicing.
 
 #include <cstdint>
 #include <filesystem>
@@ -17,11 +18,13 @@
 #include <string>
 #include <vector>
 
+#include "sensor_sim/dng_writer.h"
+
 namespace ct::sensor {
 
-enum class OutputFormat { Exr, Tiff, Png };
+enum class OutputFormat { Exr, Tiff, Png, Dng };
 
-// From the extension (.exr, .tif, .tiff, .png, any case); an InputError naming the file otherwise.
+// From the extension (.exr, .tif, .tiff, .png, .dng, any case); an InputError naming the file otherwise.
 OutputFormat output_format(const std::filesystem::path& file);
 
 struct OutputLayout {
@@ -38,12 +41,14 @@ struct OutputLayout {
   int bits = 16;
   double code_scale = 65535.0;
   std::string colour_space;  // "sRGB" tags the file as such; empty: untagged
-  // Every format: numeric attributes by full name (EXR: double and int attributes).
+  // DNG only: what the file says of the capture.
+  DngMetadata dng;
+  // Every format but DNG: numeric attributes by full name (EXR: double and int attributes).
   std::map<std::string, double> number_attributes;
   std::map<std::string, int> integer_attributes;
 };
 
-// The next rows; every image span holds rows·width·3 floats ([row][x][channel]); components in layout order.
+// The next rows; every image span holds rows·width·3 floats (a DNG's image rows·width: the mosaic) ([row][x][channel]); components in layout order.
 struct OutputRows {
   int rows = 0;
   std::span<const float> image;

@@ -21,6 +21,8 @@
 #include "sensor_sim/adc.h"
 #include "sensor_sim/cfa.h"
 #include "sensor_sim/display.h"
+#include "sensor_sim/dng_writer.h"
+#include "sensor_sim/illumination.h"
 #include "sensor_sim/linear_signal.h"
 #include "sensor_sim/noise.h"
 #include "sensor_sim/optics.h"
@@ -47,24 +49,34 @@ struct Run {
   RenderingIntent intent;
   double exposure_s = 0;
   int threads = 0;
+  std::vector<double> lighting;  // a reflectance image's illuminant per band (empty for radiance)
   int width() const { return model.width(); }
   int height() const { return model.height(); }
 };
 
 // Rows [y0, y1) of a layer read for sensor rows: the rendered rows [k·y0, k·y1). A NaN or infinite radiance
-// has no photon count: it is bad input, named by channel and pixel.
-std::vector<float> read_sensor_rows(SpectralExrReader& reader, const SpectralLayer& layer, int k, int y0, int y1) {
+// has no photon count, and no surface emits or reflects a negative total radiance: both are bad input, named by
+// channel and pixel. (A component may dip below zero by rounding where it was taken as a difference.) A
+// reflectance image is lit: each band's value times the illuminant's band average `lighting` (illumination.h).
+std::vector<float> read_sensor_rows(SpectralExrReader& reader, const SpectralLayer& layer, int k, int y0, int y1,
+                                    const std::vector<double>& lighting) {
   const SpectralExrInfo& info = reader.info();
   std::vector<float> values(to_size(k * (y1 - y0)) * to_size(info.width) * layer.channels.size());
   reader.read_rows(layer, k * y0, k * y1, values);
-  const auto bad = std::find_if(values.begin(), values.end(), [](float v) { return !std::isfinite(v); });
+  const bool total = layer.component.empty();
+  const auto bad = std::find_if(values.begin(), values.end(),
+                                [total](float v) { return !std::isfinite(v) || (total && v < 0.0f); });
   if (bad != values.end()) {
     const std::size_t i = static_cast<std::size_t>(bad - values.begin()), bands = layer.channels.size();
     const std::size_t pixel = i / bands;
-    throw InputError(fmt::format("{}: channel {}: value {} at pixel ({}, {}) is not finite", info.file,
+    throw InputError(fmt::format("{}: channel {}: value {} at pixel ({}, {}) is {}", info.file,
                                  layer.channels[i % bands], *bad, pixel % to_size(info.width),
-                                 to_size(k * y0) + pixel / to_size(info.width)));
+                                 to_size(k * y0) + pixel / to_size(info.width),
+                                 std::isfinite(*bad) ? "negative: a radiance is >= 0" : "not finite"));
   }
+  if (!lighting.empty())
+    for (std::size_t i = 0; i < values.size(); ++i)
+      values[i] = static_cast<float>(values[i] * lighting[i % lighting.size()]);
   return values;
 }
 
@@ -82,8 +94,9 @@ std::vector<float> linear_rows(const Run& run, std::span<const float> spectral, 
 }
 
 // Stages 4–5 for sensor rows [y0, y1): what the sensor reads out (DN with the ADC, else e⁻), three channels
-// per pixel — with a CFA, one per pixel demosaiced into three.
-std::vector<float> read_out_rows(const Run& run, std::span<const float> linear, int y0, int y1) {
+// per pixel — with a CFA, one per pixel demosaiced into three, or (`mosaic_only`, for a DNG) the mosaic itself.
+std::vector<float> read_out_rows(const Run& run, std::span<const float> linear, int y0, int y1,
+                                 bool mosaic_only = false) {
   const SensorConfig& c = run.config;
   const std::size_t width = to_size(run.width());
   const std::size_t rows = to_size(y1 - y0);
@@ -106,6 +119,7 @@ std::vector<float> read_out_rows(const Run& run, std::span<const float> linear, 
     for (std::size_t x = 0; x < width; ++x)
       mosaic[r * width + x] = value(r, x, cfa_channel(c.cfa.pattern, static_cast<int>(x), y0 + static_cast<int>(r)));
   });
+  if (mosaic_only) return mosaic;
   demosaic(mosaic, run.width(), static_cast<int>(rows), y0, c.cfa.pattern, c.cfa.demosaic, c.adc.bits, rgb);
   return rgb;
 }
@@ -249,11 +263,11 @@ Survey survey_image(SpectralExrReader& reader, const Run& unit_run, const Spectr
   Survey s;
   for (const RowRange& range : ranges) {
     const int y0 = range.first, y1 = range.last;
-    const std::vector<float> total_spectra = read_sensor_rows(reader, total, k, y0, y1);
+    const std::vector<float> total_spectra = read_sensor_rows(reader, total, k, y0, y1, unit_run.lighting);
     const std::vector<float> linear = linear_rows(unit_run, total_spectra, y0, y1);
     std::vector<float> emission_spectra, emission_linear;
     if (emission != nullptr) {
-      emission_spectra = read_sensor_rows(reader, *emission, k, y0, y1);
+      emission_spectra = read_sensor_rows(reader, *emission, k, y0, y1, unit_run.lighting);
       emission_linear = linear_rows(unit_run, emission_spectra, y0, y1);
     }
     std::vector<std::int32_t> ids;
@@ -340,16 +354,21 @@ double auto_exposure(Survey& survey, const SensorConfig& config, const std::stri
 }
 
 // The display rendering at unit exposure: the white balance's illuminant (display.white_balance, else the
-// brightest emitter the survey saw, else D65), its matrix, and the scale that puts the display.percentile of the
-// surfaces' brightest linear sRGB channel at display.level. `description` says what was chosen, as JSON.
+// illuminant lighting a reflectance image, else the brightest emitter the survey saw, else D65), its matrix, and
+// the scale that puts the display.percentile of the surfaces' brightest linear sRGB channel at display.level.
+// `description` says what was chosen, as JSON; `scene_light` is the illuminant's band values.
 DisplayRendering display_rendering(const Survey& survey, const LinearModel& unit_model, const SensorConfig& config,
-                                   const SpectralExrInfo& info, Json& description, std::vector<std::string>& notes) {
+                                   const SpectralExrInfo& info, const std::string& lit_by, const std::vector<double>& lighting,
+                                   Json& description, std::vector<std::string>& notes, std::vector<double>& scene_light) {
   const Bands& bands = info.bands;
   std::vector<double> light;
   std::string source;
   if (config.display.white_balance) {
     light = band_averages(cie::illuminant(*config.display.white_balance), bands);
     source = fmt::format("illuminant {} (display.white_balance)", *config.display.white_balance);
+  } else if (!lighting.empty()) {
+    light = lighting;
+    source = fmt::format("illuminant {} lighting the reflectance image (--illuminant)", lit_by);
   } else {
     const std::array<std::vector<double>, 3> xyz = xyz_band_weights(bands);
     double best = 0;
@@ -401,6 +420,7 @@ DisplayRendering display_rendering(const Survey& survey, const LinearModel& unit
                  {"level", config.display.level},
                  {"samples", brightest.size()}};
   description["matrix"] = matrix;  // camera e⁻ → linear sRGB, before the scale
+  scene_light = light;
   return d;
 }
 
@@ -410,7 +430,7 @@ DisplayRendering display_rendering(const Survey& survey, const LinearModel& unit
 void camera_levels(const SensorConfig& c, double exposure_s, OutputLayout& layout) {
   for (const char* key : {"chromatrace.black_level", "chromatrace.white_level", "chromatrace.dark_signal",
                           "chromatrace.read_noise", "chromatrace.bits", "chromatrace.noise", "chromatrace.adc",
-                          "chromatrace.pixel_area", "chromatrace.curve_gamma", "chromatrace.curve_k",
+                          "chromatrace.pixel_area", "chromatrace.cfa", "chromatrace.curve_gamma", "chromatrace.curve_k",
                           "chromatrace.curve_srgb"})
     layout.attributes.erase(key);  // an input's own, passed through as text, would clash
   auto& number = layout.number_attributes;
@@ -497,6 +517,15 @@ OutputLayout output_layout(const fs::path& output, const SensorConfig& c, int wi
   layout.format = output_format(output);
   if (layout.format == OutputFormat::Exr) return layout;
   const std::string file = output.string();
+  if (layout.format == OutputFormat::Dng) {
+    if (!c.cfa.enabled || !c.adc.enabled || c.adc.bits > 16 || c.rendering.enabled)
+      throw InputError(fmt::format(
+          "{}: a DNG holds a Bayer mosaic of at most 16-bit digital numbers: it needs cfa.enabled and adc.enabled "
+          "with adc.bits <= 16 and rendering.enabled false (are {}, {}, {}, {}); a camera preset sets them",
+          file, c.cfa.enabled, c.adc.enabled, c.adc.bits, c.rendering.enabled));
+    layout.code_scale = 1.0;
+    return layout;
+  }
   if (display_png(output, c)) {
     layout.bits = 8;
     layout.code_scale = 255.0;
@@ -527,14 +556,24 @@ OutputLayout output_layout(const fs::path& output, const SensorConfig& c, int wi
 
 // The input's total radiance, checked against what the camera needs: emitted radiance (S0), bands the curves
 // cover (unless told to treat them as zero), and room for the supersampling.
-const SpectralLayer& total_radiance(const SpectralExrInfo& info, SensorConfig& config) {
-  const SpectralLayer* total = info.find_layer("", SpectralQuantity::S0);
+const SpectralLayer& total_radiance(const SpectralExrInfo& info, SensorConfig& config, bool lit) {
+  const SpectralLayer* total = info.find_layer("", lit ? SpectralQuantity::T : SpectralQuantity::S0);
+  if (lit && total == nullptr)
+    throw InputError(fmt::format("{}: channels T.<λ>nm: missing; --illuminant lights a spectral reflectance image, and "
+                                 "this file is {}",
+                                 info.file, info.kind()));
+  if (info.bispectral && (lit || info.find_layer("", SpectralQuantity::S0) == nullptr))
+    throw InputError(fmt::format("{}: a bi-spectral (fluorescent) file: its re-radiation channels T.<λ>.<λ'>nm are not "
+                                 "supported; the sensor takes emitted radiance (S0), or the plain reflectance T.<λ>nm "
+                                 "lit with --illuminant, of a file without re-radiation",
+                                 info.file));
   if (total == nullptr) {
     if (!info.spectral()) info.total();  // the reader's "no spectral channels" message
     throw InputError(
         fmt::format("{}: channels S0.<λ>nm: missing; the sensor needs emitted radiance, and this "
-                    "file is {}",
-                    info.file, info.kind()));
+                    "file is {}{}",
+                    info.file, info.kind(),
+                    info.reflective ? " (light it with --illuminant NAME|FILE.csv)" : ""));
   }
   if (config.response.outside_curve == CurveOutside::Error)
     check_band_coverage(info.bands, config.response.curves, info.file);
@@ -590,12 +629,30 @@ void describe_output(const SpectralExrInfo& info, const SensorConfig& config, co
   }
   camera_levels(config, run.exposure_s, layout);
   layout.integer_attributes["chromatrace.pixel_area"] = pixel_area(info, config);
+  layout.integer_attributes["chromatrace.cfa"] = config.cfa.enabled ? 1 : 0;
   if (picture) {  // the codes are the display rendering's (sRGB, 0…255), not the camera's numbers
     layout.attributes["chromatrace.signal"] = "display";
     layout.number_attributes = {{"chromatrace.black_level", 0.0}, {"chromatrace.white_level", 255.0},
                                 {"chromatrace.curve_gamma", 1.0}, {"chromatrace.curve_k", 1.0}};
     layout.integer_attributes["chromatrace.curve_srgb"] = 1;
   }
+}
+
+// What a DNG says of the capture (docs/sensor.md, "DNG"): the levels as camera_levels() put them, the as-shot
+// neutral (the camera's signal of a white lit by the scene illuminant, largest channel 1), the D65 colour matrix
+// from the camera's curves, the exposure, the f-number and the camera's name.
+DngMetadata dng_metadata(const SensorConfig& c, const Run& run, const Bands& bands, const std::vector<double>& scene_light,
+                         const OutputLayout& layout) {
+  DngMetadata m;
+  m.pattern = std::string(pattern_name(c.cfa.pattern));
+  m.black_level = layout.number_attributes.at("chromatrace.black_level");
+  m.white_level = layout.number_attributes.at("chromatrace.white_level");
+  m.as_shot_neutral = dng_neutral(run.model.weights, scene_light);
+  m.colour_matrix = dng_colour_matrix(run.model.weights, bands);
+  m.camera = c.response.camera;
+  m.exposure_s = run.exposure_s;
+  if (c.optics.enabled) m.f_number = c.optics.f_number;
+  return m;
 }
 
 // The display rendering of `count` pixels of linear signal from `linear`, into `out`.
@@ -619,16 +676,25 @@ RunReport simulate_sensor(const fs::path& input, const fs::path& output, SensorC
   check_output_path(output, {input});
   SpectralExrReader reader(input);
   const SpectralExrInfo& info = reader.info();
-  const SpectralLayer* total = &total_radiance(info, config);
+  const bool lit = !options.illuminant.empty();
+  const SpectralLayer* total = &total_radiance(info, config, lit);
   const int k = config.pixel.supersample;
   const std::optional<FieldOfView> fov = cos4_field_of_view(info, config);
 
-  const auto component_list = component_layers_of(info);
+  // A lit reflectance image is one layer of light; emissive layers a file may hold beside it are not its light.
+  const auto component_list = lit ? decltype(component_layers_of(info)){} : component_layers_of(info);
   const std::vector<std::string>& components = component_list.first;
   const std::vector<const SpectralLayer*>& component_layers = component_list.second;
 
   Run run;
   run.threads = options.threads;
+  if (lit) {
+    const Illumination illumination = read_illumination(options.illuminant);
+    run.lighting = band_averages(illumination.spectrum, info.bands);
+    config.notes.push_back(fmt::format(
+        "reflectance lit by {}: radiance = reflectance x the illuminant's band average, 1 W/m2/sr/nm at 560 nm",
+        illumination.name));
+  }
   run.model = linear_model(config, 1.0, info.bands, fov, info.width, info.height);
   const int height = run.height();
   if (config.cfa.enabled && (run.width() < 2 || height < 2))
@@ -641,13 +707,15 @@ RunReport simulate_sensor(const fs::path& input, const fs::path& output, SensorC
   const int rows_per_block = block_rows(info, layers_per_block, k, options.block_rows, height);
   const std::size_t blocks = to_size((height + rows_per_block - 1) / rows_per_block);
   const bool exr = layout.format == OutputFormat::Exr;
+  const bool dng = layout.format == OutputFormat::Dng;
   const bool auto_time = !config.exposure.time_s;
   const bool picture = display_png(output, config);  // the PNG holds the display rendering
   const bool want_display = (exr && config.display.enabled) || picture;
-  const SpectralLayer* emission = info.find_layer("emission", SpectralQuantity::S0);
+  const bool want_light = want_display || dng;  // a DNG's as-shot neutral is the scene illuminant's
+  const SpectralLayer* emission = lit ? nullptr : info.find_layer("emission", SpectralQuantity::S0);
   const std::set<std::int32_t> lights = light_object_ids(info);
   const std::vector<RowRange> surveyed =
-      auto_time || want_display || config.optics.flare > 0 ? survey_rows(auto_time, k, height, rows_per_block)
+      auto_time || want_light || config.optics.flare > 0 ? survey_rows(auto_time, k, height, rows_per_block)
                                                             : std::vector<RowRange>{};
   Progress progress("sensor", blocks + surveyed.size(), options.progress);
 
@@ -656,13 +724,16 @@ RunReport simulate_sensor(const fs::path& input, const fs::path& output, SensorC
   if (!surveyed.empty()) {
     run.config = config;
     const bool exclude = auto_time && config.exposure.auto_exclude_emitters;
-    survey = survey_image(reader, run, *total, exclude || want_display ? emission : nullptr,
-                          exclude || want_display ? lights : std::set<std::int32_t>{}, surveyed, want_display, progress);
+    survey = survey_image(reader, run, *total, exclude || want_light ? emission : nullptr,
+                          exclude || want_light ? lights : std::set<std::int32_t>{}, surveyed, want_light, progress);
   }
   if (auto_time) config.exposure.time_s = auto_exposure(survey, config, info.file, config.notes);
   Json display_description;
   DisplayRendering display;
-  if (want_display) display = display_rendering(survey, run.model, config, info, display_description, config.notes);
+  std::vector<double> scene_light;
+  if (want_light)
+    display = display_rendering(survey, run.model, config, info, options.illuminant, run.lighting, display_description,
+                                config.notes, scene_light);
   // Veiling glare at unit exposure: flare × the image's mean signal, per channel.
   std::array<double, 3> glare{};
   if (config.optics.flare > 0 && survey.pixels > 0)
@@ -690,6 +761,7 @@ RunReport simulate_sensor(const fs::path& input, const fs::path& output, SensorC
   report.notes = config.notes;
   report.effective_config = config_json(config);
   describe_output(info, config, run, report, components, want_display, picture, display_description, display.scale, layout);
+  if (dng) layout.dng = dng_metadata(config, run, info.bands, scene_light, layout);
   SensorImageWriter writer(output, layout);
 
   const auto read_block = [&](int y0) {
@@ -697,10 +769,10 @@ RunReport simulate_sensor(const fs::path& input, const fs::path& output, SensorC
     in.y0 = y0;
     in.y1 = std::min(height, y0 + rows_per_block);
     in.context = config.cfa.enabled ? demosaic_context(in.y0, in.y1, height) : RowRange{in.y0, in.y1};
-    in.total = read_sensor_rows(reader, *total, k, in.context.first, in.context.last);
+    in.total = read_sensor_rows(reader, *total, k, in.context.first, in.context.last, run.lighting);
     if (exr) {
       for (const SpectralLayer* layer : component_layers)
-        in.components.push_back(read_sensor_rows(reader, *layer, k, in.y0, in.y1));
+        in.components.push_back(read_sensor_rows(reader, *layer, k, in.y0, in.y1, run.lighting));
       if (layout.object_ids) {
         in.ids.resize(to_size(k * (in.y1 - in.y0)) * to_size(info.width));
         reader.read_object_ids(k * in.y0, k * in.y1, in.ids);
@@ -718,10 +790,12 @@ RunReport simulate_sensor(const fs::path& input, const fs::path& output, SensorC
     std::vector<float> linear_ext = linear_rows(run, in.total, e0, e1);
     if (config.optics.flare > 0)  // the glare lands on every pixel: it is light, so the linear layer has it too
       for (std::size_t i = 0; i < linear_ext.size(); ++i) linear_ext[i] += static_cast<float>(glare[i % 3]);
-    std::vector<float> image = read_out_rows(run, linear_ext, e0, e1);
+    std::vector<float> image = read_out_rows(run, linear_ext, e0, e1, dng);
     const std::size_t own = to_size(y0 - e0) * row_values, own_size = to_size(y1 - y0) * row_values;
-    image.erase(image.begin() + static_cast<std::ptrdiff_t>(own + own_size), image.end());
-    image.erase(image.begin(), image.begin() + static_cast<std::ptrdiff_t>(own));
+    const std::size_t image_values = dng ? 1 : 3;  // a DNG holds the mosaic: one value per pixel
+    const std::size_t image_own = own / 3 * image_values, image_size = own_size / 3 * image_values;
+    image.erase(image.begin() + static_cast<std::ptrdiff_t>(image_own + image_size), image.end());
+    image.erase(image.begin(), image.begin() + static_cast<std::ptrdiff_t>(image_own));
     if (config.rendering.enabled) render_rows(run, image);
     if (picture)  // the picture for people in place of the raw numbers
       display_pixels(display, linear_ext.data() + own, image.size() / 3, run.threads, image.data());

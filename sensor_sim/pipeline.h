@@ -22,6 +22,9 @@ struct RunOptions {
   int threads = 0;     // 0: all cores
   int block_rows = 0;  // sensor rows per block; 0: chosen to keep the input buffers near 8 MB
   bool progress = false;
+  // For a spectral reflectance image (T channels): the illuminant that lights it, a CIE name or a CSV file
+  // (illumination.h). Empty: the input must hold emitted radiance (S0).
+  std::string illuminant;
 };
 
 struct RunReport {
@@ -36,7 +39,8 @@ struct RunReport {
 // and none of `inputs` (core/file_io.h). InputError naming the file.
 void check_output_path(const std::filesystem::path& output, const std::vector<std::filesystem::path>& inputs = {});
 
-// Runs the sensor on `input` (an emissive spectral EXR) and writes `output` (.exr, .tif/.tiff, .png).
+// Runs the sensor on `input` (an emissive spectral EXR, or a reflective one with options.illuminant) and writes
+// `output` (.exr, .tif/.tiff, .png, .dng).
 // Bad input is an InputError naming the file and the field; the output then does not exist.
 RunReport simulate_sensor(const std::filesystem::path& input, const std::filesystem::path& output, SensorConfig config,
                           const RunOptions& options);

@@ -1,6 +1,7 @@
 #include "series/runner.h"
 
 #include <fcntl.h>
+#include <sys/resource.h>
 #include <spawn.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -34,6 +35,17 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 double seconds_since(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
+
+// CPU seconds (user + system) of this process and of its waited-for children so far.
+double cpu_seconds() {
+  double total = 0;
+  for (const int who : {RUSAGE_SELF, RUSAGE_CHILDREN}) {
+    rusage usage{};
+    getrusage(who, &usage);
+    for (const timeval& t : {usage.ru_utime, usage.ru_stime}) total += static_cast<double>(t.tv_sec) + 1e-6 * static_cast<double>(t.tv_usec);
+  }
+  return total;
+}
 
 // ---- The render cache key -------------------------------------------------------------------------------
 
@@ -247,12 +259,14 @@ VariantResult run_variant(const Series& series, const SeriesVariant& variant, co
   } else {
     stage(fmt::format("rendering with {}", renderer_name(options.renderer)));
     const auto start = Clock::now();
+    const double start_cpu = cpu_seconds();
     write_file_atomically(dir / "renders" / (result.render_key + ".json"), inputs.dump(2) + "\n");
     if (options.renderer == Renderer::Tracer)
       render_with_tracer(variant.scene, render, options);
     else
       render_with_cycles(variant.scene, fs::absolute(scene_file), fs::absolute(render), fs::absolute(dir), options);
     result.render_s = seconds_since(start);
+    result.render_cpu_s = cpu_seconds() - start_cpu;
   }
 
   stage("camera");
@@ -381,7 +395,7 @@ Json result_json(const SeriesResult& result) {
     } else {
       j["size"] = {v.width, v.height};
       j["render"] = {{"file", "renders/" + v.render_key + ".exr"}, {"key", v.render_key}, {"reused", v.render_reused},
-                     {"seconds", v.render_s}};
+                     {"seconds", v.render_s}, {"cpu_seconds", v.render_cpu_s}};
       j["scene"] = folder + "/scene.json";
       j["sensor"] = {{"settings", folder + "/sensor.json"}, {"file", folder + "/camera.exr"}, {"seconds", v.sensor_s}};
       j["preview"] = folder + "/camera.png";

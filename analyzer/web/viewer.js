@@ -85,7 +85,8 @@ bySize.forEach(([r, index]) => {
 
 const details = document.getElementById('details');
 function showDetails(r) {
-  const range = `<tr><th>cube shown</th><td>[${r.range[0].toPrecision(4)}, ${r.range[1].toPrecision(4)}] per channel</td></tr>`;
+  const ranges = r.ranges.map((lh, c) => `${'RGB'[c]} ${lh[0].toPrecision(4)} to ${lh[1].toPrecision(4)}`).join(', ');
+  const range = `<tr><th>cube shown</th><td>${ranges} (${data.unit})</td></tr>`;
   const rows = range + r.summary.map(([k, v]) => `<tr><th>${k}</th><td>${v}</td></tr>`).join('');
   details.innerHTML = `<h2>${r.name}</h2><p class="class">${r.class}</p><p>${r.reason}</p><table>${rows}</table>`;
 }
@@ -121,8 +122,48 @@ for (let a = 0; a < 8; ++a)
   }
 scene.add(segments(edges.grey, 0x5a5a5a), segments(edges.r, 0xff4040), segments(edges.g, 0x40e040), segments(edges.b, 0x4080ff));
 
+// A text label facing the camera, `height` high in cube units.
+function label(text, position, colour, height = 0.045) {
+  const canvas = document.createElement('canvas');
+  const context = canvas.getContext('2d');
+  const font = '32px sans-serif';
+  context.font = font;
+  canvas.width = Math.ceil(context.measureText(text).width) + 8;
+  canvas.height = 40;
+  context.font = font;
+  context.fillStyle = colour;
+  context.textBaseline = 'middle';
+  context.fillText(text, 4, 20);
+  const material = new THREE.SpriteMaterial({ map: new THREE.CanvasTexture(canvas), depthTest: false, transparent: true });
+  const sprite = new THREE.Sprite(material);
+  sprite.scale.set((height * canvas.width) / canvas.height, height, 1);
+  sprite.position.set(...position);
+  return sprite;
+}
+
+// Tick values along each channel's edge from black (computed with the plots' ticks, analyzer/plots.h), and the
+// channels' names with the unit of the values.
+function axisLabels(r) {
+  const group = new THREE.Group();
+  const colours = ['#ff8080', '#80e080', '#80a0ff'];
+  const away = [[0, -0.07, -0.04], [-0.07, 0, -0.04], [-0.07, -0.07, 0]];
+  r.ticks.forEach((ticks, c) => {
+    for (const [at, text] of ticks) {
+      if (c > 0 && at < 0.08) continue; // black's own value is written once, on the red edge
+      const position = away[c].slice();
+      position[c] = at;
+      group.add(label(text, position, '#bbbbbb'));
+    }
+    const end = away[c].map((v) => 2 * v);
+    end[c] = 1.12;
+    group.add(label(`${'RGB'[c]} (${data.unit})`, end, colours[c], 0.055));
+  });
+  return group;
+}
+
 let points = null;
 let fits = null;
+let axes = null;
 let current = -1;
 const colourMode = document.getElementById('colour-mode');
 if (!regions.some((r) => r.component)) colourMode.querySelector('option[value=component]').remove();
@@ -139,6 +180,12 @@ function showRegion(index, force = false) {
   const r = regions[index];
   if (points) scene.remove(points);
   if (fits) scene.remove(fits);
+  if (axes) {
+    scene.remove(axes);
+    axes.traverse((o) => o.material && (o.material.map.dispose(), o.material.dispose()));
+  }
+  axes = axisLabels(r);
+  scene.add(axes);
   const positions = new Float32Array(r.count * 3);
   const colours = new Float32Array(r.count * 3);
   for (let i = 0; i < r.count; ++i) {

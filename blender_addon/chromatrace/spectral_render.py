@@ -769,13 +769,13 @@ class SpectralRender:
         cycles_setup.set_id_render(journal, self.scene, plan.view_layer)
         temporary = final + ".partial"
         journal.set(self.scene.render, "filepath", temporary)
-        start = time.monotonic()
+        start, start_cpu = time.monotonic(), time.process_time()
         bpy.ops.render.render(write_still=True, scene=self.scene.name)
         if not os.path.isfile(temporary):
             raise RuntimeError(f"Cycles wrote no file for the object-id render ({temporary})")
         cache.commit(temporary, final)
         self.rendered += 1
-        return f"{time.monotonic() - start:.2f} s"
+        return f"{time.monotonic() - start:.2f} s, {time.process_time() - start_cpu:.2f} s CPU"
 
     def _assemble(self, plan):
         request = self.request

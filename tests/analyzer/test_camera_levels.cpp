@@ -209,7 +209,9 @@ TEST(CameraLevels, RawWithBlackLevelIsAnalysedAsWithout) {
     const ClusterShape& own = s.unclipped.empty() ? s : s.unclipped.front();
     if (own.samples >= 10) d.emplace_back("axis 1", own.moments.axes.col(0));
     if (own.line) d.emplace_back("line", own.line->direction);
-    if (own.body_only) d.emplace_back("body line", own.body_only->line.direction);
+    // A volume has no body line: the robust line found among samples spread in all three directions turns with
+    // one sample more or less inside its tolerance (the image's noise, which clamping at code 0 changes a little).
+    if (own.body_only && own.shape != ShapeClass::Volume) d.emplace_back("body line", own.body_only->line.direction);
     if (own.black_plane) d.emplace_back("dichromatic plane", own.black_plane->normal);
     return d;
   };
@@ -222,7 +224,7 @@ TEST(CameraLevels, RawWithBlackLevelIsAnalysedAsWithout) {
     for (std::size_t k = 0; k < da.size(); ++k, ++compared)
       EXPECT_LT(angle_deg(da[k].second, db[k].second), 0.5) << a.results[i].name << ": " << da[k].first;
   }
-  EXPECT_GT(compared, 20u);
+  EXPECT_GT(compared, 15u) << compared;  // 9 regions: each axis 1 and dichromatic plane, and the lines their classes use
 
   // Without the metadata the black level stays in: fits through black tilt by far more than 0.5°.
   AnalysisImage unaware = raw;

@@ -14,7 +14,8 @@ namespace {
 const std::string kScenes = std::string(CHROMATRACE_SOURCE_DIR) + "/scenes";
 
 TEST(CheckScene, ShippedScenesAreValid) {
-  for (const std::string scene : {"paper/box.json", "cornell_box/cornell_box.json"}) {
+  for (const std::string scene : {"paper/box.json", "cornell_box/cornell_box.json", "textured/textured.json",
+                                  "glossy_lights/glossy_lights.json"}) {
     const test::CommandResult r = test::run_chromatrace({"check-scene", kScenes + "/" + scene});
     EXPECT_EQ(r.exit_code, 0) << scene << ": " << r.err;
     EXPECT_EQ(r.err, "") << scene;

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include <fmt/core.h>
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
@@ -34,6 +35,7 @@ struct Synthetic {
   double ball_diffuse_scale = 1.0;  // multiplies diffuse_direct (and so the total) on object 2
   int width = kW;
   double camera_x = 0.0;
+  double slope = 0.001;  // relative change of every spectrum per nm about 580 nm (0: flat within each 40 nm bin)
 };
 
 // Band b of object o's diffuse_direct and glossy_direct.
@@ -70,7 +72,7 @@ void write_render(const fs::path& file, const Synthetic& s) {
     for (std::size_t b = 0; b < nb; ++b) {
       // The value of the band as the average of 10 nm sub-bands that differ, so coarse = mean of fine.
       const double c = s.bands.centre(b);
-      const double slope = 1.0 + 0.001 * (c - 580.0);
+      const double slope = 1.0 + s.slope * (c - 580.0);
       double d = diffuse_value(o, std::size_t((c - 380) / 40)) * slope * (1 + s.sigma * noise(rng));
       if (o == 2) d *= s.ball_diffuse_scale;
       const double g = glossy_value(o, std::size_t((c - 380) / 40)) * slope * (1 + s.sigma * noise(rng));
@@ -276,6 +278,44 @@ TEST_F(Compare, IdenticalRendersHaveZeroDeltaE) {
   const json d2 = result("out2");
   EXPECT_GT(d2["image"]["delta_e00"]["p95"].get<double>(), 0.3);
   EXPECT_LT(d2["image"]["delta_e00"]["max"].get<double>(), 10.0);
+}
+
+}  // namespace
+}  // namespace ct
+
+namespace ct {
+namespace {
+
+// --colour own: each side's colour over its own bands. A fine plan nested in a coarse one gives the same colour
+// exactly when the spectra are flat within each coarse band, and a different one when they slope (the coarse
+// plan's colour error), which --colour common (both on the coarse plan) does not see.
+TEST_F(Compare, OwnColoursCountTheCoarserPlansColourError) {
+  for (const double slope : {0.0, 0.001}) {
+    Synthetic a, b;
+    a.bands = Bands::uniform(380, 780, 10);
+    a.sigma = b.sigma = 0.0;
+    a.slope = b.slope = slope;
+    const std::string fa = render(fmt::format("a{}.exr", slope), a).string();
+    const std::string fb = render(fmt::format("b{}.exr", slope), b).string();
+    const std::string own = fmt::format("own{}", slope), common = fmt::format("common{}", slope);
+    ASSERT_EQ(run({fa, fb, "-o", dir_.file(own).string(), "--colour", "own"}).exit_code, 0);
+    ASSERT_EQ(run({fa, fb, "-o", dir_.file(common).string()}).exit_code, 0);
+    const json o = result(own), c = result(common);
+    EXPECT_EQ(o["image"]["colour"], "own");
+    EXPECT_EQ(c["image"]["colour"], "common");
+    // Single-precision band values round colours to well under 10⁻³ ΔE00; a real difference is far above that.
+    constexpr double kRounding = 1e-3;
+    EXPECT_LT(c["image"]["delta_e00"]["max"].get<double>(), kRounding) << slope;
+    if (slope == 0.0)
+      EXPECT_LT(o["image"]["delta_e00"]["max"].get<double>(), kRounding);
+    else
+      EXPECT_GT(o["image"]["delta_e00"]["mean"].get<double>(), 10 * kRounding);
+  }
+  const auto bad = run({dir_.file("a0.exr").string(), dir_.file("b0.exr").string(), "-o", dir_.file("x").string(),
+                        "--colour", "mine"});
+  EXPECT_EQ(bad.exit_code, 2);
+  EXPECT_NE(bad.err.find("--colour"), std::string::npos) << bad.err;
+  EXPECT_FALSE(fs::exists(dir_.file("x")));
 }
 
 }  // namespace

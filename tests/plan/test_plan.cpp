@@ -7,10 +7,13 @@
 
 #include <cmath>
 #include <filesystem>
+#include <map>
+#include <optional>
 
 #include <fmt/core.h>
 
 #include "core/band_plan.h"
+#include "core/colour.h"
 #include "core/error.h"
 #include "core/file_io.h"
 #include "core/json_input.h"
@@ -140,6 +143,79 @@ TEST_F(Plan, PlannedSamplesGiveTheTargetNoise) {
     EXPECT_LE(p.noise_at_samples, 2.0);
     EXPECT_LE(p.noise_at_samples, 1.5 * noise);
     EXPECT_GE(p.noise_at_samples, noise / 1.5);
+  }
+}
+
+// What the histograms say must not change with the planned settings. The paper box under its own light and under
+// F11 at 64×64: the planned bands and bounce limit against the 5 nm reference at the scene's bounce limit, same
+// samples and seed (so most of the noise is common), each seen by a noise-free camera and analysed. A class that
+// the reference itself gives differently with the next seed is decided by noise, not by the settings, and is not
+// held to; every other object's class must be the reference's. The illuminant estimate must come from the same
+// method (where the reference's method does not change with the seed) and point the same way: within three of
+// its standard errors, or for an estimate without one (grey world: the image's mean colour) within 1°, which a
+// mean ΔE00 of 1 cannot exceed by much (a unit ΔE00 is about 1 % of chroma at mid grey).
+TEST_F(Plan, PlannedSettingsKeepEveryClassAndTheIlluminant) {
+  Json f11 = read_json(kBox);
+  f11["spectra"]["lamp"] = Json{{"illuminant", "F11"}};
+  for_each_scene_path(f11, [&](Json& path) {
+    if (fs::path(path.get<std::string>()).is_relative()) path = (kBox.parent_path() / path.get<std::string>()).string();
+  });
+  const fs::path f11_file = dir_ / "box_f11.json";
+  write_file_atomically(f11_file, f11.dump(2));
+  for (const fs::path& scene : {kBox, f11_file}) {
+    SCOPED_TRACE(scene.filename().string());
+    const fs::path plan_file = dir_ / "plan.json", report = dir_ / "report.json";
+    auto ok = [](const test::CommandResult& r) { ASSERT_EQ(r.exit_code, 0) << r.err; };
+    ok(run_chromatrace({"plan", scene.string(), "-o", plan_file.string(), "--report", report.string(), "-q"}));
+    const int bounces = read_json(report)["settings"]["max_bounces"].get<int>();
+    struct Analysed {
+      std::map<std::string, std::string> classes;
+      std::string method;
+      Vec3d rgb{};
+      std::optional<double> uncertainty;
+    };
+    auto analyse = [&](const std::string& name, std::vector<std::string> render_args, int seed) {
+      const fs::path exr = dir_ / (name + ".exr"), camera = dir_ / (name + "-camera.exr"), out = dir_ / name;
+      std::vector<std::string> args = {"render", scene.string(), "-o", exr.string(), "--resolution", "64x64",
+                                       "--spp", "256", "--seed", std::to_string(seed), "-q"};
+      args.insert(args.end(), render_args.begin(), render_args.end());
+      ok(run_chromatrace(args));
+      ok(run_chromatrace({"sensor", exr.string(), "-o", camera.string(), "--no-noise", "--exposure-s", "auto", "-q"}));
+      ok(run_chromatrace({"analyze", camera.string(), "-o", out.string(), "-q"}));
+      const Json a = read_json(out / "analysis.json");
+      Analysed r;
+      for (const Json& region : a["regions"])
+        if (region["source"] == "labels") r.classes[region["name"].get<std::string>()] = region["shape"]["class"];
+      const Json& e = a["illuminant"]["estimate"];
+      r.method = e["method"];
+      for (int c = 0; c < 3; ++c) r.rgb[c] = e["rgb"][c].get<double>();
+      if (e["uncertainty_deg"].is_number()) r.uncertainty = e["uncertainty_deg"].get<double>();
+      return r;
+    };
+    const Analysed planned = analyse("planned", {"--plan", plan_file.string(), "--max-bounces", std::to_string(bounces)}, 1);
+    const Analysed reference = analyse("reference", {"--bands", "380:780:5"}, 1);
+    const Analysed next_seed = analyse("reference2", {"--bands", "380:780:5"}, 2);
+    int held = 0;
+    for (const auto& [object, cls] : reference.classes) {
+      if (next_seed.classes.at(object) != cls) continue;  // decided by noise
+      ++held;
+      EXPECT_EQ(planned.classes.at(object), cls) << object;
+    }
+    std::fprintf(stderr, "%s: %d of %zu classes held to the reference's; illuminant %s (reference %s, next seed %s)\n",
+                 scene.filename().c_str(), held, reference.classes.size(), planned.method.c_str(),
+                 reference.method.c_str(), next_seed.method.c_str());
+    EXPECT_GE(held, static_cast<int>(reference.classes.size()) - 2);  // noise decides at most a couple
+    if (reference.method == next_seed.method) {
+      EXPECT_EQ(planned.method, reference.method);
+    }
+    if (planned.method == reference.method) {
+      const double dot = planned.rgb[0] * reference.rgb[0] + planned.rgb[1] * reference.rgb[1] + planned.rgb[2] * reference.rgb[2];
+      const double norms = std::hypot(planned.rgb[0], planned.rgb[1], planned.rgb[2]) *
+                           std::hypot(reference.rgb[0], reference.rgb[1], reference.rgb[2]);
+      const double angle = std::acos(std::min(1.0, dot / norms)) * 180 / M_PI;
+      const double tolerance = reference.uncertainty ? 3 * std::max(*reference.uncertainty, planned.uncertainty.value_or(0)) : 1.0;
+      EXPECT_LE(angle, tolerance) << planned.method;
+    }
   }
 }
 

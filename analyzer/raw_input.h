@@ -1,0 +1,30 @@
+#pragma once
+// Camera raw files (DNG and the raw formats LibRaw knows: CR2, CR3, NEF, ARW, RAF, ORF, RW2, PEF, …) read as
+// linear camera RGB for the analysis (docs/analyze.md, "Camera raw"): the file's black level subtracted, no
+// white balance, no colour matrix, no tone curve, and the white level the file gives, so that the clipping
+// faces of the histogram are the sensor's. Either demosaiced by one of LibRaw's methods, or, without
+// demosaicing, at half size: each 2×2 Bayer tile gives its red, its first green (in row order) and its blue
+// exactly as captured.
+
+#include <filesystem>
+#include <string>
+
+#include "analyzer/image_input.h"
+
+namespace ct::analyzer {
+
+// Whether the file is read as a camera raw: by its extension (.dng, .cr2, .nef, … any case).
+bool is_camera_raw(const std::filesystem::path& file);
+
+// The demosaicing methods LibRaw offers, by the names --raw-demosaic takes.
+const std::vector<std::string>& raw_demosaic_names();
+
+// Reads a camera raw. InputError naming the file when LibRaw cannot decode it (not a raw it knows, data
+// ending early or corrupt), when it holds no Bayer mosaic and half size is asked for, or for an unknown
+// demosaicing method.
+AnalysisImage read_camera_raw(const std::filesystem::path& file, const RawOptions& options);
+
+// What `chromatrace info` says of a camera raw: one "key: value" per line, in order.
+std::vector<std::pair<std::string, std::string>> describe_camera_raw(const std::filesystem::path& file);
+
+}  // namespace ct::analyzer

@@ -1,0 +1,32 @@
+#!/usr/bin/env bash
+# Start-up cost: wall time and peak memory (max RSS, from /usr/bin/time) of `chromatrace --help` and of
+# `chromatrace check-scene` on the minimal scene, against /bin/true (the cost of starting any process) and
+# `oiiotool --help` (a tool built on the same image libraries). The best of N runs of each (default 10).
+#   bench/bench_startup.sh [BUILD_DIR] [N]
+set -euo pipefail
+source_dir="$(cd "$(dirname "$0")/.." && pwd)"
+build_dir="${1:-$source_dir/build}"
+runs="${2:-10}"
+exe="$build_dir/cli/chromatrace"
+scene="$source_dir/tests/data/scenes/minimal.json"
+record="$(mktemp)"
+trap 'rm -f "$record"' EXIT
+
+measure() {
+  local label="$1"
+  shift
+  local best_s="" best_kb=""
+  for _ in $(seq "$runs"); do
+    /usr/bin/time -o "$record" -f "%e %M" "$@" >/dev/null 2>&1 || true
+    read -r s kb <"$record"
+    if [ -z "$best_s" ] || awk "BEGIN{exit !($s < $best_s)}"; then best_s="$s"; fi
+    if [ -z "$best_kb" ] || [ "$kb" -lt "$best_kb" ]; then best_kb="$kb"; fi
+  done
+  printf '%-34s %6s s %8.1f MB\n' "$label" "$best_s" "$(awk "BEGIN{print $best_kb / 1024}")"
+}
+
+measure "/bin/true" /bin/true
+measure "oiiotool --help" oiiotool --help
+measure "chromatrace --help" "$exe" --help
+measure "chromatrace check-scene minimal" "$exe" check-scene "$scene"
+echo "shared libraries chromatrace loads: $(ldd "$exe" | wc -l)"

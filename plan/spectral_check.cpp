@@ -1,0 +1,123 @@
+#include "plan/spectral_check.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+
+#include <fmt/core.h>
+
+#include "core/cie.h"
+#include "core/colour.h"
+
+namespace ct::plan {
+namespace {
+
+// A spectrum on the 1 nm grid [lo, hi].
+using Samples = std::vector<double>;
+
+Samples sample(const PiecewiseLinearSpectrum& s, int lo, int hi) {
+  Samples out(static_cast<std::size_t>(hi - lo + 1));
+  for (std::size_t i = 0; i < out.size(); ++i) out[i] = s(lo + static_cast<double>(i));
+  return out;
+}
+
+// The spectrum as the band plan holds it: each band's average, flat over the band. Sample i stands for
+// [i − ½, i + ½] nm (as xyz() sums), so a band [lo, hi) holds the samples lo … hi − 1 (the last also hi), and bands
+// of 1 nm hold every sample as it is.
+Samples banded(const Samples& s, const Bands& bands, int lo) {
+  Samples out(s.size(), 0.0);
+  const int last = static_cast<int>(s.size()) - 1;
+  for (std::size_t b = 0; b < bands.size(); ++b) {
+    const int a = std::clamp(static_cast<int>(std::lround(bands.lo(b))) - lo, 0, last);
+    const int e = b + 1 == bands.size() ? last + 1 : std::clamp(static_cast<int>(std::lround(bands.hi(b))) - lo, 0, last + 1);
+    if (e <= a) continue;
+    double sum = 0;
+    for (int i = a; i < e; ++i) sum += s[i];
+    for (int i = a; i < e; ++i) out[i] = sum / (e - a);
+  }
+  return out;
+}
+
+Vec3d xyz(const Samples& s, const std::array<Samples, 3>& cmf) {
+  Vec3d out{};
+  for (int c = 0; c < 3; ++c)
+    for (std::size_t i = 0; i < s.size(); ++i) out[c] += s[i] * cmf[c][i];
+  return out;
+}
+
+Samples product(const Samples& a, const Samples& b) {
+  Samples out(a.size());
+  for (std::size_t i = 0; i < a.size(); ++i) out[i] = a[i] * b[i];
+  return out;
+}
+
+const SpectrumRef* diffuse_of(const Material& m) {
+  if (auto* l = std::get_if<LambertMaterial>(&m.model)) return &l->reflectance;
+  if (auto* d = std::get_if<DichromaticMaterial>(&m.model)) return &d->diffuse;
+  if (auto* r = std::get_if<MirrorMaterial>(&m.model)) return &r->reflectance;
+  return nullptr;
+}
+
+std::string describe(const Bands& bands) {
+  bool uniform = true;
+  for (std::size_t b = 1; b < bands.size(); ++b) uniform = uniform && std::abs(bands.width(b) - bands.width(0)) < 1e-6;
+  return uniform ? fmt::format("{} bands of {:.3g} nm", bands.size(), bands.width(0)) : fmt::format("{} bands", bands.size());
+}
+
+}  // namespace
+
+std::vector<SpectralWarning> check_band_plan(const Scene& scene, const Bands& bands, SpectralMode mode, double threshold) {
+  std::vector<SpectralWarning> out;
+  if (mode == SpectralMode::Continuous || bands.size() == 0) return out;
+  const int lo = static_cast<int>(std::ceil(bands.min_wavelength() - 1e-9));
+  const int hi = static_cast<int>(std::floor(bands.max_wavelength() + 1e-9));
+  if (hi - lo < 2) return out;
+  const std::array<const PiecewiseLinearSpectrum*, 3> curves = {&cie::x_bar(), &cie::y_bar(), &cie::z_bar()};
+  std::array<Samples, 3> cmf;
+  for (int c = 0; c < 3; ++c) cmf[c] = sample(*curves[c], lo, hi);
+  const Samples flat(static_cast<std::size_t>(hi - lo + 1), 1.0);
+
+  std::vector<std::pair<std::string, Samples>> lights;
+  for (const Light& l : scene.lights)
+    if (!l.radiance.texture) lights.emplace_back(l.name, sample(l.radiance.spectrum, lo, hi));
+  if (scene.environment && !scene.environment->radiance.texture)
+    lights.emplace_back("environment", sample(scene.environment->radiance.spectrum, lo, hi));
+
+  // ΔE00 of reflectance `r` lit by `e`: banded against exact, under the white of `e`.
+  auto error = [&](const Samples& r, const Samples& e) {
+    Vec3d white = xyz(e, cmf);
+    if (!(white[1] > 0)) return 0.0;
+    const Vec3d exact = xyz(product(r, e), cmf);
+    const Vec3d approx = xyz(product(banded(r, bands, lo), banded(e, bands, lo)), cmf);
+    return delta_e_2000(xyz_to_lab(approx, white), xyz_to_lab(exact, white));
+  };
+  for (const auto& [light, e] : lights) {
+    // The light seen directly (a white surface): its own colour through the bands.
+    const double direct = error(flat, e);
+    if (direct > threshold)
+      out.push_back({light, "", direct, true,
+                     fmt::format("light \"{}\": {} give its own colour a ΔE00 of {:.1f} (its spectrum has narrow peaks "
+                                 "the bands average away); use bands fitted to it (chromatrace plan) or narrower ones "
+                                 "where it peaks, or --spectral-mode continuous",
+                                 light, describe(bands), direct)});
+    for (const Material& m : scene.materials) {
+      const SpectrumRef* ref = diffuse_of(m);
+      if (!ref || ref->texture) continue;
+      const Samples r = sample(ref->spectrum, lo, hi);
+      const double de = error(r, e);
+      if (!(de > threshold) || !(de > direct)) continue;
+      // Whose spectrum the bands cannot follow: the reflectance, if it is off under flat light too.
+      const bool reflectance_cause = error(r, flat) > 0.5 * de;
+      out.push_back({light, m.name, de, !reflectance_cause,
+                     fmt::format("material \"{}\" lit by \"{}\": {} give its colour a ΔE00 of {:.1f} ({}); use bands "
+                                 "fitted to the scene (chromatrace plan) or narrower ones, or --spectral-mode continuous",
+                                 m.name, light, describe(bands), de,
+                                 reflectance_cause ? "its reflectance changes faster than the bands"
+                                                   : "the light's spectrum has narrow peaks the bands average away")});
+    }
+  }
+  std::stable_sort(out.begin(), out.end(), [](const auto& a, const auto& b) { return a.de00 > b.de00; });
+  return out;
+}
+
+}  // namespace ct::plan

@@ -1,0 +1,32 @@
+#pragma once
+// The study's charts (docs/study.md), PNG drawn with OpenCV: error against render cost on logarithmic axes, one
+// marker per setting coloured by the knob it changes (a circle for the tracer, a square for Cycles), the Pareto
+// front as a staircase through the settings no other beats on both, and a dotted line at ΔE00 = 1.
+//
+//   error_vs_cost.png      mean ΔE00 against CPU seconds
+//   p95_vs_cost.png        95th-percentile ΔE00 against CPU seconds
+//   systematic_vs_cost.png the systematic rms ΔE00 (bands, bounces, mode, renderer) with its ±2 standard-error
+//                          interval as a bar, against CPU seconds
+//   structure_vs_cost.png  the largest turn of an object's principal direction (degrees) against CPU seconds;
+//                          a setting that changes any object's class is drawn as a cross
+
+#include <filesystem>
+
+#include <opencv2/core.hpp>
+
+#include "study/study.h"
+
+namespace ct::study {
+
+enum class ChartValue { MeanDe00, P95De00, SystematicRms, DirectionDeg };
+
+// 8-bit BGR.
+cv::Mat chart(const StudyResult& result, ChartValue value);
+
+void write_charts(const std::filesystem::path& dir, const StudyResult& result);
+
+// Ticks of a logarithmic axis over [lo, hi] (lo > 0): the powers of ten inside, and 2 and 5 times them when
+// the range spans fewer than three decades; at least the two ends' nearest powers of ten.
+std::vector<double> log_ticks(double lo, double hi);
+
+}  // namespace ct::study
