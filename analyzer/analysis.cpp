@@ -8,6 +8,7 @@
 #include "analyzer/edge_mixing.h"
 #include "analyzer/superposition.h"
 #include "core/error.h"
+#include "core/parallel.h"
 #include "core/progress.h"
 
 namespace ct::analyzer {
@@ -89,37 +90,54 @@ ImageAnalysis analyse_image(const AnalysisImage& input, const std::string& layer
   const RgbImage linear = curve ? linear_light(input) : RgbImage{};
   const LayerContext linear_context = curve ? linear_light_context(a.context, linear, *curve, full_scale) : LayerContext{};
   Progress bar("analyze", a.regions.size(), progress);
-  for (const Region& r : a.regions) {
-    a.results.push_back(analyse_region(pixels, a.context, r, options));
-    if (const ClusterShape& s = a.results.back().shape; a.encoding.curve && s.gamma)
-      a.results.back().declared_gamma = compare_gamma(*s.gamma, *a.encoding.curve, full_scale);
+  a.results.resize(a.regions.size());
+  if (!input.components.empty()) a.explanations.resize(a.regions.size());
+  auto analyse = [&](std::size_t i, const AnalyzeOptions& opts) {
+    const Region& r = a.regions[i];
+    RegionAnalysis result = analyse_region(pixels, a.context, r, opts);
+    if (const ClusterShape& s = result.shape; a.encoding.curve && s.gamma)
+      result.declared_gamma = compare_gamma(*s.gamma, *a.encoding.curve, full_scale);
     if (curve) {
-      ClusterShape light = analyse_region(linear, linear_context, r, options).shape;
+      ClusterShape light = analyse_region(linear, linear_context, r, opts).shape;
       // The whole image mixes every cluster: its class only describes; the curve's bend is judged per object.
-      if (r.source == "image") a.results.back().linear_light = std::move(light);
-      else apply_tone_curve(a.results.back(), std::move(light), *curve, options.criteria);
+      if (r.source == "image") result.linear_light = std::move(light);
+      else apply_tone_curve(result, std::move(light), *curve, opts.criteria);
     }
     if (r.source == "labels" && !input.object_ids.empty()) {
-      RegionAnalysis& result = a.results.back();
       // Mixing turns a colour's direction; the noise that matters is across the cluster's first axis (along it,
       // neighbouring pixels differ by shading as well as by noise).
       const double noise = std::hypot(result.shape.noise_sigma[1], result.shape.noise_sigma[2]);
       if (input.encoding.pixel_area.value_or(true)) {
         const EdgeMixing mixing = find_edge_mixing(pixels, input.object_ids, r, static_cast<std::int32_t>(r.label), noise);
-        apply_edge_mixing(result, mixing, pixels, a.context, r, options, input.object_names);
+        apply_edge_mixing(result, mixing, pixels, a.context, r, opts, input.object_names);
       } else {  // point-sampled pixels hold one surface's colour each: nothing mixes at an edge
         result.shape.decisions.push_back({"pixels integrate an area (chromatrace.pixel_area)", 0.0, 1.0, false});
       }
     }
-    if (!input.components.empty()) a.explanations.push_back(explain_region(input, r));
+    if (!input.components.empty()) a.explanations[i] = explain_region(input, r);
     // The light-group layers are the linear camera signal of each luminaire's light; the test reads them, not
     // the analysed layer, so it holds whatever curve encoded the final image. A layer that is one component
     // is no superposition.
     const bool whole_light = a.layer == "final" || a.layer == "linear";
-    if (const auto superposition = whole_light ? find_superposition(input, r, options.criteria) : std::nullopt)
-      apply_superposition(a.results.back().shape, *superposition, options.criteria);
+    if (const auto superposition = whole_light ? find_superposition(input, r, opts.criteria) : std::nullopt)
+      apply_superposition(result.shape, *superposition, opts.criteria);
+    a.results[i] = std::move(result);
     bar.advance();
+  };
+  // Regions holding a large share of the image (the whole image) are analysed one at a time with every thread;
+  // the others side by side, one thread each, largest first (each region's analysis is mostly serial, and its
+  // results do not depend on the thread count), so that memory stays near that of one large region.
+  const std::size_t total = std::max<std::size_t>(1, pixels.pixel_count());
+  std::vector<std::size_t> side_by_side;
+  for (std::size_t i = 0; i < a.regions.size(); ++i) {
+    if (4 * a.regions[i].pixels.size() > total) analyse(i, options);
+    else side_by_side.push_back(i);
   }
+  std::stable_sort(side_by_side.begin(), side_by_side.end(),
+                   [&](std::size_t x, std::size_t y) { return a.regions[x].pixels.size() > a.regions[y].pixels.size(); });
+  AnalyzeOptions one = options;
+  one.threads = 1;
+  parallel_for(side_by_side.size(), options.threads, [&](std::size_t k) { analyse(side_by_side[k], one); });
   bar.finish();
   if (curve) {
     std::vector<RegionAnalysis> light = a.results;

@@ -206,6 +206,9 @@ static json image_noise_json(const ImageNoise& noise) {
                                 std::max(noise.floor, noise.band_sigma(k, Vec3::UnitZ()))}}});
   return {{"estimator", "Immerkaer 1996 over the whole image: 3x3 residuals of R, G, B, per brightness band the 3-sigma clipped "
                         "median of their projection (flat areas decide, not texture)"},
+          {"spacing", noise.spacing},
+          {"spacing_reason", noise.spacing == 1 ? "the file says each pixel's three values were measured at it (chromatrace.cfa 0, or raw half size)"
+                                                : "the pixels may be demosaiced (interpolated from neighbouring photosites, so sharing their noise): the mask's taps are 3 pixels apart"},
           {"brightness", "(R + G + B) / 3 in the analysed layer's units"},
           {"pixels_used", noise.pixels},
           {"floor", noise.floor},

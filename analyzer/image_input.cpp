@@ -40,7 +40,7 @@ struct RawImage {
 
 constexpr const char* kCameraKeys[] = {"chromatrace.black_level", "chromatrace.white_level", "chromatrace.dark_signal",
                                        "chromatrace.read_noise",  "chromatrace.bits",        "chromatrace.noise",
-                                       "chromatrace.adc",         "chromatrace.pixel_area",
+                                       "chromatrace.adc",         "chromatrace.pixel_area",      "chromatrace.cfa",
                                        "chromatrace.curve_gamma", "chromatrace.curve_k",     "chromatrace.curve_srgb"};
 
 // The camera's numbers: numeric attributes (EXR), numbers spelled as text (PNG keeps attributes as text), or
@@ -211,6 +211,7 @@ void apply_camera_metadata(const RawImage& raw, AnalysisImage& out) {
   if (const auto noise = camera_number(raw, "chromatrace.noise")) e.noise = *noise != 0;
   if (const auto adc = camera_number(raw, "chromatrace.adc")) e.adc = *adc != 0;
   if (const auto area = camera_number(raw, "chromatrace.pixel_area")) e.pixel_area = *area != 0;
+  if (const auto cfa = camera_number(raw, "chromatrace.cfa")) e.demosaiced = *cfa != 0;
   if (e.black_level && *e.black_level != 0) {
     const auto black = static_cast<float>(*e.black_level);
     for (float& v : out.image.rgb) v -= black;

@@ -56,12 +56,19 @@ struct ImageEncoding {
   std::optional<bool> noise = std::nullopt;  // whether noise was on
   std::optional<bool> adc = std::nullopt;    // whether the ADC was on
   std::optional<bool> pixel_area = std::nullopt;  // whether pixels integrate an area (false: point samples)
+  // Whether R, G, B were interpolated from a colour filter array's photosites (chromatrace.cfa, or a raw file
+  // read through LibRaw's demosaicing), so that neighbouring pixels share their noise; unknown for a
+  // photograph, whose camera almost surely did.
+  std::optional<bool> demosaiced = std::nullopt;
   std::optional<ToneCurve> curve = std::nullopt;   // the response curve R, G, B were encoded with
   std::string curve_source = "";                   // why that curve: the metadata or rule it came from
 
   // The value R, G, B hold for black: −black_level once subtracted, else 0 (the ADC's code 0 lies at
   // −black_level after subtraction).
   double lowest_code() const { return black_subtracted && black_level ? -*black_level : 0.0; }
+  // Whether each pixel's noise is its own, so that adjacent pixels measure it (analyzer/noise_level.h): only
+  // when the file says no colour filter array was demosaiced.
+  bool independent_pixel_noise() const { return demosaiced == false; }
   // The level at which the analysed R, G, B clip: the white level less the subtracted black level.
   std::optional<double> clipping_level() const {
     if (!white_level) return std::nullopt;

@@ -48,11 +48,13 @@ double ImageNoise::band_sigma(std::size_t band, const Vec3& u) const {
 }
 
 ImageNoise estimate_image_noise(const RgbImage& image, const std::array<double, 3>& low_levels, const std::array<double, 3>& high_levels,
-                                double floor, std::size_t max_pixels) {
+                                double floor, int spacing, std::size_t max_pixels) {
   ImageNoise noise;
   noise.floor = floor;
+  noise.spacing = std::max(1, spacing);
   const std::size_t w = static_cast<std::size_t>(std::max(0, image.width)), h = static_cast<std::size_t>(std::max(0, image.height));
-  if (w < 3 || h < 3) return noise;
+  const std::size_t s = static_cast<std::size_t>(noise.spacing);
+  if (w < 2 * s + 1 || h < 2 * s + 1) return noise;
   // Whether each pixel may enter a neighbourhood: finite and strictly between every channel's limits.
   std::vector<std::uint8_t> usable(w * h);
   for (std::size_t p = 0; p < w * h; ++p) {
@@ -60,13 +62,13 @@ ImageNoise estimate_image_noise(const RgbImage& image, const std::array<double, 
     for (std::size_t c = 0; c < 3; ++c) ok = ok && std::isfinite(image.rgb[p * 3 + c]) && image.rgb[p * 3 + c] > low_levels[c] && image.rgb[p * 3 + c] < high_levels[c];
     usable[p] = ok;
   }
-  const std::size_t interior = (w - 2) * (h - 2);
+  const std::size_t interior = (w - 2 * s) * (h - 2 * s);
   const std::size_t stride = std::max<std::size_t>(1, interior / std::max<std::size_t>(1, max_pixels));
   const int mask[3][3] = {{1, -2, 1}, {-2, 4, -2}, {1, -2, 1}};
   std::vector<std::pair<double, std::array<float, 3>>> found;  // (brightness, residual / 6)
   std::vector<double> brightness;  // of every finite pixel visited: the bands are its quantiles
   for (std::size_t i = 0; i < interior; i += stride) {
-    const std::size_t x = 1 + i % (w - 2), y = 1 + i / (w - 2);
+    const std::size_t x = s + i % (w - 2 * s), y = s + i / (w - 2 * s);
     const float* centre = &image.rgb[(y * w + x) * 3];
     const double level = (double(centre[0]) + centre[1] + centre[2]) / 3.0;
     if (!std::isfinite(level)) continue;
@@ -75,7 +77,8 @@ ImageNoise estimate_image_noise(const RgbImage& image, const std::array<double, 
     bool ok = true;
     for (int j = -1; j <= 1 && ok; ++j)
       for (int k = -1; k <= 1 && ok; ++k) {
-        const std::size_t q = static_cast<std::size_t>(static_cast<std::ptrdiff_t>((y * w + x)) + j * static_cast<std::ptrdiff_t>(w) + k);
+        const std::size_t q = static_cast<std::size_t>(static_cast<std::ptrdiff_t>((y * w + x)) +
+                                                       static_cast<std::ptrdiff_t>(s) * (j * static_cast<std::ptrdiff_t>(w) + k));
         ok = usable[q] != 0;
         for (std::size_t c = 0; c < 3 && ok; ++c) r[c] += mask[j + 1][k + 1] * static_cast<double>(image.rgb[q * 3 + c]);
       }

@@ -214,6 +214,7 @@ AnalysisImage read_camera_raw(const std::filesystem::path& path, const RawOption
   e.black_level = black;
   e.black_subtracted = true;
   e.white_level = white;
+  e.demosaiced = !options.half_size;
   e.curve = ToneCurve{};
   e.curve_source = "a camera raw: linear camera RGB (no white balance, colour matrix or curve)";
   out.notes.push_back(fmt::format("camera raw, {}: {} Bayer mosaic, black level {:g} DN and white level {:g} DN from the file",

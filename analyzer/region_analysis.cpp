@@ -41,7 +41,8 @@ LayerContext layer_context(const RgbImage& layer, const ImageEncoding& encoding,
     for (double& level : c.high_levels)
       if (!(level > 0)) level = std::numeric_limits<double>::infinity();
   }
-  c.noise = estimate_image_noise(layer, c.clipping.low, c.high_levels, c.quantisation_sigma);
+  c.noise = estimate_image_noise(layer, c.clipping.low, c.high_levels, c.quantisation_sigma,
+                                 encoding.independent_pixel_noise() ? 1 : kInterpolatedNoiseSpacing);
   return c;
 }
 
@@ -55,7 +56,7 @@ LayerContext linear_light_context(const LayerContext& stored, const RgbImage& li
   }
   c.clipping.low.fill(curve.decode(stored.clipping.low[0], full_scale));
   c.quantisation_sigma = 0;
-  c.noise = estimate_image_noise(linear, c.clipping.low, c.high_levels, 0.0);
+  c.noise = estimate_image_noise(linear, c.clipping.low, c.high_levels, 0.0, stored.noise.spacing);
   return c;
 }
 

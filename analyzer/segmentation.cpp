@@ -11,12 +11,14 @@
 #include <fmt/core.h>
 
 #include "core/error.h"
+#include "core/parallel.h"
 
 namespace ct::analyzer {
 namespace {
 
 constexpr double kMinAngle = 0.002;  // radians: the angular noise never counts as less (noise-free renders)
 constexpr double kWeakBoundary = 1.5;  // the median step (noise σ) across a boundary that is no edge
+constexpr double kEnclosed = 0.9;      // the share of a small part's boundary with segments that one segment must hold
 constexpr std::uint8_t kInvalid = 0, kOk = 1, kDark = 2;
 
 // The image area-averaged to the working size, in linear light.
@@ -77,8 +79,14 @@ Work working_image(const RgbImage& image, const Decoder& decode, double clip_lev
   const std::size_t n = work.size();
   // Per working pixel: weighted sums of valid colour, valid weight, clipped weight, total weight.
   std::vector<double> colour(n * 3, 0.0), valid(n, 0.0), clip(n, 0.0), total(n, 0.0);
+  // Bands of working rows side by side: each adds the source rows that reach its rows, in the order a single
+  // pass would (by source row, then column), so that the sums are the same whatever the thread count.
+  const std::size_t bands = std::min<std::size_t>(static_cast<std::size_t>(work.h), 64);
+  parallel_for(bands, 0, [&](std::size_t band) {
+  const int wy0 = static_cast<int>(band * static_cast<std::size_t>(work.h) / bands), wy1 = static_cast<int>((band + 1) * static_cast<std::size_t>(work.h) / bands);
   for (int y = 0; y < H; ++y) {
     const int wy = sy.first[static_cast<std::size_t>(y)];
+    if (wy + 1 < wy0 || wy >= wy1) continue;
     const float fy = sy.share_first[static_cast<std::size_t>(y)];
     for (int x = 0; x < W; ++x) {
       const std::size_t p = static_cast<std::size_t>(y) * static_cast<std::size_t>(W) + static_cast<std::size_t>(x);
@@ -92,7 +100,7 @@ Work working_image(const RgbImage& image, const Decoder& decode, double clip_lev
       const float fx = sx.share_first[static_cast<std::size_t>(x)];
       for (int dy = 0; dy < 2; ++dy) {
         const double wyw = dy == 0 ? fy : 1.0 - fy;
-        if (wyw <= 0) continue;
+        if (wyw <= 0 || wy + dy < wy0 || wy + dy >= wy1) continue;
         for (int dx = 0; dx < 2; ++dx) {
           const double wgt = wyw * (dx == 0 ? fx : 1.0 - fx);
           if (wgt <= 0) continue;
@@ -106,6 +114,7 @@ Work working_image(const RgbImage& image, const Decoder& decode, double clip_lev
       }
     }
   }
+  });
   work.rgb.assign(n * 3, 0.0f);
   work.state.assign(n, kInvalid);
   work.clipped.assign(n, 0);
@@ -130,8 +139,11 @@ double quantile(std::vector<double> v, double q) {
 // noise; where the image is flat it holds noise only. Per channel and per band of 16 equal-count brightness
 // bands, the 25th percentile of its magnitude (0.3186 × 6σ for Gaussian noise) weights the flat pixels of the
 // band; σ² = a + b·I is fitted over the bands.
-NoiseModel estimate_noise(const Work& work) {
-  NoiseModel model;
+// The noise is estimated where it lives: in the values as the file stores them. A linear camera file's are
+// read and shot noise, σ² = a + b·v; an encoded file's (sRGB, a gamma) are what the encoding's steps and the
+// compression did to the stored values, which the same straight line describes there and no straight line
+// does in linear light (at the dark end the curve's slope shrinks them many times). `model` brings the curve.
+NoiseModel estimate_noise(const Work& work, NoiseModel model) {
   std::vector<double> brightest;
   for (std::size_t q = 0; q < work.size(); ++q)
     if (work.state[q] == kOk && !work.clipped[q]) {
@@ -139,6 +151,8 @@ NoiseModel estimate_noise(const Work& work) {
       if (m > 0) brightest.push_back(m);
     }
   model.floor = 1e-3 * quantile(brightest, 0.5);
+  std::vector<double> stored(work.rgb.size());
+  for (std::size_t k = 0; k < stored.size(); ++k) stored[k] = model.encode(work.rgb[k]);
   const int w = work.w;
   const int mask[3][3] = {{1, -2, 1}, {-2, 4, -2}, {1, -2, 1}};
   for (int c = 0; c < 3; ++c) {
@@ -154,10 +168,10 @@ NoiseModel estimate_noise(const Work& work) {
               usable = false;
               break;
             }
-            m += mask[j + 1][i + 1] * static_cast<double>(work.rgb[q * 3 + static_cast<std::size_t>(c)]);
+            m += mask[j + 1][i + 1] * stored[q * 3 + static_cast<std::size_t>(c)];
           }
         if (usable)
-          samples.emplace_back(work.rgb[(static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x)) * 3 + static_cast<std::size_t>(c)], std::abs(m));
+          samples.emplace_back(stored[(static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x)) * 3 + static_cast<std::size_t>(c)], std::abs(m));
       }
     model.samples = std::max(model.samples, samples.size());
     if (samples.size() < 64) continue;
@@ -459,9 +473,27 @@ double NoiseModel::quantisation(double value) const {
   return step / std::sqrt(12.0 * averaged);
 }
 
+double NoiseModel::encode(double value) const {
+  if (curve.empty()) return value;
+  if (!(value > curve.front())) return 0.0;
+  if (value >= curve.back()) return (static_cast<double>(curve.size()) - 1) * curve_step;
+  const auto k = static_cast<std::size_t>(std::upper_bound(curve.begin(), curve.end(), static_cast<float>(value)) - curve.begin());
+  const double lo = curve[k - 1], hi = curve[k];
+  return (static_cast<double>(k - 1) + (hi > lo ? (value - lo) / (hi - lo) : 0.0)) * curve_step;
+}
+
+double NoiseModel::slope(double value) const {
+  if (curve.empty()) return 1.0;
+  const double code = encode(value) / curve_step;
+  const auto k = std::min(static_cast<std::size_t>(std::max(0.0, code)), curve.size() - 2);
+  return (double(curve[k + 1]) - double(curve[k])) / curve_step;
+}
+
 double NoiseModel::sigma(int channel, double value) const {
   const double q = quantisation(value);
-  return std::max(floor, std::sqrt(std::max(0.0, a[channel] + b[channel] * std::max(0.0, value)) + q * q));
+  const double v = std::max(0.0, encode(value));
+  const double measured = std::sqrt(std::max(0.0, a[channel] + b[channel] * v)) * slope(value);
+  return std::max(floor, std::sqrt(measured * measured + q * q));
 }
 
 void check_segmentation_options(const SegmentationOptions& o) {
@@ -486,10 +518,22 @@ Segmentation segment_image(const RgbImage& image, const std::optional<ToneCurve>
   Work work = working_image(image, decode, clip_level, options.working_megapixels);
   out.working_width = work.w;
   out.working_height = work.h;
-  out.noise = estimate_noise(work);
-  out.noise.integer = full_scale > 1;
-  out.noise.codes = decode.table;
-  out.noise.averaged = static_cast<double>(image.pixel_count()) / static_cast<double>(work.size());
+  NoiseModel model;
+  model.integer = full_scale > 1;
+  model.codes = decode.table;
+  model.averaged = static_cast<double>(image.pixel_count()) / static_cast<double>(work.size());
+  if (decode.curve) {
+    // The curve as a table of the linear value of each stored value: an integer file's codes, else 4096 steps
+    // over the full scale.
+    if (!decode.table.empty()) {
+      model.curve = decode.table;
+    } else {
+      constexpr int kSteps = 4096;
+      model.curve_step = decode.full_scale / kSteps;
+      for (int k = 0; k <= kSteps; ++k) model.curve.push_back(static_cast<float>(decode.curve->decode(k * model.curve_step, decode.full_scale)));
+    }
+  }
+  out.noise = estimate_noise(work, std::move(model));
   const NoiseModel& noise = out.noise;
 
   // Each pixel's angular noise; the dark ones are set aside.
@@ -652,6 +696,30 @@ Segmentation segment_image(const RgbImage& image, const std::optional<ToneCurve>
     }
     parts = parts_of(work, sets);
   }
+  // Small parts that one segment encloses — nine tenths of their boundary with segments is with it, and at least
+  // half their boundary is with segments (the rest with unassigned pixels) — are details of that object finer
+  // than the smallest segment (speckle, embroidery, texture): they join it. A few passes take in clusters of them.
+  for (int pass = 0; pass < 3; ++pass) {
+    const Adjacency adj = adjacency(work, parts);
+    std::size_t joined = 0;
+    for (std::size_t bi = 0; bi < parts.pixels.size(); ++bi) {
+      if (static_cast<double>(parts.pixels[bi].size()) >= min_area) continue;
+      std::size_t best = 0, big = 0;
+      std::int32_t to = -1;
+      for (const std::int32_t ai : adj.neighbours(static_cast<std::int32_t>(bi))) {
+        if (static_cast<double>(parts.pixels[static_cast<std::size_t>(ai)].size()) < min_area) continue;
+        const std::size_t shared = adj.between(ai, static_cast<std::int32_t>(bi));
+        big += shared;
+        if (shared > best) best = shared, to = ai;
+      }
+      if (to >= 0 && double(best) >= kEnclosed * double(big) && 2 * big >= adj.perimeter[bi]) {
+        sets.join(parts.pixels[static_cast<std::size_t>(to)].front(), parts.pixels[bi].front());
+        ++joined;
+      }
+    }
+    parts = parts_of(work, sets);
+    if (joined == 0) break;
+  }
 
   // Segments by decreasing size; 0 for the rest, with the reason.
   std::vector<std::int32_t> order;
@@ -689,13 +757,23 @@ Segmentation segment_image(const RgbImage& image, const std::optional<ToneCurve>
           }
         }
     }
-  for (int y = 0; y < H; ++y) {
+  // Bands of rows side by side, each with its own counts (added afterwards: the same whatever the thread count).
+  struct Counts {
+    std::vector<std::size_t> per_label;
+    std::size_t valid = 0, unassigned = 0, dark = 0, small = 0;
+  };
+  const std::size_t row_bands = std::min<std::size_t>(static_cast<std::size_t>(H), 64);
+  std::vector<Counts> band_counts(row_bands);
+  parallel_for(row_bands, 0, [&](std::size_t band) {
+  Counts& bc = band_counts[band];
+  bc.per_label.assign(order.size() + 1, 0);
+  for (int y = static_cast<int>(band * static_cast<std::size_t>(H) / row_bands); y < static_cast<int>((band + 1) * static_cast<std::size_t>(H) / row_bands); ++y) {
     const int wy = same ? y : std::min(h - 1, static_cast<int>((y + 0.5) * h / H));
     for (int x = 0; x < W; ++x) {
       const std::size_t p = static_cast<std::size_t>(y) * static_cast<std::size_t>(W) + static_cast<std::size_t>(x);
       const float* v = &image.rgb[p * 3];
       if (!std::isfinite(v[0]) || !std::isfinite(v[1]) || !std::isfinite(v[2])) continue;
-      ++out.valid_pixels;
+      ++bc.valid;
       const int wx = same ? x : std::min(w - 1, static_cast<int>((x + 0.5) * w / W));
       const std::size_t q = static_cast<std::size_t>(wy) * static_cast<std::size_t>(w) + static_cast<std::size_t>(wx);
       std::int32_t label = work_label[q];
@@ -734,14 +812,19 @@ Segmentation segment_image(const RgbImage& image, const std::optional<ToneCurve>
           }
         }
       }
-      out.labels[p] = label;
-      ++counts[static_cast<std::size_t>(label)];
+      out.labels[p] = static_cast<std::uint16_t>(label);
+      ++bc.per_label[static_cast<std::size_t>(label)];
       if (label == 0) {
-        ++out.unassigned_pixels;
-        if (work.state[q] == kDark) ++out.dark_pixels;
-        else ++out.small_pixels;
+        ++bc.unassigned;
+        if (work.state[q] == kDark) ++bc.dark;
+        else ++bc.small;
       }
     }
+  }
+  });
+  for (const Counts& bc : band_counts) {
+    for (std::size_t k = 0; k < counts.size(); ++k) counts[k] += bc.per_label[k];
+    out.valid_pixels += bc.valid, out.unassigned_pixels += bc.unassigned, out.dark_pixels += bc.dark, out.small_pixels += bc.small;
   }
   for (std::size_t k = 1; k < counts.size(); ++k) {
     Region r{fmt::format("segment {}", k), "segment", static_cast<std::int64_t>(k), {}};

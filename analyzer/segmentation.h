@@ -11,8 +11,10 @@
 //     `working_megapixels` (never enlarged), so that the same objects give the same segments at any size.
 //  2. The noise of the working image is estimated once for the whole image (Immerkær 1996, "Fast noise
 //     variance estimation", with a low quantile of |3×3 Laplacian difference| per brightness band so that
-//     flat areas decide it), as σ²(I) = a + b·I per channel (read noise plus shot noise), plus the
-//     quantisation noise of integer files (step/√12 of the stored code, in linear light).
+//     flat areas decide it), as σ² = a + b·v per channel in the values as the file stores them (read plus
+//     shot noise for a linear file; what the encoding's steps and compression did, for an sRGB or gamma
+//     file), carried into linear light by the curve's slope, plus the quantisation noise of integer files
+//     (step/√12 of the stored code, in linear light).
 //  3. Pixels darker than `dark` noise σ have no reliable colour direction and are left unassigned ("dark").
 //  4. Linear colour clusters grow over the pixel graph (8-neighbours, the edges taken in increasing order of
 //     the angle between the two colours in units of its noise σ, as in Felzenszwalb & Huttenlocher's graph
@@ -29,10 +31,14 @@
 //     A's body line at a point of A's upper range (30 % to 150 % of its 90th percentile: a highlight), not at
 //     black (another matte surface). A mostly clipped neighbour that A surrounds (half its boundary) joins as
 //     a clipped highlight.
-//  6. Parts smaller than `min_area` of the valid image join a neighbour whose colour they share, else stay
-//     unassigned ("small": mixed edge pixels, texture finer than the working size).
+//  6. Parts smaller than `min_area` of the valid image join a neighbour whose colour they share; those that
+//     one segment encloses (nine tenths of their boundary with segments, at least half their boundary with
+//     segments) join it as details finer than the smallest segment (speckle, embroidery, a badge); the rest
+//     stay unassigned ("small": mixed edge pixels between segments, texture finer than the working size).
 //  7. Labels are carried back to full size; pixels on a boundary between segments take the segment whose
 //     colour direction is nearest theirs (unassigned working pixels stay unassigned).
+// Steps 1 and 7 run on every core, in bands of rows whose sums and counts add in a fixed order: the labels do
+// not depend on the thread count.
 
 #include <cstdint>
 #include <string>
@@ -52,8 +58,9 @@ struct SegmentationOptions {
   double dark = 3;                   // pixels with brightness below dark · σ are left unassigned
 };
 
-// The noise of the working image: σ_c(I)² = a_c + b_c · I for channel c at value I (in the image's units,
-// linear light), never below `floor`.
+// The noise of the working image: σ_c² = a_c + b_c · v for channel c at stored value v — in linear light
+// for a linear file; for an encoded one (sRGB, gamma) in the values as stored, carried into linear light by
+// the curve's slope (`curve`) — never below `floor`.
 struct NoiseModel {
   Vec3 a = Vec3::Zero();
   Vec3 b = Vec3::Zero();
@@ -65,14 +72,20 @@ struct NoiseModel {
   std::vector<float> codes;
   bool integer = false;
   double averaged = 1;
-  double sigma(int channel, double value) const;
+  // The encoding's curve: the linear value of stored value k·curve_step (empty: linear, a and b in linear light).
+  std::vector<float> curve;
+  double curve_step = 1;
+  double encode(double value) const;  // the stored value of a linear value
+  double slope(double value) const;   // d(linear) / d(stored) there
+  double sigma(int channel, double value) const;  // in linear light, at linear value `value`
   double quantisation(double value) const;
 };
 
 struct Segmentation {
   int width = 0, height = 0;                  // the image
   int working_width = 0, working_height = 0;  // the working size
-  std::vector<std::int32_t> labels;           // per pixel: k for segment k (1 = the largest), 0 for none
+  std::vector<std::uint16_t> labels;          // per pixel: k for segment k (1 = the largest), 0 for none
+                                              // (min_area >= 2e-5 keeps k under 50,000: labels.png is 16-bit)
   std::vector<Region> regions;                // segments by decreasing size, then "unassigned" when any
   std::size_t valid_pixels = 0;               // finite, not transparent, not negative
   std::size_t unassigned_pixels = 0;          // valid pixels in no segment

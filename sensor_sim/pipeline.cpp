@@ -430,7 +430,7 @@ DisplayRendering display_rendering(const Survey& survey, const LinearModel& unit
 void camera_levels(const SensorConfig& c, double exposure_s, OutputLayout& layout) {
   for (const char* key : {"chromatrace.black_level", "chromatrace.white_level", "chromatrace.dark_signal",
                           "chromatrace.read_noise", "chromatrace.bits", "chromatrace.noise", "chromatrace.adc",
-                          "chromatrace.pixel_area", "chromatrace.curve_gamma", "chromatrace.curve_k",
+                          "chromatrace.pixel_area", "chromatrace.cfa", "chromatrace.curve_gamma", "chromatrace.curve_k",
                           "chromatrace.curve_srgb"})
     layout.attributes.erase(key);  // an input's own, passed through as text, would clash
   auto& number = layout.number_attributes;
@@ -629,6 +629,7 @@ void describe_output(const SpectralExrInfo& info, const SensorConfig& config, co
   }
   camera_levels(config, run.exposure_s, layout);
   layout.integer_attributes["chromatrace.pixel_area"] = pixel_area(info, config);
+  layout.integer_attributes["chromatrace.cfa"] = config.cfa.enabled ? 1 : 0;
   if (picture) {  // the codes are the display rendering's (sRGB, 0…255), not the camera's numbers
     layout.attributes["chromatrace.signal"] = "display";
     layout.number_attributes = {{"chromatrace.black_level", 0.0}, {"chromatrace.white_level", 255.0},
