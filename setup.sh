@@ -15,6 +15,7 @@ packages=(
   blender  # the Blender add-on (blender_addon/) and its headless tests (tests/blender)
   xvfb xauth  # a display for the add-on's test in a real Blender window (tests/blender/test_gui.py)
   clang libclang-rt-14-dev  # libFuzzer and the sanitisers (.ci/sanitize, tests/fuzz)
+  slurm-wlm munge  # chromatrace farm's test on a single-node Slurm on localhost (tests/farm), and bench/bench_farm.sh
 )
 # The report viewer is bundled from npm packages (package.json): node and npm from Debian unless a node
 # with its own npm (e.g. NodeSource's) is already there.

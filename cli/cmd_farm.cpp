@@ -1,0 +1,150 @@
+// chromatrace farm render|cycles ... -o DIR: work split into Slurm jobs on a cluster (docs/farm.md). The
+// scripts, submission and following are in farm/slurm.h; this file says what the tasks of each kind run.
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <fmt/core.h>
+
+#include "cli/command.h"
+#include "cli/options.h"
+#include "core/band_plan.h"
+#include "core/error.h"
+#include "core/file_io.h"
+#include "core/scene.h"
+#include "farm/slurm.h"
+#include "reference_tracer/integrator.h"
+#include "reference_tracer/seed_split.h"
+
+namespace ct::cli {
+namespace {
+namespace fs = std::filesystem;
+
+struct Common {
+  std::string output;
+  farm::SlurmOptions slurm;
+  std::optional<int> max_concurrent;
+  bool dry_run = false, resume = false, wait = false, follow = false, quiet = false;
+};
+
+void add_common(CLI::App* cmd, Common& c) {
+  cmd->add_option("-o,--output", c.output, "Output directory: scripts, logs, parts and the result (created)")->required();
+  cmd->add_option("--partition", c.slurm.partition, "Slurm partition(s) (default: the cluster's)");
+  cmd->add_option("--time", c.slurm.time_limit, "Time limit per job, as sbatch --time (e.g. 30, 2:00:00, 1-0)");
+  cmd->add_option("--cpus-per-task", c.slurm.cpus_per_task, "CPUs per task; the task uses as many threads")
+      ->capture_default_str();
+  cmd->add_option("--mem", c.slurm.memory, "Memory per job, as sbatch --mem (e.g. 4G)");
+  cmd->add_option("--max-concurrent", c.max_concurrent, "At most this many tasks at once (the array's %N)");
+  cmd->add_option("--sbatch-arg", c.slurm.sbatch_args, "A further sbatch option for every job, e.g. --qos=long (repeatable)");
+  cmd->add_flag("--dry-run", c.dry_run, "Write the scripts and print the sbatch commands; submit nothing");
+  cmd->add_flag("--resume", c.resume, "Submit only the tasks whose outputs are missing (after a failure or scancel)");
+  cmd->add_flag("--wait", c.wait, "Follow the jobs to the end with progress; exit 1 when they did not all succeed");
+  cmd->add_flag("--follow", c.follow, "Submit nothing: follow the jobs submitted into the directory before, as --wait");
+  cmd->add_flag("-q,--quiet", c.quiet, "No progress output");
+}
+
+int run_farm(const farm::FarmJob& job, Common& c) {
+  c.slurm.max_concurrent = c.max_concurrent;
+  if (c.dry_run && (c.resume || c.wait || c.follow))
+    throw InputError("--dry-run: submits nothing, so cannot --resume, --wait or --follow");
+  if (c.follow && c.resume) throw InputError("--follow: submits nothing, so cannot --resume");
+  if (c.follow) return farm::wait(job, !c.quiet);
+  farm::submit(job, c.slurm, c.dry_run ? farm::Mode::DryRun : c.resume ? farm::Mode::Resume : farm::Mode::Submit);
+  return c.wait ? farm::wait(job, !c.quiet) : 0;
+}
+
+fs::path output_directory(const std::string& output, const std::vector<fs::path>& inputs) {
+  if (output.empty()) throw InputError("--output: no directory name");
+  check_output_directory(output, inputs);
+  return fs::absolute(output).lexically_normal();
+}
+
+// ---- farm render: the reference tracer, split by seed ----------------------------------------------------------
+
+struct RenderOptions {
+  Common common;
+  std::string scene, resolution, bands, plan, mode, components = "paths,lights";
+  int seeds = 0;
+  std::optional<int> spp, max_bounces;
+  std::optional<std::uint64_t> seed;
+};
+
+CLI::App* add_render(CLI::App* farm, RenderOptions& o) {
+  auto* cmd = farm->add_subcommand("render", "The reference tracer's render split into --seeds parts, one task each, "
+                                             "combined into DIR/render.exr (as chromatrace render --seeds)");
+  cmd->add_option("scene", o.scene, "Scene file (chromatrace-scene/1)")->required();
+  cmd->add_option("--seeds", o.seeds, "Parts (array tasks), each with its own seed and a share of the samples")->required();
+  cmd->add_option("--spp", o.spp, "Paths per pixel in all (default: the scene's render.samples)");
+  cmd->add_option("--seed", o.seed, "The first part's seed (default: the scene's render.seed)");
+  cmd->add_option("--resolution", o.resolution, "Image size WxH, overriding the scene's camera");
+  cmd->add_option("--bands", o.bands, "Band plan lo:hi:width in nm");
+  cmd->add_option("--plan", o.plan, "Band plan file (chromatrace-bands/1)");
+  cmd->add_option("--spectral-mode", o.mode, "bands or continuous");
+  cmd->add_option("--max-bounces", o.max_bounces, "Scattering events per path");
+  cmd->add_option("--components", o.components, "Component families: paths, lights, bounces, all, none")
+      ->capture_default_str();
+  add_common(cmd, o.common);
+  return cmd;
+}
+
+int run_render(RenderOptions& o) {
+  // Everything a task would refuse is refused here, before anything is submitted.
+  const Scene scene = load_scene(o.scene);
+  if (!o.resolution.empty()) parse_resolution(o.resolution);
+  if (!o.bands.empty() && !o.plan.empty()) throw InputError("--plan: give either --bands or --plan, not both");
+  if (!o.bands.empty()) Bands::parse(o.bands, "--bands");
+  if (!o.plan.empty()) read_band_plan(o.plan);
+  if (!o.mode.empty() && o.mode != "bands" && o.mode != "continuous")
+    throw InputError(fmt::format("--spectral-mode: must be bands or continuous, got \"{}\"", o.mode));
+  if (o.max_bounces && *o.max_bounces < 0)
+    throw InputError(fmt::format("--max-bounces: must be >= 0, got {}", *o.max_bounces));
+  if (o.spp && *o.spp < 1) throw InputError(fmt::format("--spp: must be at least 1, got {}", *o.spp));
+  rt::ComponentSelection::parse(o.components);
+  const rt::SeedSplit split(o.seeds, o.spp.value_or(scene.render.samples), o.seed.value_or(scene.render.seed));
+
+  farm::FarmJob job;
+  job.kind = "render";
+  job.directory = output_directory(o.common.output, {o.scene});
+  job.result = job.directory / "render.exr";
+  std::vector<std::string> render = {own_executable().string(), "render", fs::absolute(o.scene).string(),
+                                     "--seeds", std::to_string(split.parts), "--spp", std::to_string(split.samples),
+                                     "--seed", std::to_string(split.first_seed), "--components", o.components, "--quiet"};
+  const auto pass = [&](const char* option, const std::string& value) {
+    if (value.empty()) return;
+    render.push_back(option);
+    render.push_back(value);
+  };
+  pass("--resolution", o.resolution);
+  pass("--bands", o.bands);
+  pass("--plan", o.plan.empty() ? "" : fs::absolute(o.plan).string());
+  pass("--spectral-mode", o.mode);
+  pass("--max-bounces", o.max_bounces ? std::to_string(*o.max_bounces) : "");
+  std::vector<std::string> combine = {own_executable().string(), "combine", "--quiet", "-o", job.result.string()};
+  for (int part = 0; part < split.parts; ++part) {
+    const fs::path file = job.directory / "parts" / rt::part_file_name(part);
+    std::vector<std::string> words = render;
+    words.insert(words.end(), {"--part", std::to_string(part), "-o", file.string()});
+    job.task_commands.push_back(farm::shell_command(words) + " --threads \"$THREADS\"");
+    job.task_outputs.push_back(file);
+    combine.push_back(file.string());
+  }
+  job.assembly_command = farm::shell_command(combine) + " --threads \"$THREADS\"";
+  return run_farm(job, o.common);
+}
+
+}  // namespace
+
+Action add_farm(CLI::App& app) {
+  auto* cmd = app.add_subcommand("farm", "Split work into Slurm jobs on a cluster: tasks in a job array, then an assembly");
+  cmd->require_subcommand(1);
+  auto render = std::make_shared<RenderOptions>();
+  auto* render_cmd = add_render(cmd, *render);
+  return [=] {
+    if (render_cmd->parsed()) return run_render(*render);
+    return 2;
+  };
+}
+
+}  // namespace ct::cli

@@ -1,0 +1,146 @@
+// chromatrace farm on a real single-node Slurm cluster on localhost (tests/farm/local_slurm.sh: munged,
+// slurmctld and slurmd with a generated slurm.conf, all in a temporary directory, stopped after each test):
+// the split render of the cluster is the same bytes as the same split run locally, also after a task was
+// cancelled and the rest submitted with --resume. Skipped, saying why, only where Slurm cannot start.
+#include <cstdlib>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "core/file_io.h"
+#include "tests/cli/run_command.h"
+#include "tests/core/spectral_exr_fixtures.h"
+
+namespace ct {
+namespace {
+namespace fs = std::filesystem;
+using test::CommandResult;
+
+const std::string kSource = CHROMATRACE_SOURCE_DIR;
+const std::string kBox = kSource + "/scenes/paper/box.json";
+const std::string kSlurm = kSource + "/tests/farm/local_slurm.sh";
+// The paper's box, small: 4 parts of 4 paths per pixel.
+const std::vector<std::string> kRender = {kBox, "--resolution", "32x32", "--spp", "16", "--seeds", "4"};
+
+std::vector<std::string> with(std::vector<std::string> args, const std::vector<std::string>& more) {
+  args.insert(args.end(), more.begin(), more.end());
+  return args;
+}
+
+std::vector<std::string> farm_render(const fs::path& dir, const std::vector<std::string>& more) {
+  return with(with({"farm", "render"}, kRender), with({"-o", dir.string(), "--quiet"}, more));
+}
+
+// The first line of stdout that starts with `prefix`, its third word: "tasks: job 12 (...)" -> "12".
+std::string job_id(const std::string& out, const std::string& prefix) {
+  const std::size_t at = out.find(prefix + ": job ");
+  if (at == std::string::npos) return "";
+  const std::size_t start = at + prefix.size() + 6;
+  return out.substr(start, out.find_first_of(" \n", start) - start);
+}
+
+class Slurm : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    const CommandResult up = test::run_program("/bin/bash", {kSlurm, "start", cluster_.string()});
+    if (up.exit_code == 77) GTEST_SKIP() << "Slurm cannot start here: " << up.err;
+    ASSERT_EQ(up.exit_code, 0) << up.err;
+    started_ = true;
+    setenv("SLURM_CONF", (cluster_ / "slurm.conf").c_str(), 1);
+  }
+  void TearDown() override {
+    if (started_) test::run_program("/bin/bash", {kSlurm, "stop", cluster_.string()});
+    unsetenv("SLURM_CONF");
+  }
+
+  // The same split run locally: what every Slurm run must equal byte for byte.
+  std::string local_split() {
+    const fs::path local = dir_.file("local.exr");
+    const CommandResult r = test::run_chromatrace(with(with({"render"}, kRender), {"-o", local.string(), "--quiet"}));
+    EXPECT_EQ(r.exit_code, 0) << r.err;
+    return read_file(local);
+  }
+
+  test::TempDir dir_;
+  fs::path cluster_ = dir_.file("slurm");
+  bool started_ = false;
+};
+
+TEST_F(Slurm, TracerSplitIntoFourSeedsIsByteIdenticalToTheLocalSplit) {
+  const fs::path out = dir_.file("farm");
+  const CommandResult r = test::run_chromatrace(farm_render(out, {"--wait"}));
+  ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
+  EXPECT_FALSE(job_id(r.out, "tasks").empty()) << r.out;
+  EXPECT_FALSE(job_id(r.out, "assembly").empty()) << r.out;
+  for (int part = 0; part < 4; ++part) EXPECT_TRUE(fs::exists(out / "parts" / ("part_" + std::to_string(part) + ".exr")));
+  EXPECT_TRUE(fs::exists(out / "slurm" / "tasks.sh"));
+  const std::string farm = read_file(out / "render.exr");
+  EXPECT_TRUE(farm == local_split()) << "the cluster's render differs from the local split";
+}
+
+TEST_F(Slurm, CancelledTaskThenResumeGivesTheSameBytes) {
+  const fs::path out = dir_.file("farm");
+  // One task at a time, so that task 3 is still waiting when it is cancelled.
+  const CommandResult submitted = test::run_chromatrace(farm_render(out, {"--max-concurrent", "1"}));
+  ASSERT_EQ(submitted.exit_code, 0) << submitted.err;
+  const std::string tasks = job_id(submitted.out, "tasks");
+  ASSERT_FALSE(tasks.empty()) << submitted.out;
+  const CommandResult cancelled = test::run_program("/usr/bin/scancel", {tasks + "_3"});
+  ASSERT_EQ(cancelled.exit_code, 0) << cancelled.err;
+
+  // Following the jobs: three tasks succeed, the fourth never does, so the assembly cannot run.
+  const CommandResult followed = test::run_chromatrace(farm_render(out, {"--follow"}));
+  EXPECT_EQ(followed.exit_code, 1) << followed.err;
+  EXPECT_NE(followed.err.find("tasks 3 did not finish"), std::string::npos) << followed.err;
+  EXPECT_FALSE(fs::exists(out / "render.exr"));
+  EXPECT_FALSE(fs::exists(out / "parts" / "part_3.exr"));
+
+  const CommandResult resumed = test::run_chromatrace(farm_render(out, {"--resume", "--wait"}));
+  ASSERT_EQ(resumed.exit_code, 0) << resumed.err;
+  EXPECT_NE(resumed.out.find("(array 3, 1 of 4 tasks)"), std::string::npos) << resumed.out;
+  EXPECT_TRUE(read_file(out / "render.exr") == local_split()) << "the resumed render differs from the local split";
+
+  const CommandResult again = test::run_chromatrace(farm_render(out, {"--resume"}));
+  EXPECT_EQ(again.exit_code, 0) << again.err;
+  EXPECT_NE(again.out.find("nothing to submit"), std::string::npos) << again.out;
+}
+
+// Bad input needs no cluster: one line naming the option (or the missing command), exit 2, nothing submitted.
+TEST(FarmInput, BadValuesAndAMissingSbatchExitTwoWithOneLine) {
+  test::TempDir dir;
+  const fs::path out = dir.file("farm");
+  const auto check = [&](const std::vector<std::string>& more, const std::string& named) {
+    const CommandResult r = test::run_chromatrace(farm_render(out, more));
+    EXPECT_EQ(r.exit_code, 2) << r.err;
+    EXPECT_NE(r.err.find(named), std::string::npos) << r.err;
+    EXPECT_EQ(r.err.find('\n'), r.err.size() - 1) << r.err;
+    EXPECT_FALSE(fs::exists(out / "farm.json"));
+  };
+  check({"--time", "soon", "--dry-run"}, "--time");
+  check({"--mem", "4 GB", "--dry-run"}, "--mem");
+  check({"--cpus-per-task", "0", "--dry-run"}, "--cpus-per-task");
+  check({"--max-concurrent", "0", "--dry-run"}, "--max-concurrent");
+  check({"--partition", "a b", "--dry-run"}, "--partition");
+  check({"--sbatch-arg", "qos=long", "--dry-run"}, "--sbatch-arg");
+  check({"--seeds", "17", "--dry-run"}, "--seeds");
+  check({"--resume", "--dry-run"}, "--dry-run");
+
+  const char* path = std::getenv("PATH");
+  const std::string saved = path ? path : "";
+  setenv("PATH", dir.path().c_str(), 1);
+  check({}, "sbatch: not found on PATH");
+  setenv("PATH", saved.c_str(), 1);
+
+  // --dry-run writes the scripts and submits nothing.
+  const CommandResult dry = test::run_chromatrace(farm_render(out, {"--dry-run", "--max-concurrent", "2"}));
+  ASSERT_EQ(dry.exit_code, 0) << dry.err;
+  EXPECT_NE(dry.out.find("--array=0-3%2"), std::string::npos) << dry.out;
+  EXPECT_TRUE(fs::exists(out / "slurm" / "tasks.sh"));
+  EXPECT_TRUE(fs::exists(out / "slurm" / "assemble.sh"));
+  EXPECT_FALSE(fs::exists(out / "farm.json"));
+}
+
+}  // namespace
+}  // namespace ct
