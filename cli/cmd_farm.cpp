@@ -13,10 +13,12 @@
 #include "core/band_plan.h"
 #include "core/error.h"
 #include "core/file_io.h"
+#include "core/json_input.h"
 #include "core/scene.h"
 #include "farm/slurm.h"
 #include "reference_tracer/integrator.h"
 #include "reference_tracer/seed_split.h"
+#include "series/runner.h"
 
 namespace ct::cli {
 namespace {
@@ -134,6 +136,115 @@ int run_render(RenderOptions& o) {
   return run_farm(job, o.common);
 }
 
+// ---- farm cycles: a spectral Cycles render through the Blender add-on, one task per band group -----------------
+
+struct CyclesOptions {
+  Common common;
+  std::string source, bands, bands_file, components, resolution, on_mixing_nodes, on_world;
+  std::optional<int> samples, max_bounces, bands_per_render;
+  std::optional<std::uint64_t> seed;
+};
+
+CLI::App* add_cycles(CLI::App* farm, CyclesOptions& o) {
+  auto* cmd = farm->add_subcommand("cycles", "A spectral Cycles render (the Blender add-on's batch) split into one task "
+                                             "per band group, assembled into DIR/render.exr");
+  cmd->add_option("source", o.source, "Scene file (chromatrace-scene/1) or a .blend with chromatrace settings")->required();
+  cmd->add_option("--samples", o.samples, "Samples per pixel (default: the scene's)");
+  cmd->add_option("--bands", o.bands, "Band plan lo:hi:width in nm (default: the scene's)");
+  cmd->add_option("--bands-file", o.bands_file, "Band plan file (chromatrace-bands/1)");
+  cmd->add_option("--max-bounces", o.max_bounces, "Scattering events per path");
+  cmd->add_option("--components", o.components, "Component families: paths, lights, bounces, all, none (default: the scene's)");
+  cmd->add_option("--resolution", o.resolution, "Image size WxH, overriding the camera's");
+  cmd->add_option("--seed", o.seed, "Cycles seed (default: the scene's)");
+  cmd->add_option("--bands-per-render", o.bands_per_render, "Bands multiplexed into one Cycles render: 1, 2 or 3");
+  cmd->add_option("--on-mixing-nodes", o.on_mixing_nodes, "refuse or one-band (as the batch)");
+  cmd->add_option("--on-world", o.on_world, "refuse or omit (as the batch)");
+  add_common(cmd, o.common);
+  return cmd;
+}
+
+// The last line of a program's stderr that says what went wrong (the batch's one-line error).
+std::string last_line(const std::string& text) {
+  std::string line;
+  std::size_t end = text.find_last_not_of("\n");
+  if (end == std::string::npos) return "(no message)";
+  const std::size_t start = text.rfind('\n', end);
+  return text.substr(start == std::string::npos ? 0 : start + 1, end - (start == std::string::npos ? 0 : start + 1) + 1);
+}
+
+int run_cycles(CyclesOptions& o) {
+  series::RunOptions renderer;
+  renderer.renderer = series::Renderer::Cycles;
+  renderer.batch_script = blender_batch_script();
+  series::check_renderer(renderer);
+  if (!fs::is_regular_file(o.source)) throw InputError(fmt::format("{}: no such file", o.source));
+  const bool blend = fs::path(o.source).extension() == ".blend";
+
+  farm::FarmJob job;
+  job.kind = "cycles";
+  job.directory = output_directory(o.common.output, {o.source});
+  job.result = job.directory / "render.exr";
+  const fs::path parts = job.directory / "parts";
+
+  // The batch's own options, the same for every task and the assembly.
+  std::vector<std::string> batch = {renderer.blender.string(), "--background", "--factory-startup"};
+  const std::size_t threads_at = batch.size();
+  batch.insert(batch.end(), {"--python", fs::absolute(renderer.batch_script).string(), "--",
+                             blend ? "--blend" : "--scene", fs::absolute(o.source).string()});
+  const auto pass = [&](const char* option, const std::string& value) {
+    if (value.empty()) return;
+    batch.push_back(option);
+    batch.push_back(value);
+  };
+  const auto number = [](const auto& value) { return value ? std::to_string(*value) : std::string(); };
+  pass("--samples", number(o.samples));
+  pass("--bands", o.bands);
+  pass("--bands-file", o.bands_file.empty() ? "" : fs::absolute(o.bands_file).string());
+  pass("--max-bounces", number(o.max_bounces));
+  pass("--components", o.components);
+  pass("--resolution", o.resolution);
+  pass("--seed", number(o.seed));
+  pass("--bands-per-render", number(o.bands_per_render));
+  pass("--on-mixing-nodes", o.on_mixing_nodes);
+  pass("--on-world", o.on_world);
+
+  // How many band groups: the batch's pre-flight check, here and now, which also refuses bad input before
+  // anything is submitted.
+  fs::create_directories(job.directory / "slurm");
+  const fs::path preflight = job.directory / "slurm" / "preflight.json";
+  std::vector<std::string> explain = batch;
+  explain.insert(explain.end(), {"--explain", preflight.string()});
+  const farm::ProgramOutput checked = farm::run_program(explain, {{"CHROMATRACE_EXE", own_executable().string()}});
+  if (checked.status == 2) throw InputError(last_line(checked.err));
+  if (checked.status != 0 || !fs::exists(preflight))
+    throw std::runtime_error(fmt::format("the pre-flight check in Blender failed: {}", last_line(checked.err)));
+  const Json summary = read_json(preflight);
+  if (!summary.value("ok", false)) {
+    for (const Json& owner : summary.at("owners"))
+      if (owner.value("status", "") == "refused" && !owner.at("reasons").empty())
+        throw InputError(fmt::format("{}: {}", o.source, owner.at("reasons")[0].get<std::string>()));
+    throw InputError(fmt::format("{}: the pre-flight check refuses it ({})", o.source, preflight.string()));
+  }
+  const int groups = summary.at("band_groups").get<int>();
+
+  const std::string tool = "CHROMATRACE_EXE=" + farm::shell_quote(own_executable().string()) + " ";
+  // Blender's render threads: the task's CPUs (--threads before --python).
+  const std::string start = "CHROMATRACE_EXE=" + farm::shell_quote(own_executable().string()) + " " +
+                            farm::shell_command({batch.begin(), batch.begin() + static_cast<std::ptrdiff_t>(threads_at)}) +
+                            " --threads \"$THREADS\" " +
+                            farm::shell_command({batch.begin() + static_cast<std::ptrdiff_t>(threads_at), batch.end()});
+  const auto command = [&](const std::vector<std::string>& more) { return start + " " + farm::shell_command(more); };
+  for (int g = 0; g < groups; ++g) {
+    const fs::path done = parts / fmt::format("band_group_{}.done", g);
+    job.task_commands.push_back(command({"--out", job.result.string(), "--cache-dir", parts.string(), "--band-group",
+                                         std::to_string(g), "--quiet"}) +
+                                " && touch " + farm::shell_quote(done.string()));
+    job.task_outputs.push_back(done);
+  }
+  job.assembly_command = command({"--out", job.result.string(), "--cache-dir", parts.string(), "--quiet"});
+  return run_farm(job, o.common);
+}
+
 }  // namespace
 
 Action add_farm(CLI::App& app) {
@@ -141,8 +252,11 @@ Action add_farm(CLI::App& app) {
   cmd->require_subcommand(1);
   auto render = std::make_shared<RenderOptions>();
   auto* render_cmd = add_render(cmd, *render);
+  auto cycles = std::make_shared<CyclesOptions>();
+  auto* cycles_cmd = add_cycles(cmd, *cycles);
   return [=] {
     if (render_cmd->parsed()) return run_render(*render);
+    if (cycles_cmd->parsed()) return run_cycles(*cycles);
     return 2;
   };
 }

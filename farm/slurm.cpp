@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cstdlib>
 #include <cstring>
+#include <algorithm>
 #include <map>
 #include <regex>
 #include <set>
@@ -30,11 +31,6 @@ namespace {
 
 constexpr const char* kFormat = "chromatrace-farm/1";
 
-struct Output {
-  int status = -1;
-  std::string out, err;
-};
-
 std::string slurp(int fd) {
   std::string text;
   char buffer[4096];
@@ -45,9 +41,10 @@ std::string slurp(int fd) {
   return text;
 }
 
-// Runs a program found on PATH and waits; what it prints is captured (through unlinked temporary files, so
-// that no pipe can fill up).
-Output run(const std::vector<std::string>& argv) {
+}  // namespace
+
+// What the program prints goes through unlinked temporary files, so that no pipe can fill up.
+ProgramOutput run_program(const std::vector<std::string>& argv, const std::vector<std::pair<std::string, std::string>>& env) {
   char out_name[] = "/tmp/chromatrace-farm-XXXXXX", err_name[] = "/tmp/chromatrace-farm-XXXXXX";
   const int out_fd = mkstemp(out_name), err_fd = mkstemp(err_name);
   if (out_fd < 0 || err_fd < 0) throw std::runtime_error("cannot create a temporary file in /tmp");
@@ -61,8 +58,18 @@ Output run(const std::vector<std::string>& argv) {
   std::vector<char*> pointers;
   for (std::string& a : args) pointers.push_back(a.data());
   pointers.push_back(nullptr);
+  std::vector<std::string> environment;
+  for (char** e = environ; *e; ++e) {
+    const std::string_view entry(*e);
+    if (std::none_of(env.begin(), env.end(), [&](const auto& kv) { return entry.starts_with(kv.first + "="); }))
+      environment.emplace_back(entry);
+  }
+  for (const auto& [name, value] : env) environment.push_back(name + "=" + value);
+  std::vector<char*> env_pointers;
+  for (std::string& e : environment) env_pointers.push_back(e.data());
+  env_pointers.push_back(nullptr);
   pid_t pid = 0;
-  const int error = posix_spawnp(&pid, pointers[0], &actions, nullptr, pointers.data(), environ);
+  const int error = posix_spawnp(&pid, pointers[0], &actions, nullptr, pointers.data(), env_pointers.data());
   posix_spawn_file_actions_destroy(&actions);
   if (error != 0) {
     close(out_fd);
@@ -72,12 +79,14 @@ Output run(const std::vector<std::string>& argv) {
   int status = 0;
   while (waitpid(pid, &status, 0) < 0)
     if (errno != EINTR) throw std::runtime_error("waiting for a process failed");
-  Output result;
+  ProgramOutput result;
   result.status = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
   result.out = slurp(out_fd);
   result.err = slurp(err_fd);
   return result;
 }
+
+namespace {
 
 std::string first_line(const std::string& text) {
   std::string line = text.substr(0, text.find('\n'));
@@ -149,7 +158,7 @@ std::string submit_job(const std::vector<std::string>& args, const fs::path& scr
   std::vector<std::string> argv = {"sbatch", "--parsable"};
   argv.insert(argv.end(), args.begin(), args.end());
   argv.push_back(script.string());
-  const Output result = run(argv);
+  const ProgramOutput result = run_program(argv);
   if (result.status != 0) throw std::runtime_error(fmt::format("sbatch {}: {}", script.string(), first_line(result.err)));
   // --parsable prints "<id>" or "<id>;<cluster>"
   const std::string id = first_line(result.out).substr(0, result.out.find_first_of(";\n"));
@@ -176,7 +185,7 @@ std::vector<QueuedJob> queued(const std::vector<std::string>& ids) {
   for (const std::string& id : ids)
     if (!id.empty()) list += (list.empty() ? "" : ",") + id;
   if (list.empty()) return {};
-  const Output result = run({"squeue", "--noheader", "--array", "--jobs", list, "--format", "%i|%T|%r"});
+  const ProgramOutput result = run_program({"squeue", "--noheader", "--array", "--jobs", list, "--format", "%i|%T|%r"});
   if (result.status != 0) {
     // Jobs that finished long enough ago are forgotten: "Invalid job id specified".
     if (result.err.find("Invalid job id") != std::string::npos) return {};
@@ -198,7 +207,7 @@ bool of_job(const QueuedJob& queued_job, const std::string& id) {
 }
 
 void cancel(const std::string& id) {
-  const Output result = run({"scancel", id});
+  const ProgramOutput result = run_program({"scancel", id});
   if (result.status != 0) throw std::runtime_error(fmt::format("scancel {}: {}", id, first_line(result.err)));
 }
 

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include "core/file_io.h"
 #include "tests/cli/run_command.h"
@@ -105,6 +106,37 @@ TEST_F(Slurm, CancelledTaskThenResumeGivesTheSameBytes) {
   const CommandResult again = test::run_chromatrace(farm_render(out, {"--resume"}));
   EXPECT_EQ(again.exit_code, 0) << again.err;
   EXPECT_NE(again.out.find("nothing to submit"), std::string::npos) << again.out;
+}
+
+// A spectral Cycles render of the paper box in 3 band groups (9 bands, 3 per render), one task each, then the
+// assembly: a complete spectral EXR whose components sum to the total (info --check) with the channels of the
+// same render made by the add-on's batch on one machine.
+TEST_F(Slurm, CyclesBandGroupsAssembleToTheChannelsOfTheLocalBatch) {
+  if (std::string(BLENDER_EXE).empty() || !fs::exists(BLENDER_EXE)) GTEST_SKIP() << "Blender is not installed";
+  setenv("CHROMATRACE_EXE", CHROMATRACE_EXE, 1);
+  const std::vector<std::string> options = {"--bands", "420:690:30", "--resolution", "16x16", "--samples", "4"};
+  const fs::path out = dir_.file("farm");
+  const CommandResult r = test::run_chromatrace(with({"farm", "cycles", kBox, "-o", out.string(), "--wait"}, options));
+  ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
+  EXPECT_NE(r.out.find("(array 0-2, 3 of 3 tasks)"), std::string::npos) << r.out;
+
+  const fs::path local = dir_.file("local.exr");
+  const CommandResult batch = test::run_program(
+      BLENDER_EXE, with({"--background", "--factory-startup", "--python", kSource + "/blender_addon/batch.py", "--",
+                         "--scene", kBox, "--out", local.string(), "--cache-dir", dir_.file("cache").string(), "--quiet"},
+                        options));
+  ASSERT_EQ(batch.exit_code, 0) << batch.err;
+
+  const auto checked = [](const fs::path& file) {
+    const CommandResult info = test::run_chromatrace({"info", "--check", "--json", "--quiet", file.string()});
+    EXPECT_EQ(info.exit_code, 0) << file << ": " << info.err;
+    return nlohmann::json::parse(info.out.empty() ? "{}" : info.out);
+  };
+  const nlohmann::json farm = checked(out / "render.exr"), mine = checked(local);
+  ASSERT_TRUE(farm.contains("channels") && mine.contains("channels"));
+  EXPECT_EQ(farm["channels"], mine["channels"]);
+  EXPECT_EQ(farm["bands"], mine["bands"]);
+  EXPECT_EQ(farm["channels"].size(), 3u + 9u * 7u + 1u) << "R, G, B, 9 bands of the total and 6 components, object ids";
 }
 
 // Bad input needs no cluster: one line naming the option (or the missing command), exit 2, nothing submitted.
