@@ -10,6 +10,7 @@
 
 #include "cli/command.h"
 #include "cli/options.h"
+#include "cli/series_options.h"
 #include "core/band_plan.h"
 #include "core/error.h"
 #include "core/file_io.h"
@@ -245,6 +246,50 @@ int run_cycles(CyclesOptions& o) {
   return run_farm(job, o.common);
 }
 
+// ---- farm series: an experiment series, one task per distinct render --------------------------------------------
+
+struct SeriesFarmOptions {
+  Common common;
+  std::string series;
+  SeriesRenderOptions render;
+};
+
+CLI::App* add_series(CLI::App* farm, SeriesFarmOptions& o) {
+  auto* cmd = farm->add_subcommand("series", "An experiment series: one task per distinct render, then camera, "
+                                             "analysis and the figure page in DIR (as chromatrace series)");
+  cmd->add_option("series", o.series, "Series file (chromatrace-series/1)")->required();
+  add_series_render_options(cmd, o.render);
+  add_common(cmd, o.common);
+  return cmd;
+}
+
+int run_series_farm(SeriesFarmOptions& o) {
+  series::RunOptions options = series_run_options(o.render, 0, true);
+  series::check_renderer(options);
+  const Series series = load_series(o.series, 0);
+  const std::vector<std::pair<std::string, std::string>> renders = series::planned_renders(series, options);
+
+  farm::FarmJob job;
+  job.kind = "series";
+  job.directory = output_directory(o.common.output, {o.series});
+  job.result = job.directory / "index.html";  // the figure page, written last
+  const std::vector<std::string> start = {own_executable().string(), "series", fs::absolute(o.series).string(),
+                                          "-o", job.directory.string(), "--quiet"};
+  SeriesRenderOptions one = o.render;
+  one.variants.clear();
+  for (const auto& [key, variant] : renders) {
+    std::vector<std::string> words = start;
+    for (const std::string& a : series_render_arguments(one)) words.push_back(a);
+    words.insert(words.end(), {"--variant", variant, "--renders-only"});
+    job.task_commands.push_back(farm::shell_command(words) + " --threads \"$THREADS\"");
+    job.task_outputs.push_back(job.directory / "renders" / (key + ".exr"));
+  }
+  std::vector<std::string> words = start;
+  for (const std::string& a : series_render_arguments(o.render)) words.push_back(a);
+  job.assembly_command = farm::shell_command(words) + " --threads \"$THREADS\"";
+  return run_farm(job, o.common);
+}
+
 }  // namespace
 
 Action add_farm(CLI::App& app) {
@@ -254,8 +299,11 @@ Action add_farm(CLI::App& app) {
   auto* render_cmd = add_render(cmd, *render);
   auto cycles = std::make_shared<CyclesOptions>();
   auto* cycles_cmd = add_cycles(cmd, *cycles);
+  auto series = std::make_shared<SeriesFarmOptions>();
+  auto* series_cmd = add_series(cmd, *series);
   return [=] {
     if (render_cmd->parsed()) return run_render(*render);
+    if (series_cmd->parsed()) return run_series_farm(*series);
     if (cycles_cmd->parsed()) return run_cycles(*cycles);
     return 2;
   };

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include <fmt/core.h>
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
@@ -137,6 +138,47 @@ TEST_F(Slurm, CyclesBandGroupsAssembleToTheChannelsOfTheLocalBatch) {
   EXPECT_EQ(farm["channels"], mine["channels"]);
   EXPECT_EQ(farm["bands"], mine["bands"]);
   EXPECT_EQ(farm["channels"].size(), 3u + 9u * 7u + 1u) << "R, G, B, 9 bands of the total and 6 components, object ids";
+}
+
+// Timings and whether a render came from the cache say how a run went, not what it found.
+void strip_run_details(nlohmann::json& j) {
+  if (j.is_object()) {
+    for (const char* key : {"seconds", "cpu_seconds", "reused"}) j.erase(key);
+    for (auto& [key, value] : j.items()) strip_run_details(value);
+  } else if (j.is_array()) {
+    for (auto& value : j) strip_run_details(value);
+  }
+}
+
+// The paper's series: one task per distinct render, then camera, analysis and the page in the assembly job.
+// Every render is the same bytes as the local series' and every finding is the same.
+TEST_F(Slurm, SeriesRendersAndFindingsEqualTheLocalSeries) {
+  const std::vector<std::string> options = {"--resolution", "32x32", "--spp", "8"};
+  const std::string series = kSource + "/scenes/paper/series.json";
+  const fs::path out = dir_.file("farm"), local = dir_.file("local");
+  const CommandResult r = test::run_chromatrace(with({"farm", "series", series, "-o", out.string(), "--wait", "-q"}, options));
+  ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
+  const CommandResult l = test::run_chromatrace(with({"series", series, "-o", local.string(), "-q"}, options));
+  ASSERT_EQ(l.exit_code, 0) << l.err;
+
+  int renders = 0;
+  for (const auto& entry : fs::directory_iterator(local / "renders")) {
+    if (entry.path().extension() != ".exr") continue;
+    ++renders;
+    const fs::path farm = out / "renders" / entry.path().filename();
+    ASSERT_TRUE(fs::exists(farm)) << farm;
+    EXPECT_TRUE(read_file(farm) == read_file(entry.path())) << entry.path().filename() << " differs";
+  }
+  EXPECT_NE(r.out.find(fmt::format("(array 0-{}, {} of {} tasks)", renders - 1, renders, renders)), std::string::npos)
+      << r.out;
+  nlohmann::json farm = nlohmann::json::parse(read_file(out / "series.json")),
+                 mine = nlohmann::json::parse(read_file(local / "series.json"));
+  strip_run_details(farm);
+  strip_run_details(mine);
+  farm.erase("options");
+  mine.erase("options");
+  EXPECT_EQ(farm, mine);
+  EXPECT_TRUE(fs::exists(out / "index.html"));
 }
 
 // Bad input needs no cluster: one line naming the option (or the missing command), exit 2, nothing submitted.
