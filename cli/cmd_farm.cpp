@@ -148,7 +148,8 @@ struct CyclesOptions {
 
 CLI::App* add_cycles(CLI::App* farm, CyclesOptions& o) {
   auto* cmd = farm->add_subcommand("cycles", "A spectral Cycles render (the Blender add-on's batch) split into one task "
-                                             "per band group, assembled into DIR/render.exr");
+                                             "per band group (and bounce limit, with the bounces components), "
+                                             "assembled into DIR/render.exr");
   cmd->add_option("source", o.source, "Scene file (chromatrace-scene/1) or a .blend with chromatrace settings")->required();
   cmd->add_option("--samples", o.samples, "Samples per pixel (default: the scene's)");
   cmd->add_option("--bands", o.bands, "Band plan lo:hi:width in nm (default: the scene's)");
@@ -227,6 +228,8 @@ int run_cycles(CyclesOptions& o) {
     throw InputError(fmt::format("{}: the pre-flight check refuses it ({})", o.source, preflight.string()));
   }
   const int groups = summary.at("band_groups").get<int>();
+  // With the bounces components every group has a render per bounce limit: one task each.
+  const std::vector<std::string> variants = summary.at("render_variants").get<std::vector<std::string>>();
 
   const std::string tool = "CHROMATRACE_EXE=" + farm::shell_quote(own_executable().string()) + " ";
   // Blender's render threads: the task's CPUs (--threads before --python).
@@ -235,13 +238,19 @@ int run_cycles(CyclesOptions& o) {
                             " --threads \"$THREADS\" " +
                             farm::shell_command({batch.begin() + static_cast<std::ptrdiff_t>(threads_at), batch.end()});
   const auto command = [&](const std::vector<std::string>& more) { return start + " " + farm::shell_command(more); };
-  for (int g = 0; g < groups; ++g) {
-    const fs::path done = parts / fmt::format("band_group_{}.done", g);
-    job.task_commands.push_back(command({"--out", job.result.string(), "--cache-dir", parts.string(), "--band-group",
-                                         std::to_string(g), "--quiet"}) +
-                                " && touch " + farm::shell_quote(done.string()));
-    job.task_outputs.push_back(done);
-  }
+  for (int g = 0; g < groups; ++g)
+    for (const std::string& variant : variants) {
+      std::vector<std::string> more = {"--out", job.result.string(), "--cache-dir", parts.string(), "--band-group",
+                                       std::to_string(g), "--quiet"};
+      std::string name = fmt::format("band_group_{}", g);
+      if (variants.size() > 1) {
+        more.insert(more.end(), {"--bounce-limit", variant});
+        name += "_" + variant;
+      }
+      const fs::path done = parts / (name + ".done");
+      job.task_commands.push_back(command(more) + " && touch " + farm::shell_quote(done.string()));
+      job.task_outputs.push_back(done);
+    }
   job.assembly_command = command({"--out", job.result.string(), "--cache-dir", parts.string(), "--quiet"});
   return run_farm(job, o.common);
 }

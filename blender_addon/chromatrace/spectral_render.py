@@ -79,6 +79,7 @@ class Request:
         self.cache_root = None
         self.keep_cache = False
         self.only_group = None  # render only this band group into the cache, no ids, no assembly (batch --band-group)
+        self.only_variant = None  # with only_group: only this render variant (bounce limit) of it (--bounce-limit)
         self.log = _stderr_log
         for key, value in values.items():
             if not hasattr(self, key):
@@ -614,6 +615,7 @@ class SpectralRender:
         return {"format": "chromatrace-preflight/1", "scene": self.scene.name,
                 "ok": not refused, "renders": renders, "bands": len(edges) - 1, "edges_nm": edges,
                 "bands_per_render": per_render, "band_groups": len(groups), "bounce_limits": len(variants),
+                "render_variants": list(variants),
                 "object_id_render": bool(request.object_ids), "owners": owners}
 
     # ---- rendering -----------------------------------------------------------------------------------
@@ -712,6 +714,11 @@ class SpectralRender:
                     raise BadInput(f"--band-group: must be in [0, {len(groups) - 1}] for {len(groups)} band groups, "
                                    f"got {only}")
                 total = len(variants)
+                if request.only_variant is not None:
+                    if request.only_variant not in variants:
+                        raise BadInput(f"--bounce-limit: must be one of {', '.join(variants)}, got "
+                                       f"\"{request.only_variant}\"")
+                    total = 1
             applied = False
             done = 0
             for g, group in enumerate(groups):
@@ -719,6 +726,8 @@ class SpectralRender:
                     continue
                 colours_set = False
                 for variant, cycles_bounces in variants.items():
+                    if request.only_variant is not None and variant != request.only_variant:
+                        continue
                     final = os.path.join(self.cache_dir, manifest.render_file_name(g, variant))
                     if (g, variant) not in todo:
                         self.cached += 1
@@ -750,7 +759,9 @@ class SpectralRender:
                     request.log(message)
                     yield done, total, message
             if only is not None:
-                request.log(f"band group {only} of {len(groups)} is in the cache {self.cache_dir}")
+                request.log(f"band group {only} of {len(groups)}"
+                            f"{'' if request.only_variant is None else ' (' + request.only_variant + ')'} is in the cache "
+                            f"{self.cache_dir}")
                 return
             if request.object_ids:
                 ids_file = os.path.join(self.cache_dir, manifest.IDS_FILE)

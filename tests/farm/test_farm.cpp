@@ -181,6 +181,26 @@ TEST_F(Slurm, SeriesRendersAndFindingsEqualTheLocalSeries) {
   EXPECT_TRUE(fs::exists(out / "index.html"));
 }
 
+// With the bounces components each band group has a Cycles render per bounce limit: one task each (here 3
+// groups × limits k1, k2 and main). --dry-run runs the batch's pre-flight check and submits nothing.
+TEST(FarmInput, CyclesWithBouncesIsOneTaskPerBandGroupAndBounceLimit) {
+  if (std::string(BLENDER_EXE).empty() || !fs::exists(BLENDER_EXE)) GTEST_SKIP() << "Blender is not installed";
+  setenv("CHROMATRACE_EXE", CHROMATRACE_EXE, 1);
+  test::TempDir dir;
+  const fs::path out = dir.file("farm");
+  const CommandResult r = test::run_chromatrace({"farm", "cycles", kBox, "-o", out.string(), "--dry-run", "--bands",
+                                                 "420:690:30", "--components", "all", "--max-bounces", "3"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("--array=0-8 "), std::string::npos) << r.out;
+  const std::string script = read_file(out / "slurm" / "tasks.sh");
+  for (int g = 0; g < 3; ++g)
+    for (const char* limit : {"k1", "k2", "main"}) {
+      const std::string task = fmt::format("--band-group {} --quiet --bounce-limit {} ", g, limit);
+      EXPECT_NE(script.find(task), std::string::npos) << task;
+    }
+  EXPECT_FALSE(fs::exists(out / "farm.json"));
+}
+
 // Bad input needs no cluster: one line naming the option (or the missing command), exit 2, nothing submitted.
 TEST(FarmInput, BadValuesAndAMissingSbatchExitTwoWithOneLine) {
   test::TempDir dir;

@@ -181,6 +181,7 @@ class BatchArgs(unittest.TestCase):
             (["--scene", self.scene, "--out", self.out, "--band-group", "-1"], "--band-group"),
             (["--scene", self.scene, "--out", self.out, "--band-group", "x"], "--band-group"),
             (["--scene", self.scene, "--explain", "--band-group", "0"], "--band-group"),
+            (["--scene", self.scene, "--out", self.out, "--bounce-limit", "k1"], "--bounce-limit"),
         ]
         for argv, option in cases:
             with self.assertRaises(BadInput, msg=argv) as caught:
