@@ -2,6 +2,9 @@
 // slurmctld and slurmd with a generated slurm.conf, all in a temporary directory, stopped after each test):
 // the split render of the cluster is the same bytes as the same split run locally, also after a task was
 // cancelled and the rest submitted with --resume. Skipped, saying why, only where Slurm cannot start.
+#include <unistd.h>
+
+#include <algorithm>
 #include <cstdlib>
 #include <filesystem>
 #include <string>
@@ -25,14 +28,23 @@ const std::string kBox = kSource + "/scenes/paper/box.json";
 const std::string kSlurm = kSource + "/tests/farm/local_slurm.sh";
 // The paper's box, small: 4 parts of 4 paths per pixel.
 const std::vector<std::string> kRender = {kBox, "--resolution", "32x32", "--spp", "16", "--seeds", "4"};
+// Parts that take a second or more, so that one can be cancelled while it renders.
+const std::vector<std::string> kLongRender = {kBox, "--resolution", "64x64", "--spp", "512", "--seeds", "4"};
 
 std::vector<std::string> with(std::vector<std::string> args, const std::vector<std::string>& more) {
   args.insert(args.end(), more.begin(), more.end());
   return args;
 }
 
-std::vector<std::string> farm_render(const fs::path& dir, const std::vector<std::string>& more) {
-  return with(with({"farm", "render"}, kRender), with({"-o", dir.string(), "--quiet"}, more));
+std::vector<std::string> farm_render(const fs::path& dir, const std::vector<std::string>& more,
+                                     const std::vector<std::string>& render = kRender) {
+  return with(with({"farm", "render"}, render), with({"-o", dir.string(), "--quiet"}, more));
+}
+
+// Slurm's state of a job or array task ("RUNNING", "PENDING", …; "" once it has left the queue).
+std::string job_state(const std::string& id) {
+  const CommandResult r = test::run_program("/usr/bin/squeue", {"--noheader", "--array", "--jobs", id, "--format", "%T"});
+  return r.out.substr(0, r.out.find('\n'));
 }
 
 // The first line of stdout that starts with `prefix`, its third word: "tasks: job 12 (...)" -> "12".
@@ -58,9 +70,9 @@ class Slurm : public ::testing::Test {
   }
 
   // The same split run locally: what every Slurm run must equal byte for byte.
-  std::string local_split() {
+  std::string local_split(const std::vector<std::string>& render = kRender) {
     const fs::path local = dir_.file("local.exr");
-    const CommandResult r = test::run_chromatrace(with(with({"render"}, kRender), {"-o", local.string(), "--quiet"}));
+    const CommandResult r = test::run_chromatrace(with(with({"render"}, render), {"-o", local.string(), "--quiet"}));
     EXPECT_EQ(r.exit_code, 0) << r.err;
     return read_file(local);
   }
@@ -82,29 +94,42 @@ TEST_F(Slurm, TracerSplitIntoFourSeedsIsByteIdenticalToTheLocalSplit) {
   EXPECT_TRUE(farm == local_split()) << "the cluster's render differs from the local split";
 }
 
-TEST_F(Slurm, CancelledTaskThenResumeGivesTheSameBytes) {
+TEST_F(Slurm, CancelledTasksThenResumeGiveTheSameBytes) {
   const fs::path out = dir_.file("farm");
-  // One task at a time, so that task 3 is still waiting when it is cancelled.
-  const CommandResult submitted = test::run_chromatrace(farm_render(out, {"--max-concurrent", "1"}));
+  // One task at a time: task 1 is cancelled while it renders, task 3 while it still waits.
+  const CommandResult submitted = test::run_chromatrace(farm_render(out, {"--max-concurrent", "1"}, kLongRender));
   ASSERT_EQ(submitted.exit_code, 0) << submitted.err;
   const std::string tasks = job_id(submitted.out, "tasks");
   ASSERT_FALSE(tasks.empty()) << submitted.out;
-  const CommandResult cancelled = test::run_program("/usr/bin/scancel", {tasks + "_3"});
-  ASSERT_EQ(cancelled.exit_code, 0) << cancelled.err;
+  std::string state;
+  for (int i = 0; i < 1200 && (state = job_state(tasks + "_1")) != "RUNNING"; ++i) usleep(100'000);
+  ASSERT_EQ(state, "RUNNING") << "task 1 was never seen running";
+  ASSERT_EQ(job_state(tasks + "_3"), "PENDING");
+  for (const char* task : {"_1", "_3"}) {
+    const CommandResult cancelled = test::run_program("/usr/bin/scancel", {tasks + task});
+    ASSERT_EQ(cancelled.exit_code, 0) << cancelled.err;
+  }
 
-  // Following the jobs: three tasks succeed, the fourth never does, so the assembly cannot run.
-  const CommandResult followed = test::run_chromatrace(farm_render(out, {"--follow"}));
+  // Following the jobs: tasks 0 and 2 succeed, 1 and 3 never do, so the assembly cannot run.
+  const CommandResult followed = test::run_chromatrace(farm_render(out, {"--follow"}, kLongRender));
   EXPECT_EQ(followed.exit_code, 1) << followed.err;
-  EXPECT_NE(followed.err.find("tasks 3 did not finish"), std::string::npos) << followed.err;
+  EXPECT_NE(followed.err.find("tasks 1, 3 did not finish"), std::string::npos) << followed.err;
   EXPECT_FALSE(fs::exists(out / "render.exr"));
-  EXPECT_FALSE(fs::exists(out / "parts" / "part_3.exr"));
+  EXPECT_TRUE(fs::exists(out / "parts" / "part_0.exr"));
+  EXPECT_TRUE(fs::exists(out / "parts" / "part_2.exr"));
+  // The task stopped in the middle of its render left nothing in parts/, not even a temporary file.
+  std::vector<std::string> left;
+  for (const auto& entry : fs::directory_iterator(out / "parts")) left.push_back(entry.path().filename().string());
+  std::sort(left.begin(), left.end());
+  EXPECT_EQ(left, (std::vector<std::string>{"part_0.exr", "part_2.exr"}));
 
-  const CommandResult resumed = test::run_chromatrace(farm_render(out, {"--resume", "--wait"}));
+  const CommandResult resumed = test::run_chromatrace(farm_render(out, {"--resume", "--wait"}, kLongRender));
   ASSERT_EQ(resumed.exit_code, 0) << resumed.err;
-  EXPECT_NE(resumed.out.find("(array 3, 1 of 4 tasks)"), std::string::npos) << resumed.out;
-  EXPECT_TRUE(read_file(out / "render.exr") == local_split()) << "the resumed render differs from the local split";
+  EXPECT_NE(resumed.out.find("(array 1,3, 2 of 4 tasks)"), std::string::npos) << resumed.out;
+  EXPECT_TRUE(read_file(out / "render.exr") == local_split(kLongRender))
+      << "the resumed render differs from the local split";
 
-  const CommandResult again = test::run_chromatrace(farm_render(out, {"--resume"}));
+  const CommandResult again = test::run_chromatrace(farm_render(out, {"--resume"}, kLongRender));
   EXPECT_EQ(again.exit_code, 0) << again.err;
   EXPECT_NE(again.out.find("nothing to submit"), std::string::npos) << again.out;
 }
