@@ -1,4 +1,4 @@
-// chromatrace farm render|cycles ... -o DIR: work split into Slurm jobs on a cluster (docs/farm.md). The
+// chromatrace farm render|cycles|series ... -o DIR: work split into Slurm jobs on a cluster (docs/farm.md). The
 // scripts, submission and following are in farm/slurm.h; this file says what the tasks of each kind run.
 #include <filesystem>
 #include <memory>
@@ -48,11 +48,16 @@ void add_common(CLI::App* cmd, Common& c) {
   cmd->add_flag("-q,--quiet", c.quiet, "No progress output");
 }
 
-int run_farm(const farm::FarmJob& job, Common& c) {
+// The options every kind shares, checked before the kind's own work (Blender's pre-flight check, loading a series).
+void check_common(Common& c) {
   c.slurm.max_concurrent = c.max_concurrent;
   if (c.dry_run && (c.resume || c.wait || c.follow))
     throw InputError("--dry-run: submits nothing, so cannot --resume, --wait or --follow");
   if (c.follow && c.resume) throw InputError("--follow: submits nothing, so cannot --resume");
+  farm::check_options(c.slurm);
+}
+
+int run_farm(const farm::FarmJob& job, const Common& c) {
   if (c.follow) return farm::wait(job, !c.quiet);
   farm::submit(job, c.slurm, c.dry_run ? farm::Mode::DryRun : c.resume ? farm::Mode::Resume : farm::Mode::Submit);
   return c.wait ? farm::wait(job, !c.quiet) : 0;
@@ -93,6 +98,7 @@ CLI::App* add_render(CLI::App* farm, RenderOptions& o) {
 }
 
 int run_render(RenderOptions& o) {
+  check_common(o.common);
   // Everything a task would refuse is refused here, before anything is submitted.
   const Scene scene = load_scene(o.scene);
   if (!o.resolution.empty()) parse_resolution(o.resolution);
@@ -167,14 +173,14 @@ CLI::App* add_cycles(CLI::App* farm, CyclesOptions& o) {
 
 // The last line of a program's stderr that says what went wrong (the batch's one-line error).
 std::string last_line(const std::string& text) {
-  std::string line;
-  std::size_t end = text.find_last_not_of("\n");
+  const std::size_t end = text.find_last_not_of("\n");
   if (end == std::string::npos) return "(no message)";
   const std::size_t start = text.rfind('\n', end);
   return text.substr(start == std::string::npos ? 0 : start + 1, end - (start == std::string::npos ? 0 : start + 1) + 1);
 }
 
 int run_cycles(CyclesOptions& o) {
+  check_common(o.common);
   series::RunOptions renderer;
   renderer.renderer = series::Renderer::Cycles;
   renderer.batch_script = blender_batch_script();
@@ -212,26 +218,34 @@ int run_cycles(CyclesOptions& o) {
 
   // How many band groups: the batch's pre-flight check, here and now, which also refuses bad input before
   // anything is submitted.
-  fs::create_directories(job.directory / "slurm");
-  const fs::path preflight = job.directory / "slurm" / "preflight.json";
+  // Its summary goes to stdout; it lands in DIR/slurm/preflight.json only when something is submitted.
   std::vector<std::string> explain = batch;
-  explain.insert(explain.end(), {"--explain", preflight.string()});
+  explain.insert(explain.end(), {"--explain", "-"});
   const farm::ProgramOutput checked = farm::run_program(explain, {{"CHROMATRACE_EXE", own_executable().string()}});
-  if (checked.status == 2) throw InputError(last_line(checked.err));
-  if (checked.status != 0 || !fs::exists(preflight))
+  if (checked.status == 2) {
+    std::string message = last_line(checked.err);
+    for (const char* prefix : {"batch.py: error: "})
+      if (message.starts_with(prefix)) message.erase(0, std::string_view(prefix).size());
+    throw InputError(message);
+  }
+  // Blender prints its own lines too: the summary is the JSON object that starts a line.
+  const std::size_t at = checked.out.find("\n{");
+  const std::size_t first = checked.out.starts_with("{") ? 0 : at == std::string::npos ? at : at + 1;
+  const std::size_t last = first == std::string::npos ? first : checked.out.find("\n}", first);
+  if (checked.status != 0 || last == std::string::npos)
     throw std::runtime_error(fmt::format("the pre-flight check in Blender failed: {}", last_line(checked.err)));
-  const Json summary = read_json(preflight);
+  const Json summary = parse_json(checked.out.substr(first, last + 2 - first), "the Blender batch's pre-flight summary");
+  job.notes.emplace_back("preflight.json", summary.dump(1) + "\n");
   if (!summary.value("ok", false)) {
     for (const Json& owner : summary.at("owners"))
       if (owner.value("status", "") == "refused" && !owner.at("reasons").empty())
         throw InputError(fmt::format("{}: {}", o.source, owner.at("reasons")[0].get<std::string>()));
-    throw InputError(fmt::format("{}: the pre-flight check refuses it ({})", o.source, preflight.string()));
+    throw InputError(fmt::format("{}: the pre-flight check refuses it", o.source));
   }
   const int groups = summary.at("band_groups").get<int>();
   // With the bounces components every group has a render per bounce limit: one task each.
   const std::vector<std::string> variants = summary.at("render_variants").get<std::vector<std::string>>();
 
-  const std::string tool = "CHROMATRACE_EXE=" + farm::shell_quote(own_executable().string()) + " ";
   // Blender's render threads: the task's CPUs (--threads before --python).
   const std::string start = "CHROMATRACE_EXE=" + farm::shell_quote(own_executable().string()) + " " +
                             farm::shell_command({batch.begin(), batch.begin() + static_cast<std::ptrdiff_t>(threads_at)}) +
@@ -273,6 +287,7 @@ CLI::App* add_series(CLI::App* farm, SeriesFarmOptions& o) {
 }
 
 int run_series_farm(SeriesFarmOptions& o) {
+  check_common(o.common);
   series::RunOptions options = series_run_options(o.render, 0, true);
   series::check_renderer(options);
   const Series series = load_series(o.series, 0);

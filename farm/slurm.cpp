@@ -316,6 +316,7 @@ void submit(const FarmJob& job, const SlurmOptions& options, Mode mode) {
   const fs::path tasks_file = job.directory / "slurm" / "tasks.sh", assembly_file = job.directory / "slurm" / "assemble.sh";
   write_file_atomically(tasks_file, tasks_script(job, options));
   write_file_atomically(assembly_file, assembly_script(job, options));
+  for (const auto& [name, text] : job.notes) write_file_atomically(job.directory / "slurm" / name, text);
 
   std::vector<int> tasks;
   for (std::size_t i = 0; i < job.task_commands.size(); ++i)

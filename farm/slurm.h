@@ -54,6 +54,8 @@ struct FarmJob {
   std::vector<std::string> task_commands; // bash lines; "$THREADS" is the task's CPU count
   std::vector<std::filesystem::path> task_outputs;  // what each task leaves when it succeeded
   std::string assembly_command;           // bash line
+  // Further files written beside the scripts (name in slurm/, contents), e.g. the Blender batch's pre-flight.
+  std::vector<std::pair<std::string, std::string>> notes;
 };
 
 enum class Mode { Submit, Resume, DryRun };

@@ -224,6 +224,15 @@ TEST(FarmInput, CyclesWithBouncesIsOneTaskPerBandGroupAndBounceLimit) {
       EXPECT_NE(script.find(task), std::string::npos) << task;
     }
   EXPECT_FALSE(fs::exists(out / "farm.json"));
+  EXPECT_TRUE(fs::exists(out / "slurm" / "preflight.json"));
+
+  // What the batch refuses is refused before anything is written or queued, in the batch's words.
+  const fs::path bad = dir.file("bad");
+  const CommandResult refused = test::run_chromatrace({"farm", "cycles", kBox, "-o", bad.string(), "--dry-run",
+                                                       "--samples", "0"});
+  EXPECT_EQ(refused.exit_code, 2) << refused.err;
+  EXPECT_EQ(refused.err, "chromatrace farm: error: --samples: must be at least 1, got 0\n");
+  EXPECT_FALSE(fs::exists(bad));
 }
 
 // Bad input needs no cluster: one line naming the option (or the missing command), exit 2, nothing submitted.
@@ -235,7 +244,7 @@ TEST(FarmInput, BadValuesAndAMissingSbatchExitTwoWithOneLine) {
     EXPECT_EQ(r.exit_code, 2) << r.err;
     EXPECT_NE(r.err.find(named), std::string::npos) << r.err;
     EXPECT_EQ(r.err.find('\n'), r.err.size() - 1) << r.err;
-    EXPECT_FALSE(fs::exists(out / "farm.json"));
+    EXPECT_FALSE(fs::exists(out)) << "bad input left " << out;
   };
   check({"--time", "soon", "--dry-run"}, "--time");
   check({"--mem", "4 GB", "--dry-run"}, "--mem");
