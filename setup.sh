@@ -16,6 +16,7 @@ packages=(
   xvfb xauth  # a display for the add-on's test in a real Blender window (tests/blender/test_gui.py)
   clang libclang-rt-14-dev  # libFuzzer and the sanitisers (.ci/sanitize, tests/fuzz)
   python-matplotlib-data python3-skimage rawtran-doc  # real photographs the analyzer is tested on (tests/data/photos/masks.json)
+  slurm-wlm munge  # chromatrace farm's test on a single-node Slurm on localhost (tests/farm), and bench/bench_farm.sh
 )
 # The report viewer is bundled from npm packages (package.json): node and npm from Debian unless a node
 # with its own npm (e.g. NodeSource's) is already there.

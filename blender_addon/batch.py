@@ -3,8 +3,12 @@
     blender --background --factory-startup --python blender_addon/batch.py -- \
         --scene SCENE.json --out OUT.exr [--samples N] [--bands lo:hi:w | --bands-file F] [--max-bounces K]
         [--components paths,lights,bounces] [--resolution WxH] [--seed S] [--cache-dir DIR] [--keep-cache]
-        [--on-mixing-nodes refuse|one-band] [--on-world refuse|omit] [--explain [FILE]]
+        [--on-mixing-nodes refuse|one-band] [--on-world refuse|omit] [--explain [FILE]] [--band-group G [--bounce-limit NAME]]
     (or --blend FILE.blend instead of --scene; the .blend is never written)
+
+--band-group G renders only band group G (with all its bounce limits, or only --bounce-limit NAME's render) into
+the cache and stops; a run without it
+then finds every group there and assembles (chromatrace farm cycles runs one task per group, then that run).
 
 --explain prints the pre-flight summary as JSON (to stdout, or FILE) and renders nothing: every material,
 light and the world, exact / upsampled / refused with the reasons in full, and the Cycles renders needed.
@@ -85,7 +89,8 @@ def run(argv):
         scene, output=os.path.abspath(args.out) if args.out else None, samples=args.samples, max_bounces=args.max_bounces, seed=args.seed,
         bands=args.bands, bands_file=args.bands_file, families=families, resolution=args.resolution,
         cache_root=args.cache_dir, keep_cache=args.keep_cache or None, log=log,
-        on_mixing_nodes=args.on_mixing_nodes, bands_per_render=args.bands_per_render, on_world=args.on_world)
+        on_mixing_nodes=args.on_mixing_nodes, bands_per_render=args.bands_per_render, on_world=args.on_world,
+        only_group=args.band_group, only_variant=args.bounce_limit)
     if args.bands_file:
         request.bands = None
     elif args.bands:

@@ -15,14 +15,16 @@
 #include "core/scene.h"
 #include "core/spectral_exr.h"
 #include "reference_tracer/render.h"
+#include "reference_tracer/seed_split.h"
 
 namespace ct::cli {
+namespace fs = std::filesystem;
 
 Action add_render(CLI::App& app) {
   auto* cmd = app.add_subcommand("render", "Render a scene with the reference spectral path tracer");
   struct Options {
     std::string scene, output, bands, plan, mode, resolution, components = "paths,lights";
-    std::optional<int> spp, max_bounces;
+    std::optional<int> spp, max_bounces, seeds, part;
     std::optional<std::uint64_t> seed;
     int threads = 0;
     double time_limit = 0.0;
@@ -40,7 +42,11 @@ Action add_render(CLI::App& app) {
   cmd->add_option("--components", o->components,
                   "Component families: paths, lights, bounces, all, none (comma-separated)")
       ->capture_default_str();
-  cmd->add_option("--seed", o->seed, "Random seed (default: the scene's render.seed)");
+  cmd->add_option("--seed", o->seed, "Random seed (default: the scene's render.seed); the first part's with --seeds");
+  cmd->add_option("--seeds", o->seeds,
+                  "Split the samples into this many parts with consecutive seeds, rendered one after another and "
+                  "combined sample-weighted (as chromatrace farm render does on a cluster)");
+  cmd->add_option("--part", o->part, "With --seeds: render only this part (0-based) of the split into --output");
   cmd->add_option("--threads", o->threads, "Worker threads (0: all cores)")->capture_default_str();
   cmd->add_option("--time-limit", o->time_limit, "Stop after the pass during which this many seconds ran out");
   cmd->add_flag("-q,--quiet", o->quiet, "No progress output");
@@ -73,11 +79,42 @@ Action add_render(CLI::App& app) {
                                                                 options.mode.value_or(scene.render.spectral_mode)))
       fmt::print(stderr, "chromatrace render: warning: {}\n", w.message);
     set_exr_threads(thread_count(o->threads));
-    const rt::RenderedImage image = rt::render(scene, options);
-    rt::write_render(o->output, scene, image);
-    if (!o->quiet)
-      fmt::print(stderr, "{}: {}×{}, {} bands, {} spp, {:.3g} Mpaths/s\n", o->output, image.width, image.height,
-                 image.bands.size(), image.samples, image.paths / image.seconds * 1e-6);
+    const auto render_to = [&](const fs::path& output, const rt::RenderOptions& render_options) {
+      const rt::RenderedImage image = rt::render(scene, render_options);
+      rt::write_render(output, scene, image);
+      if (!o->quiet)
+        fmt::print(stderr, "{}: {}×{}, {} bands, {} spp, {:.3g} Mpaths/s\n", output.string(), image.width,
+                   image.height, image.bands.size(), image.samples, image.paths / image.seconds * 1e-6);
+    };
+    if (o->part && !o->seeds) throw InputError("--part: needs --seeds (the split it is a part of)");
+    if (!o->seeds) {
+      render_to(o->output, options);
+      return 0;
+    }
+    const rt::SeedSplit split(*o->seeds, options.samples.value_or(scene.render.samples),
+                              options.seed.value_or(scene.render.seed));
+    const auto part_options = [&](int part) {
+      rt::RenderOptions p = options;
+      p.samples = split.part_samples(part);
+      p.seed = split.part_seed(part);
+      return p;
+    };
+    if (o->part) {
+      if (*o->part < 0 || *o->part >= split.parts)
+        throw InputError(fmt::format("--part: must be in [0, {}] for --seeds {}, got {}", split.parts - 1, split.parts,
+                                     *o->part));
+      render_to(o->output, part_options(*o->part));
+      return 0;
+    }
+    // The parts go through files, as on a cluster, so that both give the same bytes (reference_tracer/seed_split.h);
+    // a staging directory beside the output, never committed, holds them and is removed at the end.
+    const StagedDirectory parts_dir(o->output + ".parts");
+    std::vector<fs::path> parts;
+    for (int part = 0; part < split.parts; ++part) {
+      parts.push_back(parts_dir.path() / rt::part_file_name(part));
+      render_to(parts.back(), part_options(part));
+    }
+    rt::combine_parts(parts, o->output, !o->quiet);
     return 0;
   };
 }

@@ -15,6 +15,7 @@
 
 #include "cli/command.h"
 #include "cli/options.h"
+#include "cli/series_options.h"
 #include "core/band_plan.h"
 #include "core/error.h"
 #include "core/file_io.h"
@@ -27,55 +28,20 @@ namespace {
 namespace fs = std::filesystem;
 
 struct Options {
-  std::string series, output, renderer = "tracer", resolution, components = "paths,lights", plan;
-  std::optional<int> max_bounces;
-  std::vector<std::string> variants;
-  std::optional<int> spp;
-  std::optional<std::uint64_t> seed;
+  std::string series, output;
+  SeriesRenderOptions render;
   int threads = 0;
-  bool quiet = false;
+  bool quiet = false, renders_only = false;
 };
 
 void add_common(CLI::App* cmd, Options& o) {
   cmd->add_option("-o,--output", o.output, "Output directory (created; its parent must exist)")->required();
-  cmd->add_option("--variant", o.variants, "Run only this variant (repeatable)");
-  cmd->add_option("--renderer", o.renderer, "tracer (the reference path tracer) or cycles (Blender's Cycles, "
-                                             "through the add-on)")
-      ->capture_default_str();
-  cmd->add_option("--resolution", o.resolution, "Image size WxH for every variant (default: the scenes')");
-  cmd->add_option("--spp", o.spp, "Paths per pixel (default: the scenes' render.samples)");
-  cmd->add_option("--seed", o.seed, "Random seed of the renders (default: the scenes' render.seed)");
-  cmd->add_option("--plan", o.plan, "Band plan file (chromatrace-bands/1, e.g. from chromatrace plan) for every variant");
-  cmd->add_option("--max-bounces", o.max_bounces, "Scattering events per path for every variant (default: the scenes')");
-  cmd->add_option("--components", o.components, "Component families rendered: paths, lights, bounces, all")
-      ->capture_default_str();
+  add_series_render_options(cmd, o.render);
   cmd->add_option("--threads", o.threads, "Worker threads (0: all cores)")->check(CLI::NonNegativeNumber);
   cmd->add_flag("-q,--quiet", o.quiet, "No progress output (the summary table is still printed)");
-}
-
-series::RunOptions run_options(const Options& o) {
-  series::RunOptions r;
-  if (o.renderer == "tracer") r.renderer = series::Renderer::Tracer;
-  else if (o.renderer == "cycles") r.renderer = series::Renderer::Cycles;
-  else throw InputError(fmt::format("--renderer: must be tracer or cycles, got \"{}\"", o.renderer));
-  if (!o.resolution.empty()) std::tie(r.width, r.height) = parse_resolution(o.resolution);
-  if (o.spp && *o.spp < 1) throw InputError(fmt::format("--spp: must be >= 1, got {}", *o.spp));
-  r.spp = o.spp;
-  r.seed = o.seed;
-  if (o.max_bounces && *o.max_bounces < 0)
-    throw InputError(fmt::format("--max-bounces: must be >= 0, got {}", *o.max_bounces));
-  r.max_bounces = o.max_bounces;
-  if (!o.plan.empty()) {
-    r.bands = read_band_plan(o.plan);
-    r.bands_file = fs::absolute(o.plan);
-  }
-  r.components = o.components;
-  r.variants = o.variants;
-  r.threads = o.threads;
-  r.progress = !o.quiet;
-  r.executable = own_executable();
-  r.batch_script = blender_batch_script();
-  return r;
+  cmd->add_flag("--renders-only", o.renders_only,
+                "Only the renders, into the cache DIR/renders (no camera, analysis, series.json or page): one task of "
+                "a series split over a cluster (chromatrace farm series)");
 }
 
 // One row per expectation: variant, target, expected, found (per object where a group differs), ✔/✗.
@@ -122,7 +88,8 @@ void check_inputs_outside(const fs::path& dir, const Series& series, const fs::p
 }
 
 int run(const Options& o, const fs::path& series_file) {
-  series::RunOptions options = run_options(o);
+  series::RunOptions options = series_run_options(o.render, o.threads, o.quiet);
+  options.renders_only = o.renders_only;
   if (o.output.empty()) throw InputError("--output: no directory given");
   const fs::path parent = fs::absolute(o.output).parent_path();
   if (!fs::is_directory(parent))
@@ -134,6 +101,15 @@ int run(const Options& o, const fs::path& series_file) {
   check_inputs_outside(o.output, series, series_file);
   // run_series checks the variants and their sensor settings before it writes anything.
   const series::SeriesResult result = series::run_series(series, o.output, options);
+  if (o.renders_only) {
+    for (const series::VariantResult& v : result.variants) {
+      if (!v.ok) fmt::print(stderr, "chromatrace series: {}: failed: {}\n", v.name, v.error);
+      else fmt::print("{}: {}\n", v.name, (fs::path(o.output) / "renders" / (v.render_key + ".exr")).string());
+    }
+    for (const series::VariantResult& v : result.variants)
+      if (!v.ok) return 1;
+    return 0;
+  }
   series::write_figure_page(o.output, series::result_json(result));
   print_summary(result, o.output);
   for (const series::VariantResult& v : result.variants)
@@ -159,7 +135,7 @@ Action add_paper(CLI::App& app) {
   add_common(cmd, *o);
   return [o] {
     Options options = *o;
-    if (options.resolution.empty()) options.resolution = "128x128";
+    if (options.render.resolution.empty()) options.render.resolution = "128x128";
     return run(options, shipped_file("scenes/paper/series.json"));
   };
 }

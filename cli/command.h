@@ -26,6 +26,9 @@ Action add_study(CLI::App& app);
 Action add_scene_bands(CLI::App& app);
 Action add_export_meshes(CLI::App& app);
 Action add_assemble(CLI::App& app);
+Action add_combine(CLI::App& app);
+// Work split into Slurm jobs on a cluster (docs/farm.md).
+Action add_farm(CLI::App& app);
 Action add_compare(CLI::App& app);
 Action add_prepare_texture(CLI::App& app);
 

@@ -32,6 +32,8 @@ int main(int argc, char** argv) {
   add(ct::cli::add_scene_bands(app));
   add(ct::cli::add_export_meshes(app));
   add(ct::cli::add_assemble(app));
+  add(ct::cli::add_combine(app));
+  add(ct::cli::add_farm(app));
   add(ct::cli::add_compare(app));
   add(ct::cli::add_prepare_texture(app));
 

@@ -269,6 +269,11 @@ VariantResult run_variant(const Series& series, const SeriesVariant& variant, co
     result.render_cpu_s = cpu_seconds() - start_cpu;
   }
 
+  if (options.renders_only) {
+    result.ok = true;
+    return result;
+  }
+
   stage("camera");
   auto start = Clock::now();
   const sensor::SensorConfig config = sensor::resolve_config({sensor_patch});
@@ -373,8 +378,18 @@ SeriesResult run_series(const Series& series, const fs::path& dir, const RunOpti
     }
   }
   result.seconds = seconds_since(start);
-  write_file_atomically(dir / "series.json", result_json(result).dump(2) + "\n");
+  if (!options.renders_only) write_file_atomically(dir / "series.json", result_json(result).dump(2) + "\n");
   return result;
+}
+
+std::vector<std::pair<std::string, std::string>> planned_renders(const Series& series, const RunOptions& options) {
+  std::vector<std::pair<std::string, std::string>> renders;
+  for (const SeriesVariant* v : select_variants(series, options.variants)) {
+    const std::string key = render_key(render_inputs(v->scene, options));
+    if (std::none_of(renders.begin(), renders.end(), [&](const auto& r) { return r.first == key; }))
+      renders.emplace_back(key, v->name);
+  }
+  return renders;
 }
 
 Json result_json(const SeriesResult& result) {

@@ -20,6 +20,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <optional>
+#include <utility>
 #include <string>
 #include <vector>
 
@@ -46,7 +47,12 @@ struct RunOptions {
   std::filesystem::path executable;  // the running chromatrace, handed to the Blender batch
   std::filesystem::path blender;     // the Blender executable (Cycles); resolved by check_renderer
   std::filesystem::path batch_script;  // blender_addon/batch.py (Cycles)
+  bool renders_only = false;  // only fill the render cache: no camera, analysis or series.json
 };
+
+// The distinct renders the selected variants need, in series order: {render key, the first variant that
+// needs it}. renders/<key>.exr is where run_series keeps each.
+std::vector<std::pair<std::string, std::string>> planned_renders(const Series& series, const RunOptions& options);
 
 // Finds what the renderer needs (Blender and the add-on's batch.py for Cycles) and fills it into `options`;
 // InputError naming what is missing.

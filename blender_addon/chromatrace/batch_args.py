@@ -3,6 +3,7 @@
     blender --background --factory-startup --python blender_addon/batch.py -- \
         (--scene SCENE.json | --blend FILE.blend) --out OUT.exr [options]
         (--scene SCENE.json | --blend FILE.blend) --explain [FILE] [options]   (the pre-flight summary only)
+        (--scene SCENE.json | --blend FILE.blend) --out OUT.exr --band-group G [options]   (one group into the cache)
 
 Every mistake is a BadInput with one line naming the option, as the `chromatrace` command reports.
 """
@@ -47,6 +48,13 @@ def _parser():
     p.add_argument("--cache-dir", help="where finished band groups are kept for resuming "
                                        "(default: $XDG_CACHE_HOME/chromatrace/blender)")
     p.add_argument("--keep-cache", action="store_true", help="keep the band-group renders after success")
+    p.add_argument("--band-group", type=int, metavar="G",
+                   help="render only band group G (0-based, with all its bounce limits) into the cache and stop: one "
+                        "task of a render split over a cluster (chromatrace farm cycles); a later run without it "
+                        "finds the group there")
+    p.add_argument("--bounce-limit", metavar="NAME",
+                   help="with --band-group: only this one of the group's renders (a bounce limit of the bounces "
+                        "components, as the pre-flight summary's render_variants names them: k1, k2, ..., main)")
     p.add_argument("-q", "--quiet", action="store_true", help="no progress lines on stderr")
     return p
 
@@ -72,6 +80,12 @@ def parse_batch_args(argv):
         raise BadInput(f"--max-bounces: must be >= 0, got {args.max_bounces}")
     if args.seed is not None and args.seed < 0:
         raise BadInput(f"--seed: must be >= 0, got {args.seed}")
+    if args.band_group is not None and args.band_group < 0:
+        raise BadInput(f"--band-group: must be >= 0, got {args.band_group}")
+    if args.band_group is not None and args.explain is not None:
+        raise BadInput("--band-group: renders a band group, --explain renders nothing; give one of them")
+    if args.bounce_limit is not None and args.band_group is None:
+        raise BadInput("--bounce-limit: needs --band-group (the group whose render it is)")
     if args.bands and args.bands_file:
         raise BadInput("--bands-file: give either --bands or --bands-file, not both")
     if args.bands_file and not os.path.isfile(args.bands_file):

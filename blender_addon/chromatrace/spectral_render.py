@@ -78,6 +78,8 @@ class Request:
         self.output = None
         self.cache_root = None
         self.keep_cache = False
+        self.only_group = None  # render only this band group into the cache, no ids, no assembly (batch --band-group)
+        self.only_variant = None  # with only_group: only this render variant (bounce limit) of it (--bounce-limit)
         self.log = _stderr_log
         for key, value in values.items():
             if not hasattr(self, key):
@@ -612,7 +614,8 @@ class SpectralRender:
         renders = None if refused else len(groups) * len(variants) + (1 if request.object_ids else 0)
         return {"format": "chromatrace-preflight/1", "scene": self.scene.name,
                 "ok": not refused, "renders": renders, "bands": len(edges) - 1, "edges_nm": edges,
-                "bands_per_render": per_render, "bounce_limits": len(variants),
+                "bands_per_render": per_render, "band_groups": len(groups), "bounce_limits": len(variants),
+                "render_variants": list(variants),
                 "object_id_render": bool(request.object_ids), "owners": owners}
 
     # ---- rendering -----------------------------------------------------------------------------------
@@ -705,11 +708,26 @@ class SpectralRender:
                         f"{' x ' + str(len(variants)) + ' bounce limits' if len(variants) > 1 else ''}; "
                         f"cache {self.cache_dir}")
             todo = set(manifest.missing_renders(self.cache_dir, groups, list(variants)))
+            only = request.only_group
+            if only is not None:
+                if only >= len(groups):
+                    raise BadInput(f"--band-group: must be in [0, {len(groups) - 1}] for {len(groups)} band groups, "
+                                   f"got {only}")
+                total = len(variants)
+                if request.only_variant is not None:
+                    if request.only_variant not in variants:
+                        raise BadInput(f"--bounce-limit: must be one of {', '.join(variants)}, got "
+                                       f"\"{request.only_variant}\"")
+                    total = 1
             applied = False
             done = 0
             for g, group in enumerate(groups):
+                if only is not None and g != only:
+                    continue
                 colours_set = False
                 for variant, cycles_bounces in variants.items():
+                    if request.only_variant is not None and variant != request.only_variant:
+                        continue
                     final = os.path.join(self.cache_dir, manifest.render_file_name(g, variant))
                     if (g, variant) not in todo:
                         self.cached += 1
@@ -740,6 +758,11 @@ class SpectralRender:
                                f"{time.monotonic() - start:.2f} s, {time.process_time() - start_cpu:.2f} s CPU")
                     request.log(message)
                     yield done, total, message
+            if only is not None:
+                request.log(f"band group {only} of {len(groups)}"
+                            f"{'' if request.only_variant is None else ' (' + request.only_variant + ')'} is in the cache "
+                            f"{self.cache_dir}")
+                return
             if request.object_ids:
                 ids_file = os.path.join(self.cache_dir, manifest.IDS_FILE)
                 if os.path.isfile(ids_file):

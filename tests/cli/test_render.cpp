@@ -7,6 +7,7 @@
 
 #include <fmt/core.h>
 
+#include "core/file_io.h"
 #include "core/spectral_exr.h"
 #include "tests/cli/run_command.h"
 
@@ -71,6 +72,10 @@ TEST_F(RenderCommand, BadInputGetsExitTwoAndOneLineNamingTheField) {
       {{"render", kBox, "-o", (dir_ / "no/such/dir/out.exr").string(), "--spp", "1", "--resolution", "4x4"}, "out.exr"},
       {{"render", kBox}, "--output"},
       {{"render", kBox, "-o", out.string(), "--no-such-option"}, "--no-such-option"},
+      {{"render", kBox, "-o", out.string(), "--seeds", "0"}, "--seeds"},
+      {{"render", kBox, "-o", out.string(), "--seeds", "5", "--spp", "4"}, "--seeds"},
+      {{"render", kBox, "-o", out.string(), "--seeds", "4", "--part", "4"}, "--part"},
+      {{"render", kBox, "-o", out.string(), "--part", "0"}, "--part"},
   };
   for (const Case& c : cases) {
     const auto r = run_chromatrace(c.args);
@@ -81,6 +86,32 @@ TEST_F(RenderCommand, BadInputGetsExitTwoAndOneLineNamingTheField) {
   }
   // Nothing half-written is left in the output directory.
   EXPECT_TRUE(fs::is_empty(dir_));
+}
+
+// render --seeds K renders K parts and combines them (reference_tracer/seed_split.h): the same bytes as the parts
+// rendered one by one with --part and joined by combine, and no scratch files left beside the output.
+TEST_F(RenderCommand, SeedSplitEqualsItsPartsCombinedAndLeavesOnlyTheOutput) {
+  const std::vector<std::string> split = {kBox, "--spp", "7", "--resolution", "16x12", "--seeds", "3", "--quiet"};
+  const fs::path out = dir_ / "split.exr";
+  std::vector<std::string> args = {"render", "-o", out.string()};
+  args.insert(args.end(), split.begin(), split.end());
+  const auto r = run_chromatrace(args);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(std::vector<fs::path>(fs::directory_iterator(dir_), fs::directory_iterator()), std::vector<fs::path>{out});
+
+  fs::create_directories(dir_ / "parts");
+  std::vector<std::string> combine = {"combine", "--quiet", "-o", (dir_ / "combined.exr").string()};
+  for (int part = 0; part < 3; ++part) {
+    const fs::path file = dir_ / "parts" / fmt::format("p{}.exr", part);
+    std::vector<std::string> one = {"render", "-o", file.string(), "--part", std::to_string(part)};
+    one.insert(one.end(), split.begin(), split.end());
+    const auto p = run_chromatrace(one);
+    ASSERT_EQ(p.exit_code, 0) << p.err;
+    combine.push_back(file.string());
+  }
+  const auto c = run_chromatrace(combine);
+  ASSERT_EQ(c.exit_code, 0) << c.err;
+  EXPECT_TRUE(read_file(out) == read_file(dir_ / "combined.exr"));
 }
 
 TEST_F(RenderCommand, BadTexturesAndEnvironmentsGetExitTwoAndOneLineNamingTheFileAndField) {

@@ -149,6 +149,11 @@ class BatchArgs(unittest.TestCase):
                                          "64x32", "--components", "paths,bounces", "--max-bounces", "0"])
         self.assertEqual((a.samples, a.resolution, a.components, a.max_bounces), (4, (64, 32), {"paths", "bounces"}, 0))
 
+    def test_band_group_is_one_group_or_none(self):
+        self.assertIsNone(batch_args.parse_batch_args(["--scene", self.scene, "--out", self.out]).band_group)
+        self.assertEqual(batch_args.parse_batch_args(["--scene", self.scene, "--out", self.out, "--band-group", "2"])
+                         .band_group, 2)
+
     def test_explain_needs_no_output_and_writes_to_stdout_or_a_file(self):
         a = batch_args.parse_batch_args(["--scene", self.scene, "--explain"])
         self.assertEqual((a.explain, a.out), ("-", None))
@@ -173,6 +178,10 @@ class BatchArgs(unittest.TestCase):
             (["--scene", self.scene, "--out", self.out, "--bands", "1:2:1", "--bands-file", self.scene], "--bands-file"),
             (["--scene", self.scene, "--out", self.out, "--bands-per-render", "4"], "--bands-per-render"),
             (["--scene", self.scene, "--out", self.out, "--frobnicate"], "--frobnicate"),
+            (["--scene", self.scene, "--out", self.out, "--band-group", "-1"], "--band-group"),
+            (["--scene", self.scene, "--out", self.out, "--band-group", "x"], "--band-group"),
+            (["--scene", self.scene, "--explain", "--band-group", "0"], "--band-group"),
+            (["--scene", self.scene, "--out", self.out, "--bounce-limit", "k1"], "--bounce-limit"),
         ]
         for argv, option in cases:
             with self.assertRaises(BadInput, msg=argv) as caught:
