@@ -324,14 +324,22 @@ double ToneCurve::decode(double stored, double full_scale) const {
   return std::copysign(v * full_scale, stored);
 }
 
+CodeDecoder::CodeDecoder(const std::optional<ToneCurve>& c, double fs)
+    : curve(c && !c->linear() ? c : std::nullopt), full_scale(fs) {
+  if (curve && fs >= 1 && fs <= 65535 && fs == std::floor(fs)) {
+    table.resize(static_cast<std::size_t>(fs) + 1);
+    for (std::size_t k = 0; k < table.size(); ++k) table[k] = static_cast<float>(curve->decode(static_cast<double>(k), fs));
+  }
+}
+
 RgbImage linear_light(const AnalysisImage& input) {
   RgbImage out = input.image;
   const ImageEncoding& e = input.encoding;
   if (!e.curve || e.curve->linear()) return out;
   // Codes of integer files are fractions of full scale; a float file stores the normalised signal itself.
-  const double full_scale = e.integer ? e.full_scale : 1.0;
+  const CodeDecoder decode(e.curve, e.integer ? e.full_scale : 1.0);
   for (float& v : out.rgb)
-    if (std::isfinite(v)) v = static_cast<float>(e.curve->decode(v, full_scale));
+    if (std::isfinite(v)) v = decode(v);
   return out;
 }
 

@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <map>
+#include <cmath>
 #include <optional>
 #include <string>
 #include <vector>
@@ -97,6 +98,20 @@ struct AnalysisImage {
   std::size_t transparent_pixels = 0;
   std::size_t negative_pixels = 0;
   std::vector<std::string> notes;  // what was decided while reading (alpha, conversions)
+};
+
+// Stored values to linear light: a table for the integer codes of an integer file (exactly the curve's value
+// at each code), else the curve itself.
+struct CodeDecoder {
+  std::optional<ToneCurve> curve;  // none when linear
+  double full_scale = 1;
+  std::vector<float> table;
+  CodeDecoder(const std::optional<ToneCurve>& c, double full_scale);
+  float operator()(float v) const {
+    if (!curve) return v;
+    if (!table.empty() && v >= 0 && v < static_cast<float>(table.size()) && v == std::floor(v)) return table[static_cast<std::size_t>(v)];
+    return static_cast<float>(curve->decode(v, full_scale));
+  }
 };
 
 // The final image in linear light: R, G, B with the encoding's curve undone (a copy of the image when the

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <numbers>
 
 #include "core/random.h"
@@ -50,6 +51,18 @@ std::optional<LineSearch> find_line(const std::vector<Vec3>& points, const std::
   const auto pick = [&] {
     return candidates[std::min(candidates.size() - 1, static_cast<std::size_t>(random.uniform() * static_cast<double>(candidates.size())))];
   };
+  // The candidates gathered once, coordinate by coordinate in single precision, so that counting a trial's
+  // inliers is one vectorised pass over contiguous arrays. A point x is within max_distance of the line through
+  // a along the unit u when |(x − a) × u|² ≤ max_distance² (the cross product has no cancellation, so single
+  // precision holds it to about 1e-7 of the distance).
+  const std::size_t n = candidates.size();
+  std::vector<float> xs(n), ys(n), zs(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const Vec3& p = points[candidates[i]];
+    xs[i] = static_cast<float>(p[0]), ys[i] = static_cast<float>(p[1]), zs[i] = static_cast<float>(p[2]);
+  }
+  const float limit = static_cast<float>(max_distance * max_distance);
+  constexpr std::size_t kBlock = 4096;  // a trial stops when its remaining points cannot beat the best
   std::size_t best_count = 0;
   Line best;
   for (int k = 0; k < kIterations; ++k) {
@@ -57,12 +70,25 @@ std::optional<LineSearch> find_line(const std::vector<Vec3>& points, const std::
     const Vec3& b = points[pick()];
     const Vec3 d = b - a;
     if (d.norm() <= max_distance) continue;  // too close to fix a direction
-    Line trial;
-    trial.point = a;
-    trial.direction = d.normalized();
+    const Vec3 u = d.normalized();
+    const float ax = static_cast<float>(a[0]), ay = static_cast<float>(a[1]), az = static_cast<float>(a[2]);
+    const float ux = static_cast<float>(u[0]), uy = static_cast<float>(u[1]), uz = static_cast<float>(u[2]);
     std::size_t count = 0;
-    for (const std::size_t i : candidates) count += trial.distance(points[i]) <= max_distance;
-    if (count > best_count) best_count = count, best = trial;
+    for (std::size_t start = 0; start < n && count + (n - start) > best_count; start += kBlock) {
+      const std::size_t end = std::min(n, start + kBlock);
+      std::int32_t in = 0;
+      for (std::size_t i = start; i < end; ++i) {
+        const float vx = xs[i] - ax, vy = ys[i] - ay, vz = zs[i] - az;
+        const float cx = vy * uz - vz * uy, cy = vz * ux - vx * uz, cz = vx * uy - vy * ux;
+        in += (cx * cx + cy * cy + cz * cz <= limit) ? 1 : 0;
+      }
+      count += static_cast<std::size_t>(in);
+    }
+    if (count > best_count) {
+      best_count = count;
+      best.point = a;
+      best.direction = u;
+    }
   }
   if (best_count < 2) return std::nullopt;
   LineSearch result;

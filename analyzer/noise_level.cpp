@@ -22,9 +22,10 @@ double quantile(std::vector<double>& v, double q) {
 }  // namespace
 
 std::size_t ImageNoise::band_of(double brightness) const {
-  std::size_t k = 0;
-  while (k + 1 < bands.size() && brightness > bands[k].hi) ++k;
-  return k;
+  if (bands.empty()) return 0;
+  // The first band whose top is not below the brightness (the last for anything brighter; the first for NaN).
+  const auto k = std::partition_point(bands.begin(), bands.end() - 1, [&](const Band& b) { return brightness > b.hi; });
+  return static_cast<std::size_t>(k - bands.begin());
 }
 
 double ImageNoise::band_sigma(std::size_t band, const Vec3& u) const {

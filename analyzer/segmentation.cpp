@@ -51,25 +51,7 @@ Spans spans(int from, int to) {
   return s;
 }
 
-// A decoder from stored values to linear light: a table for integer codes, else the curve itself.
-struct Decoder {
-  std::optional<ToneCurve> curve;
-  double full_scale = 1;
-  std::vector<float> table;
-  Decoder(const std::optional<ToneCurve>& c, double fs) : curve(c && !c->linear() ? c : std::nullopt), full_scale(fs) {
-    if (curve && fs >= 1 && fs <= 65535 && fs == std::floor(fs)) {
-      table.resize(static_cast<std::size_t>(fs) + 1);
-      for (std::size_t k = 0; k < table.size(); ++k) table[k] = static_cast<float>(curve->decode(static_cast<double>(k), fs));
-    }
-  }
-  float operator()(float v) const {
-    if (!curve) return v;
-    if (!table.empty() && v >= 0 && v == std::floor(v) && v < static_cast<float>(table.size())) return table[static_cast<std::size_t>(v)];
-    return static_cast<float>(curve->decode(v, full_scale));
-  }
-};
-
-Work working_image(const RgbImage& image, const Decoder& decode, double clip_level, double megapixels) {
+Work working_image(const RgbImage& image, const CodeDecoder& decode, double clip_level, double megapixels) {
   const int W = image.width, H = image.height;
   const double f = std::sqrt(static_cast<double>(image.pixel_count()) / (megapixels * 1e6));
   Work work;
@@ -514,7 +496,7 @@ Segmentation segment_image(const RgbImage& image, const std::optional<ToneCurve>
   out.options = options;
   out.width = image.width;
   out.height = image.height;
-  const Decoder decode(curve, full_scale);
+  const CodeDecoder decode(curve, full_scale);
   Work work = working_image(image, decode, clip_level, options.working_megapixels);
   out.working_width = work.w;
   out.working_height = work.h;

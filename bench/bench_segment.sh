@@ -31,7 +31,7 @@ measure() {  # label, command…: prints seconds and peak memory of the whole pr
 measure "analyze --segment (2 threads, all outputs)" "$exe" analyze "$work/photo.jpg" -o "$work/analysis" --segment --threads 2 -q
 echo "  output: $(du -sb "$work/analysis" | cut -f1) bytes in $(find "$work/analysis" -type f | wc -l) files;" \
      "$(python3 -c "import json,sys; a=json.load(open(sys.argv[1])); s=a['segmentation']; print(sum(r['source']=='segment' for r in a['regions']), 'segments,', '%.1f %% unassigned' % (100*s['unassigned_fraction']))" "$work/analysis/analysis.json" 2>/dev/null || echo '')"
-measure "analyze --segment --no-plots --no-report" "$exe" analyze "$work/photo.jpg" -o "$work/bare" --segment --threads 2
+measure "analyze --segment --no-plots --no-report" "$exe" analyze "$work/photo.jpg" -o "$work/bare" --segment --threads 2 --no-plots --no-report
 grep -o 'segmentation: .*' "$work/out.txt" | sed 's/^/  /'
 measure "analyze, no --segment (the rest of the work)" "$exe" analyze "$work/photo.jpg" -o "$work/plain" --threads 2 -q
 measure "baseline: pyrMeanShiftFiltering alone" "$build/bench/bench_meanshift" "$work/photo.jpg"
