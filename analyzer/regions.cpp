@@ -73,17 +73,30 @@ Rect parse_rect(const std::string& text, const std::string& option) {
 
 RegionSamples gather_samples(const RgbImage& image, const Region& region) {
   RegionSamples s;
-  s.rgb.reserve(region.pixels.size() * 3);
-  s.pixels.reserve(region.pixels.size());
-  for (const std::uint32_t p : region.pixels) {
+  const std::vector<std::uint32_t>& pixels = region.pixels;
+  bool consecutive = true;
+  for (std::size_t i = 1; i < pixels.size() && consecutive; ++i) consecutive = pixels[i] == pixels[0] + i;
+  if (consecutive && !pixels.empty()) {
+    const std::span<const float> run(image.rgb.data() + static_cast<std::size_t>(pixels[0]) * 3, pixels.size() * 3);
+    if (std::all_of(run.begin(), run.end(), [](float v) { return std::isfinite(v); })) {
+      s.rgb = run;
+      s.pixels = pixels;
+      return s;
+    }
+  }
+  s.own_rgb_.reserve(pixels.size() * 3);
+  s.own_pixels_.reserve(pixels.size());
+  for (const std::uint32_t p : pixels) {
     const float* v = &image.rgb[static_cast<std::size_t>(p) * 3];
     if (!std::isfinite(v[0]) || !std::isfinite(v[1]) || !std::isfinite(v[2])) {
       ++s.non_finite;
       continue;
     }
-    s.rgb.insert(s.rgb.end(), v, v + 3);
-    s.pixels.push_back(p);
+    s.own_rgb_.insert(s.own_rgb_.end(), v, v + 3);
+    s.own_pixels_.push_back(p);
   }
+  s.rgb = s.own_rgb_;
+  s.pixels = s.own_pixels_;
   return s;
 }
 

@@ -4,6 +4,7 @@
 
 #include <cstdint>
 #include <map>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -36,12 +37,26 @@ Rect parse_rect(const std::string& text, const std::string& option);
 
 // A region's colours: the RGB of its pixels whose three values are finite, packed [i][channel], and
 // those pixels' indices. NaN and infinite pixels are counted, not analysed.
+// The finite samples of a region, [i][channel], and the pixel each came from. When the region is a run of
+// consecutive pixels that are all finite (the whole image, typically) they are views of the image and of the
+// region themselves, else copies held here: a 24-megapixel image is not copied again.
 struct RegionSamples {
-  std::vector<float> rgb;
-  std::vector<std::uint32_t> pixels;
+  std::span<const float> rgb;
+  std::span<const std::uint32_t> pixels;
   std::size_t non_finite = 0;
 
+  RegionSamples() = default;
+  RegionSamples(RegionSamples&&) = default;  // the views keep pointing at the moved buffers
+  RegionSamples& operator=(RegionSamples&&) = default;
+  RegionSamples(const RegionSamples&) = delete;
+  RegionSamples& operator=(const RegionSamples&) = delete;
+
   std::size_t size() const { return pixels.size(); }
+
+ private:
+  friend RegionSamples gather_samples(const RgbImage& image, const Region& region);
+  std::vector<float> own_rgb_;
+  std::vector<std::uint32_t> own_pixels_;
 };
 RegionSamples gather_samples(const RgbImage& image, const Region& region);
 
