@@ -18,6 +18,8 @@ namespace {
 
 constexpr int kTileSize = 16;
 
+}  // namespace
+
 void check_options(const RenderOptions& o) {
   if (o.samples && *o.samples < 1) throw InputError(fmt::format("--spp: must be at least 1, got {}", *o.samples));
   if (o.max_bounces && *o.max_bounces < 0)
@@ -25,8 +27,6 @@ void check_options(const RenderOptions& o) {
   if (o.time_limit_s < 0) throw InputError(fmt::format("--time-limit: must be >= 0 s, got {}", o.time_limit_s));
   if (o.threads < 0) throw InputError(fmt::format("--threads: must be >= 0, got {}", o.threads));
 }
-
-}  // namespace
 
 RenderedImage render(const Scene& scene, const RenderOptions& options) {
   check_options(options);
