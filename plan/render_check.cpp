@@ -29,13 +29,13 @@ std::vector<std::string> render_warnings(const Scene& scene, const RenderRequest
   if (p.bounce_de00 > target_de00)
     out.push_back(fmt::format(
         "{} {} leaves {:.0f} % of the luminance unrendered (light after more than {} bounce{}), a predicted mean "
-        "ΔE00 of {:.1f}; use {} bounces (what chromatrace plan chooses for a mean ΔE00 of {:g})",
+        "ΔE00 of {:.3g}; use {} bounces (what chromatrace plan chooses for a mean ΔE00 of {:g})",
         settings.bounces_name, settings.max_bounces, 100 * p.share_beyond, settings.max_bounces,
         settings.max_bounces == 1 ? "" : "s", p.bounce_de00,
         p.bounces_for_target, target_de00));
   if (p.noise_de00 > target_de00)
     out.push_back(fmt::format(
-        "{} {} gives Monte Carlo noise of a predicted mean ΔE00 of {:.1f} (the tracer in bands mode); use {} "
+        "{} {} gives Monte Carlo noise of a predicted mean ΔE00 of {:.3g} (the tracer in bands mode); use {} "
         "samples for {:g} (chromatrace plan)",
         settings.samples_name, settings.samples, p.noise_de00, p.samples_for_target, target_de00));
   return out;

@@ -140,7 +140,7 @@ TEST(RenderCheck, BounceShareIsTheTracersWithinItsNoise) {
   const std::vector<std::string> warnings = plan::render_warnings(box, request);
   const std::string expected =
       fmt::format("render.max_bounces 2 leaves {:.0f} % of the luminance unrendered (light after more than 2 bounces), a "
-                  "predicted mean ΔE00 of {:.1f}; use {} bounces",
+                  "predicted mean ΔE00 of {:.3g}; use {} bounces",
                   100 * p.share_beyond, p.bounce_de00, p.bounces_for_target);
   ASSERT_FALSE(warnings.empty());
   EXPECT_EQ(warnings[0].rfind(expected, 0), 0u) << warnings[0];
@@ -215,7 +215,7 @@ TEST(RenderCheck, CheckSceneAndRenderSayItAndPlansSettingsAreSilent) {
             std::string::npos)
       << render.err;
   EXPECT_NE(render.err.find(fmt::format("chromatrace render: warning: --spp 4 gives Monte Carlo noise of a predicted "
-                                        "mean ΔE00 of {:.1f} (the tracer in bands mode); use {} samples for 1",
+                                        "mean ΔE00 of {:.3g} (the tracer in bands mode); use {} samples for 1",
                                         p.noise_de00, p.samples_for_target)),
             std::string::npos)
       << render.err;
