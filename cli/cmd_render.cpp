@@ -74,6 +74,7 @@ Action add_render(CLI::App& app) {
     if (o->output.empty()) throw InputError("--output: no file name");
     // Fail before a long render, not after it.
     rt::check_options(options);
+    rt::check_image_memory(scene, options);
     check_output_file(o->output, scene.files);
     if (o->part && !o->seeds) throw InputError("--part: needs --seeds (the split it is a part of)");
     std::optional<rt::SeedSplit> seed_split;
