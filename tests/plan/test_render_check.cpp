@@ -188,8 +188,8 @@ TEST(RenderCheck, FewSamplesGiveThePredictedNoise) {
   fs::remove_all(dir);
 }
 
-// check-scene lists the warnings, render prints them before rendering, each naming the setting as it was given; the
-// settings plan chooses are silent.
+// check-scene lists the warnings, render prints them before rendering, each naming the setting as it was given (and
+// with the prediction's figures whatever the thread count); the settings plan chooses are silent.
 TEST(RenderCheck, CheckSceneAndRenderSayItAndPlansSettingsAreSilent) {
   const fs::path dir = fs::temp_directory_path() / ("ct-render-check-cli-" + std::to_string(::getpid()));
   fs::create_directories(dir);
@@ -219,6 +219,13 @@ TEST(RenderCheck, CheckSceneAndRenderSayItAndPlansSettingsAreSilent) {
                                         p.noise_de00, p.samples_for_target)),
             std::string::npos)
       << render.err;
+
+  // A part of a split by seed is judged by the samples of the whole (the parts are combined).
+  const auto part = test::run_chromatrace({"render", kBox.string(), "-o", (dir / "p.exr").string(), "--resolution",
+                                           fmt::format("{}x{}", kSize, kSize), "--spp", "4", "--seeds", "2", "--part",
+                                           "0", "-q"});
+  EXPECT_EQ(part.exit_code, 0) << part.err;
+  EXPECT_NE(part.err.find("warning: --spp 4 gives"), std::string::npos) << part.err;
 
   // What plan would choose: nothing to say.
   doc["render"]["max_bounces"] = p.bounces_for_target;
