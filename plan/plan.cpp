@@ -248,13 +248,13 @@ class Model {
   // left beyond them is at most that share of what went before), at most kMaxReferenceBounces.
   Model(const Scene& scene, const PlanOptions& options, std::vector<std::string>& notes, int reference_bounces = 0);
 
-  // Mean and 95th percentile of ΔE00 of a plan (bands, bounce limit) against exact spectra at the scene's limit.
+  // Mean and 95th percentile of ΔE00 of a plan (bands, bounce limit) against exact spectra at depth().
   std::pair<double, double> evaluate(const std::vector<int>& edges, int max_bounces) const;
   std::pair<double, double> evaluate_exact(int max_bounces) const;  // exact spectra, truncated bounces
 
   const std::vector<int>& grid_edges() const { return grid_edges_; }  // candidate edge positions (grid indices)
   int lo() const { return grid_.lo; }
-  int scene_max_bounces() const { return kmax_; }
+  int depth() const { return kmax_; }  // the truth's bounce limit
   const std::vector<Pixel>& pixels() const { return pixels_; }
   double hit_fraction() const { return hit_fraction_; }
   // Mean ΔE00 of the preview's Monte Carlo noise (one render against the truth) and its paths per pixel.
@@ -650,7 +650,6 @@ std::vector<std::size_t> split_widest(std::vector<std::size_t> idx, std::size_t 
   return idx;
 }
 
-
 // Monte Carlo noise: the preview's, as mean ΔE00, falls as 1/√(paths per pixel).
 double noise_at(const Model& model, int samples) {
   return model.preview_noise() * std::sqrt(static_cast<double>(model.preview_samples()) / std::max(1, samples));
@@ -663,7 +662,7 @@ int samples_for(const Model& model, double target) {
 // The luminance fraction that arrives after more than k events, k = 0 .. the model's depth − 1, over the preview;
 // with `surfaces_only`, over the pixels not on or next to a light (where the light's own emission does not count).
 std::vector<double> energy_after(const Model& model, bool surfaces_only = false) {
-  const int kmax = model.scene_max_bounces();
+  const int kmax = model.depth();
   std::vector<double> per_k(static_cast<std::size_t>(kmax) + 1, 0.0);
   for (const Pixel& px : model.pixels())
     if (!(surfaces_only && px.near_light))
@@ -680,7 +679,7 @@ std::vector<double> energy_after(const Model& model, bool surfaces_only = false)
 
 // The fewest bounces whose truncation alone costs at most a quarter of the target (the rest is the bands').
 int bounces_for(const Model& model, double target) {
-  const int kmax = model.scene_max_bounces();
+  const int kmax = model.depth();
   for (int k = 1; k <= kmax; ++k)
     if (model.evaluate_exact(k).first <= 0.25 * target) return k;
   return kmax;
@@ -728,7 +727,7 @@ Plan make_plan(const Scene& scene, const PlanOptions& options) {
                                  scene.render.max_bounces));
   Plan plan;
   const Model model(scene, options, plan.notes);
-  const int kmax = model.scene_max_bounces();
+  const int kmax = model.depth();
   plan.noise_at_scene_samples = noise_at(model, scene.render.samples);
   plan.samples = samples_for(model, options.target_de00);
   plan.noise_at_samples = noise_at(model, plan.samples);
@@ -820,7 +819,7 @@ SettingsPrediction predict_settings(const Scene& scene, int max_bounces, int sam
   SettingsPrediction p;
   p.max_bounces = max_bounces;
   p.samples = samples;
-  p.reference_bounces = model.scene_max_bounces();
+  p.reference_bounces = model.depth();
   const std::vector<double> after = energy_after(model, true);
   p.share_beyond = max_bounces < static_cast<int>(after.size()) ? after[static_cast<std::size_t>(max_bounces)] : 0.0;
   p.bounce_de00 = model.evaluate_exact(max_bounces).first;
