@@ -14,8 +14,8 @@
 #include "core/file_io.h"
 #include "core/geometry.h"
 #include "core/json_input.h"
-#include "plan/spectral_check.h"
 #include "core/scene.h"
+#include "plan/render_check.h"
 #include "sensor_sim/config.h"
 
 namespace ct::cli {
@@ -60,8 +60,7 @@ Json scene_summary(const Scene& scene) {
 
   const Camera& c = scene.camera;
   const RenderSettings& r = scene.render;
-  std::vector<std::string> warnings;
-  for (const plan::SpectralWarning& w : plan::check_band_plan(scene, r.bands, r.spectral_mode)) warnings.push_back(w.message);
+  const std::vector<std::string> warnings = plan::render_warnings(scene, plan::scene_settings(scene));
   return {
       {"warnings", warnings},
       {"name", scene.name},

@@ -6,7 +6,6 @@
 #include <fmt/core.h>
 
 #include "cli/command.h"
-#include "plan/spectral_check.h"
 #include "cli/options.h"
 #include "core/band_plan.h"
 #include "core/error.h"
@@ -14,6 +13,7 @@
 #include "core/parallel.h"
 #include "core/scene.h"
 #include "core/spectral_exr.h"
+#include "plan/render_check.h"
 #include "reference_tracer/render.h"
 #include "reference_tracer/seed_split.h"
 
@@ -73,11 +73,28 @@ Action add_render(CLI::App& app) {
     options.progress = !o->quiet;
     if (o->output.empty()) throw InputError("--output: no file name");
     // Fail before a long render, not after it.
+    rt::check_options(options);
+    rt::check_image_memory(scene, options);
     check_output_file(o->output, scene.files);
-    // Where the bands cannot hold the scene's colours: said before the render, not found after it.
-    for (const plan::SpectralWarning& w : plan::check_band_plan(scene, options.bands.value_or(scene.render.bands),
-                                                                options.mode.value_or(scene.render.spectral_mode)))
-      fmt::print(stderr, "chromatrace render: warning: {}\n", w.message);
+    if (o->part && !o->seeds) throw InputError("--part: needs --seeds (the split it is a part of)");
+    std::optional<rt::SeedSplit> seed_split;
+    if (o->seeds) {
+      seed_split.emplace(*o->seeds, options.samples.value_or(scene.render.samples),
+                         options.seed.value_or(scene.render.seed));
+      if (o->part && (*o->part < 0 || *o->part >= seed_split->parts))
+        throw InputError(fmt::format("--part: must be in [0, {}] for --seeds {}, got {}", seed_split->parts - 1,
+                                     seed_split->parts, *o->part));
+    }
+    // What the settings leave out (colours the bands cannot hold, light beyond the bounce limit, noise): said
+    // before the render, not found after it.
+    plan::RenderRequest request = plan::scene_settings(scene);
+    if (options.bands) request.bands = *options.bands;
+    if (options.mode) request.mode = *options.mode;
+    if (o->max_bounces) request.max_bounces = *o->max_bounces, request.bounces_name = "--max-bounces";
+    if (o->spp) request.samples = *o->spp, request.samples_name = "--spp";
+    request.threads = o->threads;
+    for (const std::string& warning : plan::render_warnings(scene, request))
+      fmt::print(stderr, "chromatrace render: warning: {}\n", warning);
     set_exr_threads(thread_count(o->threads));
     const auto render_to = [&](const fs::path& output, const rt::RenderOptions& render_options) {
       const rt::RenderedImage image = rt::render(scene, render_options);
@@ -86,13 +103,11 @@ Action add_render(CLI::App& app) {
         fmt::print(stderr, "{}: {}×{}, {} bands, {} spp, {:.3g} Mpaths/s\n", output.string(), image.width,
                    image.height, image.bands.size(), image.samples, image.paths / image.seconds * 1e-6);
     };
-    if (o->part && !o->seeds) throw InputError("--part: needs --seeds (the split it is a part of)");
     if (!o->seeds) {
       render_to(o->output, options);
       return 0;
     }
-    const rt::SeedSplit split(*o->seeds, options.samples.value_or(scene.render.samples),
-                              options.seed.value_or(scene.render.seed));
+    const rt::SeedSplit& split = *seed_split;
     const auto part_options = [&](int part) {
       rt::RenderOptions p = options;
       p.samples = split.part_samples(part);
@@ -100,9 +115,6 @@ Action add_render(CLI::App& app) {
       return p;
     };
     if (o->part) {
-      if (*o->part < 0 || *o->part >= split.parts)
-        throw InputError(fmt::format("--part: must be in [0, {}] for --seeds {}, got {}", split.parts - 1, split.parts,
-                                     *o->part));
       render_to(o->output, part_options(*o->part));
       return 0;
     }

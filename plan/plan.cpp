@@ -233,19 +233,28 @@ struct Pixel {
   std::size_t index = 0;  // in the preview image
   std::vector<std::array<double, 2>> y;  // [k][lobe]: lobe 0 diffuse (k = 0: emission), 1 glossy
   double total = 0;
+  bool near_light = false;  // on or next to a light (near_light())
 };
+
+// A reference depth's tail: 1 % of the luminance is a mean ΔE00 of about 0.25 at mid grey (L* ∝ Y^⅓, so
+// ΔL* ≈ (L* + 16)/3 · ΔY/Y ≈ 25 · ΔY/Y), the quarter of a target of 1 that plan gives the bounce limit.
+constexpr double kNegligibleShare = 0.01;
+constexpr int kMaxReferenceBounces = 64;
 
 class Model {
  public:
-  Model(const Scene& scene, const PlanOptions& options, std::vector<std::string>& notes);
+  // The model's truth is exact spectra at the scene's own bounce limit or, given `reference_bounces` > 0, at that
+  // many events or more: as many as it takes for the mean albedo's powers to fall to kNegligibleShare (the light
+  // left beyond them is at most that share of what went before), at most kMaxReferenceBounces.
+  Model(const Scene& scene, const PlanOptions& options, std::vector<std::string>& notes, int reference_bounces = 0);
 
-  // Mean and 95th percentile of ΔE00 of a plan (bands, bounce limit) against exact spectra at the scene's limit.
+  // Mean and 95th percentile of ΔE00 of a plan (bands, bounce limit) against exact spectra at depth().
   std::pair<double, double> evaluate(const std::vector<int>& edges, int max_bounces) const;
   std::pair<double, double> evaluate_exact(int max_bounces) const;  // exact spectra, truncated bounces
 
   const std::vector<int>& grid_edges() const { return grid_edges_; }  // candidate edge positions (grid indices)
   int lo() const { return grid_.lo; }
-  int scene_max_bounces() const { return kmax_; }
+  int depth() const { return kmax_; }  // the truth's bounce limit
   const std::vector<Pixel>& pixels() const { return pixels_; }
   double hit_fraction() const { return hit_fraction_; }
   // Mean ΔE00 of the preview's Monte Carlo noise (one render against the truth) and its paths per pixel.
@@ -274,12 +283,12 @@ class Model {
   std::size_t pixel_count_ = 0;
 };
 
-Model::Model(const Scene& scene, const PlanOptions& options, std::vector<std::string>& notes) {
+Model::Model(const Scene& scene, const PlanOptions& options, std::vector<std::string>& notes, int reference_bounces) {
   const Bands& sb = scene.render.bands;
   grid_.lo = static_cast<int>(std::ceil(sb.min_wavelength() - 1e-9));
   grid_.hi = static_cast<int>(std::floor(sb.max_wavelength() + 1e-9));
   if (grid_.hi - grid_.lo < 2) throw InputError(fmt::format("{}: render.bands: range too narrow to plan", scene.source));
-  kmax_ = scene.render.max_bounces;
+  kmax_ = reference_bounces > 0 ? reference_bounces : scene.render.max_bounces;
 
   const sensor::CameraCurves curves = sensor::camera_curves(options.camera, {"r", "g", "b"}, "--camera");
   if (sb.min_wavelength() < curves.min_wavelength() - 1e-9 || sb.max_wavelength() > curves.max_wavelength() + 1e-9)
@@ -357,6 +366,11 @@ Model::Model(const Scene& scene, const PlanOptions& options, std::vector<std::st
     for (std::size_t i = 0; i < albedo_.v.size(); ++i) s += albedo_.v[i] * obs_[1].v[i];
     mean_albedo_ = ysum > 0 ? s / ysum : 0;
   }
+  if (reference_bounces > 0 && mean_albedo_ > 0 && mean_albedo_ < 1)
+    kmax_ = std::clamp(static_cast<int>(std::ceil(std::log(kNegligibleShare) / std::log(mean_albedo_))), kmax_,
+                       std::max(kmax_, kMaxReferenceBounces));
+  else if (reference_bounces > 0 && mean_albedo_ >= 1)
+    kmax_ = std::max(kmax_, kMaxReferenceBounces);
   // The background: what the environment (or, in edge pixels, any surface) sends.
   surfaces_[0].emission = light_;
   surfaces_[0].diffuse = albedo_;
@@ -405,6 +419,7 @@ Model::Model(const Scene& scene, const PlanOptions& options, std::vector<std::st
 
   // The preview render.
   Scene preview = scene;
+  preview.render.max_bounces = kmax_;
   const int w = scene.camera.width, h = scene.camera.height;
   const int size = std::max(1, options.preview_size);
   if (w >= h) {
@@ -438,11 +453,13 @@ Model::Model(const Scene& scene, const PlanOptions& options, std::vector<std::st
   const auto *dd = layer("diffuse_direct"), *gd = layer("glossy_direct"), *di = layer("diffuse_indirect"),
              *gi = layer("glossy_indirect");
   pixel_count_ = N;
+  const auto first_light = static_cast<std::int32_t>(scene.objects.size()) + 1;
   std::size_t hits = 0;
   for (std::size_t p = 0; p < N; ++p) {
     Pixel px;
     px.index = p;
     px.id = img.object_ids[p];
+    px.near_light = near_light(img.object_ids, img.width, img.height, p, first_light);
     if (px.id < 0 || static_cast<std::size_t>(px.id) >= ids) px.id = 0;
     if (px.id != 0) ++hits;
     px.y.assign(static_cast<std::size_t>(kmax_) + 1, {0.0, 0.0});
@@ -470,7 +487,6 @@ Model::Model(const Scene& scene, const PlanOptions& options, std::vector<std::st
   // The exact colours and the white.
   std::vector<Vec3d> xyz(pixels_.size());
   std::vector<double> ys;
-  const auto first_light = static_cast<std::int32_t>(scene.objects.size()) + 1;
   for (std::size_t p = 0; p < pixels_.size(); ++p) {
     const Pixel& px = pixels_[p];
     Vec3d x{};
@@ -478,7 +494,7 @@ Model::Model(const Scene& scene, const PlanOptions& options, std::vector<std::st
       for (int lobe = 0; lobe < 2; ++lobe)
         for (int c = 0; c < 3; ++c) x[c] += px.y[k][lobe] * exact_[px.id][k][lobe][c];
     xyz[p] = x;
-    if (!near_light(img.object_ids, img.width, img.height, px.index, first_light)) ys.push_back(x[1]);
+    if (!px.near_light) ys.push_back(x[1]);
   }
   // Pixels with no light count as values of zero.
   for (std::size_t p = 0, lit = 0; p < N; ++p) {
@@ -634,6 +650,41 @@ std::vector<std::size_t> split_widest(std::vector<std::size_t> idx, std::size_t 
   return idx;
 }
 
+// Monte Carlo noise: the preview's, as mean ΔE00, falls as 1/√(paths per pixel).
+double noise_at(const Model& model, int samples) {
+  return model.preview_noise() * std::sqrt(static_cast<double>(model.preview_samples()) / std::max(1, samples));
+}
+// The paths per pixel at which the noise alone is predicted at the target.
+int samples_for(const Model& model, double target) {
+  return std::max(1, static_cast<int>(std::ceil(model.preview_samples() * std::pow(model.preview_noise() / target, 2))));
+}
+
+// The luminance fraction that arrives after more than k events, k = 0 .. the model's depth − 1, over the preview;
+// with `surfaces_only`, over the pixels not on or next to a light (where the light's own emission does not count).
+std::vector<double> energy_after(const Model& model, bool surfaces_only = false) {
+  const int kmax = model.depth();
+  std::vector<double> per_k(static_cast<std::size_t>(kmax) + 1, 0.0);
+  for (const Pixel& px : model.pixels())
+    if (!(surfaces_only && px.near_light))
+      for (int k = 0; k <= kmax; ++k) per_k[k] += px.y[k][0] + px.y[k][1];
+  const double total = std::accumulate(per_k.begin(), per_k.end(), 0.0);
+  std::vector<double> out;
+  for (int k = 0; k < kmax; ++k) {
+    double left = 0;
+    for (int j = k + 1; j <= kmax; ++j) left += per_k[j];
+    out.push_back(total > 0 ? left / total : 0.0);
+  }
+  return out;
+}
+
+// The fewest bounces whose truncation alone costs at most a quarter of the target (the rest is the bands').
+int bounces_for(const Model& model, double target) {
+  const int kmax = model.depth();
+  for (int k = 1; k <= kmax; ++k)
+    if (model.evaluate_exact(k).first <= 0.25 * target) return k;
+  return kmax;
+}
+
 }  // namespace
 
 PiecewiseLinearSpectrum scene_light_spectrum(const Scene& scene) {
@@ -676,34 +727,12 @@ Plan make_plan(const Scene& scene, const PlanOptions& options) {
                                  scene.render.max_bounces));
   Plan plan;
   const Model model(scene, options, plan.notes);
-  const int kmax = model.scene_max_bounces();
-  // Samples: the paths per pixel at which the noise alone is predicted at the target.
-  plan.noise_at_scene_samples = model.preview_noise() * std::sqrt(static_cast<double>(model.preview_samples()) /
-                                                                  std::max(1, scene.render.samples));
-  plan.samples = std::max(1, static_cast<int>(std::ceil(model.preview_samples() *
-                                                        std::pow(model.preview_noise() / options.target_de00, 2))));
-  plan.noise_at_samples =
-      model.preview_noise() * std::sqrt(static_cast<double>(model.preview_samples()) / plan.samples);
-
-  // Energy left after k bounces, over the preview's pixels.
-  std::vector<double> per_k(static_cast<std::size_t>(kmax) + 1, 0.0);
-  for (const Pixel& px : model.pixels())
-    for (int k = 0; k <= kmax; ++k) per_k[k] += px.y[k][0] + px.y[k][1];
-  const double total = std::accumulate(per_k.begin(), per_k.end(), 0.0);
-  for (int k = 0; k < kmax; ++k) {
-    double left = 0;
-    for (int j = k + 1; j <= kmax; ++j) left += per_k[j];
-    plan.energy_after.push_back(total > 0 ? left / total : 0.0);
-  }
-
-  // Bounces: the fewest whose truncation alone costs at most a quarter of the target.
-  const double bounce_budget = 0.25 * options.target_de00;
-  plan.max_bounces = kmax;
-  for (int k = 1; k <= kmax; ++k)
-    if (model.evaluate_exact(k).first <= bounce_budget) {
-      plan.max_bounces = k;
-      break;
-    }
+  const int kmax = model.depth();
+  plan.noise_at_scene_samples = noise_at(model, scene.render.samples);
+  plan.samples = samples_for(model, options.target_de00);
+  plan.noise_at_samples = noise_at(model, plan.samples);
+  plan.energy_after = energy_after(model);
+  plan.max_bounces = bounces_for(model, options.target_de00);
   plan.predicted_bounce_only = model.evaluate_exact(plan.max_bounces).first;
 
   // Bands: the fewest (multiples of 3 for Cycles) whose fitted edges meet the target.
@@ -780,6 +809,24 @@ Plan make_plan(const Scene& scene, const PlanOptions& options) {
   plan.tracer_relative_time = events(plan.max_bounces) * (kTracerEventBands + static_cast<double>(plan.bands.size())) /
                               (events(kmax) * (kTracerEventBands + static_cast<double>(scene.render.bands.size())));
   return plan;
+}
+
+SettingsPrediction predict_settings(const Scene& scene, int max_bounces, int samples, const PlanOptions& options) {
+  if (!(options.target_de00 > 0))
+    throw InputError(fmt::format("--target-de00: must be > 0, got {:g}", options.target_de00));
+  std::vector<std::string> notes;
+  const Model model(scene, options, notes, std::max(1, max_bounces));
+  SettingsPrediction p;
+  p.max_bounces = max_bounces;
+  p.samples = samples;
+  p.reference_bounces = model.depth();
+  const std::vector<double> after = energy_after(model, true);
+  p.share_beyond = max_bounces < static_cast<int>(after.size()) ? after[static_cast<std::size_t>(max_bounces)] : 0.0;
+  p.bounce_de00 = model.evaluate_exact(max_bounces).first;
+  p.bounces_for_target = bounces_for(model, options.target_de00);
+  p.noise_de00 = noise_at(model, samples);
+  p.samples_for_target = samples_for(model, options.target_de00);
+  return p;
 }
 
 Json bands_document(const Plan& plan) {

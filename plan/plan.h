@@ -79,6 +79,21 @@ struct Plan {
 
 Plan make_plan(const Scene& scene, const PlanOptions& options);
 
+// A render's bounce limit and samples judged by the same model (check-scene and render warn with it,
+// plan/render_check.h). The truth is exact spectra at a reference depth: at least `max_bounces` events, and as many
+// as it takes for the light left beyond to fall below 1 % of what went before (the powers of the mean albedo).
+struct SettingsPrediction {
+  int max_bounces = 0, samples = 0;  // the settings judged
+  int reference_bounces = 0;         // the model's depth
+  double share_beyond = 0;           // luminance fraction that arrives after more than max_bounces events, over the
+                                     // pixels not on or next to a light (as the white is taken: the lit surfaces)
+  double bounce_de00 = 0;            // predicted mean ΔE00 of leaving it out (exact spectra)
+  int bounces_for_target = 0;        // what plan chooses: the fewest whose truncation costs ≤ a quarter of the target
+  double noise_de00 = 0;             // predicted mean ΔE00 of the tracer's Monte Carlo noise at `samples`
+  int samples_for_target = 0;        // what plan chooses: paths per pixel for noise at the target
+};
+SettingsPrediction predict_settings(const Scene& scene, int max_bounces, int samples, const PlanOptions& options);
+
 // The chromatrace-bands/1 document of the plan's bands, and the full report (settings, predictions, cost).
 Json bands_document(const Plan& plan);
 Json report_document(const Plan& plan, const Scene& scene, const PlanOptions& options);

@@ -18,6 +18,8 @@ namespace {
 
 constexpr int kTileSize = 16;
 
+}  // namespace
+
 void check_options(const RenderOptions& o) {
   if (o.samples && *o.samples < 1) throw InputError(fmt::format("--spp: must be at least 1, got {}", *o.samples));
   if (o.max_bounces && *o.max_bounces < 0)
@@ -26,7 +28,23 @@ void check_options(const RenderOptions& o) {
   if (o.threads < 0) throw InputError(fmt::format("--threads: must be >= 0, got {}", o.threads));
 }
 
-}  // namespace
+void check_image_memory(const Scene& scene, const RenderOptions& options) {
+  // The light groups in TracerScene's order: the lights' (a light without one is its own), then the environment's.
+  std::vector<std::string> groups;
+  auto add = [&](const std::string& g) {
+    if (std::find(groups.begin(), groups.end(), g) == groups.end()) groups.push_back(g);
+  };
+  for (const Light& light : scene.lights) add(light.group.empty() ? light.name : light.group);
+  if (scene.environment) add(scene.environment->group);
+  const LayerPlan plan =
+      plan_layers(options.components, groups, options.max_bounces.value_or(scene.render.max_bounces));
+  const int w = scene.camera.width, h = scene.camera.height;
+  const int nb = static_cast<int>(options.bands.value_or(scene.render.bands).size());
+  // Before allocating: an image of 10^9 x 10^9 pixels or of 10^6 bands is bad input, not a process to kill.
+  check_memory((static_cast<double>(plan.layer_count()) * nb * sizeof(float) + sizeof(std::int32_t)) * w * h,
+               fmt::format("the image ({}x{} pixels, {} bands, {} layers: the resolution, --bands and --components)",
+                           w, h, nb, plan.layer_count()));
+}
 
 RenderedImage render(const Scene& scene, const RenderOptions& options) {
   check_options(options);
@@ -52,10 +70,7 @@ RenderedImage render(const Scene& scene, const RenderOptions& options) {
   image.settings = settings;
   const int w = image.width, h = image.height, nb = static_cast<int>(settings.bands.size());
   const std::size_t layer_size = static_cast<std::size_t>(w) * h * nb;
-  // Before allocating: an image of 10^9 x 10^9 pixels or of 10^6 bands is bad input, not a process to kill.
-  check_memory((static_cast<double>(plan.layer_count()) * nb * sizeof(float) + sizeof(std::int32_t)) * w * h,
-               fmt::format("the image ({}x{} pixels, {} bands, {} layers: the resolution, --bands and --components)",
-                           w, h, nb, plan.layer_count()));
+  check_image_memory(scene, options);
   image.layers.assign(static_cast<std::size_t>(plan.layer_count()), std::vector<float>(layer_size, 0.0f));
   image.object_ids.resize(static_cast<std::size_t>(w) * h);
   for (const Object& o : scene.objects) image.object_names[o.id] = o.name;

@@ -37,6 +37,12 @@ struct RenderedImage {
   TracerSettings settings;
 };
 
+// Throws InputError naming the option when one is out of range (render() checks too; a command checks first to
+// fail before anything else is said or done).
+void check_options(const RenderOptions& options);
+// Throws InputError when the image `render` would allocate needs more memory than the machine has (render() checks
+// too, before allocating).
+void check_image_memory(const Scene& scene, const RenderOptions& options);
 RenderedImage render(const Scene& scene, const RenderOptions& options);
 // Writes the image atomically; `scene` supplies the header's scene and camera description.
 void write_render(const std::filesystem::path& path, const Scene& scene, const RenderedImage& image);
