@@ -65,8 +65,8 @@ def channels_by_file(document):
     for band in document["bands"]:
         for terms in expressions:
             for term in terms:
-                file = band["files"][term.get("file", MAIN)]
-                wanted.setdefault(file, set()).update(_join(view_layer, f"{p}.{band['channel']}") for p in term["passes"])
+                channels = wanted.setdefault(band["files"][term.get("file", MAIN)], set())
+                channels.update(_join(view_layer, f"{p}.{band['channel']}") for p in term["passes"])
     if "object_ids" in document:
         wanted.setdefault(document["object_ids"]["file"], set()).add(document["object_ids"]["channel"])
     return wanted

@@ -778,7 +778,8 @@ class SpectralRender:
                     bpy.ops.render.render(write_still=True, scene=self.scene.name)
                     if not os.path.isfile(temporary):
                         raise RuntimeError(f"Cycles wrote no file for render {done + 1} ({temporary})")
-                    cache.commit(temporary, final, lambda path: self._unreadable(path, wanted[os.path.basename(final)]))
+                    channels = wanted.get(os.path.basename(final), set())
+                    cache.commit(temporary, final, lambda path: self._unreadable(path, channels))
                     self.rendered += 1
                     done += 1
                     message = (f"render {done}/{total} ({describe_band_range(plan.edges, group)}, {variant}): "
@@ -796,7 +797,7 @@ class SpectralRender:
                     if not applied:
                         self._apply_settings(journal, plan)
                         applied = True
-                    message = self._render_ids(journal, plan, ids_file, wanted[manifest.IDS_FILE])
+                    message = self._render_ids(journal, plan, ids_file, wanted.get(manifest.IDS_FILE, set()))
                     done += 1
                     request.log(f"render {done}/{total} (object ids): {message}")
                     yield done, total, message
@@ -847,7 +848,7 @@ class SpectralRender:
             path = os.path.join(self.cache_dir, name)
             if not os.path.isfile(path):
                 continue
-            problem = self._unreadable(path, wanted[name])
+            problem = self._unreadable(path, wanted.get(name, set()))
             if problem is None:
                 continue
             self.request.log(f"warning: {name} in the cache does not read back, so it is rendered again: {problem}")
