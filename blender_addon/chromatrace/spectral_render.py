@@ -125,7 +125,7 @@ def _rna_plain(struct):
 _NOT_PIXELS = ("name", "preview_", "debug_", "bake", "use_bake", "use_stamp", "stamp_", "metadata_", "threads",
                "use_lock_interface", "use_auto_tile", "tile_size", "use_placeholder", "use_overwrite", "frame_map",
                "fps", "file_extension", "is_movie_format", "views_format", "sequencer_gl_preview", "use_render_cache",
-               "has_multiple_engines", "simplify_gpencil", "line_thickness", "texture_limit")
+               "has_multiple_engines", "simplify_gpencil", "line_thickness")
 # An object's (and a light object's) visibility to each kind of ray.
 _RAY_VISIBILITY = ("visible_camera", "visible_diffuse", "visible_glossy", "visible_transmission",
                    "visible_volume_scatter", "visible_shadow", "is_holdout", "is_shadow_catcher",
