@@ -17,6 +17,24 @@ VIEW_LAYER_PASSES = {
 }
 
 
+# Cycles (scene.cycles) and render (scene.render) settings apply() fixes, besides those the request chooses.
+CYCLES_SETTINGS = (("use_animated_seed", False), ("use_adaptive_sampling", False), ("use_denoising", False),
+                   ("sample_clamp_direct", 0.0), ("sample_clamp_indirect", 0.0), ("blur_glossy", 0.0),
+                   ("light_sampling_threshold", 0.0), ("caustics_reflective", True), ("caustics_refractive", True),
+                   ("use_layer_samples", "IGNORE"), ("time_limit", 0.0), ("use_guiding", False), ("use_fast_gi", False),
+                   ("film_exposure", 1.0), ("sample_offset", 0), ("volume_bounces", 0))
+RENDER_SETTINGS = (("film_transparent", False), ("use_motion_blur", False), ("use_compositing", False),
+                   ("use_sequencer", False), ("use_freestyle", False), ("use_simplify", False), ("use_border", False),
+                   ("use_file_extension", False), ("use_persistent_data", True), ("pixel_aspect_x", 1.0),
+                   ("pixel_aspect_y", 1.0), ("resolution_percentage", 100), ("use_single_layer", False),
+                   ("use_multiview", False))
+BOUNCES = ("max_bounces", "diffuse_bounces", "glossy_bounces", "transmission_bounces")
+# Every scene.cycles and scene.render setting a render sets, whatever the scene held: the cache key leaves them out.
+FIXED = {"cycles": {a for a, _v in CYCLES_SETTINGS} | set(BOUNCES) | {"device", "samples", "seed", "pixel_filter_type",
+                                                                       "filter_width"},
+         "render": {a for a, _v in RENDER_SETTINGS} | {"engine", "resolution_x", "resolution_y", "filepath"}}
+
+
 def _set_if(journal, target, attribute, value):
     if target is not None and hasattr(target, attribute):
         journal.set(target, attribute, value)
@@ -37,18 +55,9 @@ def apply(journal, scene, view_layer, samples, seed, point_filter, resolution, p
     journal.set(c, "device", "CPU")
     journal.set(c, "samples", samples)
     journal.set(c, "seed", seed)
-    for attribute, value in (("use_animated_seed", False), ("use_adaptive_sampling", False),
-                             ("use_denoising", False), ("sample_clamp_direct", 0.0), ("sample_clamp_indirect", 0.0),
-                             ("blur_glossy", 0.0), ("light_sampling_threshold", 0.0), ("caustics_reflective", True),
-                             ("caustics_refractive", True), *pixel_filter(point_filter), ("use_layer_samples", "IGNORE"),
-                             ("time_limit", 0.0), ("use_guiding", False), ("use_fast_gi", False),
-                             ("film_exposure", 1.0), ("sample_offset", 0), ("volume_bounces", 0)):
+    for attribute, value in (*CYCLES_SETTINGS, *pixel_filter(point_filter)):
         _set_if(journal, c, attribute, value)
-    for attribute, value in (("film_transparent", False), ("use_motion_blur", False), ("use_compositing", False),
-                             ("use_sequencer", False), ("use_freestyle", False), ("use_simplify", False),
-                             ("use_border", False), ("use_file_extension", False), ("use_persistent_data", True),
-                             ("pixel_aspect_x", 1.0), ("pixel_aspect_y", 1.0), ("resolution_percentage", 100),
-                             ("use_single_layer", False), ("use_multiview", False)):
+    for attribute, value in RENDER_SETTINGS:
         _set_if(journal, render, attribute, value)
     if resolution is not None:
         journal.set(render, "resolution_x", resolution[0])
@@ -90,5 +99,5 @@ def set_id_render(journal, scene, view_layer):
 
 def set_bounces(journal, scene, cycles_max_bounces):
     c = scene.cycles
-    for attribute in ("max_bounces", "diffuse_bounces", "glossy_bounces", "transmission_bounces"):
+    for attribute in BOUNCES:
         journal.set(c, attribute, cycles_max_bounces)

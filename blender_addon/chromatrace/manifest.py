@@ -6,6 +6,7 @@ Format `chromatrace-assemble/1`, documented in core/assembly.h.
 import os
 
 from .bands import channel_of
+from .components import MAIN
 
 FORMAT = "chromatrace-assemble/1"
 
@@ -53,6 +54,22 @@ def build_manifest(edges_nm, groups, variants, view_layer, total, components, ob
     if attributes:
         manifest["attributes"] = dict(attributes)
     return manifest
+
+
+def channels_by_file(document):
+    """{render file: the channels `chromatrace assemble` reads from it} of a manifest: what each file in the cache
+    must hold to be used."""
+    view_layer = document["view_layer"]
+    wanted = {}
+    expressions = [document["total"]] + [c["terms"] for c in document.get("components", [])]
+    for band in document["bands"]:
+        for terms in expressions:
+            for term in terms:
+                channels = wanted.setdefault(band["files"][term.get("file", MAIN)], set())
+                channels.update(_join(view_layer, f"{p}.{band['channel']}") for p in term["passes"])
+    if "object_ids" in document:
+        wanted.setdefault(document["object_ids"]["file"], set()).add(document["object_ids"]["channel"])
+    return wanted
 
 
 def _join(view_layer, name):

@@ -8,9 +8,11 @@ What it guarantees:
 - Everything it changes (colours, Cycles and colour-management settings, passes, light groups, object
   indices, the world's strength) goes through a Journal and is put back in a `finally`, whether the render
   succeeds, fails or is cancelled (closing the generator). It never saves the .blend.
-- Each finished Cycles render is moved into a cache directory keyed by a hash of the scene and settings
-  (cache.py); a run that was killed resumes with the renders still missing. The final EXR is written
-  atomically by `chromatrace assemble`.
+- Each finished Cycles render is read back (`chromatrace info`: to the end of its pixel data, at the render's
+  size, with the channels assemble takes from it) and only then moved into a cache directory keyed by a hash of
+  everything that decides its pixels (cache.py); one that does not read (a full disk) fails the run and is
+  removed. A run that was killed resumes with the renders still missing; a cached render that does not read
+  back is rendered again, with a warning. The final EXR is written atomically by `chromatrace assemble`.
 """
 
 import hashlib
@@ -110,11 +112,34 @@ def _group_name(name):
 
 def _rna_plain(struct):
     values = {}
+    if struct is None:
+        return values
     for prop in struct.bl_rna.properties:
         if prop.type in ("BOOLEAN", "INT", "FLOAT", "ENUM", "STRING") and prop.identifier != "rna_type":
             value = getattr(struct, prop.identifier)
             values[prop.identifier] = materials._plain(value)
     return values
+
+
+# Settings that cannot change a final render's pixels (the viewport's, baking, stamps and output naming, which
+# Cycles writes as metadata, debugging), by name prefix: left out of the cache key, so that changing one does not
+# render again.
+_NOT_PIXELS = ("name", "preview_", "debug_", "bake", "use_bake", "use_stamp", "stamp_", "metadata_", "threads",
+               "use_lock_interface", "use_auto_tile", "tile_size", "use_placeholder", "use_overwrite", "frame_map",
+               "fps", "file_extension", "is_movie_format", "views_format", "sequencer_gl_preview", "use_render_cache",
+               "has_multiple_engines", "simplify_gpencil", "line_thickness")
+# An object's (and a light object's) visibility to each kind of ray.
+_RAY_VISIBILITY = ("visible_camera", "visible_diffuse", "visible_glossy", "visible_transmission",
+                   "visible_volume_scatter", "visible_shadow", "is_holdout", "is_shadow_catcher",
+                   "show_instancer_for_render")
+# The view layer's filter: which kinds of things it renders.
+_VIEW_LAYER_FILTER = ("use_solid", "use_sky", "use_ao", "use_strand", "use_volumes", "use_motion_blur")
+
+
+def _pixel_settings(struct, fixed=()):
+    """The plain settings of an RNA struct that may change a render's pixels: all but those that cannot
+    (_NOT_PIXELS) and those the render sets itself (`fixed`)."""
+    return {k: v for k, v in _rna_plain(struct).items() if k not in fixed and not k.startswith(_NOT_PIXELS)}
 
 
 class SpectralRender:
@@ -487,8 +512,11 @@ class SpectralRender:
         for ob in plan.objects:
             digest = hashlib.sha256()
             digest.update(repr([list(row) for row in ob.matrix_world]).encode())
+            digest.update(json.dumps([[getattr(ob, a, None) for a in _RAY_VISIBILITY],
+                                      _rna_plain(getattr(ob, "cycles", None))], sort_keys=True).encode())
             if ob.type == "LIGHT":
-                digest.update(json.dumps(_rna_plain(ob.data), sort_keys=True).encode())
+                digest.update(json.dumps([_rna_plain(ob.data), _rna_plain(getattr(ob.data, "cycles", None))],
+                                         sort_keys=True).encode())
                 if ob.data.use_nodes:
                     digest.update(json.dumps(materials.node_tree_digest(ob.data.node_tree)).encode())
             else:
@@ -502,6 +530,8 @@ class SpectralRender:
             geometry[ob.name] = digest.hexdigest()
         camera = scene.camera
         world = scene.world
+        focus = camera.data.dof.focus_object
+        view_layer = plan.view_layer
         return {
             "addon": list(VERSION), "blender": bpy.app.version_string,
             "edges": plan.edges, "per_render": plan.per_render, "replicate": plan.replicate,
@@ -513,10 +543,23 @@ class SpectralRender:
             "passes": sorted(plan.passes), "light_groups": plan.assignments, "ids": plan.ids,
             "geometry": geometry,
             "nodes": {m.name: materials.node_tree_digest(m.node_tree) for m in plan.materials},
-            "camera": [repr([list(r) for r in camera.matrix_world]), _rna_plain(camera.data)],
+            "material_settings": {m.name: _rna_plain(getattr(m, "cycles", None)) for m in plan.materials},
+            "camera": [repr([list(r) for r in camera.matrix_world]), _rna_plain(camera.data),
+                       _rna_plain(getattr(camera.data, "cycles", None))],
+            # Depth of field: f-stop, focus distance or object, the aperture's blades, rotation and ratio.
+            "depth_of_field": [_rna_plain(camera.data.dof),
+                               repr([list(r) for r in focus.matrix_world]) if focus is not None else None],
             "world": materials.node_tree_digest(world.node_tree) if world and world.use_nodes else None,
             "world_state": [plan.world["status"], plan.world_group,
                             list(world.color) if world is not None else None],
+            "world_settings": [_rna_plain(getattr(world, "cycles", None)),
+                               _rna_plain(getattr(world, "cycles_visibility", None))] if world is not None else None,
+            # Cycles and render settings the render does not set itself: light paths (transparent bounces,
+            # minimum bounces, volume steps), sampling pattern, dicing, culling, film transparency of glass, …
+            "cycles": _pixel_settings(scene.cycles, cycles_setup.FIXED["cycles"]),
+            "render": _pixel_settings(scene.render, cycles_setup.FIXED["render"]),
+            "view_layer": [[getattr(view_layer, a, None) for a in _VIEW_LAYER_FILTER],
+                           view_layer.material_override.name if view_layer.material_override else None],
         }
 
     def _resolution(self):
@@ -707,6 +750,7 @@ class SpectralRender:
             request.log(f"{len(plan.edges) - 1} bands in {len(groups)} renders of {plan.per_render} band(s)"
                         f"{' x ' + str(len(variants)) + ' bounce limits' if len(variants) > 1 else ''}; "
                         f"cache {self.cache_dir}")
+            wanted = manifest.channels_by_file(self._manifest(plan))
             todo = set(manifest.missing_renders(self.cache_dir, groups, list(variants)))
             only = request.only_group
             if only is not None:
@@ -719,6 +763,7 @@ class SpectralRender:
                         raise BadInput(f"--bounce-limit: must be one of {', '.join(variants)}, got "
                                        f"\"{request.only_variant}\"")
                     total = 1
+            self._drop_unreadable(plan, wanted, todo)
             applied = False
             done = 0
             for g, group in enumerate(groups):
@@ -751,7 +796,8 @@ class SpectralRender:
                     bpy.ops.render.render(write_still=True, scene=self.scene.name)
                     if not os.path.isfile(temporary):
                         raise RuntimeError(f"Cycles wrote no file for render {done + 1} ({temporary})")
-                    cache.commit(temporary, final)
+                    channels = wanted.get(os.path.basename(final), set())
+                    cache.commit(temporary, final, lambda path: self._unreadable(path, channels))
                     self.rendered += 1
                     done += 1
                     message = (f"render {done}/{total} ({describe_band_range(plan.edges, group)}, {variant}): "
@@ -774,7 +820,7 @@ class SpectralRender:
                     if not applied:
                         self._apply_settings(journal, plan)
                         applied = True
-                    message = self._render_ids(journal, plan, ids_file)
+                    message = self._render_ids(journal, plan, ids_file, wanted.get(manifest.IDS_FILE, set()))
                     done += 1
                     request.log(f"render {done}/{total} (object ids): {message}")
                     yield done, total, message
@@ -787,7 +833,7 @@ class SpectralRender:
             journal.restore()
             shutil.rmtree(work_dir, ignore_errors=True)
 
-    def _render_ids(self, journal, plan, final):
+    def _render_ids(self, journal, plan, final, channels):
         """The object-id render: one sample per pixel, at the pixel's centre."""
         cycles_setup.set_id_render(journal, self.scene, plan.view_layer)
         temporary = final + ".partial"
@@ -796,24 +842,59 @@ class SpectralRender:
         bpy.ops.render.render(write_still=True, scene=self.scene.name)
         if not os.path.isfile(temporary):
             raise RuntimeError(f"Cycles wrote no file for the object-id render ({temporary})")
-        cache.commit(temporary, final)
+        cache.commit(temporary, final, lambda path: self._unreadable(path, channels))
         self.rendered += 1
         return f"{time.monotonic() - start:.2f} s, {time.process_time() - start_cpu:.2f} s CPU"
 
-    def _assemble(self, plan):
-        request = self.request
+    def _unreadable(self, path, channels):
+        """Why a Cycles render file cannot be assembled, or None: it must read to the end of its pixel data, be of
+        the render's size and hold `channels`."""
+        try:
+            info = self.tool.image_info(path)
+        except (BadInput, RuntimeError) as e:
+            return str(e)
+        size = [info["width"], info["height"]]
+        if size != self._resolution():
+            return f"{path}: {size[0]}x{size[1]} pixels, not the render's {'x'.join(map(str, self._resolution()))}"
+        missing = sorted(set(channels) - {c["name"] for c in info["channels"]})
+        if missing:
+            return f"{path}: no channel {', '.join(missing)}"
+        return None
+
+    def _drop_unreadable(self, plan, wanted, todo):
+        """Adds to `todo` (and removes from the cache) every cached render that does not read back."""
+        cached = [(g, v) for g in range(len(plan.groups)) for v in plan.variants if (g, v) not in todo]
+        files = [(manifest.render_file_name(g, v), (g, v)) for g, v in cached]
+        if self.request.object_ids:
+            files.append((manifest.IDS_FILE, None))
+        for name, entry in files:
+            path = os.path.join(self.cache_dir, name)
+            if not os.path.isfile(path):
+                continue
+            problem = self._unreadable(path, wanted.get(name, set()))
+            if problem is None:
+                continue
+            self.request.log(f"warning: {name} in the cache does not read back, so it is rendered again: {problem}")
+            cache.discard(path)
+            if entry is not None:
+                todo.add(entry)
+
+    def _manifest(self, plan, attributes=None):
+        """The `chromatrace-assemble/1` document of the plan's renders."""
         names = None
-        if request.object_ids:
+        if self.request.object_ids:
             names = {}
             for ob in plan.objects:
                 if ob.name in plan.ids:
                     names[plan.ids[ob.name]] = ob.chromatrace.scene_name or ob.name
-        document = manifest.build_manifest(
+        return manifest.build_manifest(
             plan.edges, plan.groups, list(plan.variants), plan.view_layer.name, plan.total,
-            plan.components, object_names=names, attributes=self._attributes(plan), replicate=plan.replicate)
+            plan.components, object_names=names, attributes=attributes, replicate=plan.replicate)
+
+    def _assemble(self, plan):
+        request = self.request
         manifest_file = os.path.join(self.cache_dir, "manifest.json")
-        with open(manifest_file, "w") as f:
-            json.dump(document, f, indent=1)
+        cache.write_json(manifest_file, self._manifest(plan, self._attributes(plan)))
         self.tool.assemble(manifest_file, os.path.abspath(request.output))
         request.log(f"wrote {request.output} ({self.rendered} renders made, {self.cached} from the cache)")
 

@@ -76,6 +76,10 @@ class Tool:
         return self.run("sensor", spectral_exr, "-o", png, "--preset", "canon_eos_5d_mkiii", "--exposure-s", "auto",
                         "--no-noise", "-q")
 
+    def image_info(self, image):
+        """`chromatrace info --json`: size, channels, …; BadInput when the file does not read to its end."""
+        return self.run("info", image, "--json", json_output=True)
+
     def assemble(self, manifest_file, output):
         return self.run("assemble", manifest_file, "-o", output, "--quiet")
 

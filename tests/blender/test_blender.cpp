@@ -21,6 +21,7 @@
 #include "core/scene.h"
 #include "core/spectral_exr.h"
 #include "tests/cli/run_command.h"
+#include "tests/cli/text_files.h"
 #include "tests/common/view_factor.h"
 #include "tests/core/spectral_exr_fixtures.h"
 
@@ -289,8 +290,18 @@ TEST_F(Blender, MaxBouncesZeroShowsEmittersOnly) {
   EXPECT_GT(*std::max_element(total.begin(), total.end()), 1.0f);  // the lamp is in view
 }
 
-// A run killed after two of five renders (four band groups and the object ids) leaves them in the cache;
-// running again renders only the other three and writes the same file as a run that was never interrupted.
+// The regular files under `root`, recursively.
+std::vector<fs::path> files_under(const fs::path& root) {
+  std::vector<fs::path> files;
+  if (fs::exists(root))
+    for (const auto& entry : fs::recursive_directory_iterator(root))
+      if (entry.is_regular_file()) files.push_back(entry.path());
+  return files;
+}
+
+// A run killed after two of five renders (four band groups and the object ids) leaves them in the cache; the
+// first is then cut short (as a full disk leaves a file). Running again renders that one again with a warning
+// and only the other three besides, and writes the same file as a run that was never interrupted.
 TEST_F(Blender, KilledRunResumesWithOnlyTheRemainingRenders) {
   const fs::path out = dir_.file("resumed.exr"), reference = dir_.file("reference.exr");
   const std::vector<std::string> common = {"--scene", kBox, "--resolution", "24x24", "--samples", "4",
@@ -304,17 +315,25 @@ TEST_F(Blender, KilledRunResumesWithOnlyTheRemainingRenders) {
   EXPECT_EQ(killed.exit_code, 128 + 9) << killed.err;
   EXPECT_FALSE(fs::exists(out));
   EXPECT_EQ(lines_starting(killed.err, "chromatrace: render ").size(), 2u) << killed.err;
+  const std::vector<fs::path> cached = files_under(dir_.file("cache"));
+  const auto first = std::find_if(cached.begin(), cached.end(), [](const fs::path& p) { return p.filename() == "g000_main.exr"; });
+  ASSERT_NE(first, cached.end());
+  fs::resize_file(*first, fs::file_size(*first) / 2);
 
   const CommandResult resumed = batch(args);
   ASSERT_EQ(resumed.exit_code, 0) << resumed.err;
+  const auto warnings = lines_starting(resumed.err, "chromatrace: warning: ");
+  ASSERT_EQ(warnings.size(), 1u) << resumed.err;
+  EXPECT_NE(warnings[0].find("g000_main.exr in the cache does not read back, so it is rendered again"),
+            std::string::npos) << warnings[0];
   const auto renders = lines_starting(resumed.err, "chromatrace: render ");
   ASSERT_EQ(renders.size(), 5u) << resumed.err;
-  EXPECT_NE(renders[0].find("already in the cache"), std::string::npos) << renders[0];
+  EXPECT_EQ(renders[0].find("already in the cache"), std::string::npos) << renders[0];
   EXPECT_NE(renders[1].find("already in the cache"), std::string::npos) << renders[1];
   EXPECT_EQ(renders[2].find("already in the cache"), std::string::npos) << renders[2];
   EXPECT_EQ(renders[3].find("already in the cache"), std::string::npos) << renders[3];
   EXPECT_NE(renders[4].find("(object ids)"), std::string::npos) << renders[4];
-  EXPECT_NE(resumed.err.find("(3 renders made, 2 from the cache)"), std::string::npos) << resumed.err;
+  EXPECT_NE(resumed.err.find("(4 renders made, 1 from the cache)"), std::string::npos) << resumed.err;
 
   std::vector<std::string> fresh = common;
   fresh.insert(fresh.end(), {"--out", reference.string()});
@@ -328,6 +347,83 @@ TEST_F(Blender, KilledRunResumesWithOnlyTheRemainingRenders) {
   EXPECT_EQ(a.info().metadata, b.info().metadata);
   EXPECT_EQ(a.info().object_names, b.info().object_names);
   EXPECT_EQ(a.read_layer(a.info().total()), b.read_layer(b.info().total()));  // Cycles is deterministic per seed
+}
+
+// A Cycles render that cannot be written whole (a file-size limit, as a full disk) fails the run with exit 1
+// naming it: nothing cut short is left in the cache or at the output, and the previous output stays. The
+// same run without the limit then renders everything: the failed run left nothing in the cache.
+TEST_F(Blender, OutOfSpaceLeavesNothingCutShortInTheCacheOrAtTheOutput) {
+  fs::create_directory(dir_.file("out"));
+  const fs::path out = dir_.file("out/box.exr");
+  std::ofstream(out) << "the previous render";
+  std::vector<std::string> args = {"--background", "--factory-startup", "--python", kSource + "/blender_addon/batch.py",
+                                   "--", "--scene", kBox, "--out", out.string(), "--resolution", "160x160",
+                                   "--samples", "4", "--bands", "400:700:100", "--max-bounces", "1", "--components",
+                                   "paths", "--cache-dir", dir_.file("cache").string()};
+  const CommandResult r = test::run_program_with_file_size_limit(BLENDER_EXE, args, 256);
+  EXPECT_EQ(r.exit_code, 1) << r.err;
+  EXPECT_NE(r.err.find("batch.py: failed: Cycles did not write g000_main.exr completely (a full disk?): "),
+            std::string::npos) << r.err;
+  EXPECT_EQ(files_under(dir_.file("cache")), std::vector<fs::path>{});
+  EXPECT_EQ(test::read_text(out), "the previous render");
+  EXPECT_EQ(files_under(dir_.file("out")), std::vector<fs::path>{out});
+
+  args.push_back("--keep-cache");
+  const CommandResult unlimited = test::run_program(BLENDER_EXE, args);
+  ASSERT_EQ(unlimited.exit_code, 0) << unlimited.err;
+  EXPECT_NE(unlimited.err.find("(2 renders made, 0 from the cache)"), std::string::npos) << unlimited.err;
+  EXPECT_EQ(test::run_chromatrace({"info", "--check", out.string()}).exit_code, 0);
+  for (const fs::path& file : files_under(dir_.file("cache"))) {  // the limit is what failed above
+    if (file.filename() == "g000_main.exr") {
+      EXPECT_GT(fs::file_size(file), 256u * 1024u);
+    }
+  }
+}
+
+// A changed depth of field (its f-stop alone) or an object's ray visibility renders again; the same .blend
+// again takes every render from the cache.
+TEST_F(Blender, ChangedFStopOrRayVisibilityRendersAgain) {
+  const fs::path blend = dir_.file("box.blend");
+  const CommandResult made = test::run_program(
+      BLENDER_EXE, {"--background", "--factory-startup", "--python", kSource + "/tests/blender/make_blend.py", "--",
+                    kBox, blend.string()});
+  ASSERT_EQ(made.exit_code, 0) << made.err;
+  const auto render = [&](const std::string& name) {
+    return batch({"--blend", blend.string(), "--out", dir_.file(name).string(), "--resolution", "16x16", "--samples",
+                  "2", "--bands", "400:700:100", "--max-bounces", "1", "--components", "none", "--keep-cache"});
+  };
+  const auto change = [&](const std::string& statement) {
+    const CommandResult r = test::run_program(
+        BLENDER_EXE, {"--background", "--factory-startup", blend.string(), "--python-exit-code", "1", "--python-expr",
+                      "import bpy\n" + statement + "\nbpy.ops.wm.save_mainfile()"});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+  };
+  const auto total = [&](const std::string& name) {
+    SpectralExrReader reader(dir_.file(name));
+    return reader.read_layer(reader.info().total());
+  };
+  const CommandResult first = render("first.exr");
+  ASSERT_EQ(first.exit_code, 0) << first.err;
+  EXPECT_NE(first.err.find("(2 renders made, 0 from the cache)"), std::string::npos) << first.err;
+  const CommandResult again = render("again.exr");
+  ASSERT_EQ(again.exit_code, 0) << again.err;
+  EXPECT_NE(again.err.find("(0 renders made, 2 from the cache)"), std::string::npos) << again.err;
+
+  const std::string dof = "d = bpy.context.scene.camera.data.dof\nd.use_dof = True\nd.focus_distance = 0.1\n";
+  change(dof + "d.aperture_fstop = 2.0");
+  const CommandResult focused = render("focused.exr");
+  ASSERT_EQ(focused.exit_code, 0) << focused.err;
+  EXPECT_NE(focused.err.find("(2 renders made, 0 from the cache)"), std::string::npos) << focused.err;
+  change(dof + "d.aperture_fstop = 0.2");
+  const CommandResult wider = render("wider.exr");
+  ASSERT_EQ(wider.exit_code, 0) << wider.err;
+  EXPECT_NE(wider.err.find("(2 renders made, 0 from the cache)"), std::string::npos) << wider.err;
+  EXPECT_NE(total("wider.exr"), total("focused.exr"));  // the f-stop changes the pixels: a reused render would not
+
+  change("bpy.data.objects['sphere'].visible_shadow = False");
+  const CommandResult unshadowed = render("unshadowed.exr");
+  ASSERT_EQ(unshadowed.exit_code, 0) << unshadowed.err;
+  EXPECT_NE(unshadowed.err.find("(2 renders made, 0 from the cache)"), std::string::npos) << unshadowed.err;
 }
 
 // A .blend with chromatrace settings renders headless, and the file on disk stays byte for byte the same.

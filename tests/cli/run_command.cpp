@@ -1,9 +1,11 @@
 #include "tests/cli/run_command.h"
 
 #include <fcntl.h>
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <csignal>
 #include <stdexcept>
 #include <string>
 
@@ -19,11 +21,8 @@ std::string drain(int fd) {
   return text;
 }
 
-}  // namespace
-
-CommandResult run_chromatrace(const std::vector<std::string>& args) { return run_program(CHROMATRACE_EXE, args); }
-
-CommandResult run_program(const std::string& program, const std::vector<std::string>& args) {
+// Runs the program; kib > 0 limits the size of the files it writes.
+CommandResult run(const std::string& program, const std::vector<std::string>& args, long kib) {
   // stdout and stderr go to unlinked temporary files, so a chatty command cannot dead-lock on a full pipe.
   char out_name[] = "/tmp/chromatrace-out-XXXXXX";
   char err_name[] = "/tmp/chromatrace-err-XXXXXX";
@@ -45,6 +44,11 @@ CommandResult run_program(const std::string& program, const std::vector<std::str
   if (pid == 0) {
     dup2(out_fd, STDOUT_FILENO);
     dup2(err_fd, STDERR_FILENO);
+    if (kib > 0) {
+      const rlimit limit{static_cast<rlim_t>(kib) * 1024, static_cast<rlim_t>(kib) * 1024};
+      signal(SIGXFSZ, SIG_IGN);  // kept across exec
+      if (setrlimit(RLIMIT_FSIZE, &limit) != 0) _exit(126);
+    }
     execv(exe.c_str(), argv.data());
     _exit(127);
   }
@@ -58,6 +62,19 @@ CommandResult run_program(const std::string& program, const std::vector<std::str
   result.out = drain(out_fd);
   result.err = drain(err_fd);
   return result;
+}
+
+}  // namespace
+
+CommandResult run_chromatrace(const std::vector<std::string>& args) { return run_program(CHROMATRACE_EXE, args); }
+
+CommandResult run_program(const std::string& program, const std::vector<std::string>& args) {
+  return run(program, args, 0);
+}
+
+CommandResult run_program_with_file_size_limit(const std::string& program, const std::vector<std::string>& args,
+                                               long kib) {
+  return run(program, args, kib);
 }
 
 }  // namespace ct::test

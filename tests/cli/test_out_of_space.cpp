@@ -25,18 +25,9 @@ using test::write_text;
 
 const fs::path kMinimal = fs::path(CHROMATRACE_TEST_DATA) / "scenes" / "minimal.json";
 
-std::string quoted(const std::string& word) {
-  std::string q = "'";
-  for (const char c : word) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return q + "'";
-}
-
-// chromatrace with these arguments in a child whose files may grow to `kib` KiB, SIGXFSZ ignored, so that a
-// write beyond it fails with EFBIG as a write to a full disk fails with ENOSPC.
+// chromatrace with these arguments in a child whose files may grow to `kib` KiB, SIGXFSZ ignored.
 test::CommandResult run_with_file_size_limit(int kib, const std::vector<std::string>& args) {
-  std::string command = "trap '' XFSZ; ulimit -f " + std::to_string(kib) + "; exec " + quoted(CHROMATRACE_EXE);
-  for (const std::string& a : args) command += " " + quoted(a);
-  return test::run_program("/bin/bash", {"-c", command});
+  return test::run_program_with_file_size_limit(CHROMATRACE_EXE, args, kib);
 }
 
 // The names in `dir` (hidden ones included), sorted.

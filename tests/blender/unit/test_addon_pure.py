@@ -106,6 +106,20 @@ class Manifest(unittest.TestCase):
                                              replicate=True)
         self.assertEqual([b["channel"] for b in replicated["bands"]], ["R", "R"])
 
+    def test_channels_by_file_are_what_assemble_reads(self):
+        total, planned = components.component_plan({"paths", "bounces"}, [], 2)
+        variants = list(components.render_variants(2, True))
+        m = manifest.build_manifest([400, 450, 500, 550, 600], bands.band_groups(4), variants, "VL", total, planned,
+                                    object_names={1: "a"})
+        wanted = manifest.channels_by_file(m)
+        self.assertEqual(set(wanted), {"g000_main.exr", "g000_k1.exr", "g001_main.exr", "g001_k1.exr", "ids.exr"})
+        self.assertEqual(wanted["ids.exr"], {"VL.IndexOB.X"})
+        # The second group holds one band, in R; its K = 1 render gives bounce.0 (Emit) and bounce.1 (Combined).
+        self.assertEqual(wanted["g001_k1.exr"], {"VL.Combined.R", "VL.Emit.R"})
+        self.assertEqual({c[-1] for c in wanted["g000_main.exr"]}, {"R", "G", "B"})
+        for passes in ("Combined", "Emit", "DiffDir", "DiffInd", "DiffCol", "GlossDir", "GlossInd", "GlossCol"):
+            self.assertIn(f"VL.{passes}.R", wanted["g001_main.exr"])
+
     def test_missing_renders(self):
         with tempfile.TemporaryDirectory() as d:
             groups = bands.band_groups(6)
@@ -304,6 +318,38 @@ class Cache(unittest.TestCase):
     def test_key_depends_on_content_only(self):
         self.assertEqual(cache.cache_key({"a": 1, "b": [1, 2]}), cache.cache_key({"b": [1, 2], "a": 1}))
         self.assertNotEqual(cache.cache_key({"a": 1}), cache.cache_key({"a": 2}))
+
+
+    def test_a_render_enters_the_cache_only_when_it_reads_back(self):
+        with tempfile.TemporaryDirectory() as d:
+            partial, final = os.path.join(d, "g000_main.exr.partial"), os.path.join(d, "g000_main.exr")
+            with open(final, "w") as f:
+                f.write("the previous render")
+            with open(partial, "w") as f:
+                f.write("cut short")
+            with self.assertRaisesRegex(RuntimeError, "g000_main.exr completely .*: ends early"):
+                cache.commit(partial, final, lambda path: "ends early")
+            self.assertEqual(os.listdir(d), ["g000_main.exr"])
+            with open(final) as f:
+                self.assertEqual(f.read(), "the previous render")
+            with open(partial, "w") as f:
+                f.write("whole")
+            cache.commit(partial, final, lambda path: None)
+            self.assertEqual(os.listdir(d), ["g000_main.exr"])
+            with open(final) as f:
+                self.assertEqual(f.read(), "whole")
+
+    def test_json_written_whole_or_not_at_all(self):
+        with tempfile.TemporaryDirectory() as d:
+            path = os.path.join(d, "manifest.json")
+            cache.write_json(path, {"a": [1, 2]})
+            with open(path) as f:
+                self.assertEqual(json.load(f), {"a": [1, 2]})
+            with self.assertRaises(TypeError):  # fails part-way through the dump
+                cache.write_json(path, {"a": [1, 2], "b": object()})
+            self.assertEqual(os.listdir(d), ["manifest.json"])
+            with open(path) as f:
+                self.assertEqual(json.load(f), {"a": [1, 2]})
 
 
 class CameraMath(unittest.TestCase):
