@@ -1,6 +1,7 @@
 #include "analyzer/cluster_shape.h"
 
 #include <algorithm>
+#include <initializer_list>
 #include <cmath>
 #include <limits>
 #include <numbers>
@@ -95,6 +96,11 @@ class ShapeDecision {
   }
 
  private:
+  // Whether every one of the tests passed; each is evaluated (and recorded), in order, whatever the others gave.
+  static bool all(std::initializer_list<bool> results) {
+    return std::all_of(results.begin(), results.end(), [](bool passed) { return passed; });
+  }
+
   bool test(std::string name, double value, double threshold, bool passed) {
     s_.decisions.push_back({std::move(name), value, threshold, passed});
     return passed;
@@ -235,23 +241,23 @@ class ShapeDecision {
     const double limit = std::max(2 * noise_perp_, k_.two_line_residual * s_.sigma[1]);
     const double highlight_samples = static_cast<double>(highlight.inliers.size());
     const double highlight_length = (m.highlight.t_max - m.highlight.t_min) / tolerance_;
-    two_line_ok_ = test("two-line rms <= max(2 * noise, two_line_residual * sigma2)", two_line_rms_, limit, two_line_rms_ <= limit) &
+    two_line_ok_ = all({test("two-line rms <= max(2 * noise, two_line_residual * sigma2)", two_line_rms_, limit, two_line_rms_ <= limit),
                    test("highlight samples >= min_highlight_samples", highlight_samples,
                         static_cast<double>(k_.min_highlight_samples),
-                        highlight_samples >= static_cast<double>(k_.min_highlight_samples)) &
+                        highlight_samples >= static_cast<double>(k_.min_highlight_samples)),
                    test("highlight fraction >= min_highlight_fraction", m.highlight_fraction, k_.min_highlight_fraction,
-                        m.highlight_fraction >= k_.min_highlight_fraction) &
+                        m.highlight_fraction >= k_.min_highlight_fraction),
                    test("highlight length / tolerance >= highlight_length", highlight_length, k_.highlight_length,
-                        highlight_length >= k_.highlight_length) &
+                        highlight_length >= k_.highlight_length),
                    test("angle between lines (deg) >= min_line_angle_deg", m.angle_deg, k_.min_line_angle_deg,
-                        m.angle_deg >= k_.min_line_angle_deg) &
-                   test("gap between lines <= 2 * tolerance", m.gap, 2 * tolerance_, m.gap <= 2 * tolerance_) &
+                        m.angle_deg >= k_.min_line_angle_deg),
+                   test("gap between lines <= 2 * tolerance", m.gap, 2 * tolerance_, m.gap <= 2 * tolerance_),
                    test("junction on highlight line <= highlight_end", m.junction_on_highlight, k_.highlight_end,
-                        m.junction_on_highlight <= k_.highlight_end) &
+                        m.junction_on_highlight <= k_.highlight_end),
                    test("junction on body line within highlight_end of its ends", m.junction_on_body, k_.highlight_end,
-                        m.junction_on_body >= -k_.highlight_end && m.junction_on_body <= 1 + k_.highlight_end) &
+                        m.junction_on_body >= -k_.highlight_end && m.junction_on_body <= 1 + k_.highlight_end),
                    test("junction inside the colour cube (within 2 * tolerance) / tolerance", outside_cube(m.junction) / tolerance_,
-                        2.0, outside_cube(m.junction) <= 2 * tolerance_);
+                        2.0, outside_cube(m.junction) <= 2 * tolerance_)});
   }
 
   // How far a colour lies outside the cube of values the image can hold (0 inside): below the lowest code or
@@ -279,8 +285,8 @@ class ShapeDecision {
     const PrincipalCurve& c = *s_.curve;
     const double curve_limit = std::max(2 * noise_perp_, k_.curve_residual * c.straight_rms);
     curve_ok_ =
-        test("curve rms <= max(2 * noise, curve_residual * straight rms)", c.curve_rms, curve_limit, c.curve_rms <= curve_limit) &
-        test("bend (sagitta / chord) > max_bend_for_straight", c.bend, k_.max_bend_for_straight, c.bend > k_.max_bend_for_straight);
+        all({test("curve rms <= max(2 * noise, curve_residual * straight rms)", c.curve_rms, curve_limit, c.curve_rms <= curve_limit),
+             test("bend (sagitta / chord) > max_bend_for_straight", c.bend, k_.max_bend_for_straight, c.bend > k_.max_bend_for_straight)});
     if (two_line_ok_ && curve_ok_) test("two-line rms <= curve rms", two_line_rms_, c.curve_rms, two_line_rms_ <= c.curve_rms);
   }
 
@@ -304,9 +310,9 @@ class ShapeDecision {
     // The highlight leaves the body line: their junction lies on the body line, away from its dark end (two
     // lines from black are a fork). It need not lie at the highlight line's own end: the bowl's scans bridge
     // the gap between the body line and the straight far part of a broad highlight.
-    if (!(test("body line fraction >= p_body_fraction", body_fraction_, k_.p_body_fraction, body_fraction_ >= k_.p_body_fraction) &
+    if (!all({test("body line fraction >= p_body_fraction", body_fraction_, k_.p_body_fraction, body_fraction_ >= k_.p_body_fraction),
           test("junction on body line in [t_junction, 1]", m.junction_on_body, k_.t_junction,
-               m.junction_on_body >= k_.t_junction && m.junction_on_body <= 1)))
+               m.junction_on_body >= k_.t_junction && m.junction_on_body <= 1)}))
       return false;
     const std::vector<std::size_t> rest = clearly_off_body();
     Eigen::Matrix<double, 3, 2> frame;
@@ -330,10 +336,10 @@ class ShapeDecision {
     const double body_spread = along_body.size() < 2 ? 0.0 : quantile_range(along_body, 0.05, 0.95);
     const double spread = std::sqrt(std::max(0.0, body_spread * body_spread - noise_spread * noise_spread));
     const double area = highlight_spread > 0 ? spread / highlight_spread : 0.0;
-    if (!(test("highlight leads away from black (|junction + direction| - |junction|) > 0", brightening, 0.0, brightening > 0) &
-          test("off-body pixels on one side >= p_one_side", sided, k_.p_one_side, sided >= k_.p_one_side) &
+    if (!all({test("highlight leads away from black (|junction + direction| - |junction|) > 0", brightening, 0.0, brightening > 0),
+          test("off-body pixels on one side >= p_one_side", sided, k_.p_one_side, sided >= k_.p_one_side),
           test("off-body spread along body (beyond the noise) / along highlight >= p_area_ratio", area, k_.p_area_ratio,
-               area >= k_.p_area_ratio)))
+               area >= k_.p_area_ratio)}))
       return false;
     return settle(ShapeClass::P, fmt::format("a body line ({:.0f} %) with a broad highlight leaving it along a stretch of it and "
                                              "filling an area on one side",
