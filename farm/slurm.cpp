@@ -22,8 +22,8 @@
 #include "core/error.h"
 #include "core/file_io.h"
 #include "core/json_input.h"
+#include "core/process.h"
 
-extern char** environ;
 
 namespace ct::farm {
 namespace fs = std::filesystem;
@@ -54,33 +54,18 @@ ProgramOutput run_program(const std::vector<std::string>& argv, const std::vecto
   posix_spawn_file_actions_init(&actions);
   posix_spawn_file_actions_adddup2(&actions, out_fd, STDOUT_FILENO);
   posix_spawn_file_actions_adddup2(&actions, err_fd, STDERR_FILENO);
-  std::vector<std::string> args = argv;
-  std::vector<char*> pointers;
-  for (std::string& a : args) pointers.push_back(a.data());
-  pointers.push_back(nullptr);
-  std::vector<std::string> environment;
-  for (char** e = environ; *e; ++e) {
-    const std::string_view entry(*e);
-    if (std::none_of(env.begin(), env.end(), [&](const auto& kv) { return entry.starts_with(kv.first + "="); }))
-      environment.emplace_back(entry);
-  }
-  for (const auto& [name, value] : env) environment.push_back(name + "=" + value);
-  std::vector<char*> env_pointers;
-  for (std::string& e : environment) env_pointers.push_back(e.data());
-  env_pointers.push_back(nullptr);
-  pid_t pid = 0;
-  const int error = posix_spawnp(&pid, pointers[0], &actions, nullptr, pointers.data(), env_pointers.data());
-  posix_spawn_file_actions_destroy(&actions);
-  if (error != 0) {
+  int status = 0;
+  try {
+    status = spawn_and_wait(argv, env, &actions);
+  } catch (...) {
+    posix_spawn_file_actions_destroy(&actions);
     close(out_fd);
     close(err_fd);
-    throw std::runtime_error(fmt::format("cannot run {}: {}", argv[0], std::strerror(error)));
+    throw;
   }
-  int status = 0;
-  while (waitpid(pid, &status, 0) < 0)
-    if (errno != EINTR) throw std::runtime_error("waiting for a process failed");
+  posix_spawn_file_actions_destroy(&actions);
   ProgramOutput result;
-  result.status = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+  result.status = status;
   result.out = slurp(out_fd);
   result.err = slurp(err_fd);
   return result;

@@ -22,6 +22,7 @@
 #include "core/error.h"
 #include "core/file_io.h"
 #include "core/parallel.h"
+#include "core/process.h"
 #include "core/spectral_exr.h"
 #include "reference_tracer/render.h"
 #include "sensor_sim/config.h"
@@ -102,35 +103,20 @@ void render_with_tracer(Scene scene, const fs::path& out, const RunOptions& opti
 }
 
 // Runs a program and waits; its stderr goes to ours (the batch's progress lines), its stdout to `log`, and
-// its environment is ours with `env` set. posix_spawn: no code of ours runs between fork and exec.
+// its environment is ours with `env` set.
 int run_program(const std::vector<std::string>& argv, const std::vector<std::pair<std::string, std::string>>& env,
                 const fs::path& log) {
-  std::vector<std::string> environment;
-  for (char** e = environ; *e; ++e) {
-    const std::string_view entry(*e);
-    const bool replaced = std::any_of(env.begin(), env.end(), [&](const auto& kv) { return entry.starts_with(kv.first + "="); });
-    if (!replaced) environment.emplace_back(entry);
-  }
-  for (const auto& [name, value] : env) environment.push_back(name + "=" + value);
-  const auto pointers = [](std::vector<std::string>& strings) {
-    std::vector<char*> p;
-    for (std::string& s : strings) p.push_back(s.data());
-    p.push_back(nullptr);
-    return p;
-  };
-  std::vector<std::string> args = argv;
-  std::vector<char*> arg_pointers = pointers(args), env_pointers = pointers(environment);
   posix_spawn_file_actions_t actions;
   posix_spawn_file_actions_init(&actions);
   posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-  pid_t pid = 0;
-  const int error = posix_spawnp(&pid, arg_pointers[0], &actions, nullptr, arg_pointers.data(), env_pointers.data());
-  posix_spawn_file_actions_destroy(&actions);
-  if (error != 0) throw std::runtime_error(fmt::format("cannot start {}: {}", argv[0], std::strerror(error)));
-  int status = 0;
-  while (waitpid(pid, &status, 0) < 0)
-    if (errno != EINTR) throw std::runtime_error("waiting for a process failed");
-  return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+  try {
+    const int status = spawn_and_wait(argv, env, &actions);
+    posix_spawn_file_actions_destroy(&actions);
+    return status;
+  } catch (...) {
+    posix_spawn_file_actions_destroy(&actions);
+    throw;
+  }
 }
 
 void render_with_cycles(const Scene& scene, const fs::path& scene_file, const fs::path& out, const fs::path& dir,
