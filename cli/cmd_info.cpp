@@ -46,8 +46,10 @@ std::string join(const std::vector<std::string>& items) {
 
 std::string bands_text(const SpectralExrInfo& info) {
   const Bands& bands = info.bands;
-  const std::string source =
-      info.edges_from_file ? "edges from chromatrace.bandEdgesNm" : "edges halfway between centres";
+  std::string source = info.edges_from_file ? "edges from chromatrace.bandEdgesNm" : "edges halfway between centres";
+  if (const BandReconstruction* r = bands.reconstruction())
+    source += fmt::format("; values reconstructed into {} bands of {} nm from {} nm by chromatrace.bandReconstruction",
+                          r->fine, r->step_nm, r->lo_nm);
   std::string text = fmt::format("{} bands, {}-{} nm, centres {}-{} nm, ", bands.size(), bands.min_wavelength(),
                                  bands.max_wavelength(), info.centres_nm.front(), info.centres_nm.back());
   if (uniform_widths(bands)) return text + fmt::format("width {} nm ({})", bands.width(0), source);
@@ -176,6 +178,8 @@ nlohmann::json to_json(const SpectralExrInfo& info, const std::optional<Spectral
                   {"centres_nm", info.centres_nm},
                   {"edges_nm", info.bands.edges()},
                   {"edges_from", info.edges_from_file ? "chromatrace.bandEdgesNm" : "centres"}};
+    if (const BandReconstruction* r = info.bands.reconstruction())
+      j["bands"]["reconstruction"] = {{"lo_nm", r->lo_nm}, {"step_nm", r->step_nm}, {"fine_bands", r->fine}};
     j["emissive_units"] = info.emissive_units ? nlohmann::json(*info.emissive_units) : nlohmann::json();
     for (const SpectralLayer& layer : info.layers)
       j["layers"].push_back(

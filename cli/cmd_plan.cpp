@@ -31,6 +31,8 @@ Action add_plan(CLI::App& app) {
   cmd->add_option("--preview-spp", o->plan.preview_samples, "Paths per pixel of the preview render")->capture_default_str();
   cmd->add_flag("--bounce-components", o->plan.bounce_components,
                 "Cost Cycles renders for separate bounce components (one render per bounce order)");
+  cmd->add_flag("!--no-reconstruction", o->plan.reconstruction,
+                "Read band values as a step function instead of fitting a reconstruction to the scene's spectra");
   cmd->add_option("--threads", o->plan.threads, "Worker threads (0: all cores)")->capture_default_str();
   cmd->add_flag("-q,--quiet", o->quiet, "No summary on stderr");
 

@@ -102,6 +102,7 @@ int run(const Options& o) {
   for (std::size_t i = 0; i < bands.size(); ++i) centres.push_back(bands.centre(i));
   Json report = {{"file", o.file},
                  {"bands", {{"count", bands.size()}, {"edges_nm", bands.edges()}, {"centres_nm", centres}}}};
+  if (const BandReconstruction* r = bands.reconstruction()) report["bands"]["reconstruction"] = reconstruction_json(*r);
   Json spectra_json = Json::object();
   for (const NamedSpectrum& s : spectra) spectra_json[s.name] = spectrum_entry(s.spectrum, bands);
   report["spectra"] = spectra_json;

@@ -7,6 +7,7 @@
 
 #include <fmt/core.h>
 
+#include "core/band_plan.h"
 #include "core/error.h"
 #include "core/exr_vocabulary.h"
 #include "core/json_input.h"
@@ -254,10 +255,11 @@ AssemblyManifest read_assembly_manifest(const fs::path& file) {
   const std::string format = root["format"].string();
   if (format != "chromatrace-assemble/1")
     root["format"].fail(fmt::format("must be \"chromatrace-assemble/1\", got \"{}\"", format));
-  root.expect_object({"format", "edges_nm", "view_layer", "bands", "total", "components", "object_ids", "object_names",
-                      "attributes", "sum_tolerance"});
+  root.expect_object({"format", "edges_nm", "reconstruction", "view_layer", "bands", "total", "components", "object_ids",
+                      "object_names", "attributes", "sum_tolerance"});
   const fs::path directory = file.parent_path();
   manifest.bands = read_edges(root["edges_nm"]);
+  if (const auto r = root.find("reconstruction")) manifest.bands = read_reconstruction(*r, manifest.bands);
 
   const std::string view_layer = root.find("view_layer") ? root["view_layer"].string() : "";
   const std::vector<JsonNode> bands = root["bands"].elements();

@@ -8,6 +8,7 @@
 // where the object ids are, and the header's metadata:
 //
 //   {"format": "chromatrace-assemble/1", "edges_nm": [400, 450, 500, 550], "view_layer": "ViewLayer",
+//    "reconstruction": {"lo_nm": 400, "step_nm": 1, "matrix": [...]},  (optional, as in a band-plan file)
 //    "bands": [{"channel": "R", "files": {"main": "g000.exr"}}, ...],
 //    "total": [{"passes": ["Combined"]}],
 //    "components": [{"name": "diffuse_direct", "terms": [{"passes": ["DiffDir", "DiffCol"]}]}, ...],

@@ -14,7 +14,7 @@ Bands read_band_plan(const std::filesystem::path& file) {
   const JsonNode root(document, file.string());
   const std::string format = root["format"].string();
   if (format != "chromatrace-bands/1") root["format"].fail(fmt::format("must be \"chromatrace-bands/1\", got \"{}\"", format));
-  root.expect_object({"format", "edges_nm"});
+  root.expect_object({"format", "edges_nm", "reconstruction"});
   const JsonNode edges_node = root["edges_nm"];
   std::vector<double> edges;
   for (const JsonNode& edge : edges_node.elements()) {
@@ -27,7 +27,42 @@ Bands read_band_plan(const std::filesystem::path& file) {
   if (edges.back() <= 360.0 || edges.front() >= 830.0)
     edges_node.fail(fmt::format("bands [{}, {}] nm do not overlap the visible range 360-830 nm (wavelengths in nm?)",
                                 edges.front(), edges.back()));
-  return Bands::from_edges(std::move(edges), edges_node.location());
+  const Bands bands = Bands::from_edges(std::move(edges), edges_node.location());
+  if (const auto r = root.find("reconstruction")) return read_reconstruction(*r, bands);
+  return bands;
+}
+
+Json band_plan_document(const Bands& bands) {
+  Json j;
+  j["format"] = "chromatrace-bands/1";
+  j["edges_nm"] = bands.edges();
+  if (const BandReconstruction* r = bands.reconstruction()) j["reconstruction"] = reconstruction_json(*r);
+  return j;
+}
+
+Json reconstruction_json(const BandReconstruction& r) {
+  const std::size_t n = r.fine ? r.matrix.size() / r.fine : 0;
+  Json rows = Json::array();
+  for (std::size_t j = 0; j < r.fine; ++j)
+    rows.push_back(std::vector<double>(r.matrix.begin() + static_cast<std::ptrdiff_t>(j * n),
+                                       r.matrix.begin() + static_cast<std::ptrdiff_t>((j + 1) * n)));
+  return Json{{"lo_nm", r.lo_nm}, {"step_nm", r.step_nm}, {"matrix", rows}};
+}
+
+Bands read_reconstruction(const JsonNode& node, const Bands& bands) {
+  node.expect_object({"lo_nm", "step_nm", "matrix"});
+  BandReconstruction r;
+  r.lo_nm = node["lo_nm"].number_above(0);
+  r.step_nm = node["step_nm"].number_above(0);
+  const std::vector<JsonNode> rows = node["matrix"].elements();
+  r.fine = rows.size();
+  for (const JsonNode& row : rows) {
+    const std::vector<JsonNode> entries = row.elements();
+    if (entries.size() != bands.size())
+      row.fail(fmt::format("{} entries, needs one per band ({})", entries.size(), bands.size()));
+    for (const JsonNode& e : entries) r.matrix.push_back(e.number());
+  }
+  return bands.with_reconstruction(std::move(r), node["matrix"].location());
 }
 
 }  // namespace ct

@@ -57,8 +57,7 @@ std::array<std::vector<double>, 3> xyz_band_weights(const Bands& bands) {
   std::array<std::vector<double>, 3> w;
   const PiecewiseLinearSpectrum* cmf[3] = {&cie::x_bar(), &cie::y_bar(), &cie::z_bar()};
   for (int c = 0; c < 3; ++c) {
-    w[c].resize(bands.size());
-    for (std::size_t i = 0; i < bands.size(); ++i) w[c][i] = cmf[c]->integral(bands.lo(i), bands.hi(i));
+    w[c] = band_weights(bands, [&](double lo, double hi) { return cmf[c]->integral(lo, hi); });
   }
   return w;
 }

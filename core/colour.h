@@ -17,7 +17,8 @@ Vec3d spectrum_to_xyz(const PiecewiseLinearSpectrum& emission);
 // Tristimulus values of band values (a step function over `bands`), with the CMFs integrated exactly
 // over each band.
 Vec3d bands_to_xyz(const std::vector<double>& values, const Bands& bands);
-// Per-band weights w_c[i] = ∫_{band i} c̄(λ) dλ, so that XYZ = Σ_i value_i · w[i] (values are averages).
+// Per-band weights w_c[i] = ∫_{band i} c̄(λ) dλ, so that XYZ = Σ_i value_i · w[i] (values are averages); with
+// the bands' reconstruction, the weights of the spectrum it makes of the values (band_weights).
 std::array<std::vector<double>, 3> xyz_band_weights(const Bands& bands);
 // Reflectance under an illuminant, normalised so that reflectance 1 gives Y = 1.
 Vec3d reflectance_to_xyz(const PiecewiseLinearSpectrum& reflectance, const PiecewiseLinearSpectrum& illuminant);

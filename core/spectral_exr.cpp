@@ -38,6 +38,7 @@
 #include "core/exr_output.h"
 #include "core/exr_vocabulary.h"
 #include "core/file_io.h"
+#include "core/limits.h"
 
 namespace ct {
 namespace {
@@ -47,6 +48,8 @@ namespace fs = std::filesystem;
 constexpr const char* kLayoutVersion = "1.0";
 constexpr const char* kEmissiveUnits = "W.m^-2.sr^-1";
 constexpr const char* kBandEdgesAttribute = "chromatrace.bandEdgesNm";
+// The bands' reconstruction (core/spectrum.h): a float vector [lo_nm, step_nm, fine, matrix row by row].
+constexpr const char* kReconstructionAttribute = "chromatrace.bandReconstruction";
 using exr::kComponentsAttribute;
 using exr::kMaxObjectId;
 using exr::kObjectIdChannel;
@@ -274,6 +277,26 @@ Bands band_edges(const Imf::Header& header, const SpectralLayer& reference, cons
   return Bands::from_edges(std::vector<double>(edges.begin(), edges.end()), where);
 }
 
+// The bands with chromatrace.bandReconstruction applied, when the file has it (it needs chromatrace.bandEdgesNm).
+Bands band_reconstruction(const Imf::Header& header, const Bands& bands, bool edges_from_file, const std::string& file) {
+  const Imf::Attribute* attribute = find_attribute(header, kReconstructionAttribute);
+  if (attribute == nullptr) return bands;
+  const std::string where = fmt::format("{}: attribute {}", file, kReconstructionAttribute);
+  if (!edges_from_file) throw InputError(fmt::format("{}: given without {}", where, kBandEdgesAttribute));
+  const auto* vector = dynamic_cast<const Imf::FloatVectorAttribute*>(attribute);
+  if (vector == nullptr) throw InputError(fmt::format("{}: must be a float vector, got {}", where, attribute->typeName()));
+  const std::vector<float>& v = vector->value();
+  if (v.size() < 3) throw InputError(fmt::format("{}: {} values, needs at least 3 (lo, step, fine bands)", where, v.size()));
+  if (!(v[2] >= 1 && v[2] <= static_cast<float>(kMaxBands) && v[2] == std::floor(v[2])))
+    throw InputError(fmt::format("{}: the fine band count {} must be a whole number from 1 to {}", where, v[2], kMaxBands));
+  BandReconstruction r;
+  r.lo_nm = v[0];
+  r.step_nm = v[1];
+  r.fine = static_cast<std::size_t>(v[2]);
+  r.matrix.assign(v.begin() + 3, v.end());
+  return bands.with_reconstruction(std::move(r), where);
+}
+
 // The channels sorted into spectral ones, bi-spectral re-radiation ones, object ids and others.
 struct SortedChannels {
   std::vector<NamedChannel> spectral, reradiation;
@@ -322,6 +345,7 @@ void describe_bands(const Imf::Header& header, const std::string& file, const st
   check_same_wavelengths(info.layers, wavelengths, file);
   info.centres_nm = wavelengths.front();
   info.bands = band_edges(header, info.layers.front(), info.centres_nm, file, info.edges_from_file);
+  info.bands = band_reconstruction(header, info.bands, info.edges_from_file, file);
   const std::size_t n = info.centres_nm.size();
   if (info.bispectral && info.reradiation_channels.size() != n * (n - 1) / 2)
     info.notes.push_back(
@@ -386,7 +410,7 @@ SpectralExrInfo describe(const Imf::Header& header, const std::string& file, std
   static const std::set<std::string> kReported{
       "channels",  "compression",           "dataWindow",     "displayWindow",
       "lineOrder", "spectralLayoutVersion", "emissiveUnits",  "polarisationHandedness",
-      "EV",        kBandEdgesAttribute,     kObjectsAttribute};
+      "EV",        kBandEdgesAttribute,     kObjectsAttribute,     kReconstructionAttribute};
   for (auto it = header.begin(); it != header.end(); ++it)
     if (!kReported.contains(it.name())) info.metadata[it.name()] = attribute_text(it.attribute());
   return info;
@@ -512,7 +536,8 @@ void check_layout(const SpectralExrLayout& layout, const std::string& file) {
   for (const auto& [name, value] : layout.attributes) {
     if (!name.starts_with("chromatrace.") || name.size() == 12)
       throw InputError(fmt::format("{}: attribute \"{}\": must be named chromatrace.<key>", file, name));
-    if (name == kBandEdgesAttribute || name == kObjectsAttribute || name == kComponentsAttribute)
+    if (name == kBandEdgesAttribute || name == kObjectsAttribute || name == kComponentsAttribute ||
+        name == kReconstructionAttribute)
       throw InputError(fmt::format("{}: attribute \"{}\": written by the writer itself", file, name));
   }
 }
@@ -712,6 +737,11 @@ SpectralExrWriter::SpectralExrWriter(const fs::path& path, SpectralExrLayout lay
   if (!layout_.reflective) header.insert("emissiveUnits", Imf::StringAttribute(kEmissiveUnits));
   const std::vector<double>& edges = layout_.bands.edges();
   header.insert(kBandEdgesAttribute, Imf::FloatVectorAttribute(std::vector<float>(edges.begin(), edges.end())));
+  if (const BandReconstruction* r = layout_.bands.reconstruction()) {
+    std::vector<float> v{static_cast<float>(r->lo_nm), static_cast<float>(r->step_nm), static_cast<float>(r->fine)};
+    v.insert(v.end(), r->matrix.begin(), r->matrix.end());
+    header.insert(kReconstructionAttribute, Imf::FloatVectorAttribute(v));
+  }
   if (!layout_.components.empty())
     header.insert(kComponentsAttribute, Imf::StringAttribute(exr::component_list_text(layout_.components)));
   if (layout_.object_ids) header.insert(kObjectsAttribute, Imf::StringAttribute(exr::object_names_text(layout_.object_names)));

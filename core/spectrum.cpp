@@ -132,6 +132,36 @@ Bands Bands::from_centres(const std::vector<double>& centres, const std::string&
   return from_edges(std::move(edges), what);
 }
 
+Bands Bands::with_reconstruction(BandReconstruction r, const std::string& what) const {
+  if (!std::isfinite(r.lo_nm) || !std::isfinite(r.step_nm) || !(r.step_nm > 0) || r.lo_nm <= 0)
+    throw InputError(fmt::format("{}: fine bands need a positive start and step, got {} and {} nm", what, r.lo_nm, r.step_nm));
+  if (r.fine == 0 || r.fine > kMaxBands)
+    throw InputError(fmt::format("{}: {} fine bands, must be 1 to {}", what, r.fine, kMaxBands));
+  if (r.matrix.size() != r.fine * size())
+    throw InputError(fmt::format("{}: the matrix has {} entries, needs {} fine bands × {} bands = {}", what,
+                                 r.matrix.size(), r.fine, size(), r.fine * size()));
+  for (std::size_t k = 0; k < r.matrix.size(); ++k)
+    if (!std::isfinite(r.matrix[k]))
+      throw InputError(fmt::format("{}: matrix entry [{}][{}] is not finite", what, k / size(), k % size()));
+  Bands b = *this;
+  b.reconstruction_ = std::make_shared<const BandReconstruction>(std::move(r));
+  return b;
+}
+
+std::vector<double> band_weights(const Bands& bands, const std::function<double(double, double)>& integral) {
+  std::vector<double> w(bands.size(), 0.0);
+  if (const BandReconstruction* r = bands.reconstruction()) {
+    for (std::size_t j = 0; j < r->fine; ++j) {
+      const double lo = r->lo_nm + r->step_nm * static_cast<double>(j);
+      const double f = integral(lo, lo + r->step_nm);
+      for (std::size_t i = 0; i < w.size(); ++i) w[i] += r->matrix[j * w.size() + i] * f;
+    }
+    return w;
+  }
+  for (std::size_t i = 0; i < w.size(); ++i) w[i] = integral(bands.lo(i), bands.hi(i));
+  return w;
+}
+
 std::vector<double> band_averages(const PiecewiseLinearSpectrum& s, const Bands& bands) {
   std::vector<double> out(bands.size());
   for (std::size_t i = 0; i < bands.size(); ++i) out[i] = s.average(bands.lo(i), bands.hi(i));

@@ -9,6 +9,7 @@
 
 #include <cstddef>
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -53,6 +54,18 @@ class PiecewiseLinearSpectrum {
   Extrapolation outside_ = Extrapolation::Zero;
 };
 
+// How the band values of a render stand for a spectrum when a step function (each band's value over the band)
+// is not good enough: a linear map from the N band values to the values of `fine` uniform bands
+// [lo + j·step, lo + (j+1)·step), fine value j = Σ_i matrix[j·N + i]·value_i. `chromatrace plan` fits it to the
+// scene's spectra (docs/plan.md); it travels with the bands (band-plan file, EXR header) and every conversion of
+// band values to a colour (band_weights) uses it.
+struct BandReconstruction {
+  double lo_nm = 0, step_nm = 0;
+  std::size_t fine = 0;
+  std::vector<double> matrix;  // fine × N, row-major
+  bool operator==(const BandReconstruction&) const = default;
+};
+
 // A band plan: N contiguous or non-contiguous bands [lo_i, hi_i). Stored as N+1 edges when contiguous;
 // arbitrary (lo, hi) pairs are allowed for files whose bands were given by centres only.
 class Bands {
@@ -77,11 +90,28 @@ class Bands {
   const std::vector<double>& edges() const { return edges_; }
   double min_wavelength() const { return edges_.front(); }
   double max_wavelength() const { return edges_.back(); }
-  bool operator==(const Bands&) const = default;
+
+  // The reconstruction the band values carry, or null (a step function).
+  const BandReconstruction* reconstruction() const { return reconstruction_.get(); }
+  // The same bands with a reconstruction: its matrix must have fine × size() finite entries, its fine bands a
+  // positive step and whole-nm-scale range inside 1–100000 nm. Errors name `what`.
+  Bands with_reconstruction(BandReconstruction r, const std::string& what = "reconstruction") const;
+  Bands without_reconstruction() const { return from_edges(edges_); }
+  bool operator==(const Bands& o) const {
+    return edges_ == o.edges_ && (reconstruction_ == o.reconstruction_ ||
+                                  (reconstruction_ && o.reconstruction_ && *reconstruction_ == *o.reconstruction_));
+  }
 
  private:
   std::vector<double> edges_;
+  std::shared_ptr<const BandReconstruction> reconstruction_;
 };
+
+// Weights w_i such that Σ_i value_i·w_i = ∫ f(λ)·s(λ) dλ for the spectrum s that band values stand for, given
+// integral(lo, hi) = ∫ f over [lo, hi]: w_i = integral(lo_i, hi_i) for a step function, and
+// Σ_j matrix[j·N + i]·integral(fine band j) with a reconstruction. Every observer or camera applied to band
+// values goes through this.
+std::vector<double> band_weights(const Bands& bands, const std::function<double(double, double)>& integral);
 
 // Band averages of a spectrum over each band.
 std::vector<double> band_averages(const PiecewiseLinearSpectrum& s, const Bands& bands);

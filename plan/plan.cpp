@@ -7,8 +7,10 @@
 #include <optional>
 #include <set>
 
+#include <Eigen/Dense>
 #include <fmt/core.h>
 
+#include "core/band_plan.h"
 #include "core/colour.h"
 #include "core/error.h"
 #include "core/geometry.h"
@@ -176,7 +178,11 @@ struct Basis {
 // Tristimulus values of every (id, k, lobe) template: k = 0 the surface's own emission; k >= 1 what it reflects
 // after k scattering events, by radiosity over the transfer factors; where that gives no light (a surface no
 // sampled ray lit), the mean-albedo model E·R·ρ̄^(k−1).
-std::vector<std::vector<std::array<Vec3d, 2>>> templates(const Basis& b, const Transfer& t, int kmax) {
+// The spectra behind the templates (in the basis), [id][k][lobe].
+using TemplateSpectra = std::vector<std::vector<std::array<std::vector<double>, 2>>>;
+
+std::vector<std::vector<std::array<Vec3d, 2>>> templates(const Basis& b, const Transfer& t, int kmax,
+                                                         TemplateSpectra* spectra = nullptr) {
   const std::size_t ids = b.emission.size(), n = b.size(), lights = t.lit.empty() ? 0 : t.lit[0].size();
   const std::size_t first_light = ids - lights;
   std::vector<std::vector<std::array<Vec3d, 2>>> out(ids, std::vector<std::array<Vec3d, 2>>(kmax + 1));
@@ -188,7 +194,11 @@ std::vector<std::vector<std::array<Vec3d, 2>>> templates(const Basis& b, const T
   };
   std::vector<std::vector<double>> irr(ids, std::vector<double>(n, 0.0)), sent(ids, std::vector<double>(n, 0.0));
   std::vector<double> f(n), fallback(n);
-  for (std::size_t id = 0; id < ids; ++id) out[id][0][0] = project(b.emission[id]);
+  if (spectra) spectra->assign(ids, std::vector<std::array<std::vector<double>, 2>>(kmax + 1, {std::vector<double>(n, 0.0), std::vector<double>(n, 0.0)}));
+  for (std::size_t id = 0; id < ids; ++id) {
+    out[id][0][0] = project(b.emission[id]);
+    if (spectra) (*spectra)[id][0][0] = b.emission[id];
+  }
   for (int k = 1; k <= kmax; ++k) {
     for (std::size_t o = 1; o < ids; ++o) {
       std::fill(irr[o].begin(), irr[o].end(), 0.0);
@@ -211,8 +221,10 @@ std::vector<std::vector<std::array<Vec3d, 2>>> templates(const Basis& b, const T
           fallback[i] = b.light[i] * (o == 0 ? b.mean_albedo[i] : r[i]) * std::pow(b.mean_albedo[i], k - 1);
         }
         Vec3d x = project(f);
-        if (!(x[1] > 0)) x = project(fallback);
+        const bool fell_back = !(x[1] > 0);
+        if (fell_back) x = project(fallback);
         out[o][k][lobe] = x;
+        if (spectra) (*spectra)[o][k][lobe] = fell_back ? fallback : f;
       }
     for (std::size_t o = 1; o < ids; ++o)
       for (std::size_t i = 0; i < n; ++i) sent[o][i] = b.albedo[o][i] * irr[o][i];
@@ -248,8 +260,15 @@ class Model {
   // left beyond them is at most that share of what went before), at most kMaxReferenceBounces.
   Model(const Scene& scene, const PlanOptions& options, std::vector<std::string>& notes, int reference_bounces = 0);
 
-  // Mean and 95th percentile of ΔE00 of a plan (bands, bounce limit) against exact spectra at depth().
-  std::pair<double, double> evaluate(const std::vector<int>& edges, int max_bounces) const;
+  // Mean and 95th percentile of ΔE00 of a plan (bands, bounce limit) against exact spectra at depth(); the band
+  // values turned into colours through a reconstruction fitted to the plan's own template spectra
+  // (fit_reconstruction) when the model fits one (reconstructs()), else as a step function. `fitted` receives it.
+  std::pair<double, double> evaluate(const std::vector<int>& edges, int max_bounces) const {
+    return evaluate(edges, max_bounces, reconstruct_, nullptr);
+  }
+  std::pair<double, double> evaluate(const std::vector<int>& edges, int max_bounces, bool reconstruct,
+                                     BandReconstruction* fitted) const;
+  bool reconstructs() const { return reconstruct_; }
   std::pair<double, double> evaluate_exact(int max_bounces) const;  // exact spectra, truncated bounces
 
   const std::vector<int>& grid_edges() const { return grid_edges_; }  // candidate edge positions (grid indices)
@@ -264,6 +283,7 @@ class Model {
 
  private:
   std::pair<double, double> score(const std::vector<std::vector<std::array<Vec3d, 2>>>& templates, int max_bounces) const;
+  BandReconstruction fit_reconstruction(const TemplateSpectra& banded, int max_bounces) const;
 
   Grid grid_;
   int kmax_ = 0;
@@ -274,6 +294,9 @@ class Model {
   Transfer transfer_;
   std::vector<std::vector<std::array<Vec3d, 2>>> exact_;  // [id][k][lobe], scaled to Y = 1
   std::vector<std::vector<std::array<double, 2>>> exact_y_;
+  TemplateSpectra exact_spectra_;                         // [id][k][lobe], 1 nm samples
+  std::vector<std::vector<std::array<double, 2>>> share_;  // [id][k][lobe]: Σ over pixels of the luminance share
+  bool reconstruct_ = false;
   std::vector<Pixel> pixels_;
   std::vector<Vec3d> lab_exact_;
   Vec3d white_{};
@@ -303,8 +326,13 @@ Model::Model(const Scene& scene, const PlanOptions& options, std::vector<std::st
     if (nm > grid_.lo + 1e-9) grid_edges_.push_back(static_cast<int>(std::lround(nm)) - grid_.lo);
   grid_edges_.push_back(grid_.hi - grid_.lo);
 
+  reconstruct_ = options.reconstruction;
   auto spectrum_of = [&](const SpectrumRef& ref, const std::string& what) -> Sampled {
     if (ref.texture) {
+      if (reconstruct_)
+        notes.push_back(fmt::format("{} is an image texture, whose spectra the model does not hold: no reconstruction "
+                                    "is fitted (the bands' values are read as a step function)", what));
+      reconstruct_ = false;
       notes.push_back(fmt::format("{} is an image texture: modelled as a flat reflectance of 0.5", what));
       return grid_.sample([](double) { return 0.5; });
     }
@@ -406,7 +434,7 @@ Model::Model(const Scene& scene, const PlanOptions& options, std::vector<std::st
   exact.light = light_.v;
   exact.mean_albedo = albedo_.v;
   if (has_environment_) exact.environment = environment_.v;
-  exact_ = templates(exact, transfer_, kmax_);
+  exact_ = templates(exact, transfer_, kmax_, &exact_spectra_);
   exact_y_.assign(ids, std::vector<std::array<double, 2>>(static_cast<std::size_t>(kmax_) + 1, {0.0, 0.0}));
   for (std::size_t id = 0; id < ids; ++id)
     for (int k = 0; k <= kmax_; ++k)
@@ -483,6 +511,10 @@ Model::Model(const Scene& scene, const PlanOptions& options, std::vector<std::st
     if (px.total > 0) pixels_.push_back(std::move(px));
   }
   hit_fraction_ = N ? static_cast<double>(hits) / static_cast<double>(N) : 0;
+  share_.assign(ids, std::vector<std::array<double, 2>>(static_cast<std::size_t>(kmax_) + 1, {0.0, 0.0}));
+  for (const Pixel& px : pixels_)
+    for (int k = 0; k <= kmax_; ++k)
+      for (int lobe = 0; lobe < 2; ++lobe) share_[px.id][k][lobe] += px.y[k][lobe] / px.total;
 
   // The exact colours and the white.
   std::vector<Vec3d> xyz(pixels_.size());
@@ -549,7 +581,45 @@ std::pair<double, double> Model::score(const std::vector<std::vector<std::array<
 
 std::pair<double, double> Model::evaluate_exact(int max_bounces) const { return score(exact_, max_bounces); }
 
-std::pair<double, double> Model::evaluate(const std::vector<int>& edges, int max_bounces) const {
+// The reconstruction that best turns the band values of the model's templates into their exact spectra: 1 nm
+// fine bands over the model's grid, the matrix R minimising Σ_t w_t·|a_t − R·b_t|² over the templates t up to the
+// bounce limit (b_t their band values and a_t their exact 1 nm averages, both at unit luminance; w_t the
+// template's share of the preview's pixels), R = A·W·Bᵀ·(B·W·Bᵀ + εI)⁻¹ with a ridge ε of 10⁻⁹ of the mean
+// diagonal for bands no template tells apart. For a free matrix this minimiser is the same whatever weights the
+// wavelengths get, so the one fit serves every observer and camera. Entries are rounded to float, as the EXR
+// header stores them.
+BandReconstruction Model::fit_reconstruction(const TemplateSpectra& banded, int max_bounces) const {
+  const std::size_t nb = banded.front().front()[0].size(), fine = grid_.n() - 1;
+  Eigen::MatrixXd g = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(nb), static_cast<Eigen::Index>(nb));
+  Eigen::MatrixXd h = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(fine), static_cast<Eigen::Index>(nb));
+  Eigen::VectorXd b(static_cast<Eigen::Index>(nb)), a(static_cast<Eigen::Index>(fine));
+  for (std::size_t id = 0; id < banded.size(); ++id)
+    for (int k = 0; k <= std::min(max_bounces, kmax_); ++k)
+      for (int lobe = 0; lobe < 2; ++lobe) {
+        const double y = exact_y_[id][k][lobe], w = share_[id][k][lobe];
+        if (!(y > 0) || !(w > 0)) continue;
+        const std::vector<double>& s = exact_spectra_[id][k][lobe];
+        for (std::size_t i = 0; i < nb; ++i) b[static_cast<Eigen::Index>(i)] = banded[id][k][lobe][i] / y;
+        for (std::size_t j = 0; j < fine; ++j) a[static_cast<Eigen::Index>(j)] = 0.5 * (s[j] + s[j + 1]) / y;
+        g.noalias() += w * b * b.transpose();
+        h.noalias() += w * a * b.transpose();
+      }
+  const double ridge = 1e-9 * std::max(g.trace() / static_cast<double>(nb), 1e-300);
+  g.diagonal().array() += ridge;
+  const Eigen::MatrixXd r = g.ldlt().solve(h.transpose()).transpose();  // fine × nb (g is symmetric)
+  BandReconstruction out;
+  out.lo_nm = grid_.lo;
+  out.step_nm = 1;
+  out.fine = fine;
+  out.matrix.resize(fine * nb);
+  for (std::size_t j = 0; j < fine; ++j)
+    for (std::size_t i = 0; i < nb; ++i)
+      out.matrix[j * nb + i] = static_cast<float>(r(static_cast<Eigen::Index>(j), static_cast<Eigen::Index>(i)));
+  return out;
+}
+
+std::pair<double, double> Model::evaluate(const std::vector<int>& edges, int max_bounces, bool reconstruct,
+                                          BandReconstruction* fitted) const {
   const std::size_t nb = edges.size() - 1;
   const int K = std::min(max_bounces, kmax_);
   auto averages = [&](const Sampled& f) {
@@ -571,7 +641,29 @@ std::pair<double, double> Model::evaluate(const std::vector<int>& edges, int max
   banded.light = averages(light_);
   banded.mean_albedo = averages(albedo_);
   if (has_environment_) banded.environment = averages(environment_);
-  auto t = templates(banded, transfer_, K);
+  TemplateSpectra spectra;
+  auto t = templates(banded, transfer_, K, reconstruct ? &spectra : nullptr);
+  if (reconstruct) {
+    // The observer's weights of the reconstructed spectrum (band_weights with 1 nm fine bands), and the templates
+    // through them.
+    const BandReconstruction r = fit_reconstruction(spectra, K);
+    for (int c = 0; c < 3; ++c) {
+      std::fill(banded.weight[c].begin(), banded.weight[c].end(), 0.0);
+      for (std::size_t j = 0; j < r.fine; ++j) {
+        const double f = Grid::integral(obs_[c], static_cast<int>(j), static_cast<int>(j) + 1);
+        for (std::size_t i = 0; i < nb; ++i) banded.weight[c][i] += r.matrix[j * nb + i] * f;
+      }
+    }
+    for (std::size_t id = 0; id < t.size(); ++id)
+      for (int k = 0; k <= K; ++k)
+        for (int lobe = 0; lobe < 2; ++lobe)
+          for (int c = 0; c < 3; ++c) {
+            double x = 0;
+            for (std::size_t i = 0; i < nb; ++i) x += spectra[id][k][lobe][i] * banded.weight[c][i];
+            t[id][k][lobe][c] = x;
+          }
+    if (fitted) *fitted = r;
+  }
   for (std::size_t id = 0; id < t.size(); ++id)
     for (int k = 0; k <= K; ++k)
       for (int lobe = 0; lobe < 2; ++lobe) {
@@ -771,7 +863,10 @@ Plan make_plan(const Scene& scene, const PlanOptions& options) {
     edges_nm.push_back(model.lo() + cand[i]);
   }
   plan.bands = Bands::from_edges(edges_nm, "plan");
-  std::tie(plan.predicted_mean, plan.predicted_p95) = model.evaluate(edges, plan.max_bounces);
+  BandReconstruction reconstruction;
+  std::tie(plan.predicted_mean, plan.predicted_p95) =
+      model.evaluate(edges, plan.max_bounces, model.reconstructs(), &reconstruction);
+  if (model.reconstructs()) plan.bands = plan.bands.with_reconstruction(std::move(reconstruction), "plan");
   plan.predicted_band_only = model.evaluate(edges, kmax).first;
   {
     std::vector<int> scene_edges;
@@ -779,8 +874,8 @@ Plan make_plan(const Scene& scene, const PlanOptions& options) {
     bool on_grid = true;
     for (std::size_t i = 0; i < scene_edges.size(); ++i)
       on_grid = on_grid && std::abs(scene.render.bands.edges()[i] - (model.lo() + scene_edges[i])) < 1e-9;
-    plan.scene_bands_predicted_mean =
-        on_grid ? model.evaluate(scene_edges, kmax).first : std::numeric_limits<double>::quiet_NaN();
+    plan.scene_bands_predicted_mean = on_grid ? model.evaluate(scene_edges, kmax, false, nullptr).first
+                                              : std::numeric_limits<double>::quiet_NaN();
   }
   if (!plan.target_met)
     plan.notes.push_back(fmt::format("no plan of up to {} bands reaches the target: the best predicts {:.3g}",
@@ -829,12 +924,7 @@ SettingsPrediction predict_settings(const Scene& scene, int max_bounces, int sam
   return p;
 }
 
-Json bands_document(const Plan& plan) {
-  Json j;
-  j["format"] = "chromatrace-bands/1";
-  j["edges_nm"] = plan.bands.edges();
-  return j;
-}
+Json bands_document(const Plan& plan) { return band_plan_document(plan.bands); }
 
 Json report_document(const Plan& plan, const Scene& scene, const PlanOptions& options) {
   Json j;
@@ -845,7 +935,11 @@ Json report_document(const Plan& plan, const Scene& scene, const PlanOptions& op
   j["renderer"] = options.renderer == Renderer::Cycles ? "cycles" : "tracer";
   j["target_met"] = plan.target_met;
   Json s;
-  s["bands"] = bands_document(plan);
+  s["bands"] = band_plan_document(plan.bands.without_reconstruction());  // the matrix is in the band-plan file
+  if (const BandReconstruction* r = plan.bands.reconstruction())
+    s["reconstruction"] = {{"fitted", true}, {"lo_nm", r->lo_nm}, {"step_nm", r->step_nm}, {"fine_bands", r->fine}};
+  else
+    s["reconstruction"] = {{"fitted", false}};
   s["band_count"] = plan.bands.size();
   s["max_bounces"] = plan.max_bounces;
   s["samples"] = plan.samples;

@@ -44,6 +44,9 @@ struct PlanOptions {
   int threads = 0;            // 0: all cores
   // Cycles: also render the bounce components separately (each bounce order is a Cycles render of its own).
   bool bounce_components = false;
+  // Fit a reconstruction of the bands' values (core/spectrum.h: BandReconstruction) to the scene's spectra and
+  // plan with it; not when the scene has image textures, whose spectra the model does not hold.
+  bool reconstruction = true;
 };
 
 struct BandTrial {

@@ -24,8 +24,9 @@ Samples sample(const PiecewiseLinearSpectrum& s, int lo, int hi) {
 // The spectrum as the band plan holds it: each band's average, flat over the band. Sample i stands for
 // [i − ½, i + ½] nm (as xyz() sums), so a band [lo, hi) holds the samples lo … hi − 1 (the last also hi), and bands
 // of 1 nm hold every sample as it is.
-Samples banded(const Samples& s, const Bands& bands, int lo) {
-  Samples out(s.size(), 0.0);
+// The band values themselves: each band's average over its samples (0 for a band that holds none).
+std::vector<double> band_values(const Samples& s, const Bands& bands, int lo) {
+  std::vector<double> out(bands.size(), 0.0);
   const int last = static_cast<int>(s.size()) - 1;
   for (std::size_t b = 0; b < bands.size(); ++b) {
     const int a = std::clamp(static_cast<int>(std::lround(bands.lo(b))) - lo, 0, last);
@@ -33,7 +34,19 @@ Samples banded(const Samples& s, const Bands& bands, int lo) {
     if (e <= a) continue;
     double sum = 0;
     for (int i = a; i < e; ++i) sum += s[i];
-    for (int i = a; i < e; ++i) out[i] = sum / (e - a);
+    out[b] = sum / (e - a);
+  }
+  return out;
+}
+
+Samples banded(const Samples& s, const Bands& bands, int lo) {
+  Samples out(s.size(), 0.0);
+  const std::vector<double> values = band_values(s, bands, lo);
+  const int last = static_cast<int>(s.size()) - 1;
+  for (std::size_t b = 0; b < bands.size(); ++b) {
+    const int a = std::clamp(static_cast<int>(std::lround(bands.lo(b))) - lo, 0, last);
+    const int e = b + 1 == bands.size() ? last + 1 : std::clamp(static_cast<int>(std::lround(bands.hi(b))) - lo, 0, last + 1);
+    for (int i = a; i < e; ++i) out[i] = values[b];
   }
   return out;
 }
@@ -88,7 +101,16 @@ std::vector<SpectralWarning> check_band_plan(const Scene& scene, const Bands& ba
     Vec3d white = xyz(e, cmf);
     if (!(white[1] > 0)) return 0.0;
     const Vec3d exact = xyz(product(r, e), cmf);
-    const Vec3d approx = xyz(product(banded(r, bands, lo), banded(e, bands, lo)), cmf);
+    Vec3d approx;
+    if (bands.reconstruction()) {
+      // The render's band values ⟨R⟩⟨E⟩, turned into a colour through the bands' reconstruction.
+      std::vector<double> v = band_values(r, bands, lo);
+      const std::vector<double> ve = band_values(e, bands, lo);
+      for (std::size_t b = 0; b < v.size(); ++b) v[b] *= ve[b];
+      approx = bands_to_xyz(v, bands);
+    } else {
+      approx = xyz(product(banded(r, bands, lo), banded(e, bands, lo)), cmf);
+    }
     return delta_e_2000(xyz_to_lab(approx, white), xyz_to_lab(exact, white));
   };
   for (const auto& [light, e] : lights) {

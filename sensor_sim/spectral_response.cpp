@@ -104,9 +104,9 @@ std::array<std::vector<double>, 3> photon_response(const Bands& bands, const Cam
                                              : PiecewiseLinearSpectrum({0.0, 1e5}, {0.0, 1e5});
   std::array<std::vector<double>, 3> q;
   for (std::size_t c = 0; c < 3; ++c) {
-    q[c].resize(bands.size());
-    for (std::size_t b = 0; b < bands.size(); ++b)
-      q[c][b] = scale * integral_of_product(transmittance, camera.curves[c], weight, bands.lo(b), bands.hi(b));
+    q[c] = band_weights(bands, [&](double lo, double hi) {
+      return scale * integral_of_product(transmittance, camera.curves[c], weight, lo, hi);
+    });
   }
   return q;
 }

@@ -9,6 +9,7 @@
 #include <fmt/core.h>
 #include <fmt/format.h>
 
+#include "core/band_plan.h"
 #include "core/error.h"
 #include "core/colour.h"
 #include "core/file_io.h"
@@ -63,7 +64,6 @@ bool same_settings(const Setting& a, const Setting& b) {
          a.mode == b.mode;
 }
 
-Json bands_document(const Bands& bands) { return {{"format", "chromatrace-bands/1"}, {"edges_nm", bands.edges()}}; }
 
 // ---- Analyses compared ------------------------------------------------------------------------------------
 
@@ -289,7 +289,7 @@ StudyResult run_study(const fs::path& scene_file, const fs::path& dir, const Stu
     ro.max_bounces = s.max_bounces;
     ro.bands = s.bands;
     ro.bands_file = fs::absolute(dir / "plans" / (s.name + ".json"));
-    write_file_atomically(ro.bands_file, bands_document(s.bands).dump(2) + "\n");
+    write_file_atomically(ro.bands_file, band_plan_document(s.bands).dump(2) + "\n");
     ro.components = kComponents;
     ro.threads = options.threads;
     ro.progress = options.progress;

@@ -23,12 +23,13 @@ IDS_FILE = "ids.exr"
 
 
 def build_manifest(edges_nm, groups, variants, view_layer, total, components, object_names=None,
-                   attributes=None, replicate=False, sum_tolerance=1e-4):
+                   attributes=None, replicate=False, sum_tolerance=1e-4, reconstruction=None):
     """The manifest dict, with file paths relative to the directory the manifest is written to.
 
     groups: lists of band indices, one per render; variants: names of the renders every group has
     (components.render_variants); object_names: {id: name} when the renders carry the Object Index pass;
-    replicate: one band per render copied to R, G and B (read back from R).
+    replicate: one band per render copied to R, G and B (read back from R); reconstruction: the band plan's
+    reconstruction ({"lo_nm", "step_nm", "matrix"}), which the EXR header carries.
     """
     band_count = len(edges_nm) - 1
     bands = [None] * band_count
@@ -53,6 +54,8 @@ def build_manifest(edges_nm, groups, variants, view_layer, total, components, ob
         manifest["object_names"] = {str(i): name for i, name in sorted(object_names.items())}
     if attributes:
         manifest["attributes"] = dict(attributes)
+    if reconstruction is not None:
+        manifest["reconstruction"] = reconstruction
     return manifest
 
 

@@ -889,7 +889,8 @@ class SpectralRender:
                     names[plan.ids[ob.name]] = ob.chromatrace.scene_name or ob.name
         return manifest.build_manifest(
             plan.edges, plan.groups, list(plan.variants), plan.view_layer.name, plan.total,
-            plan.components, object_names=names, attributes=attributes, replicate=plan.replicate)
+            plan.components, object_names=names, attributes=attributes, replicate=plan.replicate,
+            reconstruction=plan.bands["bands"].get("reconstruction"))
 
     def _assemble(self, plan):
         request = self.request

@@ -385,6 +385,25 @@ TEST(SpectralExrWriter, RoundTripsBitExact) {
   EXPECT_TRUE(info.notes.empty());
 }
 
+// The bands' reconstruction travels in the header (chromatrace.bandReconstruction) and reads back the same, and the
+// colours of the file's band values then come through it (here: a matrix that puts each band's value on the fine
+// band [lo + j, lo + j + 1) of index j = band, which makes the CIE weights those of that 1 nm band).
+TEST(SpectralExrWriter, CarriesTheBandReconstruction) {
+  TempDir dir;
+  const fs::path path = dir.file("reconstructed.exr");
+  ComponentImage image = test::make_component_image(5, 4, 1);
+  const Bands& bands = image.layout.bands;
+  BandReconstruction r{500, 1, bands.size(), std::vector<double>(bands.size() * bands.size(), 0.0)};
+  for (std::size_t i = 0; i < bands.size(); ++i) r.matrix[i * bands.size() + i] = 1;
+  image.layout.bands = bands.with_reconstruction(r);
+  test::write_image(path, image, 2);
+  const SpectralExrReader reader(path);
+  EXPECT_EQ(reader.info().bands, image.layout.bands);
+  const auto w = xyz_band_weights(reader.info().bands);
+  for (std::size_t i = 0; i < bands.size(); ++i)
+    EXPECT_NEAR(w[1][i], cie::y_bar().integral(500.0 + i, 501.0 + i), 1e-12) << i;
+}
+
 TEST(SpectralExrWriter, SameInputGivesTheSameBytesWhateverTheBlocksAndThreads) {
   TempDir dir;
   const ComponentImage image = test::make_component_image(11, 23, 7);

@@ -1,15 +1,23 @@
 // Spectra and bands: Planck's law, Wien's peak, band averages and resampling against analytic answers.
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <numbers>
 #include <random>
 
+#include "core/band_plan.h"
+#include "core/colour.h"
 #include "core/error.h"
 #include "core/spectrum.h"
 
 namespace ct {
 namespace {
+
+namespace fs = std::filesystem;
 
 TEST(Planck, IntegratesToStefanBoltzmann) {
   // ∫ B(λ, T) dλ = σ T⁴ / π, with σ = 2π⁵k⁴ / (15 h³ c²) (exact in SI since 2019).
@@ -152,6 +160,74 @@ TEST(IntegralOfProduct, IsExactForLinearFactors) {
   EXPECT_NEAR(integral_of_product(f, g, 0, 10), 5.0, 1e-12);
   // ∫ (2 + 0.1x − 0.06x²)(0.5x) = ∫ x + 0.05x² − 0.03x³ = 50 + 16.6667 − 75 = −8.3333.
   EXPECT_NEAR(integral_of_product(f, g, h, 0, 10), 50.0 + 50.0 / 3.0 - 75.0, 1e-12);
+}
+
+
+// A reconstruction that gives each 1 nm fine band the value of the band it lies in is the step function itself: the
+// weights of any curve through it are the step function's, to rounding.
+TEST(BandReconstruction, TheStepFunctionAsAMatrixGivesTheStepWeights) {
+  const Bands bands = Bands::from_edges({380, 430, 520, 600, 780});
+  BandReconstruction r{380, 1, 400, {}};
+  for (std::size_t j = 0; j < r.fine; ++j)
+    for (std::size_t i = 0; i < bands.size(); ++i) r.matrix.push_back(bands.lo(i) <= 380.0 + j && 380.0 + j < bands.hi(i));
+  const Bands with = bands.with_reconstruction(r);
+  ASSERT_NE(with.reconstruction(), nullptr);
+  EXPECT_FALSE(with == bands);
+  EXPECT_EQ(with.without_reconstruction(), bands);
+  const auto step = xyz_band_weights(bands), rec = xyz_band_weights(with);
+  for (int c = 0; c < 3; ++c)
+    for (std::size_t i = 0; i < bands.size(); ++i) EXPECT_NEAR(rec[c][i], step[c][i], 1e-12 * std::abs(step[c][i]) + 1e-15);
+}
+
+// Band values through a reconstruction are its fine spectrum: the weights integrate the curve against the fine
+// values Σ_i R_ji·b_i. With a curve that is 1 on one fine band and 0 elsewhere the weights are that band's row.
+TEST(BandReconstruction, WeightsOfAFineBandsIndicatorAreItsRow) {
+  const Bands bands = Bands::from_edges({400, 500, 600, 700});
+  BandReconstruction r{400, 10, 30, {}};
+  for (std::size_t k = 0; k < r.fine * bands.size(); ++k) r.matrix.push_back(std::sin(0.7 * static_cast<double>(k)));
+  const Bands with = bands.with_reconstruction(r);
+  const std::size_t j = 17;  // [570, 580)
+  const auto w = band_weights(with, [&](double lo, double hi) { return lo >= 570 - 1e-9 && hi <= 580 + 1e-9 ? hi - lo : 0.0; });
+  for (std::size_t i = 0; i < bands.size(); ++i) EXPECT_NEAR(w[i], 10 * r.matrix[j * bands.size() + i], 1e-12);
+}
+
+TEST(BandReconstruction, BadMatricesNameTheField) {
+  const Bands bands = Bands::from_edges({400, 500, 600});
+  auto message = [&](BandReconstruction r) {
+    try {
+      bands.with_reconstruction(std::move(r), "plan.json: reconstruction");
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  EXPECT_NE(message({400, 1, 3, {1, 2, 3, 4, 5}}).find("needs 3 fine bands × 2 bands = 6"), std::string::npos);
+  EXPECT_NE(message({400, 1, 1, {1, std::nan("")}}).find("plan.json: reconstruction: matrix entry [0][1] is not finite"),
+            std::string::npos);
+  EXPECT_NE(message({400, 0, 1, {1, 2}}).find("positive start and step"), std::string::npos);
+}
+
+// The band-plan file carries the reconstruction and reads back the same; a row of the wrong length is named.
+TEST(BandReconstruction, BandPlanFileRoundTripsAndNamesABadRow) {
+  const fs::path dir = fs::temp_directory_path() / ("ct-band-plan-" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  const Bands bands = Bands::from_edges({400, 550, 700}).with_reconstruction({400, 50, 6, {1, 0, 1, 0, 1, 0, 0.5, 0.5, 0, 1, 0, 1}});
+  {
+    std::ofstream(dir / "plan.json") << band_plan_document(bands).dump(1);
+  }
+  EXPECT_EQ(read_band_plan(dir / "plan.json"), bands);
+  Json doc = band_plan_document(bands);
+  doc["reconstruction"]["matrix"][2] = Json::array({0.5});
+  {
+    std::ofstream(dir / "bad.json") << doc.dump(1);
+  }
+  try {
+    read_band_plan(dir / "bad.json");
+    ADD_FAILURE() << "accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("reconstruction.matrix[2]: 1 entries, needs one per band (2)"), std::string::npos) << e.what();
+  }
+  fs::remove_all(dir);
 }
 
 }  // namespace

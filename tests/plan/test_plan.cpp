@@ -64,6 +64,7 @@ class Plan : public ::testing::Test {
     plan::Plan plan;
     double measured = 0;  // the plan against the 5 nm reference
     double floor = 0;     // a 4 nm render against the 5 nm reference: Monte Carlo noise, little else
+    double step = 0;      // the plan's render read as a step function (no reconstruction) against the reference
   };
 
   // Plans `scene` for a mean ΔE00 of 1 and measures the plan against a 5 nm reference at the scene's bounce
@@ -82,6 +83,11 @@ class Plan : public ::testing::Test {
     const fs::path c = render(scene, Bands::uniform(lo, hi, 4.0), kmax, 1, kSpp, "floor.exr");
     out.measured = plan::measure_delta_e(a, b, scene).mean;
     out.floor = plan::measure_delta_e(c, b, scene).mean;
+    if (out.plan.bands.reconstruction()) {
+      EXPECT_EQ(SpectralExrReader(a).info().bands, out.plan.bands);  // the render carries the reconstruction
+      const fs::path d = render(scene, out.plan.bands.without_reconstruction(), out.plan.max_bounces, 1, kSpp, "step.exr");
+      out.step = plan::measure_delta_e(d, b, scene).mean;
+    }
     return out;
   }
 
@@ -90,9 +96,12 @@ class Plan : public ::testing::Test {
   void check(const Outcome& o, const Scene& scene, const std::string& what) {
     SCOPED_TRACE(what);
     std::fprintf(stderr, "%s: %zu bands (scene: %zu), max bounces %d (scene: %d), predicted %.3f, measured %.3f, "
-                 "noise floor %.3f\n",
+                 "noise floor %.3f; the same values read as a step function %.3f\n",
                  what.c_str(), o.plan.bands.size(), scene.render.bands.size(), o.plan.max_bounces,
-                 scene.render.max_bounces, o.plan.predicted_mean, o.measured, o.floor);
+                 scene.render.max_bounces, o.plan.predicted_mean, o.measured, o.floor, o.step);
+    // The plan's bands carry a reconstruction fitted to the scene; their values read without it are further off.
+    ASSERT_NE(o.plan.bands.reconstruction(), nullptr);
+    EXPECT_GT(o.step, o.measured);
     EXPECT_TRUE(o.plan.target_met);
     EXPECT_LE(o.plan.predicted_mean, 1.0);
     EXPECT_LE(o.plan.bands.size(), scene.render.bands.size() / 2);
@@ -234,6 +243,19 @@ TEST_F(Plan, CommandWritesABandFileThatRenderTakes) {
   const auto rr = run_chromatrace({"render", kCornell.string(), "-o", exr.string(), "--plan", bands.string(),
                                    "--spp", "1", "--resolution", "8x8", "--quiet"});
   ASSERT_EQ(rr.exit_code, 0) << rr.err;
+  // The band file holds the reconstruction fitted to the scene (1 nm over the scene's 400-700 nm), the report says
+  // so, and the render carries it in its header, as `info` shows.
+  ASSERT_NE(b.reconstruction(), nullptr);
+  EXPECT_EQ(b.reconstruction()->fine, 300u);
+  EXPECT_EQ(j["settings"]["reconstruction"]["fitted"], true);
+  EXPECT_EQ(SpectralExrReader(exr).info().bands, b);
+  const auto info = run_chromatrace({"info", "--check", exr.string()});
+  EXPECT_EQ(info.exit_code, 0) << info.err;
+  EXPECT_NE(info.out.find("values reconstructed into 300 bands of 1 nm from 400 nm"), std::string::npos) << info.out;
+  // Without one: the same edges as a step function.
+  const auto step = run_chromatrace({"plan", kCornell.string(), "--no-reconstruction", "--threads", "2", "--quiet"});
+  ASSERT_EQ(step.exit_code, 0) << step.err;
+  EXPECT_EQ(parse_json(step.out, "stdout")["settings"]["reconstruction"]["fitted"], false);
   // Same inputs, same bytes.
   const fs::path bands2 = dir_ / "plan2.json";
   ASSERT_EQ(run_chromatrace({"plan", kCornell.string(), "-o", bands2.string(), "--threads", "1", "--quiet"}).exit_code, 0);

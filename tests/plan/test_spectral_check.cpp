@@ -15,6 +15,7 @@
 #include "core/file_io.h"
 #include "core/json_input.h"
 #include "core/scene.h"
+#include "plan/plan.h"
 #include "plan/spectral_check.h"
 #include "tests/cli/run_command.h"
 
@@ -70,6 +71,24 @@ TEST(SpectralCheck, NarrowBandReflectanceIsNamedAsTheCause) {
   EXPECT_FALSE(it->light_is_cause);
   EXPECT_NE(it->message.find("reflectance changes faster than the bands"), std::string::npos) << it->message;
   EXPECT_TRUE(plan::check_band_plan(s, Bands::parse("380:780:1"), SpectralMode::Bands).empty());
+}
+
+// Band values read through a reconstruction are judged through it. Under F11 the 6 bands `plan` fits with a
+// reconstruction hold the lamp's and every paint's colour (nothing named), while the same edges read as a step
+// function average the lamp's three peaks away (the lamp named).
+TEST(SpectralCheck, AReconstructionIsPartOfTheBands) {
+  Json doc = read_json(kBox);
+  doc["spectra"]["lamp"] = Json{{"illuminant", "F11"}};
+  const Scene s = parse_scene(doc, "box-f11.json", kBox.parent_path());
+  plan::PlanOptions options;
+  options.threads = 2;
+  const plan::Plan p = plan::make_plan(s, options);
+  ASSERT_NE(p.bands.reconstruction(), nullptr);
+  EXPECT_TRUE(plan::check_band_plan(s, p.bands, SpectralMode::Bands).empty());
+  const auto step = plan::check_band_plan(s, p.bands.without_reconstruction(), SpectralMode::Bands);
+  ASSERT_FALSE(step.empty());
+  EXPECT_EQ(step.front().light, "ceiling_lamp");
+  EXPECT_TRUE(step.front().light_is_cause);
 }
 
 TEST(SpectralCheck, CheckSceneAndRenderSayIt) {
