@@ -102,7 +102,7 @@ def bench(light, args, work):
                                                           res=args.resolution, out=os.path.join(work, "rgb.exr"))])
     found = re.search(r"PLAIN_RENDER_SECONDS ([0-9.]+) ([0-9.]+)", plain.stdout)
     if not found:
-        sys.exit("plain RGB render printed no timing")
+        sys.exit("plain RGB render printed no timing:\n" + plain.stdout[-400:] + plain.stderr[-800:])
     plain_cpu = float(found.group(2))
 
     compare_dir = os.path.join(work, f"{light}-compare")

@@ -18,6 +18,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "core/band_plan.h"
 #include "core/scene.h"
 #include "core/spectral_exr.h"
 #include "tests/cli/run_command.h"
@@ -288,6 +289,21 @@ TEST_F(Blender, MaxBouncesZeroShowsEmittersOnly) {
     EXPECT_EQ(*std::max_element(v.begin(), v.end()), 0.0f) << c;
   }
   EXPECT_GT(*std::max_element(total.begin(), total.end()), 1.0f);  // the lamp is in view
+}
+
+// A band plan with a reconstruction (`chromatrace plan`) reaches the Cycles render's header through the assembly
+// manifest: the EXR reads back the plan's bands, reconstruction included, so its colours come through it.
+TEST_F(Blender, PlannedBandsCarryTheirReconstructionIntoTheExr) {
+  const fs::path plan = dir_.file("plan.json"), out = dir_.file("planned.exr");
+  const CommandResult p = test::run_chromatrace({"plan", kBox, "--edge-step", "5", "-o", plan.string(), "--quiet"});
+  ASSERT_EQ(p.exit_code, 0) << p.err;
+  const CommandResult r = batch({"--scene", kBox, "--out", out.string(), "--resolution", "16x16", "--samples", "2",
+                                 "--bands-file", plan.string(), "--max-bounces", "1", "--components", "none"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const Bands planned = read_band_plan(plan);
+  ASSERT_NE(planned.reconstruction(), nullptr);
+  EXPECT_EQ(SpectralExrReader(out).info().bands, planned);
+  EXPECT_EQ(test::run_chromatrace({"info", "--check", out.string()}).exit_code, 0);
 }
 
 // The regular files under `root`, recursively.

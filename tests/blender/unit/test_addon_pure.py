@@ -105,6 +105,10 @@ class Manifest(unittest.TestCase):
         replicated = manifest.build_manifest([400, 450, 500], bands.band_groups(2, 1), ["main"], "V", total, planned,
                                              replicate=True)
         self.assertEqual([b["channel"] for b in replicated["bands"]], ["R", "R"])
+        self.assertNotIn("reconstruction", m)  # a step function unless the band plan carries a reconstruction
+        fitted = {"lo_nm": 400, "step_nm": 100, "matrix": [[1, 0], [0, 1]]}
+        self.assertEqual(manifest.build_manifest([400, 450, 500], bands.band_groups(2), ["main"], "V", total, planned,
+                                                 reconstruction=fitted)["reconstruction"], fitted)
 
     def test_channels_by_file_are_what_assemble_reads(self):
         total, planned = components.component_plan({"paths", "bounces"}, [], 2)
