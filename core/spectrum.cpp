@@ -143,6 +143,10 @@ Bands Bands::with_reconstruction(BandReconstruction r, const std::string& what) 
   for (std::size_t k = 0; k < r.matrix.size(); ++k)
     if (!std::isfinite(r.matrix[k]))
       throw InputError(fmt::format("{}: matrix entry [{}][{}] is not finite", what, k / size(), k % size()));
+  // Held at float precision, as the EXR header stores it, so that a plan and the renders made with it agree.
+  for (double& m : r.matrix) m = static_cast<float>(m);
+  r.lo_nm = static_cast<float>(r.lo_nm);
+  r.step_nm = static_cast<float>(r.step_nm);
   Bands b = *this;
   b.reconstruction_ = std::make_shared<const BandReconstruction>(std::move(r));
   return b;

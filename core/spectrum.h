@@ -94,7 +94,8 @@ class Bands {
   // The reconstruction the band values carry, or null (a step function).
   const BandReconstruction* reconstruction() const { return reconstruction_.get(); }
   // The same bands with a reconstruction: its matrix must have fine × size() finite entries, its fine bands a
-  // positive step and whole-nm-scale range inside 1–100000 nm. Errors name `what`.
+  // positive start and step. Its numbers are kept at float precision, as the EXR header stores them. Errors name
+  // `what`.
   Bands with_reconstruction(BandReconstruction r, const std::string& what = "reconstruction") const;
   Bands without_reconstruction() const { return from_edges(edges_); }
   bool operator==(const Bands& o) const {

@@ -586,8 +586,8 @@ std::pair<double, double> Model::evaluate_exact(int max_bounces) const { return 
 // bounce limit (b_t their band values and a_t their exact 1 nm averages, both at unit luminance; w_t the
 // template's share of the preview's pixels), R = A·W·Bᵀ·(B·W·Bᵀ + εI)⁻¹ with a ridge ε of 10⁻⁹ of the mean
 // diagonal for bands no template tells apart. For a free matrix this minimiser is the same whatever weights the
-// wavelengths get, so the one fit serves every observer and camera. Entries are rounded to float, as the EXR
-// header stores them.
+// wavelengths get, so the one fit serves every observer and camera. Entries are rounded to float, as the bands
+// hold them (Bands::with_reconstruction), so that the prediction uses the matrix the renders carry.
 BandReconstruction Model::fit_reconstruction(const TemplateSpectra& banded, int max_bounces) const {
   const std::size_t nb = banded.front().front()[0].size(), fine = grid_.n() - 1;
   Eigen::MatrixXd g = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(nb), static_cast<Eigen::Index>(nb));

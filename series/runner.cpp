@@ -19,6 +19,7 @@
 
 #include "analyzer/analysis.h"
 #include "analyzer/output.h"
+#include "core/band_plan.h"
 #include "core/error.h"
 #include "core/file_io.h"
 #include "core/parallel.h"
@@ -73,15 +74,19 @@ Json render_inputs(const Scene& scene, const RunOptions& options) {
   document.erase("name");
   document.erase("description");
   hash_named_files(document);
-  return {{"renderer", renderer_name(options.renderer)},
+  const Bands& bands = options.bands ? *options.bands : scene.render.bands;
+  Json inputs = {{"renderer", renderer_name(options.renderer)},
           {"scene", document},
           {"width", options.width.value_or(scene.camera.width)},
           {"height", options.height.value_or(scene.camera.height)},
           {"samples", options.spp.value_or(scene.render.samples)},
           {"seed", options.seed.value_or(scene.render.seed)},
           {"max_bounces", options.max_bounces.value_or(scene.render.max_bounces)},
-          {"bands", options.bands ? options.bands->edges() : scene.render.bands.edges()},
+          {"bands", bands.edges()},
           {"components", options.components}};
+  // The reconstruction changes no pixel's band values, but the file carries it and every colour made of them.
+  if (const BandReconstruction* r = bands.reconstruction()) inputs["reconstruction"] = reconstruction_json(*r);
+  return inputs;
 }
 
 std::string render_key(const Json& inputs) { return fmt::format("{:016x}", fnv1a(inputs.dump())); }

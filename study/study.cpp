@@ -404,6 +404,7 @@ Json result_json(const StudyResult& result) {
                 {"renderer", renderer_label(s.renderer)},
                 {"bands", s.bands.edges()},
                 {"band_count", s.bands.size()},
+                {"reconstruction", s.bands.reconstruction() != nullptr},
                 {"samples", s.samples},
                 {"max_bounces", s.max_bounces},
                 {"spectral_mode", s.mode}};

@@ -291,6 +291,13 @@ TEST_F(Plan, SeriesTakesThePlan) {
   const Json plain = run({});
   EXPECT_NE(plain["key"], planned["key"]);
   EXPECT_EQ(SpectralExrReader(out / plain["file"].get<std::string>()).info().bands.size(), 40u);
+  // The same edges with a reconstruction are another render: its file carries the reconstruction.
+  const fs::path fitted = dir_ / "fitted.json";
+  BandReconstruction r{380, 400, 1, {0.1, 0.2, 0.3, 0.4, 0.5, 0.6}};
+  write_file_atomically(fitted, band_plan_document(read_band_plan(bands).with_reconstruction(r)).dump());
+  const Json reconstructed = run({"--plan", fitted.string(), "--max-bounces", "2"});
+  EXPECT_NE(reconstructed["key"], planned["key"]);
+  EXPECT_EQ(SpectralExrReader(out / reconstructed["file"].get<std::string>()).info().bands, read_band_plan(fitted));
 }
 
 TEST_F(Plan, BadInputGetsExitTwoAndOneLineNamingTheField) {
