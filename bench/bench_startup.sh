@@ -1,7 +1,10 @@
 #!/usr/bin/env bash
 # Start-up cost: wall time and peak memory (max RSS, from /usr/bin/time) of `chromatrace --help` and of
-# `chromatrace check-scene` on the minimal scene, against /bin/true (the cost of starting any process) and
-# `oiiotool --help` (a tool built on the same image libraries). The best of N runs of each (default 10).
+# `chromatrace check-scene` on the minimal scene (both run by the front executable), against /bin/true (the cost
+# of starting any process) and `oiiotool --help` (a tool built on the same image libraries); and of
+# `chromatrace render --help`, which the front hands to the full program (what every other command pays before
+# its work). The best of N runs of each (default 10). The shared libraries each executable loads, from the
+# loader's report (LD_DEBUG=files: each library it maps, once per executable started).
 #   bench/bench_startup.sh [BUILD_DIR] [N]
 set -euo pipefail
 source_dir="$(cd "$(dirname "$0")/.." && pwd)"
@@ -29,4 +32,7 @@ measure "/bin/true" /bin/true
 measure "oiiotool --help" oiiotool --help
 measure "chromatrace --help" "$exe" --help
 measure "chromatrace check-scene minimal" "$exe" check-scene "$scene"
-echo "shared libraries chromatrace loads: $(ldd "$exe" | wc -l)"
+measure "chromatrace render --help" "$exe" render --help
+loaded() { LD_DEBUG=files "$@" 2>&1 >/dev/null | grep -c "generating link map" || true; }
+echo "shared libraries loaded: --help $(loaded "$exe" --help), check-scene $(loaded "$exe" check-scene "$scene")," \
+  "render --help $(loaded "$exe" render --help)"
