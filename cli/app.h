@@ -3,8 +3,8 @@
 // app, the list of subcommands with their descriptions, the handling of parse errors and of an action's errors.
 //
 // `chromatrace` (cli/front.cpp) is small: it runs --help, --version and check-scene itself and hands every other
-// command line to the full program (cli/main.cpp, installed as libexec/chromatrace/chromatrace), which holds every
-// subcommand and the image libraries they need (README.md, "The `chromatrace` command"; bench/README.md,
+// command line to the full program (cli/main.cpp, installed as libexec/chromatrace/chromatrace-full), which holds
+// every subcommand and the image libraries they need (README.md, "The `chromatrace` command"; bench/README.md,
 // "Start-up").
 
 #include <optional>

@@ -1,5 +1,5 @@
-// The full chromatrace program: every subcommand. Installed as libexec/chromatrace/chromatrace and started by the
-// `chromatrace` front (cli/front.cpp) with the user's command line unchanged; cli/app.h says why there are two.
+// The full chromatrace program: every subcommand. Installed as libexec/chromatrace/chromatrace-full and started by
+// the `chromatrace` front (cli/front.cpp) with the user's command line unchanged; cli/app.h says why there are two.
 #include <map>
 #include <string_view>
 #include <utility>
