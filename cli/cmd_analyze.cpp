@@ -9,6 +9,7 @@
 
 #include "analyzer/analysis.h"
 #include "analyzer/output.h"
+#include "cli/app.h"
 #include "cli/command.h"
 #include "core/error.h"
 #include "core/file_io.h"
@@ -41,7 +42,7 @@ void check_output(const std::filesystem::path& dir, const std::string& image, co
 }  // namespace
 
 Action add_analyze(CLI::App& app) {
-  auto* cmd = app.add_subcommand("analyze", "Analyse the colour histograms of image regions: shapes, illuminant, light paths");
+  auto* cmd = add_command(app, "analyze");
   struct Options {
     std::string image, output, layer, illuminant, input_transfer = "auto";
     analyzer::RegionOptions regions;

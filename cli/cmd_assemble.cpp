@@ -5,6 +5,7 @@
 
 #include <fmt/core.h>
 
+#include "cli/app.h"
 #include "cli/command.h"
 #include "core/assembly.h"
 #include "core/error.h"
@@ -15,8 +16,7 @@
 namespace ct::cli {
 
 Action add_assemble(CLI::App& app) {
-  auto* cmd = app.add_subcommand(
-      "assemble", "Build a spectral EXR from band-multiplexed RGB renders listed in a manifest (chromatrace-assemble/1)");
+  auto* cmd = add_command(app, "assemble");
   struct Options {
     std::string manifest, output;
     int threads = 0;

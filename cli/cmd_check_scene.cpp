@@ -9,6 +9,7 @@
 #include <fmt/core.h>
 #include <fmt/format.h>
 
+#include "cli/app.h"
 #include "cli/command.h"
 #include "core/error.h"
 #include "core/file_io.h"
@@ -230,9 +231,7 @@ int check(const Options& options) {
 
 Action add_check_scene(CLI::App& app) {
   auto options = std::make_shared<Options>();
-  CLI::App* command = app.add_subcommand(
-      "check-scene",
-      "Validate a scene (chromatrace-scene/1) or an experiment series (chromatrace-series/1) and summarise it");
+  CLI::App* command = add_command(app, "check-scene");
   command->add_option("file", options->file, "scene or series JSON file")->required();
   command->add_flag("--json", options->json, "print the summary as JSON");
   command->add_flag("-q,--quiet", options->quiet, "print nothing when the file is valid (errors still go to stderr)");

@@ -3,6 +3,7 @@
 #include <filesystem>
 #include <vector>
 
+#include "cli/app.h"
 #include "cli/command.h"
 #include "core/error.h"
 #include "core/file_io.h"
@@ -13,8 +14,7 @@
 namespace ct::cli {
 
 Action add_combine(CLI::App& app) {
-  auto* cmd = app.add_subcommand(
-      "combine", "Combine reference-tracer renders of one scene with different seeds, weighted by their samples");
+  auto* cmd = add_command(app, "combine");
   struct Options {
     std::vector<std::string> parts;
     std::string output;

@@ -6,6 +6,7 @@
 
 #include <fmt/core.h>
 
+#include "cli/app.h"
 #include "cli/command.h"
 #include "compare/compare.h"
 #include "core/error.h"
@@ -47,8 +48,7 @@ double parse_tolerance(const std::string& text) {
 }  // namespace
 
 Action add_compare(CLI::App& app) {
-  auto* cmd = app.add_subcommand(
-      "compare", "Cross-validate two spectral renders of one scene: per object, band and component, and ΔE00");
+  auto* cmd = add_command(app, "compare");
   struct Options {
     std::string a, b, output, tolerance, pixels = "matched", camera = "cie1931", colour = "common";
     double sigmas = 4.0;

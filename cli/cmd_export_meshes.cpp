@@ -9,6 +9,7 @@
 
 #include <fmt/core.h>
 
+#include "cli/app.h"
 #include "cli/command.h"
 #include "core/error.h"
 #include "core/file_io.h"
@@ -87,9 +88,7 @@ int run(const Options& o) {
 
 Action add_export_meshes(CLI::App& app) {
   auto o = std::make_shared<Options>();
-  auto* cmd = app.add_subcommand("export-meshes",
-                                 "Write every object and light of a scene as a world-space PLY mesh (with normals "
-                                 "where shading is smooth), tessellated as the reference tracer does");
+  auto* cmd = add_command(app, "export-meshes");
   cmd->add_option("scene", o->scene, "Scene file (chromatrace-scene/1)")->required();
   cmd->add_option("directory", o->directory, "Output directory (created if missing; its parent must exist)")->required();
   cmd->add_flag("--ascii", o->ascii, "Write ASCII PLY instead of binary little-endian");

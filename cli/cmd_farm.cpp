@@ -8,6 +8,7 @@
 
 #include <fmt/core.h>
 
+#include "cli/app.h"
 #include "cli/command.h"
 #include "cli/options.h"
 #include "cli/series_options.h"
@@ -317,7 +318,7 @@ int run_series_farm(SeriesFarmOptions& o) {
 }  // namespace
 
 Action add_farm(CLI::App& app) {
-  auto* cmd = app.add_subcommand("farm", "Split work into Slurm jobs on a cluster: tasks in a job array, then an assembly");
+  auto* cmd = add_command(app, "farm");
   cmd->require_subcommand(1);
   auto render = std::make_shared<RenderOptions>();
   auto* render_cmd = add_render(cmd, *render);

@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "analyzer/raw_input.h"
+#include "cli/app.h"
 #include "cli/command.h"
 #include "core/error.h"
 #include "core/parallel.h"
@@ -293,8 +294,7 @@ int run_info(const InfoOptions& options) {
 
 Action add_info(CLI::App& app) {
   auto options = std::make_shared<InfoOptions>();
-  CLI::App* sub = app.add_subcommand(
-      "info", "Describe an image: kind, size, bands, layers, components, object ids, metadata, per-band statistics");
+  CLI::App* sub = add_command(app, "info");
   sub->add_option("file", options->file, "OpenEXR file (spectral or not), or a camera raw (DNG, CR2, NEF, …)")->required();
   sub->add_flag("--json", options->json, "Print one JSON object instead of text");
   sub->add_flag("--check", options->check,

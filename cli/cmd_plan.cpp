@@ -4,6 +4,7 @@
 
 #include <fmt/core.h>
 
+#include "cli/app.h"
 #include "cli/command.h"
 #include "core/error.h"
 #include "core/file_io.h"
@@ -13,7 +14,7 @@
 namespace ct::cli {
 
 Action add_plan(CLI::App& app) {
-  auto* cmd = app.add_subcommand("plan", "Choose the fewest bands and bounces that keep a scene within a ΔE00 target");
+  auto* cmd = add_command(app, "plan");
   struct Options {
     std::string scene, output, report, renderer = "cycles";
     plan::PlanOptions plan;

@@ -8,6 +8,7 @@
 
 #include <fmt/core.h>
 
+#include "cli/app.h"
 #include "cli/command.h"
 #include "core/band_plan.h"
 #include "core/error.h"
@@ -101,10 +102,7 @@ int run(const Options& o) {
 
 Action add_prepare_texture(CLI::App& app) {
   auto o = std::make_shared<Options>();
-  auto* cmd = app.add_subcommand(
-      "prepare-texture",
-      "Per-band-group EXR textures (R, G, B = band averages of each texel's spectrum) of an image texture or HDRI, "
-      "for Cycles through the Blender add-on; cached by content");
+  auto* cmd = add_command(app, "prepare-texture");
   cmd->add_option("image", o->image, "image texture or HDRI (any format OpenImageIO reads)")->required();
   cmd->add_option("--bands", o->bands, "Band plan lo:hi:width in nm");
   cmd->add_option("--bands-file", o->bands_file, "Band plan file (chromatrace-bands/1: {\"edges_nm\": [...]})");

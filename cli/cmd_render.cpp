@@ -5,6 +5,7 @@
 
 #include <fmt/core.h>
 
+#include "cli/app.h"
 #include "cli/command.h"
 #include "cli/options.h"
 #include "core/band_plan.h"
@@ -21,7 +22,7 @@ namespace ct::cli {
 namespace fs = std::filesystem;
 
 Action add_render(CLI::App& app) {
-  auto* cmd = app.add_subcommand("render", "Render a scene with the reference spectral path tracer");
+  auto* cmd = add_command(app, "render");
   struct Options {
     std::string scene, output, bands, plan, mode, resolution, components = "paths,lights";
     std::optional<int> spp, max_bounces, seeds, part;

@@ -11,6 +11,7 @@
 #include <fmt/core.h>
 #include <fmt/format.h>
 
+#include "cli/app.h"
 #include "cli/command.h"
 #include "core/band_plan.h"
 #include "core/error.h"
@@ -152,9 +153,7 @@ int run(const Options& o) {
 
 Action add_scene_bands(CLI::App& app) {
   auto o = std::make_shared<Options>();
-  auto* cmd = app.add_subcommand(
-      "scene-bands",
-      "Band averages of the spectra, materials and lights of a scene (or of a chromatrace-spectra/1 list)");
+  auto* cmd = add_command(app, "scene-bands");
   cmd->add_option("file", o->file, "scene (chromatrace-scene/1) or spectra list (chromatrace-spectra/1)")->required();
   cmd->add_option("--bands", o->bands, "Band plan lo:hi:width in nm (default: the scene's render.bands, else 380:780:10)");
   cmd->add_option("--bands-file", o->bands_file, "Band plan file (chromatrace-bands/1: {\"edges_nm\": [...]})");

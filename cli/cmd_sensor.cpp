@@ -9,6 +9,7 @@
 
 #include <fmt/core.h>
 
+#include "cli/app.h"
 #include "cli/command.h"
 #include "core/error.h"
 #include "core/parallel.h"
@@ -124,7 +125,7 @@ int run(const Options& o) {
 }  // namespace
 
 Action add_sensor(CLI::App& app) {
-  auto* cmd = app.add_subcommand("sensor", "Simulate a camera: spectral radiance to the numbers a sensor records");
+  auto* cmd = add_command(app, "sensor");
   auto o = std::make_shared<Options>();
   cmd->add_option("input", o->input, "Spectral EXR (emitted radiance, S0 channels; or reflectance with --illuminant)");
   cmd->add_option("-o,--output", o->output,

@@ -13,6 +13,7 @@
 #include <fmt/core.h>
 #include <fmt/format.h>
 
+#include "cli/app.h"
 #include "cli/command.h"
 #include "cli/options.h"
 #include "cli/series_options.h"
@@ -120,8 +121,7 @@ int run(const Options& o, const fs::path& series_file) {
 }  // namespace
 
 Action add_series(CLI::App& app) {
-  auto* cmd = app.add_subcommand("series", "Run an experiment series end to end: render, camera and analysis per "
-                                            "variant, found vs expected structures, a figure page");
+  auto* cmd = add_command(app, "series");
   auto o = std::make_shared<Options>();
   cmd->add_option("series", o->series, "Series file (chromatrace-series/1)")->required();
   add_common(cmd, *o);
@@ -129,8 +129,7 @@ Action add_series(CLI::App& app) {
 }
 
 Action add_paper(CLI::App& app) {
-  auto* cmd = app.add_subcommand("paper", "Reproduce the paper's Figures 3 and 4: its experiment series, shipped "
-                                           "with chromatrace, at 128x128 pixels unless told otherwise");
+  auto* cmd = add_command(app, "paper");
   auto o = std::make_shared<Options>();
   add_common(cmd, *o);
   return [o] {

@@ -8,6 +8,7 @@
 
 #include <fmt/core.h>
 
+#include "cli/app.h"
 #include "cli/command.h"
 #include "cli/options.h"
 #include "core/error.h"
@@ -97,8 +98,7 @@ void print_summary(const study::StudyResult& result, const fs::path& dir) {
 }  // namespace
 
 Action add_study(CLI::App& app) {
-  auto* cmd = app.add_subcommand("study", "Measure render cost against error for band plans, samples, bounces, "
-                                           "spectral mode and renderer, against a converged reference");
+  auto* cmd = add_command(app, "study");
   auto o = std::make_shared<Options>();
   cmd->add_option("scene", o->scene, "Scene file (chromatrace-scene/1)")->required();
   cmd->add_option("-o,--output", o->output, "Output directory (created; its parent must exist)")->required();

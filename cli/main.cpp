@@ -1,66 +1,33 @@
-// chromatrace: explains colour-histogram structure by simulating image formation.
-#include <cstdio>
-#include <exception>
-#include <string>
+// The full chromatrace program: every subcommand. Installed as libexec/chromatrace/chromatrace-full and started by
+// the `chromatrace` front (cli/front.cpp) with the user's command line unchanged; cli/app.h says why there are two.
+#include <map>
+#include <string_view>
 #include <utility>
 #include <vector>
 
-#include <fmt/core.h>
-
+#include "cli/app.h"
 #include "cli/command.h"
-#include "core/error.h"
 
 int main(int argc, char** argv) {
-  CLI::App app{"chromatrace: simulate how an image was made and explain its colour histogram"};
-  app.require_subcommand(1);
-  app.set_version_flag("--version", "chromatrace 0.1.0");
-
-  std::vector<std::pair<CLI::App*, ct::cli::Action>> commands;
-  // Each add_* creates one subcommand; pair it with its action (the filter lists all, not just parsed ones).
-  auto add = [&](ct::cli::Action action) {
-    commands.emplace_back(app.get_subcommands([](CLI::App*) { return true; }).back(), std::move(action));
+  using namespace ct::cli;
+  const std::map<std::string_view, Action (*)(CLI::App&)> add = {
+      {"info", add_info},         {"check-scene", add_check_scene},
+      {"render", add_render},     {"analyze", add_analyze},
+      {"sensor", add_sensor},     {"series", add_series},
+      {"paper", add_paper},       {"plan", add_plan},
+      {"study", add_study},       {"scene-bands", add_scene_bands},
+      {"export-meshes", add_export_meshes}, {"assemble", add_assemble},
+      {"combine", add_combine},   {"farm", add_farm},
+      {"compare", add_compare},   {"prepare-texture", add_prepare_texture},
   };
-  add(ct::cli::add_info(app));
-  add(ct::cli::add_check_scene(app));
-  add(ct::cli::add_render(app));
-  add(ct::cli::add_analyze(app));
-  add(ct::cli::add_sensor(app));
-  add(ct::cli::add_series(app));
-  add(ct::cli::add_paper(app));
-  add(ct::cli::add_plan(app));
-  add(ct::cli::add_study(app));
-  add(ct::cli::add_scene_bands(app));
-  add(ct::cli::add_export_meshes(app));
-  add(ct::cli::add_assemble(app));
-  add(ct::cli::add_combine(app));
-  add(ct::cli::add_farm(app));
-  add(ct::cli::add_compare(app));
-  add(ct::cli::add_prepare_texture(app));
-
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::CallForHelp& e) {
-    return app.exit(e);
-  } catch (const CLI::CallForAllHelp& e) {
-    return app.exit(e);
-  } catch (const CLI::CallForVersion& e) {
-    return app.exit(e);
-  } catch (const CLI::ParseError& e) {
-    fmt::print(stderr, "chromatrace: error: {}\n", e.what());
-    return 2;
+  CLI::App app{kAppDescription};
+  setup_app(app);
+  std::vector<std::pair<CLI::App*, Action>> commands;
+  // Each add_* creates one subcommand (the last one of the app); pair it with its action.
+  for (const CommandInfo& c : command_list()) {
+    Action action = add.at(c.name)(app);
+    commands.emplace_back(app.get_subcommands([](CLI::App*) { return true; }).back(), std::move(action));
   }
-
-  for (auto& [sub, action] : commands) {
-    if (!sub->parsed()) continue;
-    try {
-      return action();
-    } catch (const ct::InputError& e) {
-      fmt::print(stderr, "chromatrace {}: error: {}\n", sub->get_name(), e.what());
-      return 2;
-    } catch (const std::exception& e) {
-      fmt::print(stderr, "chromatrace {}: failed: {}\n", sub->get_name(), e.what());
-      return 1;
-    }
-  }
-  return 2;
+  if (const auto code = parse_command_line(app, argc, argv)) return *code;
+  return run_parsed(commands);
 }

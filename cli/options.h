@@ -11,7 +11,9 @@ namespace ct::cli {
 // "WxH" with positive integers (e.g. "64x48"): {W, H}; InputError naming `option` otherwise.
 std::pair<int, int> parse_resolution(const std::string& text, std::string_view option = "--resolution");
 
-// The running chromatrace executable (/proc/self/exe), or "chromatrace" where that cannot be read.
+// The `chromatrace` command as the commands it starts must call it: the front executable the full program was
+// started by ($CHROMATRACE_FRONT, set by cli/front.cpp), else the running executable (/proc/self/exe), else
+// "chromatrace" where that cannot be read.
 std::filesystem::path own_executable();
 
 // A file shipped with chromatrace: installed beside the executable (../share/chromatrace/...), else in the

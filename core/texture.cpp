@@ -3,25 +3,16 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
-#include <memory>
 #include <unordered_map>
 
-#include <OpenImageIO/imageio.h>
 #include <fmt/core.h>
 
 #include "core/colour.h"
 #include "core/error.h"
-#include "core/limits.h"
 #include "core/parallel.h"
 
 namespace ct {
 namespace {
-
-std::string one_line(std::string text) {
-  std::replace(text.begin(), text.end(), '\n', ' ');
-  while (!text.empty() && text.back() == ' ') text.pop_back();
-  return text;
-}
 
 // Index of wrapping t·n into [0, n).
 std::size_t wrapped_cell(double t, int n) {
@@ -30,86 +21,13 @@ std::size_t wrapped_cell(double t, int n) {
   return static_cast<std::size_t>(std::min(cell, n - 1.0));
 }
 
-std::unique_ptr<OIIO::ImageInput> open_image(const std::filesystem::path& path) {
-  const std::string name = path.string();
-  if (!std::filesystem::is_regular_file(path)) throw InputError(fmt::format("{}: no such image file", name));
-  auto in = OIIO::ImageInput::open(name);
-  if (!in) {
-    const std::string why = one_line(OIIO::geterror());
-    throw InputError(fmt::format("{}: cannot read image: {}", name, why.empty() ? "unknown format" : why));
-  }
-  const OIIO::ImageSpec& spec = in->spec();
-  if (spec.width < 1 || spec.height < 1 || spec.nchannels < 1)
-    throw InputError(fmt::format("{}: image has no pixels", name));
-  check_image_size(name, spec.width, spec.height, spec.nchannels);
-  return in;
-}
-
-bool is_float_image(const OIIO::ImageSpec& spec) {
-  return spec.format.basetype == OIIO::TypeDesc::FLOAT || spec.format.basetype == OIIO::TypeDesc::HALF ||
-         spec.format.basetype == OIIO::TypeDesc::DOUBLE;
-}
-
 }  // namespace
-
-TextureColourSpace default_texture_colour_space(const std::filesystem::path& path) {
-  return is_float_image(open_image(path)->spec()) ? TextureColourSpace::Linear : TextureColourSpace::Srgb;
-}
 
 std::size_t ImageTexture::texel_at(double u, double v) const {
   // v runs up from the bottom row; image rows are stored from the top.
   const std::size_t x = wrapped_cell(u, width);
   const std::size_t y = static_cast<std::size_t>(height) - 1 - wrapped_cell(v, height);
   return y * static_cast<std::size_t>(width) + x;
-}
-
-ImageTexture read_image_texture(const std::filesystem::path& path, const std::string& file,
-                                std::optional<TextureColourSpace> colour_space, TextureUse use, double scale) {
-  const std::string name = path.string();
-  auto in = open_image(path);
-  const OIIO::ImageSpec& spec = in->spec();
-  const bool is_float = is_float_image(spec);
-  ImageTexture texture;
-  texture.file = file;
-  texture.colour_space = colour_space.value_or(is_float ? TextureColourSpace::Linear : TextureColourSpace::Srgb);
-  texture.use = use;
-  texture.scale = scale;
-  texture.width = spec.width;
-  texture.had_alpha = spec.alpha_channel >= 0 || spec.nchannels == 2 || spec.nchannels >= 4;
-  texture.height = spec.height;
-
-  const int channels = spec.nchannels;
-  std::vector<float> pixels(texture.texel_count() * static_cast<std::size_t>(channels));
-  if (!in->read_image(0, 0, 0, channels, OIIO::TypeDesc::FLOAT, pixels.data()))
-    throw InputError(fmt::format("{}: cannot read pixels: {}", name, one_line(in->geterror())));
-  // R, G, B by name when the image names them so; otherwise the first channels (one: grey; two: grey, alpha).
-  std::array<int, 3> source = {0, 0, 0};
-  const auto named = [&](const char* c) {
-    const auto it = std::find(spec.channelnames.begin(), spec.channelnames.end(), c);
-    return it == spec.channelnames.end() ? -1 : static_cast<int>(it - spec.channelnames.begin());
-  };
-  if (named("R") >= 0 && named("G") >= 0 && named("B") >= 0) source = {named("R"), named("G"), named("B")};
-  else if (channels >= 3) source = {0, 1, 2};
-
-  texture.rgb.resize(texture.texel_count() * 3);
-  for (std::size_t t = 0; t < texture.texel_count(); ++t) {
-    for (int c = 0; c < 3; ++c) {
-      double value = pixels[t * static_cast<std::size_t>(channels) + static_cast<std::size_t>(source[c])];
-      const std::size_t x = t % static_cast<std::size_t>(texture.width), y = t / static_cast<std::size_t>(texture.width);
-      if (!std::isfinite(value))
-        throw InputError(fmt::format("{}: texel ({}, {}) (x from the left, y from the top) is not finite", name, x, y));
-      if (value < 0.0)
-        throw InputError(fmt::format("{}: texel ({}, {}) (x from the left, y from the top) has the negative value {}",
-                                     name, x, y, value));
-      if (texture.colour_space == TextureColourSpace::Srgb) value = srgb_decode(value);
-      if (use == TextureUse::Reflectance && value > 1.0)
-        throw InputError(fmt::format("{}: texel ({}, {}) (x from the left, y from the top) reaches {} in linear sRGB, "
-                                     "but a reflectance must be in [0, 1]",
-                                     name, x, y, value));
-      texture.rgb[3 * t + static_cast<std::size_t>(c)] = static_cast<float>(value);
-    }
-  }
-  return texture;
 }
 
 ScaledSigmoid texel_spectrum(const std::array<double, 3>& linear_srgb, TextureUse use) {

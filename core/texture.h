@@ -42,6 +42,10 @@ struct ImageTexture {
   std::size_t texel_at(double u, double v) const;
 };
 
+// Reading an image (read_image_texture, default_texture_colour_space) is core/texture_io.cpp, the one part of
+// textures that needs OpenImageIO: it is the library chromatrace_texture_io, which chromatrace_scene's users get
+// unless they define these two functions themselves (the chromatrace front executable does: cli/front.cpp).
+//
 // Reads an image with OpenImageIO (any format it reads: PNG, JPEG, TIFF, EXR, HDR, ...): one channel is grey,
 // two grey and alpha, three or more RGB(A); alpha is ignored. `colour_space` unset: linear for float images
 // (EXR, HDR), sRGB for integer ones (8- or 16-bit PNG, JPEG, TIFF). sRGB texels are decoded with the sRGB

@@ -105,6 +105,12 @@ Json report_document(const Plan& plan, const Scene& scene, const PlanOptions& op
 // uniform environment by 4π·R², R the scene's bounding radius), as a 1 nm table.
 PiecewiseLinearSpectrum scene_light_spectrum(const Scene& scene);
 
+// The q-quantile of v (nearest rank), 0 for none.
+double percentile(std::vector<double> v, double q);
+// Whether pixel p of a w × h id image or one of its 8 neighbours shows a light (an id >= first_light): with a box
+// pixel filter such a pixel may hold light from the emitter itself, so it does not set the white.
+bool near_light(const std::vector<std::int32_t>& ids, int w, int h, std::size_t p, std::int32_t first_light);
+
 struct Measurement {
   double mean = 0, p95 = 0, max = 0;
   double rms = 0;  // root mean square: independent errors add in it as squares (to first order)

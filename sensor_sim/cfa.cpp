@@ -72,8 +72,6 @@ RowRange demosaic_context(int y0, int y1, int height) {
   return r;
 }
 
-int demosaic_max_bits(DemosaicMethod method) { return method == DemosaicMethod::Vng ? 8 : 16; }
-
 void demosaic(std::span<const float> mosaic, int width, int rows, int y0, BayerPattern pattern, DemosaicMethod method,
               int bits, std::span<float> rgb) {
   const std::size_t pixels = static_cast<std::size_t>(width) * static_cast<std::size_t>(rows);

@@ -24,9 +24,6 @@ struct RowRange {
 };
 RowRange demosaic_context(int y0, int y1, int height);
 
-// The largest ADC resolution a method accepts.
-int demosaic_max_bits(DemosaicMethod method);
-
 // Demosaics `rows` rows of a width-wide mosaic of whole digital numbers in [0, 2^bits − 1] whose first row
 // is image row `y0` (its parity fixes where the pattern starts). `rgb` receives rows·width·3 values.
 void demosaic(std::span<const float> mosaic, int width, int rows, int y0, BayerPattern pattern, DemosaicMethod method,

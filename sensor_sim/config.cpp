@@ -13,7 +13,6 @@
 #include "core/cie.h"
 #include "core/csv.h"
 #include "core/error.h"
-#include "sensor_sim/cfa.h"
 
 namespace ct::sensor {
 namespace {
@@ -331,6 +330,7 @@ SensorConfig read_settings(const JsonNode& root) {
 
 std::string_view pattern_name(BayerPattern pattern) { return name_of(pattern, kPatterns); }
 std::string_view demosaic_name(DemosaicMethod method) { return name_of(method, kDemosaic); }
+int demosaic_max_bits(DemosaicMethod method) { return method == DemosaicMethod::Vng ? 8 : 16; }
 
 std::optional<double> saturation_electrons(const SensorConfig& config) {
   std::optional<double> limit;

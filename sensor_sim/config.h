@@ -191,5 +191,7 @@ Json config_json(const SensorConfig& config);
 // "RGGB", "bilinear", "gamma", … as the JSON spells them.
 std::string_view pattern_name(BayerPattern pattern);
 std::string_view demosaic_name(DemosaicMethod method);
+// The largest ADC resolution a demosaicing method accepts (OpenCV's, sensor_sim/cfa.h).
+int demosaic_max_bits(DemosaicMethod method);
 
 }  // namespace ct::sensor

@@ -9,11 +9,16 @@ trap 'rm -rf "$prefix"' EXIT
 cmake --install "$build_dir" --prefix "$prefix" > /dev/null
 fail() { echo "install: $*" >&2; exit 1; }
 [ -x "$prefix/bin/chromatrace" ] || fail "bin/chromatrace missing"
+[ -x "$prefix/libexec/chromatrace/chromatrace-full" ] || fail "libexec/chromatrace/chromatrace-full missing"
 [ -f "$prefix/share/chromatrace/data/cie1931_2deg_1nm.csv" ] || fail "share/chromatrace/data missing"
 [ -f "$prefix/share/chromatrace/data/README.md" ] || fail "data README (sources, licences) missing"
 [ -f "$prefix/share/chromatrace/scenes/paper/box.json" ] || fail "scenes missing"
 [ -f "$prefix/share/doc/chromatrace/README.md" ] || fail "docs missing"
 "$prefix/bin/chromatrace" --version | grep -q '^chromatrace ' || fail "installed command does not run"
+# --help starts without the image libraries; a command handed to the full program finds it and loads them.
+oiio_loaded() { LD_DEBUG=files "$prefix/bin/chromatrace" "$@" 2>&1 >/dev/null | grep 'libOpenImageIO.*link map' >/dev/null; }
+! oiio_loaded --help || fail "installed chromatrace --help loads OpenImageIO"
+oiio_loaded render --help || fail "installed chromatrace render --help does not reach the full program"
 "$prefix/bin/chromatrace" check-scene --quiet "$prefix/share/chromatrace/scenes/paper/box.json" \
   || fail "installed scene does not validate"
 # `paper` runs the series installed with the command, not one in a source tree.

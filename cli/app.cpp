@@ -1,0 +1,93 @@
+#include "cli/app.h"
+
+#include <array>
+#include <cstdio>
+#include <exception>
+#include <stdexcept>
+#include <string>
+
+#include <fmt/core.h>
+
+#include "core/error.h"
+
+namespace ct::cli {
+
+std::span<const CommandInfo> command_list() {
+  static constexpr std::array<CommandInfo, 16> kCommands = {{
+      {"info", "Describe an image: kind, size, bands, layers, components, object ids, metadata, per-band statistics"},
+      {"check-scene",
+       "Validate a scene (chromatrace-scene/1) or an experiment series (chromatrace-series/1) and summarise it"},
+      {"render", "Render a scene with the reference spectral path tracer"},
+      {"analyze", "Analyse the colour histograms of image regions: shapes, illuminant, light paths"},
+      {"sensor", "Simulate a camera: spectral radiance to the numbers a sensor records"},
+      {"series",
+       "Run an experiment series end to end: render, camera and analysis per variant, found vs expected structures, a "
+       "figure page"},
+      {"paper",
+       "Reproduce the paper's Figures 3 and 4: its experiment series, shipped with chromatrace, at 128x128 pixels "
+       "unless told otherwise"},
+      {"plan", "Choose the fewest bands and bounces that keep a scene within a ΔE00 target"},
+      {"study",
+       "Measure render cost against error for band plans, samples, bounces, spectral mode and renderer, against a "
+       "converged reference"},
+      {"scene-bands",
+       "Band averages of the spectra, materials and lights of a scene (or of a chromatrace-spectra/1 list)"},
+      {"export-meshes",
+       "Write every object and light of a scene as a world-space PLY mesh (with normals where shading is smooth), "
+       "tessellated as the reference tracer does"},
+      {"assemble",
+       "Build a spectral EXR from band-multiplexed RGB renders listed in a manifest (chromatrace-assemble/1)"},
+      {"combine", "Combine reference-tracer renders of one scene with different seeds, weighted by their samples"},
+      {"farm", "Split work into Slurm jobs on a cluster: tasks in a job array, then an assembly"},
+      {"compare", "Cross-validate two spectral renders of one scene: per object, band and component, and ΔE00"},
+      {"prepare-texture",
+       "Per-band-group EXR textures (R, G, B = band averages of each texel's spectrum) of an image texture or HDRI, "
+       "for Cycles through the Blender add-on; cached by content"},
+  }};
+  return kCommands;
+}
+
+void setup_app(CLI::App& app) {
+  app.require_subcommand(1);
+  app.set_version_flag("--version", "chromatrace 0.1.0");
+}
+
+CLI::App* add_command(CLI::App& app, std::string_view name) {
+  for (const CommandInfo& c : command_list())
+    if (c.name == name) return app.add_subcommand(std::string(c.name), std::string(c.description));
+  throw std::logic_error(fmt::format("add_command: no subcommand {}", name));
+}
+
+std::optional<int> parse_command_line(CLI::App& app, int argc, char** argv) {
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForVersion& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    fmt::print(stderr, "chromatrace: error: {}\n", e.what());
+    return 2;
+  }
+  return std::nullopt;
+}
+
+int run_parsed(const std::vector<std::pair<CLI::App*, Action>>& commands) {
+  for (const auto& [sub, action] : commands) {
+    if (!sub->parsed()) continue;
+    try {
+      return action();
+    } catch (const ct::InputError& e) {
+      fmt::print(stderr, "chromatrace {}: error: {}\n", sub->get_name(), e.what());
+      return 2;
+    } catch (const std::exception& e) {
+      fmt::print(stderr, "chromatrace {}: failed: {}\n", sub->get_name(), e.what());
+      return 1;
+    }
+  }
+  return 2;
+}
+
+}  // namespace ct::cli
