@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -40,7 +41,7 @@ cv::Scalar colour_of(const std::string& knob) {
 std::string short_label(const Setting& s) {
   if (s.knob == "base") return "base";
   if (s.knob == "bands") return fmt::format("{} bands", s.bands.size());
-  if (s.knob == "fitted") return fmt::format("{} fitted", s.bands.size());
+  if (s.knob == "fitted") return s.value;  // "4 fitted for 1": plans for different targets may share a count
   if (s.knob == "samples") return fmt::format("{} spp", s.samples);
   if (s.knob == "bounces") return fmt::format("{} bounce{}", s.max_bounces, s.max_bounces == 1 ? "" : "s");
   if (s.knob == "planned") return "planned";
@@ -169,10 +170,13 @@ cv::Mat chart(const StudyResult& result, ChartValue value) {
   auto point = [&](const SettingResult& r) {
     return cv::Point(static_cast<int>(std::lround(x.at(r.cpu_s))), static_cast<int>(std::lround(y.at(std::max(value_of(r, value), floor)))));
   };
+  std::vector<cv::Rect> taken;  // markers and labels placed so far (plot coordinates)
   if (value != ChartValue::DirectionDeg) {
     const int py = static_cast<int>(std::lround(y.at(1.0)));
     for (int px = left; px < W - right; px += 8) cv::line(img, {px, py}, {std::min(px + 3, W - right), py}, kSoft, 1);
     put_text(img, "dE00 = 1", {W - right - 6, py - 6}, 0.42, kSoft, Align::Right);
+    const int w = series::text_width("dE00 = 1", 0.42);
+    taken.emplace_back(cv::Point(W - right - 6 - w, py - 18) - origin, cv::Size(w, 14));
   }
   // The Pareto front (of mean ΔE00 against CPU seconds) as a staircase, on every chart.
   std::vector<const SettingResult*> front;
@@ -193,7 +197,6 @@ cv::Mat chart(const StudyResult& result, ChartValue value) {
       cv::line(plot, {px, lo}, {px, hi}, colour_of(r->setting.knob), 1, cv::LINE_AA);
       for (int e : {lo, hi}) cv::line(plot, {px - 4, e}, {px + 4, e}, colour_of(r->setting.knob), 1, cv::LINE_AA);
     }
-  std::vector<cv::Rect> taken;  // markers and labels placed so far
   for (const SettingResult* r : shown) taken.emplace_back(point(*r) - origin - cv::Point(7, 7), cv::Size(14, 14));
   for (const SettingResult* r : shown) {
     const cv::Point p = point(*r) - origin;
@@ -202,22 +205,24 @@ cv::Mat chart(const StudyResult& result, ChartValue value) {
     draw_marker(plot, p, colour_of(r->setting.knob), r->setting.renderer == series::Renderer::Cycles,
                 value == ChartValue::DirectionDeg && changed, 6);
     // The label in the first free place of: right, left, above right, below right, above left, below left; in
-    // none, right of the marker anyway.
+    // none, the first of them inside the plot (else right of the marker anyway).
     const std::string text = short_label(r->setting);
     const int w = series::text_width(text, 0.4), h = 12;
     const cv::Point offsets[] = {{10, 4}, {-10 - w, 4}, {8, -10}, {8, 18}, {-8 - w, -10}, {-8 - w, 18}};
-    cv::Rect place(p + offsets[0] - cv::Point(0, h), cv::Size(w, h));
+    std::optional<cv::Rect> place, first_inside;
     for (const cv::Point& o : offsets) {
       const cv::Rect candidate(p + o - cv::Point(0, h), cv::Size(w, h));
       const bool inside = candidate.x >= 0 && candidate.y >= 0 && candidate.br().x < plot.cols && candidate.br().y < plot.rows;
       const bool free = std::none_of(taken.begin(), taken.end(), [&](const cv::Rect& t) { return (t & candidate).area() > 0; });
+      if (inside && !first_inside) first_inside = candidate;
       if (inside && free) {
         place = candidate;
         break;
       }
     }
-    taken.push_back(place);
-    put_text(plot, text, {place.x, place.y + h}, 0.4, kInk);
+    if (!place) place = first_inside.value_or(cv::Rect(p + offsets[0] - cv::Point(0, h), cv::Size(w, h)));
+    taken.push_back(*place);
+    put_text(plot, text, {place->x, place->y + h}, 0.4, kInk);
   }
 
   // Legend.
