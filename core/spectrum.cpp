@@ -133,6 +133,11 @@ Bands Bands::from_centres(const std::vector<double>& centres, const std::string&
 }
 
 Bands Bands::with_reconstruction(BandReconstruction r, const std::string& what) const {
+  // Held at float precision, as the EXR header stores it, so that a plan and the renders made with it agree (and
+  // checked so: a double beyond a float's range is no entry).
+  for (double& m : r.matrix) m = static_cast<float>(m);
+  r.lo_nm = static_cast<float>(r.lo_nm);
+  r.step_nm = static_cast<float>(r.step_nm);
   if (!std::isfinite(r.lo_nm) || !std::isfinite(r.step_nm) || !(r.step_nm > 0) || r.lo_nm <= 0)
     throw InputError(fmt::format("{}: fine bands need a positive start and step, got {} and {} nm", what, r.lo_nm, r.step_nm));
   if (r.fine == 0 || r.fine > kMaxBands)
@@ -143,10 +148,6 @@ Bands Bands::with_reconstruction(BandReconstruction r, const std::string& what) 
   for (std::size_t k = 0; k < r.matrix.size(); ++k)
     if (!std::isfinite(r.matrix[k]))
       throw InputError(fmt::format("{}: matrix entry [{}][{}] is not finite", what, k / size(), k % size()));
-  // Held at float precision, as the EXR header stores it, so that a plan and the renders made with it agree.
-  for (double& m : r.matrix) m = static_cast<float>(m);
-  r.lo_nm = static_cast<float>(r.lo_nm);
-  r.step_nm = static_cast<float>(r.step_nm);
   Bands b = *this;
   b.reconstruction_ = std::make_shared<const BandReconstruction>(std::move(r));
   return b;

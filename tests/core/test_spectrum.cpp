@@ -206,6 +206,7 @@ TEST(BandReconstruction, BadMatricesNameTheField) {
   EXPECT_NE(message({400, 1, 1, {1, std::nan("")}}).find("plan.json: reconstruction: matrix entry [0][1] is not finite"),
             std::string::npos);
   EXPECT_NE(message({400, 0, 1, {1, 2}}).find("positive start and step"), std::string::npos);
+  EXPECT_NE(message({400, 1, 1, {1e300, 2}}).find("matrix entry [0][0] is not finite"), std::string::npos);  // beyond a float
 }
 
 // The band-plan file carries the reconstruction and reads back the same; a row of the wrong length is named.
