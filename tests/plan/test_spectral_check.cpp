@@ -104,6 +104,16 @@ TEST(SpectralCheck, CheckSceneAndRenderSayIt) {
                                              "--resolution", "4x4", "--spp", "1", "-q"});
   EXPECT_EQ(render.exit_code, 0) << render.err;
   EXPECT_NE(render.err.find("chromatrace render: warning: light \"ceiling_lamp\""), std::string::npos) << render.err;
+  // For Cycles (the Blender batch asks this way) the same lines, without the continuous mode Cycles does not have;
+  // settings given as options are judged instead of the scene's: 1 nm bands hold the LED.
+  const auto cycles = test::run_chromatrace({"check-scene", (dir / "led.json").string(), "--renderer", "cycles"});
+  EXPECT_EQ(cycles.exit_code, 0) << cycles.err;
+  EXPECT_NE(cycles.out.find("warning    light \"ceiling_lamp\""), std::string::npos) << cycles.out;
+  EXPECT_NE(check.out.find("--spectral-mode continuous"), std::string::npos) << check.out;
+  EXPECT_EQ(cycles.out.find("--spectral-mode"), std::string::npos) << cycles.out;
+  const auto narrow = test::run_chromatrace({"check-scene", (dir / "led.json").string(), "--bands", "380:780:1"});
+  EXPECT_EQ(narrow.exit_code, 0) << narrow.err;
+  EXPECT_EQ(narrow.out.find("ceiling_lamp\":"), std::string::npos) << narrow.out;
   // Narrow bands: the same scene renders without a word about its bands.
   const auto fine = test::run_chromatrace({"render", (dir / "led.json").string(), "-o", (dir / "f.exr").string(),
                                            "--bands", "380:780:1", "--resolution", "4x4", "--spp", "1", "-q"});
