@@ -114,6 +114,15 @@ TEST(SpectralCheck, CheckSceneAndRenderSayIt) {
   const auto narrow = test::run_chromatrace({"check-scene", (dir / "led.json").string(), "--bands", "380:780:1"});
   EXPECT_EQ(narrow.exit_code, 0) << narrow.err;
   EXPECT_EQ(narrow.out.find("ceiling_lamp\":"), std::string::npos) << narrow.out;
+  // Bad settings to judge: one line naming the option, exit 2.
+  for (const std::vector<std::string>& bad : std::vector<std::vector<std::string>>{
+           {"--samples", "0"}, {"--max-bounces", "-1"}, {"--renderer", "eevee"}, {"--bands", "380:780:0"}}) {
+    std::vector<std::string> args = {"check-scene", (dir / "led.json").string()};
+    args.insert(args.end(), bad.begin(), bad.end());
+    const auto r = test::run_chromatrace(args);
+    EXPECT_EQ(r.exit_code, 2) << bad[0];
+    EXPECT_NE(r.err.find("error: " + bad[0] + ":"), std::string::npos) << r.err;
+  }
   // Narrow bands: the same scene renders without a word about its bands.
   const auto fine = test::run_chromatrace({"render", (dir / "led.json").string(), "-o", (dir / "f.exr").string(),
                                            "--bands", "380:780:1", "--resolution", "4x4", "--spp", "1", "-q"});
