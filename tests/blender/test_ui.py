@@ -143,6 +143,15 @@ if bpy.ops.chromatrace.render_spectral() != {"FINISHED"} or not os.path.isfile(s
     failures.append("Render Spectral did not write its file")
 if not os.path.isfile(os.path.join(work, "ui.preview.png")):
     failures.append("Render Spectral wrote no preview (ui.preview.png) beside its file")
+# Before it renders, Render Spectral says what these settings leave out (2 bounces, 2 samples, 100 nm bands), as
+# the batch does, with fixes Cycles has (no continuous mode).
+from chromatrace.operators import RENDER_WARNINGS  # noqa: E402
+said = RENDER_WARNINGS.get(scene.name, [])
+if (not any(w.startswith("render.max_bounces 2 leaves") for w in said)
+        or not any(w.startswith("render.samples 2 gives Monte Carlo noise") for w in said)
+        or not any("bands of 100 nm give its" in w and "chromatrace plan" in w for w in said)
+        or any("--spectral-mode" in w for w in said)):
+    failures.append(f"Render Spectral did not say what its settings leave out: {said}")
 if bpy.ops.chromatrace.preflight() != {"FINISHED"}:
     failures.append("Check Spectra did not finish")
 drawn = draw(ui.CHROMATRACE_PT_preflight, context)
