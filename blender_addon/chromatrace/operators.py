@@ -18,7 +18,8 @@ def _tool(context):
     return tool.Tool(tool.find_executable(executable_preference(context)))
 
 
-# Per scene name: what the last Render Spectral's settings leave out (settings_warnings), one line each.
+# Per scene name: what the last Render Spectral said: its settings' warnings (settings_warnings), then the
+# render's own (the world left out, one band per render); one line each.
 RENDER_WARNINGS = {}
 
 
@@ -64,6 +65,11 @@ class CHROMATRACE_OT_render_spectral(bpy.types.Operator):
         """Reports the output (and its preview) and shows the preview in an Image Editor."""
         output = bpy.path.abspath(context.scene.chromatrace.output_path)
         preview = self._render.preview
+        # What the render itself warned of (the world left out, one band per render), as the batch prints it.
+        for message in self._messages:
+            if message.startswith("warning: "):
+                RENDER_WARNINGS.setdefault(context.scene.name, []).append(message[len("warning: "):])
+                self.report({"WARNING"}, message[len("warning: "):])
         self.report({"INFO"}, f"wrote {output}" + (f"; preview {preview}" if preview else ""))
         if preview and not bpy.app.background:
             show_image(context, preview)

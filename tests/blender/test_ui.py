@@ -152,6 +152,19 @@ if (not any(w.startswith("render.max_bounces 2 leaves") for w in said)
         or not any("bands of 100 nm give its" in w and "chromatrace plan" in w for w in said)
         or any("--spectral-mode" in w for w in said)):
     failures.append(f"Render Spectral did not say what its settings leave out: {said}")
+# A sky texture cannot be a spectrum: with World light: Omit the render goes on without it and says so.
+sky_world = bpy.data.worlds.new("Sky")
+sky_world.use_nodes = True
+sky = sky_world.node_tree.nodes.new("ShaderNodeTexSky")
+sky_world.node_tree.links.new(sky.outputs["Color"], sky_world.node_tree.nodes["Background"].inputs["Color"])
+dark_world = scene.world
+scene.world, s.on_world = sky_world, "OMIT"
+s.output_path = os.path.join(work, "sky.exr")
+if bpy.ops.chromatrace.render_spectral() != {"FINISHED"}:
+    failures.append("Render Spectral with the world omitted did not finish")
+if not any(w.startswith("rendered without the world's light") for w in RENDER_WARNINGS.get(scene.name, [])):
+    failures.append(f"Render Spectral did not say it left the world out: {RENDER_WARNINGS.get(scene.name)}")
+scene.world, s.on_world = dark_world, "REFUSE"
 if bpy.ops.chromatrace.preflight() != {"FINISHED"}:
     failures.append("Check Spectra did not finish")
 drawn = draw(ui.CHROMATRACE_PT_preflight, context)
