@@ -10,6 +10,10 @@
 the cache and stops; a run without it
 then finds every group there and assembles (chromatrace farm cycles runs one task per group, then that run).
 
+Before rendering a --scene it prints what its settings leave out, one `chromatrace: warning: ...` line each (also
+with --quiet): the band plan's colour errors, a bounce limit that drops light and samples whose noise is predicted
+above a mean ΔE00 of 1 (`chromatrace check-scene --renderer cycles` with the batch's options; docs/render.md).
+
 --explain prints the pre-flight summary as JSON (to stdout, or FILE) and renders nothing: every material,
 light and the world, exact / upsampled / refused with the reasons in full, and the Cycles renders needed.
 
@@ -104,6 +108,13 @@ def run(argv):
             with open(args.explain, "w") as f:
                 f.write(text + "\n")
         return
+    if args.scene and args.band_group is None:
+        # What these settings leave out, said before rendering as `chromatrace render` says it (also with
+        # --quiet); a band-group task of a farm leaves it to the run that assembles.
+        for warning in chromatrace_tool.render_warnings(
+                args.scene, bands=args.bands, bands_file=args.bands_file, samples=args.samples,
+                max_bounces=args.max_bounces, resolution=args.resolution):
+            _log(f"warning: {warning}")
     spectral_render.TEST_HOOK = _test_hook()
     spectral_render.SpectralRender(scene, request, chromatrace_tool).run()
 

@@ -3,6 +3,8 @@
 #include <cstdio>
 #include <filesystem>
 #include <memory>
+#include <optional>
+#include <tuple>
 #include <string>
 #include <vector>
 
@@ -11,6 +13,8 @@
 
 #include "cli/app.h"
 #include "cli/command.h"
+#include "cli/options.h"
+#include "core/band_plan.h"
 #include "core/error.h"
 #include "core/file_io.h"
 #include "core/geometry.h"
@@ -24,6 +28,10 @@ namespace {
 
 struct Options {
   std::string file, variant, emit, emit_sensor;
+  // The render settings to judge instead of the scene's (those a renderer is given on its command line, as the
+  // Blender batch passes on its own): the warnings name them by these options.
+  std::string bands, bands_file, resolution, renderer = "tracer";
+  std::optional<int> samples, max_bounces;
   bool json = false;
   bool quiet = false;
   int threads = 0;
@@ -41,8 +49,34 @@ const char* fov_axis_name(FovAxis axis) {
   return "";
 }
 
+bool overrides(const Options& o) {
+  return !o.bands.empty() || !o.bands_file.empty() || !o.resolution.empty() || o.samples || o.max_bounces ||
+         o.renderer != "tracer";
+}
+
+// The settings the warnings judge: the scene's, with the options' in their place.
+plan::RenderRequest judged_settings(const Scene& scene, const Options& o) {
+  plan::RenderRequest request = plan::scene_settings(scene);
+  if (o.renderer != "tracer" && o.renderer != "cycles")
+    throw InputError(fmt::format("--renderer: must be tracer or cycles, got \"{}\"", o.renderer));
+  // Cycles renders band averages only: its band plan is judged in the bands mode, and no fix names the other.
+  if (o.renderer == "cycles") request.mode = SpectralMode::Bands, request.continuous_available = false;
+  if (!o.bands.empty() && !o.bands_file.empty()) throw InputError("--bands-file: give either --bands or --bands-file, not both");
+  if (!o.bands.empty()) request.bands = Bands::parse(o.bands, "--bands");
+  if (!o.bands_file.empty()) request.bands = read_band_plan(o.bands_file);
+  if (o.max_bounces) {
+    if (*o.max_bounces < 0) throw InputError(fmt::format("--max-bounces: must be >= 0, got {}", *o.max_bounces));
+    request.max_bounces = *o.max_bounces, request.bounces_name = "--max-bounces";
+  }
+  if (o.samples) {
+    if (*o.samples < 1) throw InputError(fmt::format("--samples: must be at least 1, got {}", *o.samples));
+    request.samples = *o.samples, request.samples_name = "--samples";
+  }
+  return request;
+}
+
 // What a person or a script wants to know about a valid scene; the text output is printed from this.
-Json scene_summary(const Scene& scene) {
+Json scene_summary(const Scene& scene, const plan::RenderRequest& settings) {
   std::size_t triangles = 0;
   Bounds extent;
   for (const TriangleMesh& mesh : scene_meshes(scene)) {
@@ -61,7 +95,7 @@ Json scene_summary(const Scene& scene) {
 
   const Camera& c = scene.camera;
   const RenderSettings& r = scene.render;
-  const std::vector<std::string> warnings = plan::render_warnings(scene, plan::scene_settings(scene));
+  const std::vector<std::string> warnings = plan::render_warnings(scene, settings);
   return {
       {"warnings", warnings},
       {"name", scene.name},
@@ -184,6 +218,8 @@ int check(const Options& options) {
   const Json document = read_json(options.file);
   Json report;
   if (document_format(document) == kSeriesFormat) {
+    if (overrides(options))
+      throw InputError(fmt::format("--bands: {} is a series; the render settings to judge apply to a scene", options.file));
     const Series series = load_series(options.file, options.threads);
     // Each variant's sensor settings, merged along "extends", must be valid for the sensor simulator.
     for (std::size_t i = 0; i < series.variants.size(); ++i)
@@ -199,16 +235,21 @@ int check(const Options& options) {
                           {"figure", v.figure},
                           {"expect", expect_json(v.expect)},
                           {"sensor", v.sensor},
-                          {"scene", scene_summary(v.scene)}});
+                          {"scene", scene_summary(v.scene, plan::scene_settings(v.scene))}});
     report = {{"file", options.file}, {"format", kSeriesFormat}, {"valid", true},
               {"name", series.name},  {"base", series.base},     {"variants", variants}};
   } else {
     if (!options.variant.empty() || !options.emit.empty() || !options.emit_sensor.empty())
       throw InputError(fmt::format("--variant: {} is a scene, not a series", options.file));
+    Scene scene = load_scene(options.file);
+    if (!options.resolution.empty())
+      std::tie(scene.camera.width, scene.camera.height) = parse_resolution(options.resolution);
+    plan::RenderRequest settings = judged_settings(scene, options);
+    settings.threads = options.threads;
     report = {{"file", options.file},
               {"format", kSceneFormat},
               {"valid", true},
-              {"scene", scene_summary(load_scene(options.file))}};
+              {"scene", scene_summary(scene, settings)}};
   }
 
   if (options.quiet) return 0;
@@ -241,7 +282,15 @@ Action add_check_scene(CLI::App& app) {
   command->add_option("--emit-sensor", options->emit_sensor,
                       "write the variant's sensor settings (chromatrace-sensor/1) to this file")
       ->needs("--variant");
-  command->add_option("--threads", options->threads, "threads for checking series variants (0: all)")
+  command->add_option("--bands", options->bands, "judge this band plan (lo:hi:width nm) instead of the scene's");
+  command->add_option("--bands-file", options->bands_file, "judge this band plan file (chromatrace-bands/1) instead");
+  command->add_option("--samples", options->samples, "judge this many samples per pixel instead of the scene's");
+  command->add_option("--max-bounces", options->max_bounces, "judge this bounce limit instead of the scene's");
+  command->add_option("--renderer", options->renderer,
+                      "the renderer the warnings are for: tracer, or cycles (bands mode only, as the Blender batch)")
+      ->capture_default_str();
+  command->add_option("--resolution", options->resolution, "judge the render at this size WxH (the noise's pixel size)");
+  command->add_option("--threads", options->threads, "threads for checking series variants and the warnings' previews (0: all)")
       ->check(CLI::NonNegativeNumber);
   return [options] { return check(*options); };
 }

@@ -18,7 +18,7 @@ RenderRequest scene_settings(const Scene& scene) {
 
 std::vector<std::string> render_warnings(const Scene& scene, const RenderRequest& settings, double target_de00) {
   std::vector<std::string> out;
-  for (const SpectralWarning& w : check_band_plan(scene, settings.bands, settings.mode)) out.push_back(w.message);
+  for (const SpectralWarning& w : check_band_plan(scene, settings.bands, settings.mode, 2.0, settings.continuous_available)) out.push_back(w.message);
   // The model needs a band range of at least 2 nm (plan says so; a render of a narrower one is left alone).
   if (settings.max_bounces < 1 || scene.render.bands.max_wavelength() - scene.render.bands.min_wavelength() < 2)
     return out;

@@ -19,6 +19,9 @@ struct RenderRequest {
   int max_bounces = 0, samples = 0;
   // How the user named each setting in the message: "render.max_bounces" (check-scene) or "--max-bounces".
   std::string bounces_name = "render.max_bounces", samples_name = "render.samples";
+  // The renderer has the continuous spectral mode (the tracer; Cycles renders bands only): the band warnings'
+  // fixes name it only then.
+  bool continuous_available = true;
   int threads = 0;
 };
 

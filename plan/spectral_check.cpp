@@ -79,7 +79,9 @@ std::string describe(const Bands& bands) {
 
 }  // namespace
 
-std::vector<SpectralWarning> check_band_plan(const Scene& scene, const Bands& bands, SpectralMode mode, double threshold) {
+std::vector<SpectralWarning> check_band_plan(const Scene& scene, const Bands& bands, SpectralMode mode, double threshold,
+                                             bool continuous_available) {
+  const char* continuous = continuous_available ? ", or --spectral-mode continuous" : "";
   std::vector<SpectralWarning> out;
   if (mode == SpectralMode::Continuous || bands.size() == 0) return out;
   const int lo = static_cast<int>(std::ceil(bands.min_wavelength() - 1e-9));
@@ -120,8 +122,8 @@ std::vector<SpectralWarning> check_band_plan(const Scene& scene, const Bands& ba
       out.push_back({light, "", direct, true,
                      fmt::format("light \"{}\": {} give its own colour a ΔE00 of {:.1f} (its spectrum has narrow peaks "
                                  "the bands average away); use bands fitted to it (chromatrace plan) or narrower ones "
-                                 "where it peaks, or --spectral-mode continuous",
-                                 light, describe(bands), direct)});
+                                 "where it peaks{}",
+                                 light, describe(bands), direct, continuous)});
     for (const Material& m : scene.materials) {
       const SpectrumRef* ref = diffuse_of(m);
       if (!ref || ref->texture) continue;
@@ -132,10 +134,11 @@ std::vector<SpectralWarning> check_band_plan(const Scene& scene, const Bands& ba
       const bool reflectance_cause = error(r, flat) > 0.5 * de;
       out.push_back({light, m.name, de, !reflectance_cause,
                      fmt::format("material \"{}\" lit by \"{}\": {} give its colour a ΔE00 of {:.1f} ({}); use bands "
-                                 "fitted to the scene (chromatrace plan) or narrower ones, or --spectral-mode continuous",
+                                 "fitted to the scene (chromatrace plan) or narrower ones{}",
                                  m.name, light, describe(bands), de,
                                  reflectance_cause ? "its reflectance changes faster than the bands"
-                                                   : "the light's spectrum has narrow peaks the bands average away")});
+                                                   : "the light's spectrum has narrow peaks the bands average away",
+                                 continuous)});
     }
   }
   std::stable_sort(out.begin(), out.end(), [](const auto& a, const auto& b) { return a.de00 > b.de00; });

@@ -26,8 +26,9 @@ struct SpectralWarning {
 
 // Pairs whose ΔE00 exceeds `threshold`, worst first; none in the continuous mode. Textured reflectances and
 // lights are left out (their spectra differ from texel to texel). The default, 2, is a difference seen at a glance
-// (1 needs a close side-by-side look): one surface's colour, where plans aim at a mean of 1 over the image.
+// (1 needs a close side-by-side look): one surface's colour, where plans aim at a mean of 1 over the image. The
+// fix names the continuous mode only where the renderer has it (`continuous_available`: the tracer, not Cycles).
 std::vector<SpectralWarning> check_band_plan(const Scene& scene, const Bands& bands, SpectralMode mode,
-                                             double threshold = 2.0);
+                                             double threshold = 2.0, bool continuous_available = true);
 
 }  // namespace ct::plan

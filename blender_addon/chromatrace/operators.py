@@ -1,6 +1,10 @@
 """Operators: the spectral render (modal, with progress and Esc to cancel), scene import and export, and
 small helpers for materials and the spectrum table."""
 
+import os
+import shutil
+import tempfile
+
 import bpy
 from bpy.props import StringProperty
 from bpy_extras.io_utils import ExportHelper, ImportHelper
@@ -12,6 +16,29 @@ from .properties import MODEL_ITEMS, executable_preference
 
 def _tool(context):
     return tool.Tool(tool.find_executable(executable_preference(context)))
+
+
+# Per scene name: what the last Render Spectral said: its settings' warnings (settings_warnings), then the
+# render's own (the world left out, one band per render); one line each.
+RENDER_WARNINGS = {}
+
+
+def settings_warnings(scene, chromatrace_tool, request):
+    """What the scene's render settings leave out, said before rendering as the batch says it for a scene file
+    (`chromatrace check-scene --renderer cycles`): the scene written as a scene file (scene_export) and judged
+    with its band plan, samples, bounce limit and resolution. Only for a scene imported from a scene file, whose
+    lights and materials the check reads; [] for others. One line each."""
+    if not scene.chromatrace.source_file:
+        return []
+    work = tempfile.mkdtemp(prefix="chromatrace-check-")
+    try:
+        path = os.path.join(work, "scene.json")
+        scene_export.export_scene(scene, path, chromatrace_tool, log=lambda message: None)
+        return chromatrace_tool.render_warnings(path, bands_file=request.bands_file)
+    except (BadInput, RuntimeError) as e:
+        return [f"the render settings were not checked: {e}"]
+    finally:
+        shutil.rmtree(work, ignore_errors=True)
 
 
 class CHROMATRACE_OT_render_spectral(bpy.types.Operator):
@@ -26,13 +53,23 @@ class CHROMATRACE_OT_render_spectral(bpy.types.Operator):
     def _start(self, context):
         self._messages = []
         request = spectral_render.Request.from_scene(context.scene, log=self._messages.append)
-        self._render = spectral_render.SpectralRender(context.scene, request, _tool(context))
+        chromatrace_tool = _tool(context)
+        warnings = settings_warnings(context.scene, chromatrace_tool, request)
+        RENDER_WARNINGS[context.scene.name] = warnings
+        for warning in warnings:
+            self.report({"WARNING"}, warning)
+        self._render = spectral_render.SpectralRender(context.scene, request, chromatrace_tool)
         return self._render
 
     def _done(self, context):
         """Reports the output (and its preview) and shows the preview in an Image Editor."""
         output = bpy.path.abspath(context.scene.chromatrace.output_path)
         preview = self._render.preview
+        # What the render itself warned of (the world left out, one band per render), as the batch prints it.
+        for message in self._messages:
+            if message.startswith("warning: "):
+                RENDER_WARNINGS.setdefault(context.scene.name, []).append(message[len("warning: "):])
+                self.report({"WARNING"}, message[len("warning: "):])
         self.report({"INFO"}, f"wrote {output}" + (f"; preview {preview}" if preview else ""))
         if preview and not bpy.app.background:
             show_image(context, preview)

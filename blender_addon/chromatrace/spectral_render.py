@@ -238,18 +238,17 @@ class SpectralRender:
         return [i for i in issues if not i["fallback"]], [i for i in issues if i["fallback"]]
 
     def _check_nodes(self, used, walks, world):
-        """Refuses (BadInput) what cannot be rendered; returns whether one band per render is needed."""
+        """Refuses (BadInput) what cannot be rendered; returns the channel-mixing issues that need one band per
+        render (empty: none)."""
         hard, mixing = self._node_issues(used, walks, world)
         if hard:
             raise BadInput(f"cannot render spectrally: {node_rules.summarise(hard)}")
         if mixing and self.request.on_mixing_nodes != "one-band":
             raise BadInput(f"nodes mix colour channels: {node_rules.summarise(mixing)} "
                            "(choose one band per render to render anyway)")
-        if mixing:
-            self.request.log(f"one band per render: {node_rules.summarise(mixing)}")
         if world["status"] == "omitted":
             self.request.log(f"warning: {self._world_warning(world)}")
-        return bool(mixing)
+        return mixing
 
     def _world_warning(self, world):
         reasons = "; ".join(node_rules.describe_issue(i) for i in world["issues"] if not i["fallback"])
@@ -352,11 +351,20 @@ class SpectralRender:
         view_layer, objects, used, lights = self._scene_parts()
         walks = self._walks(used, lights)
         world = self._world_state(walks)
-        replicate = self._check_nodes(used, walks, world)
+        mixing = self._check_nodes(used, walks, world)
+        replicate = bool(mixing)
         keys, inputs, emitters = self._spectral_inputs(used, lights, walks, world)
         bands = self._band_averages(work_dir, keys, inputs)
         edges = bands["bands"]["edges_nm"]
         per_render = 1 if replicate else request.bands_per_render
+        if replicate:
+            count = len(edges) - 1
+            request.log(f"warning: one band per render, {count} Cycles renders of the bands instead of "
+                        f"{len(band_groups(count, request.bands_per_render))}, because nodes mix colour channels: "
+                        f"{node_rules.summarise(mixing)}; each band is rendered alone as a grey (in R, G and B), so "
+                        "these nodes act on its value only (a change of hue or saturation does nothing to a grey); "
+                        "nodes that act on each channel alike (Mix, Gamma, Invert, Bright/Contrast) keep three bands "
+                        "per render")
         textures = self._prepare_textures(work_dir, inputs, edges, per_render, replicate)
         transmission = any(materials.has_transmission(walks[("material", m.name)]) for m in used)
         light_groups, assignments, world_group = self._light_groups(view_layer, objects, emitters, world)

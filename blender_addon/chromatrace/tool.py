@@ -59,6 +59,19 @@ class Tool:
     def check_scene(self, scene_file):
         return self.run("check-scene", scene_file, "--json", json_output=True)
 
+    def render_warnings(self, scene_file, bands=None, bands_file=None, samples=None, max_bounces=None, resolution=None):
+        """What a Cycles render of the scene file with these settings leaves out, said before rendering
+        (`chromatrace check-scene --renderer cycles`): one line each, cause, size and fix, the settings named by
+        the batch's options (--bands-file, --samples, --max-bounces)."""
+        args = ["check-scene", scene_file, "--json", "--renderer", "cycles"]
+        for option, value in (("--bands", bands), ("--bands-file", bands_file), ("--samples", samples),
+                              ("--max-bounces", max_bounces)):
+            if value is not None:
+                args += [option, value]
+        if resolution is not None:
+            args += ["--resolution", f"{resolution[0]}x{resolution[1]}"]
+        return self.run(*args, json_output=True)["scene"]["warnings"]
+
     def export_meshes(self, scene_file, directory):
         return self.run("export-meshes", scene_file, directory, "--uvs", "--json", json_output=True)
 

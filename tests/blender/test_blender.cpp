@@ -306,6 +306,44 @@ TEST_F(Blender, PlannedBandsCarryTheirReconstructionIntoTheExr) {
   EXPECT_EQ(test::run_chromatrace({"info", "--check", out.string()}).exit_code, 0);
 }
 
+// What a Cycles render's settings leave out is said before it renders, as `chromatrace render` says it for the
+// tracer (docs/render.md, docs/stability.md): the paper box under CIE F11 (three narrow peaks) with 100 nm bands
+// cannot hold the lamp's own colour, 2 bounces drop light and 4 samples are noisy. The batch prints exactly the
+// lines `check-scene --renderer cycles` gives for the same options (also with --quiet), each naming the cause and
+// a fix Cycles has (bands fitted by chromatrace plan; Cycles has no continuous mode), the settings named by the
+// batch's own options.
+TEST_F(Blender, WarnsBeforeRenderingWhatItsSettingsLeaveOut) {
+  json doc = rebase_scene_paths(read_json(kBox), fs::path(kBox).parent_path(), {});
+  doc["spectra"]["lamp"] = {{"illuminant", "F11"}};
+  const fs::path scene = write_scene("f11.json", doc), out = dir_.file("f11.exr");
+  const std::vector<std::string> settings = {"--bands", "380:780:100", "--samples", "4", "--max-bounces", "2",
+                                             "--resolution", "8x8"};
+  std::vector<std::string> args = {"--scene", scene.string(), "--out", out.string(), "--components", "none", "--quiet"};
+  args.insert(args.end(), settings.begin(), settings.end());
+  const CommandResult r = batch(args);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  std::vector<std::string> check_args = {"check-scene", scene.string(), "--json", "--renderer", "cycles"};
+  check_args.insert(check_args.end(), settings.begin(), settings.end());
+  const CommandResult check = test::run_chromatrace(check_args);
+  ASSERT_EQ(check.exit_code, 0) << check.err;
+  std::vector<std::string> expected;
+  const json report = json::parse(check.out);
+  for (const json& w : report["scene"]["warnings"]) expected.push_back("chromatrace: warning: " + w.get<std::string>());
+  EXPECT_EQ(lines_starting(r.err, "chromatrace: warning: "), expected) << r.err;
+
+  auto said = [&](const std::string& start) {
+    for (const std::string& line : expected)
+      if (line.rfind("chromatrace: warning: " + start, 0) == 0) return line;
+    return std::string();
+  };
+  const std::string lamp = said("light \"ceiling_lamp\": 4 bands of 100 nm give its own colour a ΔE00 of ");
+  EXPECT_NE(lamp.find("(its spectrum has narrow peaks the bands average away); use bands fitted to it (chromatrace plan)"),
+            std::string::npos) << r.err;
+  EXPECT_NE(said("--max-bounces 2 leaves "), "") << r.err;
+  EXPECT_NE(said("--samples 4 gives Monte Carlo noise"), "") << r.err;
+  for (const std::string& line : expected) EXPECT_EQ(line.find("--spectral-mode"), std::string::npos) << line;
+}
+
 // The regular files under `root`, recursively.
 std::vector<fs::path> files_under(const fs::path& root) {
   std::vector<fs::path> files;

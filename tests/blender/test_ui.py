@@ -143,6 +143,28 @@ if bpy.ops.chromatrace.render_spectral() != {"FINISHED"} or not os.path.isfile(s
     failures.append("Render Spectral did not write its file")
 if not os.path.isfile(os.path.join(work, "ui.preview.png")):
     failures.append("Render Spectral wrote no preview (ui.preview.png) beside its file")
+# Before it renders, Render Spectral says what these settings leave out (2 bounces, 2 samples, 100 nm bands), as
+# the batch does, with fixes Cycles has (no continuous mode).
+from chromatrace.operators import RENDER_WARNINGS  # noqa: E402
+said = RENDER_WARNINGS.get(scene.name, [])
+if (not any(w.startswith("render.max_bounces 2 leaves") for w in said)
+        or not any(w.startswith("render.samples 2 gives Monte Carlo noise") for w in said)
+        or not any("bands of 100 nm give its" in w and "chromatrace plan" in w for w in said)
+        or any("--spectral-mode" in w for w in said)):
+    failures.append(f"Render Spectral did not say what its settings leave out: {said}")
+# A sky texture cannot be a spectrum: with World light: Omit the render goes on without it and says so.
+sky_world = bpy.data.worlds.new("Sky")
+sky_world.use_nodes = True
+sky = sky_world.node_tree.nodes.new("ShaderNodeTexSky")
+sky_world.node_tree.links.new(sky.outputs["Color"], sky_world.node_tree.nodes["Background"].inputs["Color"])
+dark_world = scene.world
+scene.world, s.on_world = sky_world, "OMIT"
+s.output_path = os.path.join(work, "sky.exr")
+if bpy.ops.chromatrace.render_spectral() != {"FINISHED"}:
+    failures.append("Render Spectral with the world omitted did not finish")
+if not any(w.startswith("rendered without the world's light") for w in RENDER_WARNINGS.get(scene.name, [])):
+    failures.append(f"Render Spectral did not say it left the world out: {RENDER_WARNINGS.get(scene.name)}")
+scene.world, s.on_world = dark_world, "REFUSE"
 if bpy.ops.chromatrace.preflight() != {"FINISHED"}:
     failures.append("Check Spectra did not finish")
 drawn = draw(ui.CHROMATRACE_PT_preflight, context)

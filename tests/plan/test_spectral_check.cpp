@@ -104,6 +104,25 @@ TEST(SpectralCheck, CheckSceneAndRenderSayIt) {
                                              "--resolution", "4x4", "--spp", "1", "-q"});
   EXPECT_EQ(render.exit_code, 0) << render.err;
   EXPECT_NE(render.err.find("chromatrace render: warning: light \"ceiling_lamp\""), std::string::npos) << render.err;
+  // For Cycles (the Blender batch asks this way) the same lines, without the continuous mode Cycles does not have;
+  // settings given as options are judged instead of the scene's: 1 nm bands hold the LED.
+  const auto cycles = test::run_chromatrace({"check-scene", (dir / "led.json").string(), "--renderer", "cycles"});
+  EXPECT_EQ(cycles.exit_code, 0) << cycles.err;
+  EXPECT_NE(cycles.out.find("warning    light \"ceiling_lamp\""), std::string::npos) << cycles.out;
+  EXPECT_NE(check.out.find("--spectral-mode continuous"), std::string::npos) << check.out;
+  EXPECT_EQ(cycles.out.find("--spectral-mode"), std::string::npos) << cycles.out;
+  const auto narrow = test::run_chromatrace({"check-scene", (dir / "led.json").string(), "--bands", "380:780:1"});
+  EXPECT_EQ(narrow.exit_code, 0) << narrow.err;
+  EXPECT_EQ(narrow.out.find("ceiling_lamp\":"), std::string::npos) << narrow.out;
+  // Bad settings to judge: one line naming the option, exit 2.
+  for (const std::vector<std::string>& bad : std::vector<std::vector<std::string>>{
+           {"--samples", "0"}, {"--max-bounces", "-1"}, {"--renderer", "eevee"}, {"--bands", "380:780:0"}}) {
+    std::vector<std::string> args = {"check-scene", (dir / "led.json").string()};
+    args.insert(args.end(), bad.begin(), bad.end());
+    const auto r = test::run_chromatrace(args);
+    EXPECT_EQ(r.exit_code, 2) << bad[0];
+    EXPECT_NE(r.err.find("error: " + bad[0] + ":"), std::string::npos) << r.err;
+  }
   // Narrow bands: the same scene renders without a word about its bands.
   const auto fine = test::run_chromatrace({"render", (dir / "led.json").string(), "-o", (dir / "f.exr").string(),
                                            "--bands", "380:780:1", "--resolution", "4x4", "--spp", "1", "-q"});
