@@ -173,11 +173,12 @@ struct Basis {
   std::size_t size() const { return light.size(); }
 };
 
-// Tristimulus values of every (id, k, lobe) template: k = 0 the surface's own emission; k >= 1 what it reflects
-// after k scattering events, by radiosity over the transfer factors; where that gives no light (a surface no
-// sampled ray lit), the mean-albedo model E·R·ρ̄^(k−1).
 // The spectra behind the templates (in the basis), [id][k][lobe].
 using TemplateSpectra = std::vector<std::vector<std::array<std::vector<double>, 2>>>;
+
+// Tristimulus values of every (id, k, lobe) template: k = 0 the surface's own emission; k >= 1 what it reflects
+// after k scattering events, by radiosity over the transfer factors; where that gives no light (a surface no
+// sampled ray lit), the mean-albedo model E·R·ρ̄^(k−1). With `spectra`, also the spectrum behind each.
 
 std::vector<std::vector<std::array<Vec3d, 2>>> templates(const Basis& b, const Transfer& t, int kmax,
                                                          TemplateSpectra* spectra = nullptr) {
@@ -281,7 +282,7 @@ class Model {
 
  private:
   std::pair<double, double> score(const std::vector<std::vector<std::array<Vec3d, 2>>>& templates, int max_bounces) const;
-  BandReconstruction fit_reconstruction(const TemplateSpectra& banded, int max_bounces) const;
+  std::optional<BandReconstruction> fit_reconstruction(const TemplateSpectra& banded, int max_bounces) const;
 
   Grid grid_;
   int kmax_ = 0;
@@ -585,8 +586,9 @@ std::pair<double, double> Model::evaluate_exact(int max_bounces) const { return 
 // template's share of the preview's pixels), R = A·W·Bᵀ·(B·W·Bᵀ + εI)⁻¹ with a ridge ε of 10⁻⁹ of the mean
 // diagonal for bands no template tells apart. For a free matrix this minimiser is the same whatever weights the
 // wavelengths get, so the one fit serves every observer and camera. Entries are rounded to float, as the bands
-// hold them (Bands::with_reconstruction), so that the prediction uses the matrix the renders carry.
-BandReconstruction Model::fit_reconstruction(const TemplateSpectra& banded, int max_bounces) const {
+// hold them (Bands::with_reconstruction), so that the prediction uses the matrix the renders carry. None when no
+// template reaches a pixel of the preview (nothing to fit to).
+std::optional<BandReconstruction> Model::fit_reconstruction(const TemplateSpectra& banded, int max_bounces) const {
   const std::size_t nb = banded.front().front()[0].size(), fine = grid_.n() - 1;
   Eigen::MatrixXd g = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(nb), static_cast<Eigen::Index>(nb));
   Eigen::MatrixXd h = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(fine), static_cast<Eigen::Index>(nb));
@@ -602,8 +604,8 @@ BandReconstruction Model::fit_reconstruction(const TemplateSpectra& banded, int 
         g.noalias() += w * b * b.transpose();
         h.noalias() += w * a * b.transpose();
       }
-  const double ridge = 1e-9 * std::max(g.trace() / static_cast<double>(nb), 1e-300);
-  g.diagonal().array() += ridge;
+  if (!(g.trace() > 0)) return std::nullopt;
+  g.diagonal().array() += 1e-9 * g.trace() / static_cast<double>(nb);
   const Eigen::MatrixXd r = g.ldlt().solve(h.transpose()).transpose();  // fine × nb (g is symmetric)
   BandReconstruction out;
   out.lo_nm = grid_.lo;
@@ -641,10 +643,11 @@ std::pair<double, double> Model::evaluate(const std::vector<int>& edges, int max
   if (has_environment_) banded.environment = averages(environment_);
   TemplateSpectra spectra;
   auto t = templates(banded, transfer_, K, reconstruct ? &spectra : nullptr);
-  if (reconstruct) {
+  const std::optional<BandReconstruction> fit = reconstruct ? fit_reconstruction(spectra, K) : std::nullopt;
+  if (fit) {
     // The observer's weights of the reconstructed spectrum (band_weights with 1 nm fine bands), and the templates
     // through them.
-    const BandReconstruction r = fit_reconstruction(spectra, K);
+    const BandReconstruction& r = *fit;
     for (int c = 0; c < 3; ++c) {
       std::fill(banded.weight[c].begin(), banded.weight[c].end(), 0.0);
       for (std::size_t j = 0; j < r.fine; ++j) {
@@ -660,7 +663,7 @@ std::pair<double, double> Model::evaluate(const std::vector<int>& edges, int max
             for (std::size_t i = 0; i < nb; ++i) x += spectra[id][k][lobe][i] * banded.weight[c][i];
             t[id][k][lobe][c] = x;
           }
-    if (fitted) *fitted = r;
+    if (fitted) *fitted = r;  // else it stays empty (fine = 0): read as a step function
   }
   for (std::size_t id = 0; id < t.size(); ++id)
     for (int k = 0; k <= K; ++k)
@@ -864,7 +867,7 @@ Plan make_plan(const Scene& scene, const PlanOptions& options) {
   BandReconstruction reconstruction;
   std::tie(plan.predicted_mean, plan.predicted_p95) =
       model.evaluate(edges, plan.max_bounces, model.reconstructs(), &reconstruction);
-  if (model.reconstructs()) plan.bands = plan.bands.with_reconstruction(std::move(reconstruction), "plan");
+  if (reconstruction.fine > 0) plan.bands = plan.bands.with_reconstruction(std::move(reconstruction), "plan");
   plan.predicted_band_only = model.evaluate(edges, kmax).first;
   {
     std::vector<int> scene_edges;
