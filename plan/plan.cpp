@@ -606,7 +606,30 @@ std::optional<BandReconstruction> Model::fit_reconstruction(const TemplateSpectr
       }
   if (!(g.trace() > 0)) return std::nullopt;
   g.diagonal().array() += 1e-9 * g.trace() / static_cast<double>(nb);
-  const Eigen::MatrixXd r = g.ldlt().solve(h.transpose()).transpose();  // fine × nb (g is symmetric)
+  const Eigen::LDLT<Eigen::MatrixXd> solver(g);
+  Eigen::MatrixXd r = solver.solve(h.transpose()).transpose();  // fine × nb (g is symmetric)
+  // The lights (and a uniform environment) as they are: every emitter's own spectrum is reconstructed exactly, so
+  // that a light seen directly, and the white a camera balances to, keep their colour however few pixels show
+  // them. The least-squares fit under the constraints R·c_l = d_l is R₀ + (D − R₀C)(CᵀG⁻¹C)⁻¹CᵀG⁻¹; with as many
+  // emitter spectra as bands or more, the constraints would fix R alone, and the fit stays unconstrained.
+  std::vector<std::size_t> emitters;
+  for (std::size_t id = 0; id < surfaces_.size(); ++id)
+    if ((surfaces_[id].emitter || (id == 0 && has_environment_)) && exact_y_[id][0][0] > 0) emitters.push_back(id);
+  if (!emitters.empty() && emitters.size() < nb) {
+    const auto count = static_cast<Eigen::Index>(emitters.size());
+    Eigen::MatrixXd c(static_cast<Eigen::Index>(nb), count), d(static_cast<Eigen::Index>(fine), count);
+    for (Eigen::Index l = 0; l < count; ++l) {
+      const std::size_t id = emitters[static_cast<std::size_t>(l)];
+      const double y = exact_y_[id][0][0];
+      const std::vector<double>& sp = exact_spectra_[id][0][0];
+      for (std::size_t i = 0; i < nb; ++i) c(static_cast<Eigen::Index>(i), l) = banded[id][0][0][i] / y;
+      for (std::size_t j = 0; j < fine; ++j) d(static_cast<Eigen::Index>(j), l) = 0.5 * (sp[j] + sp[j + 1]) / y;
+    }
+    const Eigen::MatrixXd gc = solver.solve(c);  // G⁻¹C
+    Eigen::MatrixXd m = c.transpose() * gc;       // CᵀG⁻¹C
+    m.diagonal().array() += 1e-12 * m.trace() / static_cast<double>(count);
+    r += (d - r * c) * m.ldlt().solve(gc.transpose());
+  }
   BandReconstruction out;
   out.lo_nm = grid_.lo;
   out.step_nm = 1;

@@ -71,9 +71,10 @@ class Plan : public ::testing::Test {
   // limit. The same seed makes most of the noise common to both; what is not (paths diverge after Russian roulette,
   // whose survival follows the band values) is bounded by rendering 4 nm bands against the same reference,
   // whose own band error is negligible: the "floor".
-  Outcome plan_and_measure(const Scene& scene) {
+  Outcome plan_and_measure(const Scene& scene, double target = 1.0) {
     plan::PlanOptions options;
     options.threads = 2;
+    options.target_de00 = target;
     Outcome out;
     out.plan = plan::make_plan(scene, options);
     const double lo = scene.render.bands.min_wavelength(), hi = scene.render.bands.max_wavelength();
@@ -93,7 +94,7 @@ class Plan : public ::testing::Test {
 
   // Known answers: the prediction within a factor 1.5 of the measurement, whose Monte Carlo part is small (the
   // floor at most a third of it); the target reached with at most half the scenes' own bands.
-  void check(const Outcome& o, const Scene& scene, const std::string& what) {
+  void check(const Outcome& o, const Scene& scene, const std::string& what, double target = 1.0) {
     SCOPED_TRACE(what);
     std::fprintf(stderr, "%s: %zu bands (scene: %zu), max bounces %d (scene: %d), predicted %.3f, measured %.3f, "
                  "noise floor %.3f; the same values read as a step function %.3f\n",
@@ -103,7 +104,7 @@ class Plan : public ::testing::Test {
     ASSERT_NE(o.plan.bands.reconstruction(), nullptr);
     EXPECT_GT(o.step, o.measured);
     EXPECT_TRUE(o.plan.target_met);
-    EXPECT_LE(o.plan.predicted_mean, 1.0);
+    EXPECT_LE(o.plan.predicted_mean, target);
     EXPECT_LE(o.plan.bands.size(), scene.render.bands.size() / 2);
     EXPECT_LE(o.floor, o.measured / 3);
     EXPECT_LE(o.plan.predicted_mean, 1.5 * o.measured);
@@ -122,7 +123,9 @@ TEST_F(Plan, PredictsTheMeasuredErrorOnThePaperBox) {
 
 TEST_F(Plan, PredictsTheMeasuredErrorOnTheCornellBox) {
   const Scene scene = load_scene(kCornell);
-  check(plan_and_measure(scene), scene, "cornell_box");
+  // For a target of 1 the plan's 6 bands leave a predicted 0.10, below what 512 paths per pixel resolve (the noise
+  // floor is 0.13); for 2 it takes 3 bands, whose error stands well above the noise.
+  check(plan_and_measure(scene, 2.0), scene, "cornell_box", 2.0);
 }
 
 TEST_F(Plan, PredictsTheMeasuredErrorUnderF11) {
