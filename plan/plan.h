@@ -53,6 +53,9 @@ struct BandTrial {
   int bands = 0;
   double predicted_mean = 0;
   std::vector<double> edges_nm;
+  // Why a count that met the target was not taken: the first warning check_band_plan (check-scene, render) gives
+  // for those bands, e.g. one material lit by one light off by more than 2 (the mean hides one surface).
+  std::string refused;
 };
 
 struct Plan {

@@ -123,9 +123,10 @@ TEST_F(Plan, PredictsTheMeasuredErrorOnThePaperBox) {
 
 TEST_F(Plan, PredictsTheMeasuredErrorOnTheCornellBox) {
   const Scene scene = load_scene(kCornell);
-  // For a target of 1 the plan's 6 bands leave a predicted 0.10, below what 512 paths per pixel resolve (the noise
-  // floor is 0.13); for 2 it takes 3 bands, whose error stands well above the noise.
-  check(plan_and_measure(scene, 2.0), scene, "cornell_box", 2.0);
+  // For targets of 1 and 2 the plan's 6 bands leave a predicted 0.13 and 0.31, too little against what 512 paths
+  // per pixel resolve here (the noise floor is 0.13, and paths that diverge add as much again); for 3 (5 bounces)
+  // they leave 0.63, which stands above the noise.
+  check(plan_and_measure(scene, 3.0), scene, "cornell_box", 3.0);
 }
 
 TEST_F(Plan, PredictsTheMeasuredErrorUnderF11) {
