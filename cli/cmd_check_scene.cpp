@@ -14,7 +14,6 @@
 #include "cli/app.h"
 #include "cli/command.h"
 #include "cli/options.h"
-#include "core/band_plan.h"
 #include "core/error.h"
 #include "core/file_io.h"
 #include "core/geometry.h"
@@ -61,9 +60,7 @@ plan::RenderRequest judged_settings(const Scene& scene, const Options& o) {
     throw InputError(fmt::format("--renderer: must be tracer or cycles, got \"{}\"", o.renderer));
   // Cycles renders band averages only: its band plan is judged in the bands mode, and no fix names the other.
   if (o.renderer == "cycles") request.mode = SpectralMode::Bands, request.continuous_available = false;
-  if (!o.bands.empty() && !o.bands_file.empty()) throw InputError("--bands-file: give either --bands or --bands-file, not both");
-  if (!o.bands.empty()) request.bands = Bands::parse(o.bands, "--bands");
-  if (!o.bands_file.empty()) request.bands = read_band_plan(o.bands_file);
+  if (const auto bands = band_plan_option(o.bands, o.bands_file, "--bands-file")) request.bands = *bands;
   if (o.max_bounces) {
     if (*o.max_bounces < 0) throw InputError(fmt::format("--max-bounces: must be >= 0, got {}", *o.max_bounces));
     request.max_bounces = *o.max_bounces, request.bounces_name = "--max-bounces";

@@ -8,7 +8,6 @@
 #include "cli/app.h"
 #include "cli/command.h"
 #include "cli/options.h"
-#include "core/band_plan.h"
 #include "core/error.h"
 #include "core/file_io.h"
 #include "core/parallel.h"
@@ -59,9 +58,7 @@ Action add_render(CLI::App& app) {
     rt::RenderOptions options;
     options.samples = o->spp;
     options.max_bounces = o->max_bounces;
-    if (!o->bands.empty() && !o->plan.empty()) throw InputError("--plan: give either --bands or --plan, not both");
-    if (!o->bands.empty()) options.bands = Bands::parse(o->bands, "--bands");
-    if (!o->plan.empty()) options.bands = read_band_plan(o->plan);
+    options.bands = band_plan_option(o->bands, o->plan, "--plan");
     if (!o->mode.empty()) {
       if (o->mode == "bands") options.mode = SpectralMode::Bands;
       else if (o->mode == "continuous") options.mode = SpectralMode::Continuous;

@@ -13,6 +13,7 @@
 
 #include "cli/app.h"
 #include "cli/command.h"
+#include "cli/options.h"
 #include "core/band_plan.h"
 #include "core/error.h"
 #include "core/json_input.h"
@@ -82,8 +83,7 @@ Json material_entry(const Material& material, const Bands& bands) {
 }
 
 int run(const Options& o) {
-  if (!o.bands.empty() && !o.bands_file.empty())
-    throw InputError("--bands-file: give either --bands or --bands-file, not both");
+  const std::optional<Bands> given = band_plan_option(o.bands, o.bands_file, "--bands-file");
   const Json document = read_json(o.file);
   const bool spectra_only = document_format(document) == kSpectraFormat;
   std::optional<Scene> scene;
@@ -95,9 +95,7 @@ int run(const Options& o) {
     spectra = scene->spectra;
     refuse_textures_and_environment(*scene);
   }
-  Bands bands = scene ? scene->render.bands : RenderSettings{}.bands;
-  if (!o.bands.empty()) bands = Bands::parse(o.bands, "--bands");
-  if (!o.bands_file.empty()) bands = read_band_plan(o.bands_file);
+  const Bands bands = given.value_or(scene ? scene->render.bands : RenderSettings{}.bands);
 
   std::vector<double> centres;
   for (std::size_t i = 0; i < bands.size(); ++i) centres.push_back(bands.centre(i));

@@ -5,6 +5,7 @@
 
 #include <fmt/core.h>
 
+#include "core/band_plan.h"
 #include "core/error.h"
 #include "core/limits.h"
 
@@ -26,6 +27,14 @@ std::pair<int, int> parse_resolution(const std::string& text, std::string_view o
     if (ec != std::errc() || size[i] < 1) fail();
   }
   return {static_cast<int>(size[0]), static_cast<int>(size[1])};
+}
+
+std::optional<Bands> band_plan_option(const std::string& bands, const std::string& file, std::string_view file_option) {
+  if (!bands.empty() && !file.empty())
+    throw InputError(fmt::format("{}: give either --bands or {}, not both", file_option, file_option));
+  if (!bands.empty()) return Bands::parse(bands, "--bands");
+  if (!file.empty()) return read_band_plan(file);
+  return std::nullopt;
 }
 
 namespace fs = std::filesystem;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <utility>
 
 #include <fmt/core.h>
 
@@ -21,16 +22,19 @@ Samples sample(const PiecewiseLinearSpectrum& s, int lo, int hi) {
   return out;
 }
 
-// The spectrum as the band plan holds it: each band's average, flat over the band. Sample i stands for
-// [i − ½, i + ½] nm (as xyz() sums), so a band [lo, hi) holds the samples lo … hi − 1 (the last also hi), and bands
-// of 1 nm hold every sample as it is.
+// The samples band b holds: [a, e) of `count` samples starting at `lo` nm (the last band also holds the last).
+std::pair<int, int> band_span(const Bands& bands, std::size_t b, int lo, std::size_t count) {
+  const int last = static_cast<int>(count) - 1;
+  const int a = std::clamp(static_cast<int>(std::lround(bands.lo(b))) - lo, 0, last);
+  const int e = b + 1 == bands.size() ? last + 1 : std::clamp(static_cast<int>(std::lround(bands.hi(b))) - lo, 0, last + 1);
+  return {a, e};
+}
+
 // The band values themselves: each band's average over its samples (0 for a band that holds none).
 std::vector<double> band_values(const Samples& s, const Bands& bands, int lo) {
   std::vector<double> out(bands.size(), 0.0);
-  const int last = static_cast<int>(s.size()) - 1;
   for (std::size_t b = 0; b < bands.size(); ++b) {
-    const int a = std::clamp(static_cast<int>(std::lround(bands.lo(b))) - lo, 0, last);
-    const int e = b + 1 == bands.size() ? last + 1 : std::clamp(static_cast<int>(std::lround(bands.hi(b))) - lo, 0, last + 1);
+    const auto [a, e] = band_span(bands, b, lo, s.size());
     if (e <= a) continue;
     double sum = 0;
     for (int i = a; i < e; ++i) sum += s[i];
@@ -39,13 +43,14 @@ std::vector<double> band_values(const Samples& s, const Bands& bands, int lo) {
   return out;
 }
 
+// The spectrum as the band plan holds it: each band's average, flat over the band. Sample i stands for
+// [i − ½, i + ½] nm (as xyz() sums), so a band [lo, hi) holds the samples lo … hi − 1 (the last also hi), and bands
+// of 1 nm hold every sample as it is.
 Samples banded(const Samples& s, const Bands& bands, int lo) {
   Samples out(s.size(), 0.0);
   const std::vector<double> values = band_values(s, bands, lo);
-  const int last = static_cast<int>(s.size()) - 1;
   for (std::size_t b = 0; b < bands.size(); ++b) {
-    const int a = std::clamp(static_cast<int>(std::lround(bands.lo(b))) - lo, 0, last);
-    const int e = b + 1 == bands.size() ? last + 1 : std::clamp(static_cast<int>(std::lround(bands.hi(b))) - lo, 0, last + 1);
+    const auto [a, e] = band_span(bands, b, lo, s.size());
     for (int i = a; i < e; ++i) out[i] = values[b];
   }
   return out;
