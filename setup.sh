@@ -17,6 +17,7 @@ packages=(
   clang libclang-rt-14-dev  # libFuzzer and the sanitisers (.ci/sanitize, tests/fuzz)
   python-matplotlib-data python3-skimage rawtran-doc  # real photographs the analyzer is tested on (tests/data/photos/masks.json)
   slurm-wlm munge  # chromatrace farm's test on a single-node Slurm on localhost (tests/farm), and bench/bench_farm.sh
+  python3-venv  # the virtual environments of the Blender modules below
 )
 # The report viewer is bundled from npm packages (package.json): node and npm from Debian unless a node
 # with its own npm (e.g. NodeSource's) is already there.
@@ -34,5 +35,19 @@ if [ ${#missing[@]} -gt 0 ]; then
 fi
 
 npm ci --no-audit --no-fund
-cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release
+
+# Blender 4.5 LTS and 5.0 as Python modules (PyPI's bpy, pinned), each in its own virtual environment in build/,
+# for the add-on's tests against the Blenders artists run (tests/blender; Debian's blender above is 3.4). They are
+# built for CPython 3.11, Debian 12's python3.
+bpy_versions=(4.5.15 5.0.1)
+for v in "${bpy_versions[@]}"; do
+  venv="build/bpy-$v"
+  if ! "$venv/bin/python" -c "import importlib.metadata as m, sys; sys.exit(m.version('bpy') != '$v')" 2>/dev/null; then
+    rm -rf "$venv"
+    /usr/bin/python3 -m venv "$venv"
+    "$venv/bin/pip" install --quiet --disable-pip-version-check "bpy==$v"
+  fi
+done
+
+cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release "-DCHROMATRACE_BPY_VERSIONS=$(IFS=';'; echo "${bpy_versions[*]}")"
 cmake --build build

@@ -5,6 +5,11 @@
         [--components paths,lights,bounces] [--resolution WxH] [--seed S] [--cache-dir DIR] [--keep-cache]
         [--on-mixing-nodes refuse|one-band] [--on-world refuse|omit] [--explain [FILE]] [--band-group G [--bounce-limit NAME]]
     (or --blend FILE.blend instead of --scene; the .blend is never written)
+    python blender_addon/batch.py --scene SCENE.json --out OUT.exr ...
+        the same from a Python with Blender as a module (PyPI's bpy 4.5 or 5.0), arguments with or without `--`
+
+The add-on installed as an extension (Blender 4.2+) carries the same entry as chromatrace.headless:
+    blender -b --python-expr "import bl_ext.user_default.chromatrace.headless as h; h.main()" -- --scene ...
 
 --band-group G renders only band group G (with all its bounce limits, or only --bounce-limit NAME's render) into
 the cache and stops; a run without it
@@ -25,114 +30,11 @@ For tests: CHROMATRACE_TEST_FAIL_AT_RENDER=N raises an exception just before the
 (counting from 0), CHROMATRACE_TEST_KILL_AT_RENDER=N kills the process there (SIGKILL).
 """
 
-import json
 import os
-import signal
 import sys
-import traceback
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
-from chromatrace.batch_args import parse_batch_args  # noqa: E402
-from chromatrace.errors import BadInput  # noqa: E402
+from chromatrace import headless  # noqa: E402
 
-PROG = "batch.py"
-
-
-def _log(message):
-    print(f"chromatrace: {message}", file=sys.stderr, flush=True)
-
-
-def _test_hook():
-    fail_at = os.environ.get("CHROMATRACE_TEST_FAIL_AT_RENDER")
-    kill_at = os.environ.get("CHROMATRACE_TEST_KILL_AT_RENDER")
-    # Cycles settings put back to other values before every render ("blur_glossy=1,sample_clamp_indirect=10"):
-    # tests/blender/cross_validate.py shows that compare catches the bias of Cycles' defaults.
-    biased = os.environ.get("CHROMATRACE_TEST_CYCLES_SETTINGS")
-    if fail_at is None and kill_at is None and biased is None:
-        return None
-
-    def hook(event, rendered, **info):
-        if biased:
-            import bpy
-            for item in biased.split(","):
-                key, value = item.split("=")
-                setattr(bpy.context.scene.cycles, key, float(value))
-        if kill_at is not None and rendered == int(kill_at):
-            sys.stderr.flush()
-            os.kill(os.getpid(), signal.SIGKILL)
-        if fail_at is not None and rendered == int(fail_at):
-            raise RuntimeError(f"test hook: failing before render {rendered} (group {info['group']})")
-    return hook
-
-
-def _empty_startup_scene(bpy):
-    for collection in (bpy.data.objects, bpy.data.meshes, bpy.data.materials, bpy.data.lights, bpy.data.cameras,
-                       bpy.data.worlds):
-        for item in list(collection):
-            collection.remove(item)
-
-
-def run(argv):
-    args = parse_batch_args(argv)
-    import bpy
-    import chromatrace
-    from chromatrace import scene_import, spectral_render, tool
-
-    chromatrace.register()
-    log = (lambda message: None) if args.quiet else _log
-    chromatrace_tool = tool.Tool(tool.find_executable())
-    if args.scene:
-        _empty_startup_scene(bpy)
-        scene_import.import_scene(args.scene, bpy.context.scene, chromatrace_tool, log)
-    else:
-        bpy.ops.wm.open_mainfile(filepath=os.path.abspath(args.blend))
-    scene = bpy.context.scene
-    families = args.components
-    request = spectral_render.Request.from_scene(
-        scene, output=os.path.abspath(args.out) if args.out else None, samples=args.samples, max_bounces=args.max_bounces, seed=args.seed,
-        bands=args.bands, bands_file=args.bands_file, families=families, resolution=args.resolution,
-        cache_root=args.cache_dir, keep_cache=args.keep_cache or None, log=log,
-        on_mixing_nodes=args.on_mixing_nodes, bands_per_render=args.bands_per_render, on_world=args.on_world,
-        only_group=args.band_group, only_variant=args.bounce_limit)
-    if args.bands_file:
-        request.bands = None
-    elif args.bands:
-        request.bands_file = None
-    if args.explain is not None:
-        summary = spectral_render.SpectralRender(scene, request, chromatrace_tool).preflight()
-        text = json.dumps(summary, indent=1)
-        if args.explain == "-":
-            print(text, flush=True)
-        else:
-            with open(args.explain, "w") as f:
-                f.write(text + "\n")
-        return
-    if args.scene and args.band_group is None:
-        # What these settings leave out, said before rendering as `chromatrace render` says it (also with
-        # --quiet); a band-group task of a farm leaves it to the run that assembles.
-        for warning in chromatrace_tool.render_warnings(
-                args.scene, bands=args.bands, bands_file=args.bands_file, samples=args.samples,
-                max_bounces=args.max_bounces, resolution=args.resolution):
-            _log(f"warning: {warning}")
-    spectral_render.TEST_HOOK = _test_hook()
-    spectral_render.SpectralRender(scene, request, chromatrace_tool).run()
-
-
-def main():
-    argv = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else []
-    try:
-        run(argv)
-    except BadInput as e:
-        print(f"{PROG}: error: {e}", file=sys.stderr, flush=True)
-        sys.exit(2)
-    except Exception as e:  # a runtime failure: the reason on one line, the traceback for a bug report
-        if os.environ.get("CHROMATRACE_TRACEBACK"):
-            traceback.print_exc()
-        print(f"{PROG}: failed: {str(e).strip().splitlines()[-1] if str(e).strip() else type(e).__name__}",
-              file=sys.stderr, flush=True)
-        sys.exit(1)
-    sys.exit(0)
-
-
-main()
+headless.main(headless.script_arguments(sys.argv), prog="batch.py")

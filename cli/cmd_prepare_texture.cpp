@@ -24,13 +24,26 @@ struct Options {
   int bands_per_render = 3;
   int threads = 0;
   double scale = 1.0;
-  bool json = false, quiet = false, replicate = false;
+  bool json = false, quiet = false, replicate = false, check = false;
 };
+
+// --check: the image read and judged as a render would, nothing written; its size and capture noise as JSON.
+int check_only(const Options& o, TextureUse use, std::optional<TextureColourSpace> colour_space) {
+  const ImageTexture texture = read_image_texture(o.image, o.image, colour_space, use, o.scale);
+  const Json summary = {{"image", o.image},
+                        {"width", texture.width},
+                        {"height", texture.height},
+                        {"negative_texels", negative_texels_json(texture.negatives)}};
+  fmt::print("{}\n", summary.dump(1));
+  return 0;
+}
 
 int run(const Options& o) {
   if (!o.bands.empty() && !o.bands_file.empty())
     throw InputError("--bands-file: give either --bands or --bands-file, not both");
-  if (o.bands.empty() && o.bands_file.empty()) throw InputError("--bands: give --bands lo:hi:width or --bands-file PLAN");
+  if (o.bands.empty() && o.bands_file.empty() && !o.check)
+    throw InputError("--bands: give --bands lo:hi:width or --bands-file PLAN");
+  if (o.output.empty() && !o.check) throw InputError("--output: give the output directory (-o DIR)");
   TexturePrepRequest request;
   request.image = o.image;
   if (o.kind == "reflectance") request.use = TextureUse::Reflectance;
@@ -40,6 +53,7 @@ int run(const Options& o) {
   else if (o.colour_space == "linear") request.colour_space = TextureColourSpace::Linear;
   else if (o.colour_space != "auto")
     throw InputError(fmt::format("--colour-space: expected sRGB, linear or auto, got \"{}\"", o.colour_space));
+  if (o.check) return check_only(o, request.use, request.colour_space);
   request.bands = o.bands.empty() ? read_band_plan(o.bands_file) : Bands::parse(o.bands, "--bands");
   if (o.bands_per_render < 1 || o.bands_per_render > 3)
     throw InputError(fmt::format("--bands-per-render: must be 1 to 3, got {}", o.bands_per_render));
@@ -61,6 +75,11 @@ int run(const Options& o) {
   const char* space = r.colour_space == TextureColourSpace::Srgb ? "sRGB" : "linear";
   if (!o.quiet) {
     if (r.had_alpha) fmt::print(stderr, "chromatrace prepare-texture: {}: alpha channel ignored\n", o.image);
+    if (r.negatives.count > 0)
+      fmt::print(stderr,
+                 "chromatrace prepare-texture: {}: {} negative channel values (capture noise, down to {:.3g}, within the "
+                 "image's dark end {:.3g}) set to zero\n",
+                 o.image, r.negatives.count, -r.negatives.largest, r.negatives.threshold);
     if (r.cached)
       fmt::print(stderr, "chromatrace prepare-texture: {}: cached ({} files for hash {} in {}), nothing to do\n", o.image,
                  r.files.size(), r.hash, o.output);
@@ -85,6 +104,7 @@ int run(const Options& o) {
                           {"texels", r.texels},
                           {"distinct_colours", r.distinct_colours},
                           {"alpha_ignored", r.had_alpha},
+                          {"negative_texels", negative_texels_json(r.negatives)},
                           {"bands_per_render", request.bands_per_render},
                           {"replicate", request.replicate},
                           {"scale", request.scale},
@@ -113,7 +133,10 @@ Action add_prepare_texture(CLI::App& app) {
   cmd->add_option("--scale", o->scale, "Multiplies every texel's spectrum (a texture's \"scale\")")->capture_default_str();
   cmd->add_flag("--replicate", o->replicate,
                 "With --bands-per-render 1: the band in R, G and B (the add-on's one-band fallback), not R alone");
-  cmd->add_option("-o,--output", o->output, "Output directory (the cache)")->required();
+  cmd->add_option("-o,--output", o->output, "Output directory (the cache); not with --check");
+  cmd->add_flag("--check", o->check,
+                "Read and judge the image as a render would (capture noise zeroed, negative light refused) and print "
+                "its size and negative texels as JSON; write nothing");
   cmd->add_option("--threads", o->threads, "Threads (0: all)")->capture_default_str();
   cmd->add_flag("--json", o->json, "Print a JSON summary");
   cmd->add_flag("--quiet", o->quiet, "No messages on stderr");

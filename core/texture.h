@@ -25,6 +25,19 @@ enum class TextureColourSpace { Srgb, Linear };
 // an {"rgb"} spectrum is; a radiance may exceed 1 and is upsampled in the unbounded form (upsample_rgb_unbounded).
 enum class TextureUse { Reflectance, Radiance };
 
+// Negative texels of an image, which a real HDRI has where the camera's and the stitcher's noise pushed a dark
+// texel below zero. They are capture noise, and set to zero, when each is no deeper than the image's own dark
+// end — the 10th percentile of its positive channel values (`threshold`) — and all together carry at most
+// 1e-4 of its light; otherwise they are light that cannot be (an error naming the deepest texel).
+struct NegativeTexels {
+  std::size_t count = 0;  // channel values below zero, set to zero
+  double largest = 0.0;   // the largest magnitude among them
+  double threshold = 0.0;  // the image's dark end, which none exceeds
+};
+// The rule above on an image's linear RGB (3 values per texel, rows of `width` from the top): sets capture noise
+// to zero, or throws InputError "name: ..." naming the deepest texel when the negatives carry light.
+NegativeTexels zero_capture_noise(std::vector<float>& rgb, int width, const std::string& name);
+
 struct ImageTexture {
   std::string file;  // as written in the scene
   TextureColourSpace colour_space = TextureColourSpace::Srgb;
@@ -33,6 +46,7 @@ struct ImageTexture {
   int width = 0, height = 0;
   std::vector<float> rgb;  // linear sRGB, 3 per texel, row-major from the image's top row
   bool had_alpha = false;  // the file has an alpha channel (ignored)
+  NegativeTexels negatives;  // capture noise set to zero (linear images; an sRGB file has no negatives)
 
   std::size_t texel_count() const { return static_cast<std::size_t>(width) * static_cast<std::size_t>(height); }
   std::array<double, 3> texel(std::size_t index) const {

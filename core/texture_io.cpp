@@ -44,6 +44,43 @@ bool is_float_image(const OIIO::ImageSpec& spec) {
 
 }  // namespace
 
+NegativeTexels zero_capture_noise(std::vector<float>& values, int width, const std::string& name) {
+  NegativeTexels n;
+  double negative_sum = 0.0, positive_sum = 0.0;
+  std::size_t deepest = 0;
+  std::vector<float> positive;
+  for (std::size_t i = 0; i < values.size(); ++i) {
+    const float v = values[i];
+    if (v < 0.0f) {
+      ++n.count;
+      negative_sum -= v;
+      if (-v > n.largest) {
+        n.largest = -v;
+        deepest = i;
+      }
+    } else if (v > 0.0f) {
+      positive_sum += v;
+      positive.push_back(v);
+    }
+  }
+  if (n.count == 0) return n;
+  if (!positive.empty()) {
+    auto tenth = positive.begin() + static_cast<std::ptrdiff_t>(positive.size() / 10);
+    std::nth_element(positive.begin(), tenth, positive.end());
+    n.threshold = *tenth;
+  }
+  if (n.largest > n.threshold || negative_sum > 1e-4 * positive_sum)
+    throw InputError(fmt::format(
+        "{}: {} negative channel values carry light that cannot be ({:.3g} of the image's light; the deepest, {:.4g} "
+        "at texel ({}, {}) (x from the left, y from the top), lies below the image's dark end {:.4g}, the 10th "
+        "percentile of its positive values; only negatives within it, and together under 1e-4 of the light, are "
+        "taken for capture noise and set to zero)",
+        name, n.count, positive_sum > 0 ? negative_sum / positive_sum : 1.0, -n.largest,
+        deepest / 3 % static_cast<std::size_t>(width), deepest / 3 / static_cast<std::size_t>(width), n.threshold));
+  for (float& v : values) v = std::max(v, 0.0f);
+  return n;
+}
+
 TextureColourSpace default_texture_colour_space(const std::filesystem::path& path) {
   return is_float_image(open_image(path)->spec()) ? TextureColourSpace::Linear : TextureColourSpace::Srgb;
 }
@@ -83,9 +120,6 @@ ImageTexture read_image_texture(const std::filesystem::path& path, const std::st
       const std::size_t x = t % static_cast<std::size_t>(texture.width), y = t / static_cast<std::size_t>(texture.width);
       if (!std::isfinite(value))
         throw InputError(fmt::format("{}: texel ({}, {}) (x from the left, y from the top) is not finite", name, x, y));
-      if (value < 0.0)
-        throw InputError(fmt::format("{}: texel ({}, {}) (x from the left, y from the top) has the negative value {}",
-                                     name, x, y, value));
       if (texture.colour_space == TextureColourSpace::Srgb) value = srgb_decode(value);
       if (use == TextureUse::Reflectance && value > 1.0)
         throw InputError(fmt::format("{}: texel ({}, {}) (x from the left, y from the top) reaches {} in linear sRGB, "
@@ -94,6 +128,7 @@ ImageTexture read_image_texture(const std::filesystem::path& path, const std::st
       texture.rgb[3 * t + static_cast<std::size_t>(c)] = static_cast<float>(value);
     }
   }
+  texture.negatives = zero_capture_noise(texture.rgb, texture.width, name);
   return texture;
 }
 

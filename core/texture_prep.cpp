@@ -125,6 +125,10 @@ void write_group(const std::filesystem::path& target, const ImageTexture& textur
 
 }  // namespace
 
+Json negative_texels_json(const NegativeTexels& n) {
+  return {{"zeroed", n.count}, {"largest", n.largest}, {"threshold", n.threshold}};
+}
+
 std::vector<std::vector<std::size_t>> band_groups(std::size_t band_count, int per_render) {
   if (per_render < 1 || per_render > 3) throw InputError(fmt::format("bands per render must be 1 to 3, got {}", per_render));
   std::vector<std::vector<std::size_t>> groups;
@@ -164,6 +168,11 @@ TexturePrepResult prepare_texture(const TexturePrepRequest& request, const std::
     result.texels = m->value("texels", std::size_t{0});
     result.distinct_colours = m->value("distinct_colours", std::size_t{0});
     result.had_alpha = m->value("alpha_ignored", false);
+    if (const auto n = m->find("negative_texels"); n != m->end()) {
+      result.negatives.count = n->value("zeroed", std::size_t{0});
+      result.negatives.largest = n->value("largest", 0.0);
+      result.negatives.threshold = n->value("threshold", 0.0);
+    }
     result.seconds = elapsed();
     return result;
   }
@@ -177,6 +186,7 @@ TexturePrepResult prepare_texture(const TexturePrepRequest& request, const std::
   result.texels = texture.texel_count();
   result.distinct_colours = spectra.palette.size();
   result.had_alpha = texture.had_alpha;
+  result.negatives = texture.negatives;
 
   std::error_code ec;
   std::filesystem::create_directories(directory, ec);
@@ -207,6 +217,7 @@ TexturePrepResult prepare_texture(const TexturePrepRequest& request, const std::
                          {"texels", result.texels},
                          {"distinct_colours", result.distinct_colours},
                          {"alpha_ignored", result.had_alpha},
+                         {"negative_texels", negative_texels_json(result.negatives)},
                          {"groups", groups}};
   write_file_atomically(result.manifest, manifest.dump(1) + "\n");
   result.seconds = elapsed();

@@ -17,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "core/json_input.h"
 #include "core/spectrum.h"
 #include "core/texture.h"
 
@@ -45,11 +46,15 @@ struct TexturePrepResult {
   int width = 0, height = 0;
   std::size_t texels = 0, distinct_colours = 0;
   bool had_alpha = false;
+  NegativeTexels negatives;  // capture noise set to zero (core/texture.h)
   std::vector<std::vector<std::size_t>> groups;
   std::vector<std::filesystem::path> files;  // one per group
   std::filesystem::path manifest;
   double seconds = 0.0;
 };
+
+// {"zeroed", "largest", "threshold"}: the capture noise an image had (prepare-texture's summary and manifest).
+Json negative_texels_json(const NegativeTexels& negatives);
 
 // The cache key of a request: reads the image's bytes (and its header, for the default colour space).
 std::string texture_prep_hash(const TexturePrepRequest& request);

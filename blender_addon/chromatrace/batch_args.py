@@ -43,6 +43,9 @@ def _parser():
     p.add_argument("--explain", "--preflight", nargs="?", const="-", metavar="FILE",
                    help="print (or write to FILE) the pre-flight summary as JSON: every material, light and the world "
                         "exact, upsampled or refused, and the renders needed; render nothing")
+    p.add_argument("--device", choices=["CPU", "CUDA", "OPTIX", "HIP", "ONEAPI", "METAL"], default="CPU",
+                   help="Cycles' render device: the CPU (default), or the GPUs of one backend Blender finds; recorded "
+                        "in the cache key and the output's header")
     p.add_argument("--bands-per-render", type=int, choices=[1, 2, 3],
                    help="bands multiplexed into one render (default 3; fewer for comparisons)")
     p.add_argument("--cache-dir", help="where finished band groups are kept for resuming "

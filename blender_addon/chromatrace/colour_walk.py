@@ -30,7 +30,7 @@ import os
 
 import bpy
 
-from . import node_rules
+from . import blender_compat, node_rules
 
 _SHADER = "SHADER"
 _SCALAR = ("VALUE", "INT", "BOOLEAN")
@@ -107,6 +107,8 @@ def describe(node):
     for key in ("distribution", "blend_type", "data_type"):
         if hasattr(node, key):
             props[key] = getattr(node, key)
+    if props.get("distribution") == "MULTI_GGX":
+        props["multiscatter"] = blender_compat.cycles_multiscatter()
     inputs = {}
     for key in ("Specular Tint", "Sheen Tint", "Subsurface", "Subsurface Weight", "Specular", "Specular IOR Level",
                 "Sheen", "Sheen Weight"):

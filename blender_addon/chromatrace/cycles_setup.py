@@ -5,7 +5,10 @@ Off: clamping (direct and indirect), Filter Glossy, denoising, adaptive sampling
 path guiding, fast GI, simplify, motion blur, Freestyle, compositing and the sequencer. On: both kinds of
 caustics. Box pixel filter of width 1 (for the scene format's "point", a Gaussian 0.01 wide), Standard view
 transform with look None, exposure 0 and gamma 1, Cycles film exposure 1, 32-bit float multilayer OpenEXR.
+The render device is select_device's: the CPU unless asked.
 """
+
+from .errors import BadInput
 
 VIEW_LAYER_PASSES = {
     "Emit": "use_pass_emit", "Env": "use_pass_environment",
@@ -48,11 +51,43 @@ def pixel_filter(point):
                                                                                       ("filter_width", 1.0))
 
 
+def select_device(journal, scene, cycles_preferences, device):
+    """Cycles' render device: "CPU", or every device of one GPU backend ("CUDA", "OPTIX", "HIP", "ONEAPI",
+    "METAL") that this Blender finds, set through the journal (the preferences too, so they are put back).
+    Returns what renders, for the output's header ("CPU", "CUDA: NVIDIA ..."); a backend this Blender was not
+    built with or finds no device of is refused by name."""
+    if device == "CPU":
+        journal.set(scene.cycles, "device", "CPU")
+        return "CPU"
+    backends = {item.identifier for item in
+                cycles_preferences.bl_rna.properties["compute_device_type"].enum_items}
+    if device not in backends:
+        raise BadInput(f"--device: {device}: this Blender's Cycles has no {device} backend "
+                       f"(it has {', '.join(sorted(backends - {'NONE'})) or 'none'})")
+    journal.set(cycles_preferences, "compute_device_type", device)
+    cycles_preferences.refresh_devices()
+    gpus = [d for d in cycles_preferences.devices if d.type == device]
+    if not gpus:
+        raise BadInput(f"--device: {device}: Cycles finds no {device} device on this machine")
+    for d in cycles_preferences.devices:
+        journal.set(d, "use", d.type == device)
+    journal.set(scene.cycles, "device", "GPU")
+    return f"{device}: {', '.join(d.name for d in gpus)}"
+
+
+def multilayer_exr(image_settings):
+    """The settings that make a render write a multilayer OpenEXR with every pass in one part: a format among the
+    others up to Blender 4.x; from 5.0 the one format of the multilayer media type (chosen first), which writes
+    a part per pass unless interleaved (`chromatrace assemble` reads one part)."""
+    media = [("media_type", "MULTI_LAYER_IMAGE")] if hasattr(image_settings, "media_type") else []
+    interleave = [("use_exr_interleave", True)] if hasattr(image_settings, "use_exr_interleave") else []
+    return media + [("file_format", "OPEN_EXR_MULTILAYER")] + interleave
+
+
 def apply(journal, scene, view_layer, samples, seed, point_filter, resolution, passes):
     render = scene.render
     journal.set(render, "engine", "CYCLES")
     c = scene.cycles
-    journal.set(c, "device", "CPU")
     journal.set(c, "samples", samples)
     journal.set(c, "seed", seed)
     for attribute, value in (*CYCLES_SETTINGS, *pixel_filter(point_filter)):
@@ -65,7 +100,7 @@ def apply(journal, scene, view_layer, samples, seed, point_filter, resolution, p
 
     image = render.image_settings
     # The valid bit depths depend on the format: set (and restore) the format first.
-    journal.set_together(image, [("file_format", "OPEN_EXR_MULTILAYER"), ("color_depth", "32"), ("exr_codec", "ZIP")]
+    journal.set_together(image, multilayer_exr(image) + [("color_depth", "32"), ("exr_codec", "ZIP")]
                          + [(a, v) for a, v in (("use_preview", False), ("color_management", "FOLLOW_SCENE"))
                             if hasattr(image, a)])
 

@@ -6,9 +6,13 @@ import os
 
 
 def defaults_file():
-    """core/data/defaults.json beside the add-on, in the source tree and once installed
+    """data/defaults.json inside the add-on when it is installed as an extension (blender_addon/build_extension.py
+    puts it there); otherwise core/data/defaults.json beside the add-on, in the source tree and once installed
     (<prefix>/share/chromatrace/{blender_addon,core/data})."""
     here = os.path.dirname(os.path.realpath(__file__))  # through a symlink in Blender's add-ons folder
+    packaged = os.path.join(here, "data", "defaults.json")
+    if os.path.isfile(packaged):
+        return packaged
     return os.path.normpath(os.path.join(here, "..", "..", "core", "data", "defaults.json"))
 
 

@@ -23,14 +23,19 @@ IDS_FILE = "ids.exr"
 
 
 def build_manifest(edges_nm, groups, variants, view_layer, total, components, object_names=None,
-                   attributes=None, replicate=False, sum_tolerance=1e-4, reconstruction=None):
+                   attributes=None, replicate=False, sum_tolerance=1e-4, reconstruction=None, pass_names=None):
     """The manifest dict, with file paths relative to the directory the manifest is written to.
 
     groups: lists of band indices, one per render; variants: names of the renders every group has
     (components.render_variants); object_names: {id: name} when the renders carry the Object Index pass;
     replicate: one band per render copied to R, G and B (read back from R); reconstruction: the band plan's
-    reconstruction ({"lo_nm", "step_nm", "matrix"}), which the EXR header carries.
+    reconstruction ({"lo_nm", "step_nm", "matrix"}), which the EXR header carries; pass_names: {short pass name:
+    the name in the files} where the running Blender writes other names than the components use
+    (blender_compat.pass_names).
     """
+    renamed = dict(pass_names or {})
+    total = _renamed_terms(total, renamed)
+    components = [dict(c, terms=_renamed_terms(c["terms"], renamed)) for c in components]
     band_count = len(edges_nm) - 1
     bands = [None] * band_count
     for g, group in enumerate(groups):
@@ -50,7 +55,8 @@ def build_manifest(edges_nm, groups, variants, view_layer, total, components, ob
         "sum_tolerance": sum_tolerance,
     }
     if object_names is not None:
-        manifest["object_ids"] = {"file": IDS_FILE, "channel": _join(view_layer, "IndexOB.X")}
+        manifest["object_ids"] = {"file": IDS_FILE,
+                                  "channel": _join(view_layer, f"{renamed.get('IndexOB', 'IndexOB')}.X")}
         manifest["object_names"] = {str(i): name for i, name in sorted(object_names.items())}
     if attributes:
         manifest["attributes"] = dict(attributes)
@@ -73,6 +79,10 @@ def channels_by_file(document):
     if "object_ids" in document:
         wanted.setdefault(document["object_ids"]["file"], set()).add(document["object_ids"]["channel"])
     return wanted
+
+
+def _renamed_terms(terms, names):
+    return [dict(t, passes=[names.get(p, p) for p in t["passes"]]) for t in terms]
 
 
 def _join(view_layer, name):

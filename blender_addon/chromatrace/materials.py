@@ -5,7 +5,7 @@ from collections import namedtuple
 
 import bpy
 
-from . import colour_walk
+from . import blender_compat, colour_walk
 from .errors import BadInput
 
 REFLECTANCE_NODE = "ct_reflectance"
@@ -29,18 +29,11 @@ def _new(nodes, kind, name, location):
     return node
 
 
-def cycles_ggx_masking():
-    """The Smith masking of the running Cycles' GGX (the scene format's "masking"): separable up to Blender 3.x,
-    height-correlated from 4.0."""
-    return "height-correlated" if bpy.app.version >= (4, 0, 0) else "separable"
-
-
 def build_material_nodes(material):
     """Replaces the material's nodes with those of its chromatrace model: RGB nodes named ct_reflectance and
     ct_emission hold the colours the spectral render sets; a one-sided emitter's strength is 0 on back faces."""
     s = material.chromatrace
-    material.use_nodes = True
-    tree = material.node_tree
+    tree = blender_compat.enable_nodes(material)
     nodes, links = tree.nodes, tree.links
     nodes.clear()
     output = _new(nodes, "ShaderNodeOutputMaterial", "ct_output", (600, 0))
@@ -116,12 +109,12 @@ def load_image(path, colour_space="auto"):
     if colour_space == "sRGB":
         image.colorspace_settings.name = "sRGB"
     elif colour_space == "linear":
-        image.colorspace_settings.name = "Linear" if bpy.app.version < (4, 0, 0) else "Linear Rec.709"
+        image.colorspace_settings.name = blender_compat.linear_rec709(image)
     return image
 
 
 def output_node(material):
-    if not material.use_nodes or material.node_tree is None:
+    if not blender_compat.uses_nodes(material):
         return None
     return material.node_tree.get_output_node("CYCLES")
 
@@ -140,7 +133,7 @@ def walk_material(material):
 def walk_light(light):
     """The colour walk of a light's node tree (when it uses nodes; Cycles ignores the tree otherwise)."""
     walk = colour_walk.Walk("light", light.name)
-    if light.use_nodes and light.node_tree is not None:
+    if blender_compat.uses_nodes(light):
         walk.walk_output(light.node_tree.get_output_node("CYCLES"))
     return walk.finish()
 
@@ -148,7 +141,7 @@ def walk_light(light):
 def walk_world(world):
     """The colour walk of the world: its node tree, or its colour when it uses none (as Cycles renders it)."""
     walk = colour_walk.Walk("world", world.name)
-    if world.use_nodes and world.node_tree is not None:
+    if blender_compat.uses_nodes(world):
         walk.walk_output(world.node_tree.get_output_node("CYCLES"))
     elif max(world.color) > 0.0:
         leaf = colour_walk.Leaf(world, "color", tuple(world.color), None, f"{world.name}/color")
@@ -205,7 +198,7 @@ def spectral_inputs(material, walk):
             found.append(SpectralInput(glossy.inputs["Color"], "default_value", "interface", tuple(value[:3]),
                                        value[3], f"{material.name}/ct_glossy", True))
         return found
-    if not material.use_nodes or material.node_tree is None:  # Cycles renders the viewport colour, diffusely
+    if not blender_compat.uses_nodes(material):  # Cycles renders the viewport colour, diffusely
         value = material.diffuse_color
         return [SpectralInput(material, "diffuse_color", "reflectance", tuple(value[:3]), value[3],
                               f"{material.name}/diffuse_color", False)]

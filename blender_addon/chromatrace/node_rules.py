@@ -3,8 +3,10 @@
 Multiplexing puts three different bands in R, G and B and reads each channel back as its own band. That is
 exact when every node treats the three channels alike and separately (any per-channel function, even a
 non-linear one, gives each band what a render of that band alone would). It fails where a node mixes
-channels or treats them differently — Principled specular or sheen tint (the highlight takes the hue of
-the base colour), Multiscatter GGX, subsurface radii per channel, colour ramps, hue/saturation, RGB curves,
+channels or treats them differently — Principled specular or sheen tint (Blender 3: the highlight takes the
+hue of the base colour; 4.0+: a coloured tint, by whose strongest channel Cycles weighs the layers below),
+Multiscatter GGX up to Blender 3 (a random walk the channels share; from 4.0 a per-channel albedo scaling,
+which multiplexes exactly), subsurface radii per channel, colour ramps, hue/saturation, RGB curves,
 colour-to-BW, separating or combining channels, hue/saturation/colour/value blend modes. Rendering one band
 per render, copied to all three channels, makes those nodes see grey and act on each band alone: the
 "one-band" fallback. Some inputs are not spectra at all (procedural textures, vertex colours, the Wavelength
@@ -68,7 +70,8 @@ def node_issues(node):
     issues = []
     if t in _SHADER_CHANNEL_NODES:
         issues.append((_CHANNEL_NODES[t], True))
-    if t in _MULTISCATTER_NODES and props.get("distribution") == "MULTI_GGX":
+    if t in _MULTISCATTER_NODES and props.get("distribution") == "MULTI_GGX" and \
+            props.get("multiscatter", "random-walk") == "random-walk":
         issues.append(("Multiscatter GGX couples the colour channels", True))
     if t == "ShaderNodeBsdfPrincipled":
         # A tint matters only where its lobe has weight (Blender 3: Specular, Sheen; 4: ... IOR Level, Weight).
@@ -76,7 +79,11 @@ def node_issues(node):
                               ("Sheen Tint", ("Sheen", "Sheen Weight"))):
             lobe_on = any(w in inputs and _positive(inputs[w]) for w in weights) or not any(w in inputs for w in weights)
             if tint in inputs and _positive(inputs[tint]) and lobe_on:
-                issues.append((f"{tint.lower()} takes the hue of the base colour", True))
+                if isinstance(inputs[tint], (tuple, list)):  # Principled v2 (Blender 4.0+): a colour
+                    issues.append((f"a coloured {tint.lower()} makes Cycles weigh the layers below by its strongest "
+                                   "channel", True))
+                else:
+                    issues.append((f"{tint.lower()} takes the hue of the base colour", True))
         for name in ("Subsurface", "Subsurface Weight"):
             if name in inputs and _positive(inputs[name]):
                 issues.append(("subsurface scattering has a radius per channel", True))

@@ -9,7 +9,7 @@ import bpy
 from bpy.props import StringProperty
 from bpy_extras.io_utils import ExportHelper, ImportHelper
 
-from . import materials, scene_export, scene_import, spectral_render, tool
+from . import blender_compat, materials, scene_export, scene_import, spectral_render, tool
 from .errors import BadInput
 from .properties import MODEL_ITEMS, executable_preference
 
@@ -255,7 +255,7 @@ class CHROMATRACE_OT_set_model(bpy.types.Operator):
 
     def invoke(self, context, event):
         material = context.material
-        own = material.chromatrace.model == "NODES" and material.use_nodes and material.node_tree is not None \
+        own = material.chromatrace.model == "NODES" and blender_compat.uses_nodes(material) \
             and len(material.node_tree.nodes) > 0
         if own and self.model != "NODES":
             return context.window_manager.invoke_props_dialog(self, width=420)

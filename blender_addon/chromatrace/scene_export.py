@@ -12,7 +12,7 @@ import os
 
 import bpy
 
-from . import materials, ply
+from . import blender_compat, materials, ply
 from .errors import BadInput
 from .floats import short_float
 from .geometry_digest import camera_digest, object_digest
@@ -33,8 +33,8 @@ def _material_entry(material, out_dir, log):
     if s.model == "DICHROMATIC":
         entry = {"type": "dichromatic", "diffuse": reflectance, "specular": short_float(s.specular), "lobe": s.lobe}
         entry["roughness" if s.lobe == "ggx" else "exponent"] = short_float(s.roughness if s.lobe == "ggx" else s.exponent)
-        if s.lobe == "ggx" and materials.cycles_ggx_masking() != "separable":  # the format's default
-            entry["masking"] = materials.cycles_ggx_masking()
+        if s.lobe == "ggx" and blender_compat.cycles_ggx_masking() != "separable":  # the format's default
+            entry["masking"] = blender_compat.cycles_ggx_masking()
         return entry
     if s.model == "MIRROR":
         return {"type": "mirror", "reflectance": reflectance}
@@ -102,7 +102,7 @@ def _environment(world, out_dir, log):
     no world or a dark one. Anything else is said and left out."""
     if world is None:
         return None
-    if not world.use_nodes or world.node_tree is None:
+    if not blender_compat.uses_nodes(world):
         if max(world.color) <= 0.0:
             return None
         return {"radiance": {"rgb": [short_float(c) for c in world.color]}, "group": _world_group(world)}

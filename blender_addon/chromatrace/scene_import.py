@@ -17,7 +17,7 @@ import tempfile
 import bpy
 from mathutils import Matrix
 
-from . import camera_math, defaults, materials, ply
+from . import blender_compat, camera_math, defaults, materials, ply
 from .errors import BadInput
 from .geometry_digest import camera_digest, object_digest
 
@@ -37,7 +37,7 @@ def _material(name, entry, scene_dir):
         s.lobe = entry.get("lobe", "ggx")
         if s.lobe == "ggx":
             s.roughness = entry["roughness"]
-            masking, cycles = entry.get("masking", "separable"), materials.cycles_ggx_masking()
+            masking, cycles = entry.get("masking", "separable"), blender_compat.cycles_ggx_masking()
             if masking != cycles:
                 raise BadInput(f"materials.{name}.masking: \"{masking}\", but the GGX of Cycles in Blender "
                                f"{bpy.app.version_string} has {cycles} masking: Cycles would render another material")
@@ -95,8 +95,8 @@ def _world(environment, scene_dir, view_layer):
     (nearest texel, as the tracer looks it up; rotation_deg α as a Mapping node turning the vector by −α about Z)
     or by the colour of an rgb or constant spectrum."""
     world = bpy.data.worlds.new("environment")
-    world.use_nodes = True
-    nodes, links = world.node_tree.nodes, world.node_tree.links
+    tree = blender_compat.enable_nodes(world)
+    nodes, links = tree.nodes, tree.links
     nodes.clear()
     output = nodes.new("ShaderNodeOutputWorld")
     background = nodes.new("ShaderNodeBackground")
@@ -133,7 +133,7 @@ def _world(environment, scene_dir, view_layer):
 
 def _dark(world):
     """Whether a world adds no light (as far as a constant colour or strength tells)."""
-    if not world.use_nodes or world.node_tree is None:
+    if not blender_compat.uses_nodes(world):
         return max(world.color) <= 0.0
     for node in world.node_tree.nodes:
         if node.bl_idname in ("ShaderNodeBackground", "ShaderNodeEmission"):

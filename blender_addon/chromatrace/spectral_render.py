@@ -26,7 +26,7 @@ import time
 
 import bpy
 
-from . import VERSION, cache, components, cycles_setup, defaults, manifest, materials, node_rules
+from . import VERSION, blender_compat, cache, components, cycles_setup, defaults, manifest, materials, node_rules
 from .bands import band_groups, describe_band_range, group_colour
 from .errors import BadInput
 from .geometry_digest import update_with_mesh
@@ -77,6 +77,7 @@ class Request:
         self.on_mixing_nodes = "refuse"  # or "one-band"
         self.on_world = "refuse"  # a lit world whose colours cannot be spectra (an HDRI): or "omit"
         self.bands_per_render = 3
+        self.device = "CPU"  # Cycles' device: CPU, or a GPU backend (cycles_setup.select_device)
         self.output = None
         self.cache_root = None
         self.keep_cache = False
@@ -100,6 +101,10 @@ class Request:
                       cache_root=bpy.path.abspath(s.cache_dir) if s.cache_dir else None)
         values.update({k: v for k, v in overrides.items() if v is not None})
         return cls(**values)
+
+
+def _cycles_preferences():
+    return bpy.context.preferences.addons["cycles"].preferences
 
 
 def _stderr_log(message):
@@ -525,7 +530,7 @@ class SpectralRender:
             if ob.type == "LIGHT":
                 digest.update(json.dumps([_rna_plain(ob.data), _rna_plain(getattr(ob.data, "cycles", None))],
                                          sort_keys=True).encode())
-                if ob.data.use_nodes:
+                if blender_compat.uses_nodes(ob.data):
                     digest.update(json.dumps(materials.node_tree_digest(ob.data.node_tree)).encode())
             else:
                 evaluated = ob.evaluated_get(depsgraph)
@@ -547,7 +552,7 @@ class SpectralRender:
             "averages": {k: v["bands"] for k, v in plan.bands["spectra"].items()},
             "textures": {k: v["hash"] for k, v in plan.textures.items()},
             "samples": request.samples, "seed": request.seed, "max_bounces": request.max_bounces,
-            "variants": plan.variants, "point_filter": request.point_filter, "resolution": self._resolution(),
+            "device": request.device, "variants": plan.variants, "point_filter": request.point_filter, "resolution": self._resolution(),
             "passes": sorted(plan.passes), "light_groups": plan.assignments, "ids": plan.ids,
             "geometry": geometry,
             "nodes": {m.name: materials.node_tree_digest(m.node_tree) for m in plan.materials},
@@ -557,7 +562,7 @@ class SpectralRender:
             # Depth of field: f-stop, focus distance or object, the aperture's blades, rotation and ratio.
             "depth_of_field": [_rna_plain(camera.data.dof),
                                repr([list(r) for r in focus.matrix_world]) if focus is not None else None],
-            "world": materials.node_tree_digest(world.node_tree) if world and world.use_nodes else None,
+            "world": materials.node_tree_digest(world.node_tree) if blender_compat.uses_nodes(world) else None,
             "world_state": [plan.world["status"], plan.world_group,
                             list(world.color) if world is not None else None],
             "world_settings": [_rna_plain(getattr(world, "cycles", None)),
@@ -609,9 +614,15 @@ class SpectralRender:
                     entry["reasons"].append(str(e))
                     entry["status"] = "refused"
             for spectral_input, source, scale in inputs:
-                entry["colours"].append({"input": spectral_input.label, "role": spectral_input.role,
-                                         "source": source, "scale": scale, "key": key_of(source),
-                                         "upsampled": "rgb" in source or _is_texture(source)})
+                colour = {"input": spectral_input.label, "role": spectral_input.role, "source": source,
+                          "scale": scale, "key": key_of(source), "upsampled": "rgb" in source or _is_texture(source)}
+                if _is_texture(source):
+                    try:
+                        colour["negative_texels"] = self._texture_noise(source, spectral_input.role)
+                    except BadInput as e:
+                        entry["reasons"].append(f"{kind} \"{name}\", {spectral_input.label}: {e}")
+                        entry["status"] = "refused"
+                entry["colours"].append(colour)
             refused = any(not i["fallback"] for i in issues) or (
                 any(i["fallback"] for i in issues) and request.on_mixing_nodes != "one-band")
             if status_override is not None:
@@ -669,6 +680,16 @@ class SpectralRender:
                 "render_variants": list(variants),
                 "object_id_render": bool(request.object_ids), "owners": owners}
 
+    def _texture_noise(self, source, role):
+        """The capture noise an image texture's file has, as the render will zero it ({"zeroed", "largest",
+        "threshold"}); None for an image packed into the .blend (judged when the render writes it out)."""
+        path = source["texture"]
+        if path.startswith("packed:"):
+            return None
+        kind = "reflectance" if role == "reflectance" else "radiance"
+        space = {"sRGB": "sRGB", "linear": "linear"}.get(source.get("colour_space"), "auto")
+        return self.tool.check_texture(path, kind, space)["negative_texels"]
+
     # ---- rendering -----------------------------------------------------------------------------------
 
     def _apply_settings(self, journal, plan):
@@ -676,10 +697,11 @@ class SpectralRender:
         view_layer = plan.view_layer
         cycles_setup.apply(journal, scene, view_layer, request.samples, request.seed, request.point_filter,
                            self._resolution(), plan.passes)
+        plan.device = cycles_setup.select_device(journal, scene, _cycles_preferences(), request.device)
         world = scene.world
         if world is not None and plan.world["status"] != "lit":  # dark, or omitted as asked: strength 0
             journal.set(world, "color", (0.0, 0.0, 0.0))
-            if world.use_nodes and world.node_tree is not None:
+            if blender_compat.uses_nodes(world):
                 for node in world.node_tree.nodes:
                     if node.bl_idname == "ShaderNodeBackground":
                         journal.set(node.inputs["Strength"], "default_value", 0.0)
@@ -898,7 +920,7 @@ class SpectralRender:
         return manifest.build_manifest(
             plan.edges, plan.groups, list(plan.variants), plan.view_layer.name, plan.total,
             plan.components, object_names=names, attributes=attributes, replicate=plan.replicate,
-            reconstruction=plan.bands["bands"].get("reconstruction"))
+            reconstruction=plan.bands["bands"].get("reconstruction"), pass_names=blender_compat.pass_names())
 
     def _assemble(self, plan):
         request = self.request
@@ -930,7 +952,9 @@ class SpectralRender:
             attributes["chromatrace.warning"] = self._world_warning(plan.world)
         return attributes | {
             "chromatrace.renderer": (f"Cycles (Blender {bpy.app.version_string}) via the chromatrace add-on: "
-                                     f"{plan.per_render} band(s) per render, max {request.max_bounces} bounces"),
+                                     f"{plan.per_render} band(s) per render, max {request.max_bounces} bounces, "
+                                     f"on {request.device}"),
+            "chromatrace.device": getattr(plan, "device", request.device),
             "chromatrace.samples": str(request.samples),
             "chromatrace.seed": str(request.seed),
             "chromatrace.scene": source,

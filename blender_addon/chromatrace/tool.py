@@ -83,6 +83,12 @@ class Tool:
             args.append("--replicate")
         return self.run(*args, json_output=True)
 
+    def check_texture(self, image, kind, colour_space):
+        """An image read and judged as a render would (`chromatrace prepare-texture --check`): {"width", "height",
+        "negative_texels": {"zeroed", "largest", "threshold"}}; negative light refused (BadInput naming the texel)."""
+        return self.run("prepare-texture", image, "--kind", kind, "--colour-space", colour_space, "--check",
+                        json_output=True)
+
     def preview(self, spectral_exr, png):
         """The picture a person would see (`chromatrace sensor`'s display rendering: a Canon EOS 5D Mark III,
         exposure from the scene's surfaces, white balance, colour matrix and sRGB), noise-free, as an 8-bit PNG."""

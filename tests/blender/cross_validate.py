@@ -6,7 +6,8 @@
     python3 cross_validate.py reflectance SCENE.json OBJECT  # OBJECT's reflectance changed for Cycles: must fail there
     python3 cross_validate.py turned SCENE.json  # the environment turned 90° more for Cycles: must fail
 
-Environment: CHROMATRACE_EXE, BLENDER (the executable), and optionally CROSS_SIZE (32x32), CROSS_BANDS
+Environment: CHROMATRACE_EXE, BLENDER (the executable), BLENDER_VERSION (its version: the scene's GGX masking is
+Cycles' in that version, tests/blender/scene_for_blender.py), and optionally CROSS_SIZE (32x32), CROSS_BANDS
 (380:780:40), CROSS_SPP (tracer and Cycles samples per pixel), CROSS_KEEP (a folder to keep the files in).
 Exit 0 when the assertion holds, 1 otherwise, with the compare verdict on stderr.
 """
@@ -18,8 +19,11 @@ import sys
 import tempfile
 import time
 
+from scene_for_blender import scene_for_blender
+
 EXE = os.environ["CHROMATRACE_EXE"]
 BLENDER = os.environ.get("BLENDER", "blender")
+BLENDER_VERSION = os.environ.get("BLENDER_VERSION", "3.4")
 SOURCE = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 SIZE = os.environ.get("CROSS_SIZE", "32x32")
 BANDS = os.environ.get("CROSS_BANDS", "380:780:40")
@@ -60,23 +64,10 @@ def compare(a, b, out, pixels="interior"):
         return json.load(f)
 
 
-def scene_copy(scene, work, change):
-    """A copy of the scene file with change(document) applied, its relative paths kept valid."""
-    with open(scene) as f:
-        document = json.load(f)
-    change(document)
-    here = os.path.dirname(scene)
-    for spectrum in document.get("spectra", {}).values():
-        if "csv" in spectrum:
-            spectrum["csv"] = os.path.join(here, spectrum["csv"])
-    for source in [m.get(k) for m in document["materials"].values() for k in ("reflectance", "diffuse")] + \
-            [document.get("environment", {}).get("radiance")]:
-        if isinstance(source, dict) and "texture" in source:
-            source["texture"] = os.path.join(here, source["texture"])
-    changed = os.path.join(work, "changed.json")
-    with open(changed, "w") as f:
-        json.dump(document, f)
-    return changed
+def scene_copy(scene, work, change=None, name="changed.json"):
+    """A copy of the scene file as this Blender's Cycles renders it (scene_for_blender.py) with change(document)
+    applied, its relative paths kept valid."""
+    return scene_for_blender(scene, BLENDER_VERSION, os.path.join(work, name), change)
 
 
 def scene_groups(scene):
@@ -98,6 +89,7 @@ def main():
     work = tempfile.mkdtemp(prefix="cross_validate_")
     try:
         tracer, cycles = os.path.join(work, "tracer.exr"), os.path.join(work, "cycles.exr")
+        scene = scene_copy(scene, work, name="scene.json")  # both renderers render this one
         point = case == "agree-point"
         if point:  # point pixels: Cycles' narrow Gaussian against the tracer's pixel centres
             scene = scene_copy(scene, work, lambda d: d.setdefault("render", {}).update(pixel_filter="point"))

@@ -1,17 +1,33 @@
 """What every test script that runs inside Blender shares: the add-on loaded from the source tree and
-registered, the chromatrace command, and failures collected as the script goes and reported at its end."""
+registered, the chromatrace command, the source tree's scenes as this Blender renders them, and failures
+collected as the script goes and reported at its end."""
 
 import os
+import shutil
 import sys
+import tempfile
+
+import bpy
 
 SOURCE = os.environ["CHROMATRACE_SOURCE_DIR"]
 sys.path.insert(0, os.path.join(SOURCE, "blender_addon"))
 import chromatrace  # noqa: E402
 from chromatrace import tool  # noqa: E402
 
+sys.path.insert(0, os.path.join(SOURCE, "tests", "blender"))
+from scene_for_blender import scene_for_blender  # noqa: E402
+
 chromatrace.register()
 TOOL = tool.Tool(tool.find_executable())
 failures = []
+_SCENES = tempfile.mkdtemp(prefix="chromatrace-scenes-")
+
+
+def scene_file(*parts):
+    """scenes/<parts> of the source tree as this Blender's Cycles renders it (its GGX masking), as a copy whose
+    paths are absolute (tests/blender/scene_for_blender.py)."""
+    out = os.path.join(_SCENES, "_".join(parts))
+    return scene_for_blender(os.path.join(SOURCE, "scenes", *parts), bpy.app.version_string.split()[0], out)
 
 
 def expect(condition, message):
@@ -21,6 +37,7 @@ def expect(condition, message):
 
 def finish(name):
     """Reports every failure on stderr and exits 1 (Blender runs these with --python-exit-code 1), or says ok."""
+    shutil.rmtree(_SCENES, ignore_errors=True)
     if failures:
         for f in failures:
             print(f"FAIL: {f}", file=sys.stderr)

@@ -11,7 +11,15 @@
     blender -b --factory-startup --python make_artist_scene.py -- blackbody OUT.blend KELVIN
         a grey diffuse plane under an area light whose node tree's colour is a Blackbody node at KELVIN, no world
 
-The default cube and point light are removed; the default camera is moved to look down on the scene.
+    blender -b --factory-startup --python make_artist_scene.py -- studio OUT.blend
+        what an artist starts from in this version: the default file kept (its cube, with the default material, and
+        its point light), Blender's own studio HDRI courtyard.exr as the world, a sphere whose Principled BSDF has
+        coloured tints (Blender 4.0+: Specular, Coat and Sheen Tint colours; 3.x: Principled v1's tint factors and
+        clearcoat), a floor whose colour is an Image Texture node of a 4×4 float image packed into the .blend, and
+        an area light whose colour is a Blackbody node at 3000 K
+
+The default cube and point light are removed (except in studio); the default camera is moved to look down on the
+scene.
 """
 
 import glob
@@ -112,6 +120,62 @@ def blackbody_scene(kelvin):
     bpy.context.scene.world = None
 
 
+def principled_with_tints(name):
+    """A Principled BSDF whose tints are coloured: version 2's colour inputs where the node has them, else
+    version 1's factors (Specular Tint, Sheen Tint) and its Clearcoat."""
+    material = bpy.data.materials.new(name)
+    material.use_nodes = True
+    node = material.node_tree.nodes["Principled BSDF"]
+    inputs = node.inputs
+    inputs["Base Color"].default_value = (0.7, 0.15, 0.1, 1.0)
+    inputs["Roughness"].default_value = 0.3
+    if "Coat Tint" in inputs:  # Principled v2 (Blender 4.0+)
+        inputs["Specular Tint"].default_value = (1.0, 0.85, 0.6, 1.0)
+        inputs["Coat Weight"].default_value = 0.5
+        inputs["Coat Tint"].default_value = (0.9, 0.75, 0.4, 1.0)
+        inputs["Sheen Weight"].default_value = 0.4
+        inputs["Sheen Tint"].default_value = (0.4, 0.6, 1.0, 1.0)
+    else:
+        inputs["Specular Tint"].default_value = 0.6
+        inputs["Clearcoat"].default_value = 0.5
+        inputs["Sheen"].default_value = 0.4
+        inputs["Sheen Tint"].default_value = 0.8
+    return material
+
+
+def studio_scene(out):
+    bpy.ops.mesh.primitive_uv_sphere_add(radius=0.8, location=(2.5, 0.0, 0.8))
+    sphere = bpy.context.object
+    sphere.name = "tinted sphere"
+    sphere.data.materials.append(principled_with_tints("tinted"))
+
+    bpy.ops.mesh.primitive_plane_add(size=12.0, location=(0.0, 0.0, -1.0))
+    floor = bpy.context.object
+    floor.name = "floor"
+    image = bpy.data.images.new("tiles", 4, 4, alpha=False, float_buffer=True)
+    image.pixels[:] = [v for i in range(16) for v in ((0.6, 0.5, 0.3, 1.0) if (i + i // 4) % 2 else (0.2, 0.3, 0.5, 1.0))]
+    image.filepath_raw = os.path.join(os.path.dirname(os.path.abspath(out)), "tiles.exr")
+    image.file_format = "OPEN_EXR"
+    image.save()
+    image.pack()
+    image.source = "FILE"
+    material = bpy.data.materials.new("tiles")
+    material.use_nodes = True
+    nodes = material.node_tree.nodes
+    texture = nodes.new("ShaderNodeTexImage")
+    texture.image = image
+    texture.interpolation = "Closest"
+    material.node_tree.links.new(texture.outputs["Color"], nodes["Principled BSDF"].inputs["Base Color"])
+    floor.data.materials.append(material)
+
+    area_light_with_blackbody(3000.0, (0.0, -2.0, 4.0), size=2.0, power=500.0)
+    world = bpy.context.scene.world
+    world.use_nodes = True
+    environment = world.node_tree.nodes.new("ShaderNodeTexEnvironment")
+    environment.image = bpy.data.images.load(os.path.join(STUDIO_WORLDS, "courtyard.exr"))
+    world.node_tree.links.new(environment.outputs["Color"], world.node_tree.nodes["Background"].inputs["Color"])
+
+
 def textured_scene(out):
     bpy.ops.mesh.primitive_plane_add(size=4.0, location=(0.0, 0.0, 0.0))  # u = (x + 2) / 4
     plane = bpy.context.object
@@ -142,13 +206,16 @@ def textured_scene(out):
 
 argv = sys.argv[sys.argv.index("--") + 1:]
 mode, out = argv[0], argv[1]
-clear_defaults()
+if mode != "studio":
+    clear_defaults()
 bpy.context.scene.render.engine = "CYCLES"
 if mode == "library":
     only = set(argv[3].split("|")) if len(argv) > 3 and argv[2] == "--only" else None
     library_scene(only)
 elif mode == "textured":
     textured_scene(out)
+elif mode == "studio":
+    studio_scene(out)
 elif mode == "blackbody":
     blackbody_scene(float(argv[2]))
 else:

@@ -15,7 +15,7 @@ import tempfile
 import bpy
 
 sys.path.insert(0, os.path.join(os.environ["CHROMATRACE_SOURCE_DIR"], "tests", "blender"))
-from harness import SOURCE, TOOL, chromatrace, expect, failures, finish  # noqa: E402,F401
+from harness import SOURCE, TOOL, chromatrace, expect, failures, finish, scene_file  # noqa: E402,F401
 from chromatrace import scene_import, spectral_render  # noqa: E402
 from chromatrace.errors import BadInput  # noqa: E402
 
@@ -96,7 +96,7 @@ def digest(path):
 # A scene with the factory startup's own things (a cube with a Principled BSDF, a point light, the grey world)
 # and the paper box, with settings far from what the spectral render uses.
 scene = bpy.context.scene
-scene_import.import_scene(os.path.join(SOURCE, "scenes", "paper", "box.json"), scene, TOOL, print)
+scene_import.import_scene(scene_file("paper", "box.json"), scene, TOOL, print)
 scene.cycles.samples = 7
 scene.cycles.use_denoising = True
 scene.cycles.sample_clamp_indirect = 10.0

@@ -22,7 +22,7 @@ import tempfile
 import bpy
 
 sys.path.insert(0, os.path.join(os.environ["CHROMATRACE_SOURCE_DIR"], "tests", "blender"))
-from harness import SOURCE, TOOL, chromatrace, expect, failures, finish  # noqa: E402,F401
+from harness import SOURCE, TOOL, chromatrace, expect, failures, finish, scene_file  # noqa: E402,F401
 from chromatrace import ply, scene_export, scene_import  # noqa: E402
 
 
@@ -118,9 +118,9 @@ def round_trip(original):
     return scene, work
 
 
-round_trip(os.path.join(SOURCE, "scenes", "cornell_box", "cornell_box.json"))
-round_trip(os.path.join(SOURCE, "scenes", "textured", "textured.json"))  # image textures, UVs, an HDRI world
-scene, work = round_trip(os.path.join(SOURCE, "scenes", "paper", "box.json"))
+round_trip(scene_file("cornell_box", "cornell_box.json"))
+round_trip(scene_file("textured", "textured.json"))  # image textures, UVs, an HDRI world
+scene, work = round_trip(scene_file("paper", "box.json"))
 
 # An object moved in Blender: written as a world-space mesh that moved with it.
 sphere = bpy.data.objects["sphere"]

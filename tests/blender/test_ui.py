@@ -14,7 +14,7 @@ import tempfile
 import bpy
 
 sys.path.insert(0, os.path.join(os.environ["CHROMATRACE_SOURCE_DIR"], "tests", "blender"))
-from harness import SOURCE, TOOL, chromatrace, expect, failures, finish  # noqa: E402,F401
+from harness import SOURCE, TOOL, chromatrace, expect, failures, finish, scene_file  # noqa: E402,F401
 from chromatrace import ui  # noqa: E402
 
 
@@ -133,7 +133,7 @@ if (sc.bands_argument(), sc.samples, sc.max_bounces) != ("380:780:10", 256, 8):
 
 # Import, render (synchronously in background mode) and export through the operators.
 work = tempfile.mkdtemp(prefix="chromatrace-ui-")
-bpy.ops.chromatrace.import_scene(filepath=os.path.join(SOURCE, "scenes", "paper", "box.json"))
+bpy.ops.chromatrace.import_scene(filepath=scene_file("paper", "box.json"))
 s = scene.chromatrace
 s.samples, s.max_bounces, s.bands_lo, s.bands_hi, s.bands_width = 2, 2, 400, 700, 100
 scene.render.resolution_x = scene.render.resolution_y = 16

@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/colour.h"
+#include "core/error.h"
 #include "core/spectrum.h"
 #include "core/texture.h"
 #include "tests/core/image_fixtures.h"
@@ -256,6 +257,50 @@ TEST_F(PrepareTexture, AlphaIsIgnoredAndSaid) {
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.err.find("alpha channel ignored"), std::string::npos) << r.err;
   EXPECT_TRUE(json::parse(r.out)["alpha_ignored"].get<bool>());
+}
+
+// A real HDRI's capture noise: negative texels no deeper than the image's dark end (the 10th percentile of its
+// positive channel values) and together under 1e-4 of its light are set to zero and counted, in prepare-texture
+// and in the tracer's reader alike; a negative deeper than the dark end, or many that together carry light, is
+// refused naming the deepest texel. The image: 100 texels of a dim ramp 0.01..1 in each channel, so the dark end
+// is the ramp's 10th percentile.
+TEST_F(PrepareTexture, CaptureNoiseIsZeroedAndNegativeLightRefused) {
+  std::vector<float> ramp;
+  for (int i = 0; i < 100; ++i)
+    for (int c = 0; c < 3; ++c) ramp.push_back(0.01f * static_cast<float>(i + 1));
+  std::vector<float> noisy = ramp, deep = ramp, many = ramp;
+  noisy[3 * 7 + 2] = -0.004f;  // 0.004 / 151.5 = 2.6e-5 of the light
+  noisy[3 * 42 + 0] = -0.001f;
+  deep[3 * 13 + 1] = -0.5f;  // deeper than the dark end
+  for (int i = 0; i < 60; ++i) many[3 * i + 1] = -0.05f;  // each within it, together 0.02 of the light
+  const fs::path noisy_exr = write_image("noisy.exr", 10, 10, noisy), deep_exr = write_image("deep.exr", 10, 10, deep),
+                 many_exr = write_image("many.exr", 10, 10, many);
+
+  const auto r = run_chromatrace({"prepare-texture", noisy_exr.string(), "--kind", "radiance", "--bands", "400:700:100",
+                                  "-o", (dir_ / "cache").string(), "--json"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const json summary = json::parse(r.out);
+  EXPECT_EQ(summary["negative_texels"]["zeroed"], 2);
+  EXPECT_FLOAT_EQ(summary["negative_texels"]["largest"].get<float>(), 0.004f);
+  const float dark_end = 0.01f * 11;  // the 30-th of 300 positive values, sorted, counting from 0
+  EXPECT_FLOAT_EQ(summary["negative_texels"]["threshold"].get<float>(), dark_end);
+  EXPECT_NE(r.err.find("2 negative channel values (capture noise"), std::string::npos) << r.err;
+  const ImageTexture texture = read_image_texture(noisy_exr, "noisy.exr", std::nullopt, TextureUse::Radiance, 1.0);
+  EXPECT_EQ(texture.negatives.count, 2u);
+  EXPECT_EQ(texture.rgb[3 * 7 + 2], 0.0f);
+  EXPECT_EQ(texture.rgb[3 * 7 + 1], ramp[3 * 7 + 1]);
+
+  for (const auto& [image, texel] : {std::pair{deep_exr, std::string("texel (3, 1)")},
+                                     std::pair{many_exr, std::string("texel (0, 0)")}}) {
+    const auto refused = run_chromatrace({"prepare-texture", image.string(), "--kind", "radiance", "--bands",
+                                          "400:700:100", "-o", (dir_ / "refused").string()});
+    EXPECT_EQ(refused.exit_code, 2) << refused.err;
+    EXPECT_EQ(line_count(refused.err), 1) << refused.err;
+    EXPECT_NE(refused.err.find(image.string() + ": "), std::string::npos) << refused.err;
+    EXPECT_NE(refused.err.find("carry light that cannot be"), std::string::npos) << refused.err;
+    EXPECT_NE(refused.err.find(texel), std::string::npos) << refused.err;
+    EXPECT_THROW(read_image_texture(image, "x.exr", std::nullopt, TextureUse::Radiance, 1.0), InputError);
+  }
 }
 
 }  // namespace

@@ -1,0 +1,134 @@
+"""The headless spectral render: batch.py's arguments (batch_args.py) to a spectral EXR, or to the pre-flight
+summary with --explain (batch.py's docstring says what each does). The add-on's one entry for scripts: batch.py
+runs it from the source tree or an install, and an add-on installed as an extension runs it as
+`bl_ext.<repository>.chromatrace.headless`.
+
+Exit status 0 on success, 1 on a runtime failure, 2 on bad input, with one line on stderr naming the file,
+field or option at fault (as the `chromatrace` command). Progress lines go to stderr (--quiet: none).
+
+For tests: CHROMATRACE_TEST_FAIL_AT_RENDER=N raises an exception just before the N-th new Cycles render
+(counting from 0), CHROMATRACE_TEST_KILL_AT_RENDER=N kills the process there (SIGKILL);
+CHROMATRACE_TEST_CYCLES_SETTINGS="blur_glossy=1,sample_clamp_indirect=10" puts Cycles settings back to other
+values before every render (tests/blender/cross_validate.py shows that compare catches the bias of Cycles'
+defaults).
+"""
+
+import json
+import os
+import signal
+import sys
+import traceback
+
+from .batch_args import parse_batch_args
+from .errors import BadInput
+
+
+def script_arguments(argv):
+    """The batch's own arguments: those after `--` (Blender's convention), or, in a Python that imported Blender
+    as a module, everything after the script's name."""
+    if "--" in argv:
+        return argv[argv.index("--") + 1:]
+    import bpy
+    return argv[1:] if getattr(bpy.app, "module", False) else []
+
+
+def _log(message):
+    print(f"chromatrace: {message}", file=sys.stderr, flush=True)
+
+
+def _test_hook():
+    fail_at = os.environ.get("CHROMATRACE_TEST_FAIL_AT_RENDER")
+    kill_at = os.environ.get("CHROMATRACE_TEST_KILL_AT_RENDER")
+    biased = os.environ.get("CHROMATRACE_TEST_CYCLES_SETTINGS")
+    if fail_at is None and kill_at is None and biased is None:
+        return None
+
+    def hook(event, rendered, **info):
+        if biased:
+            import bpy
+            for item in biased.split(","):
+                key, value = item.split("=")
+                setattr(bpy.context.scene.cycles, key, float(value))
+        if kill_at is not None and rendered == int(kill_at):
+            sys.stderr.flush()
+            os.kill(os.getpid(), signal.SIGKILL)
+        if fail_at is not None and rendered == int(fail_at):
+            raise RuntimeError(f"test hook: failing before render {rendered} (group {info['group']})")
+    return hook
+
+
+def _empty_startup_scene(bpy):
+    for collection in (bpy.data.objects, bpy.data.meshes, bpy.data.materials, bpy.data.lights, bpy.data.cameras,
+                       bpy.data.worlds):
+        for item in list(collection):
+            collection.remove(item)
+
+
+def _ensure_registered(bpy):
+    """Registers the add-on unless Blender already has (an enabled extension or add-on)."""
+    if not hasattr(bpy.types.Scene, "chromatrace"):
+        from . import register
+        register()
+
+
+def run(argv):
+    args = parse_batch_args(argv)
+    import bpy
+    from . import scene_import, spectral_render, tool
+
+    _ensure_registered(bpy)
+    log = (lambda message: None) if args.quiet else _log
+    chromatrace_tool = tool.Tool(tool.find_executable())
+    if args.scene:
+        _empty_startup_scene(bpy)
+        scene_import.import_scene(args.scene, bpy.context.scene, chromatrace_tool, log)
+    else:
+        bpy.ops.wm.open_mainfile(filepath=os.path.abspath(args.blend))
+    scene = bpy.context.scene
+    request = spectral_render.Request.from_scene(
+        scene, output=os.path.abspath(args.out) if args.out else None, samples=args.samples,
+        max_bounces=args.max_bounces, seed=args.seed, bands=args.bands, bands_file=args.bands_file,
+        families=args.components, resolution=args.resolution, cache_root=args.cache_dir,
+        keep_cache=args.keep_cache or None, log=log, on_mixing_nodes=args.on_mixing_nodes,
+        bands_per_render=args.bands_per_render, on_world=args.on_world, only_group=args.band_group,
+        only_variant=args.bounce_limit, device=args.device)
+    if args.bands_file:
+        request.bands = None
+    elif args.bands:
+        request.bands_file = None
+    if args.explain is not None:
+        summary = spectral_render.SpectralRender(scene, request, chromatrace_tool).preflight()
+        text = json.dumps(summary, indent=1)
+        if args.explain == "-":
+            print(text, flush=True)
+        else:
+            with open(args.explain, "w") as f:
+                f.write(text + "\n")
+        return
+    if args.scene and args.band_group is None:
+        # What these settings leave out, said before rendering as `chromatrace render` says it (also with
+        # --quiet); a band-group task of a farm leaves it to the run that assembles.
+        for warning in chromatrace_tool.render_warnings(
+                args.scene, bands=args.bands, bands_file=args.bands_file, samples=args.samples,
+                max_bounces=args.max_bounces, resolution=args.resolution):
+            _log(f"warning: {warning}")
+    spectral_render.TEST_HOOK = _test_hook()
+    spectral_render.SpectralRender(scene, request, chromatrace_tool).run()
+
+
+def main(argv=None, prog="chromatrace.headless"):
+    """Runs the batch with `argv` (by default this process's script arguments) and exits with its status."""
+    if argv is None:
+        argv = script_arguments(sys.argv)
+    try:
+        run(argv)
+    except BadInput as e:
+        print(f"{prog}: error: {e}", file=sys.stderr, flush=True)
+        sys.exit(2)
+    except Exception as e:  # a runtime failure: the reason on one line, the traceback for a bug report
+        if os.environ.get("CHROMATRACE_TRACEBACK"):
+            traceback.print_exc()
+        print(f"{prog}: failed: {str(e).strip().splitlines()[-1] if str(e).strip() else type(e).__name__}",
+              file=sys.stderr, flush=True)
+        sys.exit(1)
+    sys.exit(0)

@@ -1,0 +1,42 @@
+"""The add-on as a Blender extension (4.2 and later), as an artist installs it: the zip that
+`cmake --build build --target blender_extension` builds, installed headless into a user repository
+(Preferences > Get Extensions > Install from Disk), enabled, and rendering the paper box through the installed
+package's own headless entry, with nothing of the source tree on the path.
+
+    blender -b --factory-startup --python-exit-code 1 --python test_extension.py -- ZIP SCENE.json OUT.exr
+
+Run with BLENDER_USER_RESOURCES set to an empty folder: the install goes there, not into the user's Blender.
+"""
+
+import importlib
+import os
+import subprocess
+import sys
+
+import bpy
+
+zip_path, scene, out = sys.argv[sys.argv.index("--") + 1:][:3]
+user = os.environ.get("BLENDER_USER_RESOURCES", "")
+if not user:
+    sys.exit("test_extension.py: set BLENDER_USER_RESOURCES to an empty folder")
+if any(p.endswith("blender_addon") for p in sys.path) or "chromatrace" in sys.modules:
+    sys.exit("test_extension.py: the source tree's add-on is on the path")
+
+result = bpy.ops.extensions.package_install_files(filepath=zip_path, repo="user_default", enable_on_install=True)
+if result != {"FINISHED"}:
+    sys.exit(f"FAIL: install returned {result}")
+package = "bl_ext.user_default.chromatrace"
+if package not in bpy.context.preferences.addons:
+    sys.exit(f"FAIL: {package} is not enabled: {list(bpy.context.preferences.addons.keys())}")
+if not hasattr(bpy.types.Scene, "chromatrace"):
+    sys.exit("FAIL: the extension did not register its scene settings")
+headless = importlib.import_module(package + ".headless")
+if not os.path.realpath(headless.__file__).startswith(os.path.realpath(user)):
+    sys.exit(f"FAIL: headless came from {headless.__file__}, not from the installed extension")
+
+headless.run(["--scene", scene, "--out", out, "--resolution", "16x16", "--samples", "4", "--bands", "400:700:50",
+              "--components", "paths", "--cache-dir", os.path.join(os.path.dirname(out), "cache"), "--quiet"])
+check = subprocess.run([os.environ["CHROMATRACE_EXE"], "info", "--check", out], capture_output=True, text=True)
+if check.returncode != 0:
+    sys.exit(f"FAIL: chromatrace info --check {out}: {check.stderr.strip()}")
+print(f"extension: installed from {zip_path}, enabled as {package}, rendered {out}")
