@@ -2,7 +2,11 @@
 """Benchmark: a spectral Cycles render planned by `chromatrace plan` against one plain RGB Cycles render.
 
     CHROMATRACE_EXE=build/cli/chromatrace python3 bench/bench_plan_cycles.py [--resolution 96] [--samples 256]
-        [--reference-spp 2048] [--light d65|f11|both] [--blender blender]
+        [--reference-spp 2048] [--light d65|f11|both] [--blender blender [--blender build/tests/blender/blender-4.5 ...]]
+
+Each --blender is run in turn (a Blender binary, or a bpy module behind tests/blender/bpy_blender.py, as the
+build's build/tests/blender/blender-4.5 and blender-5.0 are), the scene's GGX masking set to that Cycles' own
+(separable up to 3.x, height-correlated from 4.0) for its renders and its reference alike.
 
 For the paper box under its own smooth light (CIE D65) and under CIE F11 (three narrow peaks):
 
@@ -46,14 +50,22 @@ def absolute_paths(node, base):
     return node
 
 
-def scene_for(light, work):
-    if light == "d65":
-        return BOX
+def blender_version(blender):
+    r = run([blender, "--background", "--factory-startup", "--python-expr",
+             "import bpy; print('BLENDER_VERSION', bpy.app.version_string.split()[0])"])
+    return re.search(r"BLENDER_VERSION (\S+)", r.stdout).group(1)
+
+
+def scene_for(light, work, masking):
     with open(BOX) as f:
         doc = absolute_paths(json.load(f), os.path.dirname(BOX))
-    doc["spectra"]["lamp"] = {"illuminant": "F11"}
-    doc["name"] = "box-f11"
-    path = os.path.join(work, "box-f11.json")
+    if light == "f11":
+        doc["spectra"]["lamp"] = {"illuminant": "F11"}
+        doc["name"] = "box-f11"
+    for material in doc["materials"].values():
+        if material.get("type") == "dichromatic" and material.get("lobe", "ggx") == "ggx":
+            material["masking"] = masking
+    path = os.path.join(work, f"box-{light}-{masking}.json")
     with open(path, "w") as f:
         json.dump(doc, f, indent=1)
     return path
@@ -66,9 +78,12 @@ def run(cmd, **kw):
     return r
 
 
-def bench(light, args, work):
+def bench(light, args, work, blender_exe, version):
     exe = os.environ["CHROMATRACE_EXE"]
-    scene = scene_for(light, work)
+    masking = "height-correlated" if int(version.split(".")[0]) >= 4 else "separable"
+    work = os.path.join(work, version)
+    os.makedirs(work, exist_ok=True)
+    scene = scene_for(light, work, masking)
     res = f"{args.resolution}x{args.resolution}"
     plan_file, report_file = os.path.join(work, f"{light}-plan.json"), os.path.join(work, f"{light}-report.json")
     run([exe, "plan", scene, "--renderer", "cycles", "--edge-step", "5", "--target-de00", "1", "-o", plan_file,
@@ -85,7 +100,7 @@ def bench(light, args, work):
          str(args.reference_spp), "--max-bounces", str(scene_bounces), "--seed", "7", "-q"])
     reference_cpu = _children_cpu() - start_cpu
 
-    blender = [args.blender, "--background", "--factory-startup"]
+    blender = [blender_exe, "--background", "--factory-startup"]
     spectral_exr = os.path.join(work, f"{light}-cycles.exr")
     spectral = run(blender + ["--python", os.path.join(ROOT, "blender_addon", "batch.py"), "--", "--scene", scene,
                               "--out", spectral_exr, "--resolution", res, "--samples", str(args.samples),
@@ -111,7 +126,7 @@ def bench(light, args, work):
         compared = json.load(f)
     mean_de = compared["image"]["delta_e00"]["mean"]
 
-    print(f"\n{light.upper()}: plan {bands} bands (edges {report['settings']['bands']['edges_nm']}), "
+    print(f"\nBlender {version}, {light.upper()}: plan {bands} bands (edges {report['settings']['bands']['edges_nm']}), "
           f"{bounces} bounces (scene: {scene_bounces}); predicted mean dE00 {report['prediction']['mean_de00']:.2f}")
     for what, cpu in groups:
         print(f"  Cycles render ({what}): {cpu:.2f} s CPU")
@@ -129,15 +144,21 @@ def main():
     p.add_argument("--samples", type=int, default=256)
     p.add_argument("--reference-spp", type=int, default=2048)
     p.add_argument("--light", choices=("d65", "f11", "both"), default="both")
-    p.add_argument("--blender", default="blender")
+    p.add_argument("--blender", action="append", help="a Blender (repeatable; default: blender)")
     args = p.parse_args()
     if not os.environ.get("CHROMATRACE_EXE"):
         sys.exit("set CHROMATRACE_EXE to the chromatrace executable (e.g. build/cli/chromatrace)")
     print(f"paper box, {args.resolution}x{args.resolution}, {args.samples} samples, {os.cpu_count()} cores, "
           f"load average {os.getloadavg()[0]:.1f}")
     with tempfile.TemporaryDirectory(prefix="chromatrace-bench-plan-") as work:
-        for light in (("d65", "f11") if args.light == "both" else (args.light,)):
-            bench(light, args, work)
+        results = []
+        for blender_exe in args.blender or ["blender"]:
+            version = blender_version(blender_exe)
+            for light in (("d65", "f11") if args.light == "both" else (args.light,)):
+                results.append((version, light, *bench(light, args, work, blender_exe, version)))
+        print("\nBlender  light  CPU planned spectral / plain RGB  measured mean dE00")
+        for version, light, ratio, mean_de in results:
+            print(f"{version:8s} {light.upper():5s}  {ratio:5.2f}x{'':27s}{mean_de:.2f}")
 
 
 if __name__ == "__main__":

@@ -2,8 +2,10 @@
 small helpers for materials and the spectrum table."""
 
 import os
+import shlex
 import shutil
 import tempfile
+import webbrowser
 
 import bpy
 from bpy.props import StringProperty
@@ -129,6 +131,41 @@ class CHROMATRACE_OT_render_spectral(bpy.types.Operator):
         context.window_manager.progress_update(done / total)
         context.workspace.status_text_set(f"chromatrace: {message} (Esc cancels)")
         return {"RUNNING_MODAL"}
+
+
+# The last analysis per scene: the command lines run (shown in the panel, to repeat by hand) and the report.
+ANALYSES = {}
+
+
+class CHROMATRACE_OT_analyze_render(bpy.types.Operator):
+    """See the spectral render through a camera and analyse its colour histograms; open the report in the browser"""
+
+    bl_idname = "chromatrace.analyze_render"
+    bl_label = "Analyze Histogram"
+
+    def execute(self, context):
+        s = context.scene.chromatrace
+        render = bpy.path.abspath(s.output_path)
+        if not os.path.isfile(render):
+            self.report({"ERROR"}, f"no spectral render at {render}: Render Spectral first")
+            return {"CANCELLED"}
+        folder = os.path.splitext(render)[0] + "_analysis"
+        chromatrace_tool = _tool(context)
+        commands, report = chromatrace_tool.analysis_commands(render, folder, s.camera_preset)
+        os.makedirs(folder, exist_ok=True)
+        try:
+            chromatrace_tool.run_commands(commands)
+        except (BadInput, RuntimeError) as e:
+            self.report({"ERROR"}, str(e))
+            return {"CANCELLED"}
+        ANALYSES[context.scene.name] = {"commands": [" ".join(map(shlex.quote, argv)) for argv in commands],
+                                        "report": report}
+        for line in ANALYSES[context.scene.name]["commands"]:
+            self.report({"INFO"}, line)
+        self.report({"INFO"}, f"report {report}")
+        if not bpy.app.background:
+            webbrowser.open("file://" + report)
+        return {"FINISHED"}
 
 
 def show_image(context, path):
@@ -348,7 +385,7 @@ def _menu_export(self, context):
     self.layout.operator(CHROMATRACE_OT_export_scene.bl_idname, text="chromatrace scene (.json)")
 
 
-_classes = (CHROMATRACE_OT_render_spectral, CHROMATRACE_OT_preflight, CHROMATRACE_OT_import_scene, CHROMATRACE_OT_export_scene,
+_classes = (CHROMATRACE_OT_render_spectral, CHROMATRACE_OT_analyze_render, CHROMATRACE_OT_preflight, CHROMATRACE_OT_import_scene, CHROMATRACE_OT_export_scene,
             CHROMATRACE_OT_build_material, CHROMATRACE_OT_set_model, CHROMATRACE_OT_apply_preset, CHROMATRACE_OT_spectrum_add, CHROMATRACE_OT_spectrum_remove)
 
 

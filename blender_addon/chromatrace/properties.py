@@ -231,6 +231,9 @@ class CHROMATRACE_PG_scene(bpy.types.PropertyGroup):
                ("OMIT", "Omit", "Render without the world's light; a warning is printed and noted in the file")],
         default="REFUSE")
     output_path: StringProperty(name="Output", subtype="FILE_PATH", default="//spectral.exr")
+    camera_preset: StringProperty(name="Camera", default="canon_eos_5d_mkiii",
+                                  description="The camera that sees the render when it is analysed "
+                                              "(`chromatrace sensor --preset`; `chromatrace sensor --help` lists them)")
     cache_dir: StringProperty(name="Cache", subtype="DIR_PATH",
                               description="Band groups already rendered, for resuming (empty: the user cache)")
     scene_name: StringProperty(name="Name")

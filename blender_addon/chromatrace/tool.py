@@ -89,6 +89,21 @@ class Tool:
         return self.run("prepare-texture", image, "--kind", kind, "--colour-space", colour_space, "--check",
                         json_output=True)
 
+    def analysis_commands(self, spectral_exr, analysis_dir, camera_preset):
+        """The command lines that take a spectral render to its histogram report: the camera (`chromatrace sensor`
+        with a preset and automatic exposure) and the analyzer (`chromatrace analyze`). Returns
+        ([[argv], [argv]], report.html)."""
+        camera = os.path.join(analysis_dir, "camera.exr")
+        return ([[self.executable, "sensor", spectral_exr, "-o", camera, "--preset", camera_preset, "--exposure-s",
+                  "auto", "--quiet"],
+                 [self.executable, "analyze", camera, "-o", os.path.join(analysis_dir, "analysis"), "--quiet"]],
+                os.path.join(analysis_dir, "analysis", "report.html"))
+
+    def run_commands(self, commands):
+        """Runs command lines made by this tool in order (each as run() does: BadInput on exit 2)."""
+        for argv in commands:
+            self.run(*argv[1:])
+
     def preview(self, spectral_exr, png):
         """The picture a person would see (`chromatrace sensor`'s display rendering: a Canon EOS 5D Mark III,
         exposure from the scene's surfaces, white balance, colour matrix and sRGB), noise-free, as an 8-bit PNG."""

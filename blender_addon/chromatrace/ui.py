@@ -4,6 +4,7 @@ import textwrap
 
 import bpy
 
+from . import operators
 from .properties import MODEL_ITEMS
 
 
@@ -24,6 +25,15 @@ class CHROMATRACE_PT_render(_Panel, bpy.types.Panel):
         row.operator("chromatrace.render_spectral", icon="RENDER_STILL")
         row.operator_menu_enum("chromatrace.apply_preset", "preset", text="Presets", icon="PRESET")
         layout.prop(s, "output_path")
+        row = layout.row(align=True)
+        row.operator("chromatrace.analyze_render", icon="GRAPH")
+        row.prop(s, "camera_preset", text="")
+        analysis = operators.ANALYSES.get(context.scene.name)
+        if analysis:  # the command lines, to repeat the analysis by hand
+            box = layout.box()
+            for line in analysis["commands"]:
+                for part in textwrap.wrap(line, 70):
+                    box.label(text=part)
         col = layout.column(heading="Bands")
         col.prop(s, "band_plan")
         if s.band_plan == "RANGE":

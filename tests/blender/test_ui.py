@@ -152,6 +152,26 @@ if (not any(w.startswith("render.max_bounces 2 leaves") for w in said)
         or not any("bands of 100 nm give its" in w and "chromatrace plan" in w for w in said)
         or any("--spectral-mode" in w for w in said)):
     failures.append(f"Render Spectral did not say what its settings leave out: {said}")
+# From the render to the histogram: Analyze Histogram runs the camera and the analyzer on the render and keeps the
+# two command lines it ran (shown in the panel, so the analysis can be repeated by hand); the report is written.
+from chromatrace.operators import ANALYSES  # noqa: E402
+if bpy.ops.chromatrace.analyze_render() != {"FINISHED"}:
+    failures.append("Analyze Histogram failed")
+analysis = ANALYSES.get(scene.name, {})
+commands = analysis.get("commands", [])
+if len(commands) != 2 or " sensor " not in commands[0] or " analyze " not in commands[1] \
+        or s.output_path not in commands[0] or "--preset canon_eos_5d_mkiii" not in commands[0]:
+    failures.append(f"Analyze Histogram kept the wrong command lines: {commands}")
+report = analysis.get("report", "")
+if not report.startswith(os.path.join(work, "ui_analysis")) or not os.path.isfile(report):
+    failures.append(f"Analyze Histogram wrote no report beside the render: {report}")
+if os.path.isfile(os.path.join(os.path.dirname(report), "analysis.json")):
+    import json  # noqa: E402
+    with open(os.path.join(os.path.dirname(report), "analysis.json")) as f:
+        if not json.load(f).get("regions"):
+            failures.append("the analysis of the render found no regions")
+else:
+    failures.append("Analyze Histogram wrote no analysis.json")
 # A sky texture cannot be a spectrum: with World light: Omit the render goes on without it and says so.
 sky_world = bpy.data.worlds.new("Sky")
 sky_world.use_nodes = True
