@@ -165,6 +165,8 @@ TEST_F(Blender, PaperBoxRendersToACheckedSpectralExrWithEveryComponentAndObjectI
   EXPECT_EQ(info.object_names.at(6), "sphere");
   EXPECT_EQ(info.object_names.at(8), "ceiling_lamp");
   EXPECT_NE(info.metadata.at("chromatrace.renderer").find("Cycles"), std::string::npos);
+  EXPECT_NE(info.metadata.at("chromatrace.renderer").find("on CPU"), std::string::npos);
+  EXPECT_EQ(info.metadata.at("chromatrace.device"), "CPU");  // Cycles' device, as --device chose it
   EXPECT_EQ(info.metadata.at("chromatrace.samples"), "4");
 
   // Pixels that see only the lamp show its band-averaged radiance exactly (no noise in directly seen
@@ -208,6 +210,8 @@ TEST_F(Blender, BadInputExitsTwoWithOneErrorLineNamingTheField) {
         "--out", out},
        blender_under_test().major >= 4 ? "materials.sphere.masking" : "materials.red_plastic.masking"},
       {{"--scene", box(), "--out", dir_.file("no/dir/out.exr").string()}, "--out"},
+      // A GPU backend this Blender does not have (Cycles has Metal only on macOS) is refused by name.
+      {{"--scene", box(), "--out", out, "--device", "METAL", "--resolution", "8x8", "--samples", "1"}, "--device"},
   };
   for (const Case& c : cases) {
     const CommandResult r = batch(c.args);
