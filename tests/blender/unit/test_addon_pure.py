@@ -110,6 +110,20 @@ class Manifest(unittest.TestCase):
         self.assertEqual(manifest.build_manifest([400, 450, 500], bands.band_groups(2), ["main"], "V", total, planned,
                                                  reconstruction=fitted)["reconstruction"], fitted)
 
+    def test_pass_names_are_those_the_running_blender_writes(self):
+        # Blender 5.0 spells its passes out: the manifest names the channels as they are in the files.
+        total, planned = components.component_plan({"paths"}, [], 2)
+        names = {"DiffDir": "Diffuse Direct", "DiffCol": "Diffuse Color", "Emit": "Emission", "IndexOB": "Object Index"}
+        m = manifest.build_manifest([400, 450, 500], bands.band_groups(2), ["main"], "VL", total, planned,
+                                    object_names={1: "a"}, pass_names=names)
+        wanted = manifest.channels_by_file(m)
+        self.assertIn("VL.Diffuse Direct.R", wanted["g000_main.exr"])
+        self.assertIn("VL.Emission.G", wanted["g000_main.exr"])
+        self.assertNotIn("VL.DiffDir.R", wanted["g000_main.exr"])
+        self.assertIn("VL.GlossDir.R", wanted["g000_main.exr"])  # a name left as it is
+        self.assertEqual(wanted["ids.exr"], {"VL.Object Index.X"})
+        self.assertEqual(planned[1]["terms"][0]["passes"], ["DiffDir", "DiffCol"])  # the plan itself is unchanged
+
     def test_channels_by_file_are_what_assemble_reads(self):
         total, planned = components.component_plan({"paths", "bounces"}, [], 2)
         variants = list(components.render_variants(2, True))
@@ -254,6 +268,24 @@ class NodeRules(unittest.TestCase):
         self.assertEqual(node_rules.node_issues(tinted_white), [])
         no_sheen = {"name": "P", "type": "ShaderNodeBsdfPrincipled", "inputs": {"Sheen": 0.0, "Sheen Tint": 0.5}}
         self.assertEqual(node_rules.node_issues(no_sheen), [])  # Blender 3's default: a tint without a lobe
+
+    def test_multiscatter_and_tints_as_each_cycles_has_them(self):
+        # Cycles 4.0+ scales each channel by its own Fresnel's albedo: Multiscatter GGX multiplexes exactly, so the
+        # default Principled BSDF of 4.x renders as it is; up to 3.x the channels share one random walk.
+        v2 = {"name": "P", "type": "ShaderNodeBsdfPrincipled",
+              "props": {"distribution": "MULTI_GGX", "multiscatter": "albedo-scaling"},
+              "inputs": {"Specular IOR Level": 0.5, "Specular Tint": (1, 1, 1, 1), "Sheen Weight": 0.0,
+                         "Sheen Tint": (1, 1, 1, 1), "Subsurface Weight": 0.0}}
+        self.assertEqual(node_rules.node_issues(v2), [])
+        walk = dict(v2, props={"distribution": "MULTI_GGX", "multiscatter": "random-walk"})
+        self.assertEqual(node_rules.node_issues(walk), [("Multiscatter GGX couples the colour channels", True)])
+        # A coloured v2 tint: Cycles weighs the layers below by its strongest channel; one band per render helps.
+        tinted = dict(v2, inputs=dict(v2["inputs"], **{"Specular Tint": (1.0, 0.8, 0.6, 1.0)}))
+        (reason, fallback), = node_rules.node_issues(tinted)
+        self.assertIn("strongest channel", reason)
+        self.assertTrue(fallback)
+        sheen_off = dict(v2, inputs=dict(v2["inputs"], **{"Sheen Tint": (0.2, 0.4, 0.9, 1.0)}))
+        self.assertEqual(node_rules.node_issues(sheen_off), [])  # no sheen weight, no sheen lobe
 
     def test_colour_paths_convert_pass_on_or_refuse_and_unknown_nodes_refuse(self):
         def kind(t, **props):
