@@ -36,7 +36,10 @@ def scene_for_blender(scene, blender_version, out, change=None):
     _absolute_paths(document, os.path.dirname(os.path.abspath(scene)))
     for material in document.get("materials", {}).values():
         if material.get("lobe", "ggx") == "ggx" and material.get("type") == "dichromatic":
-            material["masking"] = masking_of(blender_version)
+            if masking_of(blender_version) == "separable":  # the format's default, which exports leave out
+                material.pop("masking", None)
+            else:
+                material["masking"] = masking_of(blender_version)
     if change is not None:
         change(document)
     with open(out, "w") as f:
