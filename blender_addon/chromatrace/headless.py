@@ -124,11 +124,22 @@ def main(argv=None, prog="chromatrace.headless"):
         run(argv)
     except BadInput as e:
         print(f"{prog}: error: {e}", file=sys.stderr, flush=True)
-        sys.exit(2)
+        _exit(2)
     except Exception as e:  # a runtime failure: the reason on one line, the traceback for a bug report
         if os.environ.get("CHROMATRACE_TRACEBACK"):
             traceback.print_exc()
         print(f"{prog}: failed: {str(e).strip().splitlines()[-1] if str(e).strip() else type(e).__name__}",
               file=sys.stderr, flush=True)
-        sys.exit(1)
-    sys.exit(0)
+        _exit(1)
+    _exit(0)
+
+
+def _exit(status):
+    """Ends the process with `status`. Blender itself leaves without the interpreter's teardown; a Python that
+    imported Blender as a module (PyPI's bpy) must too, as its teardown can stall on the render threads."""
+    import bpy
+    if getattr(bpy.app, "module", False):
+        sys.stdout.flush()
+        sys.stderr.flush()
+        os._exit(status)
+    sys.exit(status)

@@ -131,6 +131,18 @@ def _world(environment, scene_dir, view_layer):
     return world
 
 
+def _dark_world(name):
+    """A world that adds no light: black, and, where a new world has a node tree (Blender 5.0), black there too."""
+    world = bpy.data.worlds.new(name)
+    world.color = (0.0, 0.0, 0.0)
+    if blender_compat.uses_nodes(world):
+        for node in world.node_tree.nodes:
+            if node.bl_idname in ("ShaderNodeBackground", "ShaderNodeEmission"):
+                node.inputs["Color"].default_value = (0.0, 0.0, 0.0, 1.0)
+                node.inputs["Strength"].default_value = 0.0
+    return world
+
+
 def _dark(world):
     """Whether a world adds no light (as far as a constant colour or strength tells)."""
     if not blender_compat.uses_nodes(world):
@@ -218,8 +230,7 @@ def import_scene(path, scene, tool, log=print):
             scene.world = _world(document["environment"], scene_dir, view_layer)
         elif scene.world is not None and not _dark(scene.world):
             # The scene's light is the file's: a world that lights the scene would add light the file has not.
-            dark = bpy.data.worlds.new("no environment")
-            dark.color = (0.0, 0.0, 0.0)
+            dark = _dark_world("no environment")
             log(f"the scene has no environment: its world \"{scene.world.name}\" is replaced by a dark one")
             scene.world = dark
         for material in built.values():
