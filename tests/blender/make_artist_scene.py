@@ -120,6 +120,18 @@ def blackbody_scene(kelvin):
     bpy.context.scene.world = None
 
 
+def packed_float_image(name, width, height, rgba, out):
+    """A float image saved as an OpenEXR beside OUT.blend and packed into it (a texture the .blend carries)."""
+    image = bpy.data.images.new(name, width, height, alpha=False, float_buffer=True)
+    image.pixels[:] = rgba
+    image.filepath_raw = os.path.join(os.path.dirname(os.path.abspath(out)), name.replace(" ", "_") + ".exr")
+    image.file_format = "OPEN_EXR"
+    image.save()
+    image.pack()
+    image.source = "FILE"
+    return image
+
+
 def principled_with_tints(name):
     """A Principled BSDF whose tints are coloured: version 2's colour inputs where the node has them, else
     version 1's factors (Specular Tint, Sheen Tint) and its Clearcoat."""
@@ -152,13 +164,8 @@ def studio_scene(out):
     bpy.ops.mesh.primitive_plane_add(size=12.0, location=(0.0, 0.0, -1.0))
     floor = bpy.context.object
     floor.name = "floor"
-    image = bpy.data.images.new("tiles", 4, 4, alpha=False, float_buffer=True)
-    image.pixels[:] = [v for i in range(16) for v in ((0.6, 0.5, 0.3, 1.0) if (i + i // 4) % 2 else (0.2, 0.3, 0.5, 1.0))]
-    image.filepath_raw = os.path.join(os.path.dirname(os.path.abspath(out)), "tiles.exr")
-    image.file_format = "OPEN_EXR"
-    image.save()
-    image.pack()
-    image.source = "FILE"
+    checker = [v for i in range(16) for v in ((0.6, 0.5, 0.3, 1.0) if (i + i // 4) % 2 else (0.2, 0.3, 0.5, 1.0))]
+    image = packed_float_image("tiles", 4, 4, checker, out)
     material = bpy.data.materials.new("tiles")
     material.use_nodes = True
     nodes = material.node_tree.nodes
@@ -180,13 +187,7 @@ def textured_scene(out):
     bpy.ops.mesh.primitive_plane_add(size=4.0, location=(0.0, 0.0, 0.0))  # u = (x + 2) / 4
     plane = bpy.context.object
     plane.name = "plane"
-    image = bpy.data.images.new("two colours", 2, 1, alpha=False, float_buffer=True)
-    image.pixels[:] = (0.8, 0.05, 0.05, 1.0, 0.05, 0.1, 0.8, 1.0)
-    image.filepath_raw = os.path.join(os.path.dirname(os.path.abspath(out)), "two_colours.exr")
-    image.file_format = "OPEN_EXR"
-    image.save()
-    image.pack()
-    image.source = "FILE"
+    image = packed_float_image("two colours", 2, 1, (0.8, 0.05, 0.05, 1.0, 0.05, 0.1, 0.8, 1.0), out)
     material = bpy.data.materials.new("painted")
     material.use_nodes = True
     nodes = material.node_tree.nodes
