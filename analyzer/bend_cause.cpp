@@ -111,15 +111,18 @@ std::optional<BendCause> find_bend_cause(const AnalysisImage& input, const RgbIm
     return t.cause == kCauseHighlight || t.cause == kCauseInterreflection ? b.reference_bend : b.bend;
   };
   // A cause bends the cluster when taking it away leaves it straight; it adds to the bend when taking it away
-  // lowers the bend by more than a straight cluster may bend (the camera's curve bending a highlight further).
+  // lowers the bend by more than a straight cluster may bend (the camera's curve bending a highlight further). A
+  // light-path test can only name a cause when the light itself is bent (a wall straight in linear light that the
+  // camera's curve bends has no light path to blame).
+  const auto can_name = [&](const BendTest& t) { return start(t) > k.max_bend_for_straight; };
   for (const BendTest& t : b.tests)
-    if (t.straight || start(t) - t.bend > k.max_bend_for_straight) b.causes.push_back(t.cause);
-  b.straightened = std::any_of(b.tests.begin(), b.tests.end(), [](const BendTest& t) { return t.straight; });
+    if (can_name(t) && (t.straight || start(t) - t.bend > k.max_bend_for_straight)) b.causes.push_back(t.cause);
+  b.straightened = std::any_of(b.tests.begin(), b.tests.end(), [&](const BendTest& t) { return can_name(t) && t.straight; });
   if (b.causes.empty()) {
     // The one whose removal lowers the bend most, if any lowers it.
     const auto best = std::min_element(b.tests.begin(), b.tests.end(),
                                        [&](const BendTest& x, const BendTest& y) { return x.bend / start(x) < y.bend / start(y); });
-    if (best->bend < start(*best)) b.causes.push_back(best->cause);
+    if (can_name(*best) && best->bend < start(*best)) b.causes.push_back(best->cause);
   }
   std::vector<std::string> others, named;
   for (const BendTest& t : b.tests) {

@@ -207,7 +207,7 @@ std::vector<ExpectationResult> judge(const SeriesVariant& variant, const analyze
         const analyzer::RegionAnalysis& result = analysis.results[static_cast<std::size_t>(region)];
         if (result.bend) f.explanation += (f.explanation.empty() ? "" : "; ") + result.bend->summary;
         if (const auto& g = result.declared_gamma; g && result.shape.gamma)
-          f.explanation += fmt::format("{}γ = {:.3f} ± {:.3f} flattens its {} again (declared {:.3g}: {})", f.explanation.empty() ? "" : "; ",
+          f.explanation += fmt::format("{}γ = {:.4f} ± {:.2g} flattens its {} again (declared {:.3g}: {})", f.explanation.empty() ? "" : "; ",
                                        g->fitted, g->se, result.shape.gamma->flat == analyzer::GammaFlat::Plane ? "plane" : "line",
                                        g->declared_gamma,
                                        g->agree ? fmt::format("agrees, {:.1f} standard errors off", g->difference_in_se)
