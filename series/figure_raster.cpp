@@ -58,15 +58,18 @@ int draw_panel(cv::Mat* img, int x, int top, const std::string& panel, const Var
   if (img) cv::line(*img, {x + kPad, y}, {x + kColumn - kPad, y}, kRule, 1);
   y += 4;
   for (const FindingView& f : v->findings) {
-    y += kLine;
-    if (!img) continue;
     const std::string object = f.target != f.object && f.target != "image" && !f.target.empty()
                                    ? fmt::format("{} ({})", f.object, f.target)
                                    : f.object;
-    const std::string line = fmt::format("{}: expected {}, found {}", object, expected_text(f), f.found);
-    const int w = put_text(*img, line, {x + kPad + 18, y}, 0.45, kInk);
-    (void)w;
-    draw_mark(*img, {x + kPad, y}, 12, f.ok);
+    const std::string text = fmt::format("{}: expected {}, found {}", object, expected_text(f), f.found);
+    // A long expectation (a bend cause, the paper's word) wraps within the column.
+    const std::vector<std::string> lines = wrap_text(text, width - 18, 0.45);
+    for (std::size_t k = 0; k < lines.size(); ++k) {
+      y += k == 0 ? kLine : kLine - 4;
+      if (!img) continue;
+      put_text(*img, lines[k], {x + kPad + 18, y}, 0.45, kInk);
+      if (k == 0) draw_mark(*img, {x + kPad, y}, 12, f.ok);
+    }
   }
   if (v->findings.empty()) {
     y += kLine;
