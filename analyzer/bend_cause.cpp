@@ -8,6 +8,7 @@
 
 #include "analyzer/explain.h"
 #include "analyzer/principal_curve.h"
+#include "core/scene.h"
 
 namespace ct::analyzer {
 namespace {
@@ -129,12 +130,14 @@ std::optional<BendCause> find_bend_cause(const AnalysisImage& input, const RgbIm
     const bool cause = std::find(b.causes.begin(), b.causes.end(), t.cause) != b.causes.end();
     (cause ? named : others).push_back(fmt::format("{:.3f} without {}", t.bend, t.without));
   }
+  std::vector<std::string> phrases;
+  for (const std::string& c : b.causes) phrases.push_back(bend_cause_phrase(c));
   if (b.causes.empty())
     b.summary = fmt::format("bent {:.3f} (sagitta / chord), by none of the {}: {}", b.bend,
-                            "camera curve, edge mixing, highlight lobe or interreflection", fmt::join(others, ", "));
+                            "camera curve, mixing at edges, highlight lobe or interreflection", fmt::join(others, ", "));
   else
-    b.summary = fmt::format("bent {:.3f} (sagitta / chord) {}by the {}: {}{}{}", b.bend, b.causes.size() > 1 || b.straightened ? "" : "mostly ",
-                            fmt::join(b.causes, " and the "), fmt::join(named, ", "), others.empty() ? "" : "; ",
+    b.summary = fmt::format("bent {:.3f} (sagitta / chord) {}by {}: {}{}{}", b.bend, b.causes.size() > 1 || b.straightened ? "" : "mostly ",
+                            fmt::join(phrases, " and "), fmt::join(named, ", "), others.empty() ? "" : "; ",
                             fmt::join(others, ", "));
   return b;
 }

@@ -192,7 +192,7 @@ void print_variant(const Json& v) {
   for (const auto& [target, words] : v["expect"].items()) {
     const Json& classes = words.is_object() ? words["classes"] : words;
     std::string text = fmt::format("{} {}", target, fmt::join(classes.get<std::vector<std::string>>(), "|"));
-    if (words.is_object() && words.contains("bent_by")) text += fmt::format(" bent by the {}", words["bent_by"].get<std::string>());
+    if (words.is_object() && words.contains("bent_by")) text += " bent by " + bend_cause_phrase(words["bent_by"].get<std::string>());
     expects.push_back(std::move(text));
   }
   const auto figure = v["figure"].get<std::vector<std::string>>();

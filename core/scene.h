@@ -217,6 +217,11 @@ struct Expectation {
 };
 inline constexpr std::array<std::string_view, 4> kBendCauses = {"camera curve", "mixing at edges", "highlight lobe",
                                                                  "interreflection"};
+// A cause as a sentence names it after "bent by": "the highlight lobe", "the camera curve", "interreflection",
+// "mixing at edges".
+inline std::string bend_cause_phrase(std::string_view cause) {
+  return (cause == "highlight lobe" || cause == "camera curve" ? "the " : "") + std::string(cause);
+}
 
 struct SeriesVariant {
   std::string name;

@@ -11,6 +11,7 @@
 
 #include "analyzer/image_input.h"
 #include "core/file_io.h"
+#include "core/scene.h"
 #include "series/preview.h"
 
 namespace ct::series {
@@ -160,7 +161,7 @@ std::string thumbnail_png(const fs::path& dir, const VariantView& variant, int s
 
 std::string expected_text(const FindingView& f) {
   std::string text = fmt::format("{}", fmt::join(f.any_of, " or "));
-  if (!f.bent_by.empty()) text += fmt::format(", bent by the {}", f.bent_by);
+  if (!f.bent_by.empty()) text += ", bent by " + bend_cause_phrase(f.bent_by);
   if (!f.paper.empty()) text += fmt::format(" (the paper: {})", f.paper);
   return text;
 }
