@@ -70,7 +70,7 @@ test('holds the paper\'s eight panels and the banana beside 3d, each with its im
     for (const w of p.plots) assert.ok(w > 0, `${p.panel}: a plot did not load`);
     assert.equal(p.external, 0, `${p.panel}: images must be data: URIs`);
     assert.ok(p.findings > 0, `${p.panel}: no expected vs found rows`);
-    assert.match(p.caption, /^\([a-d]\) /);
+    assert.match(p.caption, p.panel === '3e' ? /^\(e\) Beyond the paper: / : /^\([a-d]\) /);
   }
   // The paper's own captions, and 3-specular in both 3b and 4a.
   assert.equal(panels[0].caption, '(a) Diffusely reflecting surfaces under direct illumination');
