@@ -25,6 +25,36 @@ void check_size(const LabelImage& image, const RgbImage& layer, const std::strin
     throw InputError(fmt::format("{}: is {}×{}, the image is {}×{}", file, image.width, image.height, layer.width, layer.height));
 }
 
+// How far a region's own values confirm the declared curve's γ, where they can: the γ whose inverse flattens the
+// stored values again into the flat the light made, with its bootstrap standard error, compared with the declared
+// one (gamma_against_declared). The flat is a plane for a dichromatic object (L, skewed-T, fork, P, planar in linear
+// light: a per-channel power bends it even through black), or a line the curve bent (class gamma). A line that stays
+// a line carries no information on γ (a line through black stays one under any power).
+void confirm_declared_gamma(RegionAnalysis& r, const RgbImage& stored, const Region& region, const ToneCurve& curve,
+                            double full_scale, const AnalyzeOptions& options) {
+  if (r.shape.gamma || !r.linear_light || r.shape.shape == ShapeClass::Clipped) return;
+  std::optional<GammaFlat> flat;
+  switch (r.linear_light->shape) {
+    case ShapeClass::L: case ShapeClass::SkewedT: case ShapeClass::Fork: case ShapeClass::P: case ShapeClass::Planar:
+      flat = GammaFlat::Plane; break;
+    case ShapeClass::Linear:
+      if (r.shape.shape == ShapeClass::Gamma) flat = GammaFlat::Line;
+      break;
+    default: break;
+  }
+  if (!flat) return;
+  const RegionSamples samples = gather_samples(stored, region);
+  const std::size_t n = samples.size(), stride = (n + options.criteria.max_points - 1) / std::max<std::size_t>(1, options.criteria.max_points);
+  std::vector<Vec3> points;
+  for (std::size_t i = 0; i < n; i += std::max<std::size_t>(1, stride))
+    points.emplace_back(samples.rgb[i * 3], samples.rgb[i * 3 + 1], samples.rgb[i * 3 + 2]);
+  std::optional<GammaFit> fit = fit_gamma(points, *flat);
+  if (!fit) return;
+  fit->gamma_se = gamma_standard_error(points, options.seed, *flat);
+  r.shape.gamma = fit;
+  r.declared_gamma = compare_gamma(*fit, curve, full_scale);
+}
+
 }  // namespace
 
 std::vector<Region> select_regions(const AnalysisImage& input, const RgbImage& layer, const RegionOptions& options,
@@ -101,20 +131,27 @@ ImageAnalysis analyse_image(const AnalysisImage& input, const std::string& layer
       ClusterShape light = analyse_region(linear, linear_context, r, opts).shape;
       // The whole image mixes every cluster: its class only describes; the curve's bend is judged per object.
       if (r.source == "image") result.linear_light = std::move(light);
-      else apply_tone_curve(result, std::move(light), *curve, opts.criteria);
+      else {
+        apply_tone_curve(result, std::move(light), *curve, opts.criteria);
+        confirm_declared_gamma(result, pixels, r, *curve, full_scale, opts);
+      }
     }
+    EdgeMixing mixing;
     if (r.source == "labels" && !input.object_ids.empty()) {
       // Mixing turns a colour's direction; the noise that matters is across the cluster's first axis (along it,
       // neighbouring pixels differ by shading as well as by noise).
       const double noise = std::hypot(result.shape.noise_sigma[1], result.shape.noise_sigma[2]);
       if (input.encoding.pixel_area.value_or(true)) {
-        const EdgeMixing mixing = find_edge_mixing(pixels, input.object_ids, r, static_cast<std::int32_t>(r.label), noise);
+        mixing = find_edge_mixing(pixels, input.object_ids, r, static_cast<std::int32_t>(r.label), noise);
         apply_edge_mixing(result, mixing, pixels, a.context, r, opts, input.object_names);
       } else {  // point-sampled pixels hold one surface's colour each: nothing mixes at an edge
         result.shape.decisions.push_back({"pixels integrate an area (chromatrace.pixel_area)", 0.0, 1.0, false});
       }
     }
     if (!input.components.empty()) a.explanations[i] = explain_region(input, r);
+    if (r.source != "image")
+      result.bend = find_bend_cause(input, pixels, r, result.shape, result.linear_light ? &*result.linear_light : nullptr,
+                                    mixing.mixed, opts.criteria);
     // The light-group layers are the linear camera signal of each luminaire's light; the test reads them, not
     // the analysed layer, so it holds whatever curve encoded the final image. A layer that is one component
     // is no superposition.

@@ -167,6 +167,7 @@ json shape_to_json(const ClusterShape& s) {
   });
   j["gamma"] = optional_json(s.gamma, [](const GammaFit& g) {
     return json{{"gamma", g.gamma},
+                {"flattens", g.flat == GammaFlat::Plane ? "plane" : "line"},
                 {"gamma_se", g.gamma_se ? json(*g.gamma_se) : json(nullptr)},
                 {"straightness_as_is", g.straightness_as_is},
                 {"straightness_linearised", g.straightness_linearised},
@@ -238,6 +239,13 @@ json analysis_to_json(const ImageAnalysis& a, const std::vector<bool>& plotted) 
               {"files", {{"histogram", "histograms/" + stem + ".json"},
                          {"plot", plotted.empty() || (i < plotted.size() && plotted[i]) ? json("plots/" + stem + ".png") : json(nullptr)}}}};
     j["explanation"] = i < a.explanations.size() ? optional_json(a.explanations[i], explanation_json) : json(nullptr);
+    j["bend_cause"] = optional_json(r.bend, [](const BendCause& b) {
+      json tests = json::array();
+      for (const BendTest& t : b.tests)
+        tests.push_back({{"cause", t.cause}, {"without", t.without}, {"bend", t.bend}, {"straight", t.straight}});
+      return json{{"bend", b.bend}, {"reference_bend", b.reference_bend}, {"tests", tests}, {"causes", b.causes},
+                  {"straightened", b.straightened}, {"summary", b.summary}};
+    });
     regions.push_back(std::move(j));
   }
   const HistogramSpec& spec = a.context.spec;

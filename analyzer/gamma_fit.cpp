@@ -12,11 +12,13 @@ namespace {
 
 constexpr std::size_t kMaxPoints = 4000;
 
-double straightness(const std::vector<Vec3>& points, double inverse_gamma) {
+// The variance off the flat, relative to the variance in it: (λ2 + λ3) / λ1 for a line, λ3 / (λ1 + λ2) for a plane.
+double straightness(const std::vector<Vec3>& points, double inverse_gamma, GammaFlat flat) {
   std::vector<Vec3> y(points.size());
   for (std::size_t i = 0; i < points.size(); ++i)
     for (int c = 0; c < 3; ++c) y[i][c] = std::pow(points[i][c], inverse_gamma);
   const Vec3 values = principal_axes_of(y, About::Mean).values;
+  if (flat == GammaFlat::Plane) return values[0] + values[1] > 0 ? values[2] / (values[0] + values[1]) : 0.0;
   return values[0] > 0 ? (values[1] + values[2]) / values[0] : 0.0;
 }
 
@@ -26,10 +28,10 @@ namespace {
 
 // The γ whose inverse makes `sample` straightest: a coarse grid over log γ, then golden-section search in the
 // bracket around the best grid point.
-double best_gamma(const std::vector<Vec3>& sample) {
+double best_gamma(const std::vector<Vec3>& sample, GammaFlat flat) {
   const double lo = std::log(0.2), hi = std::log(5.0);
   constexpr int kGrid = 48;
-  auto cost = [&](double log_gamma) { return straightness(sample, std::exp(-log_gamma)); };
+  auto cost = [&](double log_gamma) { return straightness(sample, std::exp(-log_gamma), flat); };
   int best = 0;
   double best_cost = std::numeric_limits<double>::max();
   for (int k = 0; k <= kGrid; ++k) {
@@ -63,11 +65,12 @@ std::vector<Vec3> gamma_sample(const std::vector<Vec3>& points, std::size_t& use
 
 }  // namespace
 
-std::optional<GammaFit> fit_gamma(const std::vector<Vec3>& points) {
+std::optional<GammaFit> fit_gamma(const std::vector<Vec3>& points, GammaFlat flat) {
   GammaFit fit;
+  fit.flat = flat;
   const std::vector<Vec3> sample = gamma_sample(points, fit.used);
   if (fit.used < 10) return std::nullopt;
-  fit.gamma = best_gamma(sample);
+  fit.gamma = best_gamma(sample, flat);
   std::vector<double> values;
   for (const Vec3& p : points)
     if (p.minCoeff() > 0) values.insert(values.end(), {p[0], p[1], p[2]});
@@ -78,12 +81,12 @@ std::optional<GammaFit> fit_gamma(const std::vector<Vec3>& points) {
   };
   fit.lo = percentile(0.02);
   fit.hi = percentile(0.98);
-  fit.straightness_as_is = straightness(sample, 1.0);
-  fit.straightness_linearised = straightness(sample, 1.0 / fit.gamma);
+  fit.straightness_as_is = straightness(sample, 1.0, flat);
+  fit.straightness_linearised = straightness(sample, 1.0 / fit.gamma, flat);
   return fit;
 }
 
-double gamma_standard_error(const std::vector<Vec3>& points, std::uint64_t seed) {
+double gamma_standard_error(const std::vector<Vec3>& points, std::uint64_t seed, GammaFlat flat) {
   std::size_t used = 0;
   const std::vector<Vec3> sample = gamma_sample(points, used);
   if (sample.size() < 10) return std::numeric_limits<double>::quiet_NaN();
@@ -101,7 +104,7 @@ double gamma_standard_error(const std::vector<Vec3>& points, std::uint64_t seed)
   std::vector<Vec3> resample(m);
   for (int r = 0; r < kReplicates; ++r) {
     for (Vec3& p : resample) p = sample[next() % sample.size()];
-    gammas.push_back(best_gamma(resample));
+    gammas.push_back(best_gamma(resample, flat));
   }
   double mean = 0, var = 0;
   for (const double g : gammas) mean += g / kReplicates;

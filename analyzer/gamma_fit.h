@@ -17,8 +17,13 @@
 
 namespace ct::analyzer {
 
+// What the linearised cluster should be: a line (a matte object; (λ2 + λ3) / λ1 is minimised) or a plane (a
+// dichromatic object, whose plane through black a per-channel power bends; λ3 / (λ1 + λ2) is minimised).
+enum class GammaFlat { Line, Plane };
+
 struct GammaFit {
   double gamma = 1;                  // the encoding exponent: I' = k·I^γ (sRGB-like encodings ≈ 1/2.2)
+  GammaFlat flat = GammaFlat::Line;  // what it straightens: a line, or a plane (then the two numbers below are λ3 / (λ1 + λ2))
   double straightness_as_is = 0;     // (λ2 + λ3) / λ1 of the cluster as stored
   double straightness_linearised = 0;  // the same after x ↦ x^(1/γ)
   std::size_t used = 0;              // samples with all three channels > 0
@@ -27,12 +32,12 @@ struct GammaFit {
 };
 
 // Searches γ in [0.2, 5]; nullopt with fewer than 10 positive samples.
-std::optional<GammaFit> fit_gamma(const std::vector<Vec3>& points);
+std::optional<GammaFit> fit_gamma(const std::vector<Vec3>& points, GammaFlat flat = GammaFlat::Line);
 
 // The standard error of fit_gamma's γ on these points, by the bootstrap: γ refitted on 16 resamples (with
 // replacement, a fixed seed, up to 1000 points each, the spread scaled by √(m / n) to the n points the fit used)
 // — the spread the pixels' noise and the cluster's own scatter give the fit.
-double gamma_standard_error(const std::vector<Vec3>& points, std::uint64_t seed = 1);
+double gamma_standard_error(const std::vector<Vec3>& points, std::uint64_t seed = 1, GammaFlat flat = GammaFlat::Line);
 
 // The fitted γ against the curve the input declared (--input-transfer, or what the file said): they agree when
 // they differ by at most 3 standard errors (the bootstrap's coverage, tests/analyzer/test_cluster_shape.cpp).

@@ -7,6 +7,7 @@
 #include <optional>
 #include <string>
 
+#include "analyzer/bend_cause.h"
 #include "analyzer/cluster_shape.h"
 #include "analyzer/histogram.h"
 #include "analyzer/image_input.h"
@@ -50,6 +51,8 @@ struct RegionAnalysis {
   std::optional<ClusterShape> linear_light;
   // The γ fitted to the values as stored against the curve the input declared (when both are known).
   std::optional<GammaComparison> declared_gamma;
+  // What bends the cluster, when it is bent (analyzer/bend_cause.h); never for the whole image, which mixes every cluster.
+  std::optional<BendCause> bend;
 };
 
 // The context of the same layer with its response curve undone (`linear`, from linear_light()): the clipping

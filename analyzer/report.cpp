@@ -155,6 +155,7 @@ json summary(const RegionAnalysis& r, const std::optional<Explanation>& e) {
     row("γ against the declared curve", fmt::format("{}: fitted {:.3f}, declared {} ≈ {:.3f}, {:.1f} standard errors apart (agreement: at most {:g})",
                                                     c->agree ? "agree" : "disagree", c->fitted, c->declared, c->declared_gamma,
                                                     c->difference_in_se, kGammaAgreement));
+  if (r.bend) row("what bends it", r.bend->summary);
   if (!s.clipping.faces.empty()) row("clipped", percent(s.clipping.fraction));
   if (r.linear_light) row("class in linear light (curve undone)", std::string(class_name(r.linear_light->shape)));
   if (e) {

@@ -172,7 +172,15 @@ void print_scene(const Json& s) {
 
 Json expect_json(const std::vector<Expectation>& expect) {
   Json out = Json::object();
-  for (const Expectation& e : expect) out[e.target] = e.any_of;
+  for (const Expectation& e : expect) {
+    if (e.bent_by.empty() && e.paper.empty()) {
+      out[e.target] = e.any_of;
+      continue;
+    }
+    out[e.target] = {{"classes", e.any_of}};
+    if (!e.bent_by.empty()) out[e.target]["bent_by"] = e.bent_by;
+    if (!e.paper.empty()) out[e.target]["paper"] = e.paper;
+  }
   return out;
 }
 
@@ -181,8 +189,12 @@ void print_variant(const Json& v) {
   const Json& s = v["scene"];
   const std::string extends = v["extends"].get<std::string>();
   std::vector<std::string> expects;
-  for (const auto& [target, words] : v["expect"].items())
-    expects.push_back(fmt::format("{} {}", target, fmt::join(words.get<std::vector<std::string>>(), "|")));
+  for (const auto& [target, words] : v["expect"].items()) {
+    const Json& classes = words.is_object() ? words["classes"] : words;
+    std::string text = fmt::format("{} {}", target, fmt::join(classes.get<std::vector<std::string>>(), "|"));
+    if (words.is_object() && words.contains("bent_by")) text += " bent by " + bend_cause_phrase(words["bent_by"].get<std::string>());
+    expects.push_back(std::move(text));
+  }
   const auto figure = v["figure"].get<std::vector<std::string>>();
   fmt::print("  {}{}: from {}; materials {}, {} light(s), max {} bounces, {} pixels; sensor {}; expects {}\n",
              v["name"].get<std::string>(), figure.empty() ? "" : fmt::format(" (figure {})", fmt::join(figure, ", ")),

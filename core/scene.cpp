@@ -1,6 +1,7 @@
 #include "core/scene.h"
 
 #include <algorithm>
+#include <sstream>
 #include <cmath>
 #include <exception>
 #include <limits>
@@ -757,11 +758,29 @@ Expectation read_expectation(const std::string& target, const JsonNode& node, co
     }
     e.any_of.push_back(word);
   };
-  if (node.json().is_string()) {
-    add_word(node);
-  } else {
-    for (const JsonNode& word : node.elements()) add_word(word);
-    if (e.any_of.empty()) node.fail("expects at least one structure");
+  const auto add_words = [&](const JsonNode& words) {
+    if (words.json().is_string()) {
+      add_word(words);
+    } else {
+      for (const JsonNode& word : words.elements()) add_word(word);
+      if (e.any_of.empty()) words.fail("expects at least one structure");
+    }
+  };
+  if (!node.json().is_object()) {
+    add_words(node);
+    return e;
+  }
+  // {"classes": …, "bent_by": cause, "paper": word}
+  node.expect_object({"classes", "bent_by", "paper"});
+  add_words(node["classes"]);
+  if (const auto bent_by = node.find("bent_by")) {
+    e.bent_by = bent_by->non_empty_string();
+    if (std::find(kBendCauses.begin(), kBendCauses.end(), e.bent_by) == kBendCauses.end())
+      bent_by->fail(fmt::format("unknown cause \"{}\" (causes: {})", e.bent_by, fmt::join(kBendCauses, ", ")));
+  }
+  if (const auto paper = node.find("paper")) {
+    e.paper = paper->non_empty_string();
+    if (!structure_from_word(e.paper)) paper->fail(fmt::format("unknown structure \"{}\"", e.paper));
   }
   return e;
 }
@@ -831,7 +850,7 @@ Series load_series(const std::filesystem::path& file, int threads) {
   std::vector<Json> merged;  // merged[i]: variant i's scene document
   std::vector<std::optional<JsonNode>> expects;
   for (const JsonNode& node : variants.elements()) {
-    node.expect_object({"name", "description", "extends", "patch", "sensor", "figure", "expect"});
+    node.expect_object({"name", "description", "extends", "patch", "sensor", "figure", "components", "expect"});
     SeriesVariant variant;
     variant.name = node["name"].non_empty_string();
     if (find_by_name(series.variants, variant.name))
@@ -859,6 +878,13 @@ Series load_series(const std::filesystem::path& file, int threads) {
     merge_patch_at("sensor", variant.sensor, false);
     if (const auto figure = node.find("figure")) {
       for (const JsonNode& panel : figure->elements()) variant.figure.push_back(panel.non_empty_string());
+    }
+    if (const auto components = node.find("components")) {
+      variant.components = components->non_empty_string();
+      std::stringstream items(variant.components);
+      for (std::string item; std::getline(items, item, ',');)
+        if (item != "paths" && item != "lights" && item != "bounces" && item != "all")
+          components->fail(fmt::format("unknown component family \"{}\" (known: paths, lights, bounces, all)", item));
     }
     expects.push_back(node.find("expect"));
     merged.push_back(std::move(scene_json));

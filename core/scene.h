@@ -8,6 +8,7 @@
 // ct::InputError of one line naming the file and the JSON path, e.g.
 //   "box.json: objects[3].material: unknown material \"plstic\" (materials: wall, plastic)".
 
+#include <array>
 #include <cstdint>
 #include <filesystem>
 #include <functional>
@@ -204,12 +205,23 @@ std::vector<TriangleMesh> scene_meshes(const Scene& scene);
 // ---- Experiment series ---------------------------------------------------------------------------------
 
 // What a variant expects of one object, a group of objects or the whole image: the class the analyzer
-// gives it (each object of a group on its own) is one of `any_of`, words of core/structures.h.
+// gives it (each object of a group on its own) is one of `any_of`, words of core/structures.h; with `bent_by`,
+// the analyzer also names that cause of its bend (analyzer/bend_cause.h). `paper` is the paper's own word, when the
+// scene shows something else (a finding, stated with its numbers on the figure page).
 struct Expectation {
   std::string target;                // as written: an object's name, a group's name, or "image"
   std::vector<std::string> objects;  // the objects it covers, in scene order; empty for "image"
   std::vector<std::string> any_of;
+  std::string bent_by;               // "", "camera curve", "mixing at edges", "highlight lobe" or "interreflection"
+  std::string paper;                 // "" when the expectation is the paper's
 };
+inline constexpr std::array<std::string_view, 4> kBendCauses = {"camera curve", "mixing at edges", "highlight lobe",
+                                                                 "interreflection"};
+// A cause as a sentence names it after "bent by": "the highlight lobe", "the camera curve", "interreflection",
+// "mixing at edges".
+inline std::string bend_cause_phrase(std::string_view cause) {
+  return (cause == "highlight lobe" || cause == "camera curve" ? "the " : "") + std::string(cause);
+}
 
 struct SeriesVariant {
   std::string name;
@@ -218,6 +230,7 @@ struct SeriesVariant {
   Json patch;           // JSON Merge Patch (RFC 7386) as given
   Json sensor;          // sensor settings (a chromatrace-sensor/1 patch), merged along `extends`; {} if none
   std::vector<std::string> figure;  // the paper's panels it reproduces, e.g. {"3b", "4a"}
+  std::string components;  // component families its render holds besides the run's ("bounces"); empty: the run's
   std::vector<Expectation> expect;
   Scene scene;  // the patched scene, validated; scene.json has every path absolute
 };

@@ -103,7 +103,7 @@ std::string findings_table(const VariantView& v) {
                                    ? fmt::format("{} <span class=\"description\">({})</span>", escape_html(f.object), escape_html(f.target))
                                    : escape_html(f.object);
     html += fmt::format("<tr class=\"finding\" data-ok=\"{}\"><td>{}</td><td>{}</td><td><b>{}</b></td><td>{}</td></tr>", f.ok ? 1 : 0,
-                        object, escape_html(fmt::format("{}", fmt::join(f.any_of, " or "))), escape_html(f.found), mark(f.ok));
+                        object, escape_html(expected_text(f)), escape_html(f.found), mark(f.ok));
     if (!f.explanation.empty())
       html += fmt::format("<tr><td class=\"paths\" colspan=\"4\">light paths: {}</td></tr>", escape_html(f.explanation));
   }
@@ -205,7 +205,7 @@ std::string variants_table(const fs::path& dir, const std::vector<VariantView>& 
       }
       html += fmt::format(R"(<tr{} data-variant="{}">{}<td>{}</td><td>{}</td><td>{}</td><td>{}</td>{}</tr>)", g == 0 ? R"( class="first")" : "",
                           escape_html(v.name), g == 0 ? head : "", escape_html(group.front()->target),
-                          escape_html(fmt::format("{}", fmt::join(group.front()->any_of, " or "))), fmt::join(found, ", "), mark(ok),
+                          escape_html(expected_text(*group.front())), fmt::join(found, ", "), mark(ok),
                           g == 0 ? fmt::format(R"(<td rowspan="{}">{}</td>)", rows, files) : "");
     }
   }
@@ -256,11 +256,16 @@ void write_figure_page(const std::filesystem::path& dir, const Json& result) {
                                            "the projection is onto the image's two largest principal axes.",
                                            series, options.empty() ? "" : ": ", options_text(result, true));
   for (const int figure : {3, 4}) {
-    const auto& names = figure_panels(figure);
-    std::array<const VariantView*, 4> panels{};
+    // The paper's four panels, then those beyond the paper that a variant reproduces.
+    std::vector<std::pair<std::string, const VariantView*>> panels;
     bool any = false;
-    for (int k = 0; k < 4; ++k)
-      if (const auto it = panel_of.find(names[k]); it != panel_of.end()) panels[k] = &variants[it->second], any = true;
+    for (const std::string& name : figure_panels(figure)) {
+      const auto it = panel_of.find(name);
+      panels.emplace_back(name, it == panel_of.end() ? nullptr : &variants[it->second]);
+      any = any || it != panel_of.end();
+    }
+    for (const std::string& name : extra_panels(figure))
+      if (const auto it = panel_of.find(name); it != panel_of.end()) panels.emplace_back(name, &variants[it->second]);
     const fs::path raster = dir / raster_files[figure - 3];
     if (!any) {
       std::error_code ignored;
@@ -270,7 +275,7 @@ void write_figure_page(const std::filesystem::path& dir, const Json& result) {
     write_png(raster, figure_raster(figure, panels, subtitle));
     html += fmt::format(R"(<section class="figure" id="figure-{0}"><h2>{1}.</h2><p class="figure-note">From left to right, as in the paper; also as one image: <a href="{2}">{2}</a>.</p><div class="panels">)",
                         figure, escape_html(figure_title(figure)), raster_files[figure - 3]);
-    for (int k = 0; k < 4; ++k) html += panel_html(names[k], panels[k]);
+    for (const auto& [name, variant] : panels) html += panel_html(name, variant);
     html += "</div></section>";
   }
   if (!figures) {

@@ -5,11 +5,13 @@
 #include <stdexcept>
 
 #include <fmt/core.h>
+#include <fmt/format.h>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "analyzer/image_input.h"
 #include "core/file_io.h"
+#include "core/scene.h"
 #include "series/preview.h"
 
 namespace ct::series {
@@ -76,6 +78,8 @@ std::vector<VariantView> read_variants(const Json& result) {
             FindingView f;
             f.target = string_at(e, "target");
             f.any_of = strings_at(e, "any_of");
+            f.bent_by = string_at(e, "bent_by");
+            f.paper = string_at(e, "paper");
             f.object = string_at(o, "object");
             f.found = string_at(o, "found");
             f.ok = o.is_object() && o.contains("ok") && o["ok"].is_boolean() && o["ok"].get<bool>();
@@ -155,6 +159,13 @@ std::string thumbnail_png(const fs::path& dir, const VariantView& variant, int s
   return encode_png(small);
 }
 
+std::string expected_text(const FindingView& f) {
+  std::string text = fmt::format("{}", fmt::join(f.any_of, " or "));
+  if (!f.bent_by.empty()) text += ", bent by " + bend_cause_phrase(f.bent_by);
+  if (!f.paper.empty()) text += fmt::format(" (the paper: {})", f.paper);
+  return text;
+}
+
 std::string panel_caption(const std::string& panel) {
   static const std::map<std::string, std::string> captions = {
       {"3a", "(a) Diffusely reflecting surfaces under direct illumination"},
@@ -164,7 +175,8 @@ std::string panel_caption(const std::string& panel) {
       {"4a", "(a) Original image"},
       {"4b", "(b) With supersampling in the area of a pixel"},
       {"4c", "(c) With a different gamma factor"},
-      {"4d", "(d) With clipping effect by over exposure"}};
+      {"4d", "(d) With clipping effect by over exposure"},
+      {"3e", "(e) Beyond the paper: a concave object of one paint under global illumination, the banana"}};
   const auto it = captions.find(panel);
   return it == captions.end() ? "" : it->second;
 }
@@ -175,6 +187,11 @@ std::string figure_title(int figure) {
 
 const std::array<std::string, 4>& figure_panels(int figure) {
   static const std::array<std::string, 4> three = {"3a", "3b", "3c", "3d"}, four = {"4a", "4b", "4c", "4d"};
+  return figure == 3 ? three : four;
+}
+
+const std::vector<std::string>& extra_panels(int figure) {
+  static const std::vector<std::string> three = {"3e"}, four = {};
   return figure == 3 ? three : four;
 }
 

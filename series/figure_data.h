@@ -20,6 +20,8 @@ struct FindingView {
   std::string target;                // the expectation's target: an object, a group or "image"
   std::string object;                // the object judged
   std::vector<std::string> any_of;   // the classes expected
+  std::string bent_by;               // the cause of its bend expected, or ""
+  std::string paper;                 // the paper's word, when the series expects what the scene shows instead
   std::string found;                 // the analyzer's class, or "absent"
   bool ok = false;
   std::string explanation;           // the light paths that built it; empty without component layers
@@ -55,13 +57,19 @@ void load_images(VariantView& variant, const std::filesystem::path& dir, std::si
 // A small PNG of the camera image for the table (long side ≤ `side`); empty when there is none.
 std::string thumbnail_png(const std::filesystem::path& dir, const VariantView& variant, int side);
 
+// What a finding expects, for a person: "thickened or P, bent by the highlight lobe (the paper: curved)".
+std::string expected_text(const FindingView& finding);
+
 // The paper's panel captions: "(a) Diffusely reflecting surfaces under direct illumination" for "3a"; empty
 // for a panel the paper does not have.
 std::string panel_caption(const std::string& panel);
 // "Figure 3: Simulations of color histogram." etc., as the paper's captions begin.
 std::string figure_title(int figure);
-// "3a" … "3d" or "4a" … "4d".
+// "3a" … "3d" or "4a" … "4d": the paper's four panels of a figure.
 const std::array<std::string, 4>& figure_panels(int figure);
+// Panels beyond the paper shown beside a figure's four when a variant of the run reproduces them ("3e", the banana
+// of a concave object, beside 3d); empty when the figure has none.
+const std::vector<std::string>& extra_panels(int figure);
 
 // The camera image shown scaled by a whole factor (or reduced) so that its long side is near `box`.
 cv::Size display_size(const cv::Mat& camera, int box);

@@ -58,15 +58,18 @@ int draw_panel(cv::Mat* img, int x, int top, const std::string& panel, const Var
   if (img) cv::line(*img, {x + kPad, y}, {x + kColumn - kPad, y}, kRule, 1);
   y += 4;
   for (const FindingView& f : v->findings) {
-    y += kLine;
-    if (!img) continue;
     const std::string object = f.target != f.object && f.target != "image" && !f.target.empty()
                                    ? fmt::format("{} ({})", f.object, f.target)
                                    : f.object;
-    const std::string line = fmt::format("{}: expected {}, found {}", object, fmt::join(f.any_of, " or "), f.found);
-    const int w = put_text(*img, line, {x + kPad + 18, y}, 0.45, kInk);
-    (void)w;
-    draw_mark(*img, {x + kPad, y}, 12, f.ok);
+    const std::string text = fmt::format("{}: expected {}, found {}", object, expected_text(f), f.found);
+    // A long expectation (a bend cause, the paper's word) wraps within the column.
+    const std::vector<std::string> lines = wrap_text(text, width - 18, 0.45);
+    for (std::size_t k = 0; k < lines.size(); ++k) {
+      y += k == 0 ? kLine : kLine - 4;
+      if (!img) continue;
+      put_text(*img, lines[k], {x + kPad + 18, y}, 0.45, kInk);
+      if (k == 0) draw_mark(*img, {x + kPad, y}, 12, f.ok);
+    }
   }
   if (v->findings.empty()) {
     y += kLine;
@@ -77,23 +80,23 @@ int draw_panel(cv::Mat* img, int x, int top, const std::string& panel, const Var
 
 }  // namespace
 
-cv::Mat figure_raster(int figure, const std::array<const VariantView*, 4>& panels, const std::string& subtitle) {
-  const int width = 4 * kColumn + 3 * kGap + 2 * kPad;
+cv::Mat figure_raster(int figure, const std::vector<std::pair<std::string, const VariantView*>>& panels, const std::string& subtitle) {
+  const int n = static_cast<int>(panels.size());
+  const int width = n * kColumn + (n - 1) * kGap + 2 * kPad;
   const std::vector<std::string> title = wrap_text(figure_title(figure) + ".", width - 2 * kPad, 0.75, 2);
   const std::vector<std::string> sub = wrap_text(subtitle, width - 2 * kPad, 0.5);
   int top = kPad + 4;
   top += static_cast<int>(title.size()) * 30 + static_cast<int>(sub.size()) * 22 + 10;
-  const std::array<std::string, 4>& names = figure_panels(figure);
   int height = 0;
-  for (int k = 0; k < 4; ++k) height = std::max(height, draw_panel(nullptr, 0, top, names[k], panels[k]));
+  for (const auto& [name, variant] : panels) height = std::max(height, draw_panel(nullptr, 0, top, name, variant));
   cv::Mat img(top + height + kPad, width, CV_8UC3, kWhite);
   int y = kPad + 4;
   for (const std::string& line : title) put_text(img, line, {kPad, y += 30}, 0.75, kInk, Align::Left, 2);
   for (const std::string& line : sub) put_text(img, line, {kPad, y += 22}, 0.5, kSoftInk);
-  for (int k = 0; k < 4; ++k) {
+  for (int k = 0; k < n; ++k) {
     const int x = kPad + k * (kColumn + kGap);
     if (k > 0) cv::line(img, {x - kGap / 2, top + 8}, {x - kGap / 2, top + height - 8}, kRule, 1);
-    draw_panel(&img, x, top, names[k], panels[k]);
+    draw_panel(&img, x, top, panels[static_cast<std::size_t>(k)].first, panels[static_cast<std::size_t>(k)].second);
   }
   return img;
 }

@@ -5,6 +5,8 @@
 
 #include <array>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include <opencv2/core.hpp>
 
@@ -12,8 +14,8 @@
 
 namespace ct::series {
 
-// 8-bit BGR. `panels` are the variants shown as (a)–(d), nullptr where no variant of the run reproduces that
-// panel; `subtitle` says how the images were made.
-cv::Mat figure_raster(int figure, const std::array<const VariantView*, 4>& panels, const std::string& subtitle);
+// 8-bit BGR. `panels` are {panel, the variant shown}: the paper's (a)–(d), the variant nullptr where no variant of
+// the run reproduces that panel, then any extra panel a variant reproduces; `subtitle` says how the images were made.
+cv::Mat figure_raster(int figure, const std::vector<std::pair<std::string, const VariantView*>>& panels, const std::string& subtitle);
 
 }  // namespace ct::series

@@ -89,6 +89,15 @@ Json render_inputs(const Scene& scene, const RunOptions& options) {
   return inputs;
 }
 
+// The run's options with the component families the variant asks for besides the run's (a variant whose analysis
+// needs the bounces, say).
+RunOptions for_variant(const SeriesVariant& variant, const RunOptions& options) {
+  RunOptions o = options;
+  if (!variant.components.empty())
+    o.components = options.components == "none" ? variant.components : options.components + "," + variant.components;
+  return o;
+}
+
 std::string render_key(const Json& inputs) { return fmt::format("{:016x}", fnv1a(inputs.dump())); }
 
 // ---- Renderers ------------------------------------------------------------------------------------------
@@ -186,13 +195,23 @@ std::vector<ExpectationResult> judge(const SeriesVariant& variant, const analyze
   for (const Expectation& e : variant.expect) {
     ExpectationResult result{e, {}, true};
     auto add = [&](const std::string& object, int region) {
-      Finding f{object, region, "absent", false, ""};
+      Finding f{object, region, "absent", false, "", {}};
       if (region >= 0) {
         const auto& shape = analysis.results[static_cast<std::size_t>(region)].shape;
         f.found = std::string(analyzer::class_name(shape.shape));
-        f.ok = std::find(e.any_of.begin(), e.any_of.end(), f.found) != e.any_of.end();
+        if (const auto& bend = analysis.results[static_cast<std::size_t>(region)].bend) f.bent_by = bend->causes;
+        f.ok = std::find(e.any_of.begin(), e.any_of.end(), f.found) != e.any_of.end() &&
+               (e.bent_by.empty() || std::find(f.bent_by.begin(), f.bent_by.end(), e.bent_by) != f.bent_by.end());
         if (static_cast<std::size_t>(region) < analysis.explanations.size())
           f.explanation = explain(analysis.explanations[static_cast<std::size_t>(region)]);
+        const analyzer::RegionAnalysis& result = analysis.results[static_cast<std::size_t>(region)];
+        if (result.bend) f.explanation += (f.explanation.empty() ? "" : "; ") + result.bend->summary;
+        if (const auto& g = result.declared_gamma; g && result.shape.gamma)
+          f.explanation += fmt::format("{}γ = {:.4f} ± {:.2g} flattens its {} again (declared {:.3g}: {})", f.explanation.empty() ? "" : "; ",
+                                       g->fitted, g->se, result.shape.gamma->flat == analyzer::GammaFlat::Plane ? "plane" : "line",
+                                       g->declared_gamma,
+                                       g->agree ? fmt::format("agrees, {:.1f} standard errors off", g->difference_in_se)
+                                                : fmt::format("differs by {:.1f} standard errors", g->difference_in_se));
       }
       result.ok = result.ok && f.ok;
       result.findings.push_back(std::move(f));
@@ -225,7 +244,8 @@ class Stage {
 };
 
 VariantResult run_variant(const Series& series, const SeriesVariant& variant, const fs::path& dir,
-                          const RunOptions& options, const Stage& stage) {
+                          const RunOptions& run_options, const Stage& stage) {
+  const RunOptions options = for_variant(variant, run_options);
   VariantResult result;
   result.name = variant.name;
   result.description = variant.description;
@@ -296,6 +316,7 @@ Json finding_json(const Finding& f) {
   Json j = {{"object", f.object}, {"found", f.found}, {"ok", f.ok}};
   if (f.region >= 0) j["region"] = f.region;
   if (!f.explanation.empty()) j["explanation"] = f.explanation;
+  if (!f.bent_by.empty()) j["bent_by"] = f.bent_by;
   return j;
 }
 
@@ -376,7 +397,7 @@ SeriesResult run_series(const Series& series, const fs::path& dir, const RunOpti
 std::vector<std::pair<std::string, std::string>> planned_renders(const Series& series, const RunOptions& options) {
   std::vector<std::pair<std::string, std::string>> renders;
   for (const SeriesVariant* v : select_variants(series, options.variants)) {
-    const std::string key = render_key(render_inputs(v->scene, options));
+    const std::string key = render_key(render_inputs(v->scene, for_variant(*v, options)));
     if (std::none_of(renders.begin(), renders.end(), [&](const auto& r) { return r.first == key; }))
       renders.emplace_back(key, v->name);
   }
@@ -392,7 +413,10 @@ Json result_json(const SeriesResult& result) {
     for (const ExpectationResult& e : v.expectations) {
       Json findings = Json::array();
       for (const Finding& f : e.findings) findings.push_back(finding_json(f));
-      expect.push_back({{"target", e.expected.target}, {"any_of", e.expected.any_of}, {"ok", e.ok}, {"objects", findings}});
+      Json row = {{"target", e.expected.target}, {"any_of", e.expected.any_of}, {"ok", e.ok}, {"objects", findings}};
+      if (!e.expected.bent_by.empty()) row["bent_by"] = e.expected.bent_by;
+      if (!e.expected.paper.empty()) row["paper"] = e.expected.paper;
+      expect.push_back(std::move(row));
       met += e.ok ? 1 : 0;
     }
     Json j = {{"name", v.name}, {"description", v.description}, {"figure", v.figure}, {"ok", v.ok}};

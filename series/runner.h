@@ -65,6 +65,7 @@ struct Finding {
   std::string found;   // the analyzer's class; "absent" when not in view
   bool ok = false;
   std::string explanation;  // which light paths built it, in one line; empty without component layers
+  std::vector<std::string> bent_by;  // what bends it (analyzer/bend_cause.h); empty when it is not bent
 };
 
 struct ExpectationResult {

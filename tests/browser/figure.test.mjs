@@ -3,7 +3,8 @@
 //
 // The test runs the paper's series small (48 × 48 pixels, 8 paths per pixel), opens DIR/index.html from
 // file:// and checks that it loads offline without console errors or network requests, that it holds the
-// paper's eight panels (Figures 3 and 4, a–d), each with its camera image and its two histogram plots loaded,
+// paper's eight panels (Figures 3 and 4, a–d) and the banana beyond the paper beside 3d (3e), each with its camera
+// image and its two histogram plots loaded,
 // that every link to a variant's report.html leads to a file that exists, and that figure3.png and
 // figure4.png were written.
 // Environment: CHROMATRACE_EXE (the executable); optional CHROMATRACE_SCREENSHOT (where to save a full-page
@@ -50,7 +51,7 @@ test('loads offline without console errors or requests', () => {
   assert.deepEqual(requests, []);
 });
 
-test('holds the paper\'s eight panels, each with its image and plots', async () => {
+test('holds the paper\'s eight panels and the banana beside 3d, each with its image and plots', async () => {
   const panels = await page.evaluate(() =>
     [...document.querySelectorAll('section.panel[data-panel]')].map((p) => ({
       panel: p.dataset.panel,
@@ -61,7 +62,7 @@ test('holds the paper\'s eight panels, each with its image and plots', async () 
       findings: p.querySelectorAll('tr.finding').length,
       external: [...p.querySelectorAll('img')].filter((i) => !i.src.startsWith('data:image/png;base64,')).length,
     })));
-  assert.deepEqual(panels.map((p) => p.panel), ['3a', '3b', '3c', '3d', '4a', '4b', '4c', '4d']);
+  assert.deepEqual(panels.map((p) => p.panel), ['3a', '3b', '3c', '3d', '3e', '4a', '4b', '4c', '4d']);
   for (const p of panels) {
     assert.equal(p.camera.length, 1, `${p.panel}: one camera image`);
     assert.ok(p.camera[0] > 0, `${p.panel}: the camera image did not load`);
@@ -69,20 +70,20 @@ test('holds the paper\'s eight panels, each with its image and plots', async () 
     for (const w of p.plots) assert.ok(w > 0, `${p.panel}: a plot did not load`);
     assert.equal(p.external, 0, `${p.panel}: images must be data: URIs`);
     assert.ok(p.findings > 0, `${p.panel}: no expected vs found rows`);
-    assert.match(p.caption, /^\([a-d]\) /);
+    assert.match(p.caption, p.panel === '3e' ? /^\(e\) Beyond the paper: / : /^\([a-d]\) /);
   }
   // The paper's own captions, and 3-specular in both 3b and 4a.
   assert.equal(panels[0].caption, '(a) Diffusely reflecting surfaces under direct illumination');
-  assert.equal(panels[7].caption, '(d) With clipping effect by over exposure');
-  assert.equal(panels[1].variant, panels[4].variant);
+  assert.equal(panels[8].caption, '(d) With clipping effect by over exposure');
+  assert.equal(panels[1].variant, panels[5].variant);
 });
 
 test('links to every variant\'s report.html lead to files that exist', async () => {
   const links = await page.evaluate(() => [...document.querySelectorAll('a.report')].map((a) => a.href));
   const series = JSON.parse(fs.readFileSync(path.join(out, 'series.json'), 'utf8'));
   const ok = series.variants.filter((v) => v.ok);
-  // One in each of the eight panels and one per successful variant in the table.
-  assert.equal(links.length, 8 + ok.length);
+  // One in each of the nine panels and one per successful variant in the table.
+  assert.equal(links.length, 9 + ok.length);
   for (const link of links) {
     assert.ok(link.startsWith('file://'), link);
     assert.match(link, /\/analysis\/report\.html$/);

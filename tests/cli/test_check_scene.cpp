@@ -44,7 +44,7 @@ TEST(CheckScene, SeriesChecksEveryVariant) {
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const nlohmann::json report = nlohmann::json::parse(r.out);
   EXPECT_EQ(report["format"], "chromatrace-series/1");
-  ASSERT_EQ(report["variants"].size(), 11u);
+  ASSERT_EQ(report["variants"].size(), 13u);
   EXPECT_EQ(report["variants"][0]["name"], "1-lambert-direct");
   EXPECT_EQ(report["variants"][0]["scene"]["render"]["max_bounces"], 1);
 }

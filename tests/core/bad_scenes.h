@@ -55,6 +55,11 @@ inline const std::vector<BadScene>& bad_scenes() {
        "variants[0].expect.image[1]: unknown structure \"banana\" (the analyzer's classes: none, clipped, "
        "mixed, point, linear, thickened-line, L, skewed-T, fork, gamma, curved, thickened, volume, P, superposed, "
        "planar)"},
+      {"series_unknown_bend_cause.json",
+       "variants[0].expect.ball.bent_by: unknown cause \"the lamp\" (causes: camera curve, mixing at edges, highlight lobe, "
+       "interreflection)"},
+      {"series_unknown_components.json",
+       "variants[0].components: unknown component family \"passes\" (known: paths, lights, bounces, all)"},
       {"series_unknown_target.json",
        "variants[0].expect.wals: \"wals\" is neither an object of the scene (floor, ball) nor a group (walls, image)"},
   };

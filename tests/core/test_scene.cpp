@@ -385,7 +385,7 @@ TEST(ShippedScenes, PaperBoxHasDistinctSurfacesAndACeilingLightFacingDown) {
 
 TEST(Series, PaperSeriesValidatesEveryStep) {
   const Series series = load_series(kScenes / "paper/series.json", 2);
-  ASSERT_EQ(series.variants.size(), 11u);
+  ASSERT_EQ(series.variants.size(), 13u);
   EXPECT_EQ(series.base_scene.name, "paper-box");
   auto variant = [&](std::string_view name) -> const SeriesVariant& {
     return *std::find_if(series.variants.begin(), series.variants.end(),
@@ -416,13 +416,24 @@ TEST(Series, PaperSeriesValidatesEveryStep) {
   const Json& sensor = variant("7d-noise").sensor;
   EXPECT_EQ(sensor["noise"]["enabled"], true);
   EXPECT_EQ(sensor["rendering"]["curve"], "linear");
-  EXPECT_EQ(sensor["adc"]["bits"], 8);
+  EXPECT_EQ(sensor["adc"]["bits"], 10);
 
-  // The eight panels of the paper's Figures 3 and 4, each reproduced by one variant.
+  // The eight panels of the paper's Figures 3 and 4, each reproduced by one variant, and the banana beside 3d.
   std::vector<std::string> panels;
   for (const SeriesVariant& v : series.variants) panels.insert(panels.end(), v.figure.begin(), v.figure.end());
   std::sort(panels.begin(), panels.end());
-  EXPECT_EQ(panels, (std::vector<std::string>{"3a", "3b", "3c", "3d", "4a", "4b", "4c", "4d"}));
+  EXPECT_EQ(panels, (std::vector<std::string>{"3a", "3b", "3c", "3d", "3e", "4a", "4b", "4c", "4d"}));
+
+  // The object form of an expectation: classes, the cause of the bend and the paper's word; extra components.
+  const SeriesVariant& box_3d = variant("6b-dichromatic-global");
+  ASSERT_EQ(box_3d.expect.size(), 4u);
+  EXPECT_EQ(box_3d.expect[2].target, "sphere");
+  EXPECT_EQ(box_3d.expect[2].any_of, (std::vector<std::string>{"thickened", "P"}));
+  EXPECT_EQ(box_3d.expect[2].bent_by, "highlight lobe");
+  EXPECT_EQ(box_3d.expect[2].paper, "curved");
+  EXPECT_EQ(box_3d.expect[0].bent_by, "");
+  EXPECT_EQ(variant("6c-banana").components, "bounces");
+  EXPECT_EQ(variant("6c-banana").scene.render.max_bounces, 12);
 
   // Paths come out absolute, so the resolved scene can be written anywhere.
   const std::string csv = first.scene.json["spectra"]["beige"]["csv"];
