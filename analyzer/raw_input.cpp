@@ -5,12 +5,14 @@
 #include <cctype>
 #include <cmath>
 #include <fstream>
+#include <limits>
 #include <memory>
 
 #include <fmt/format.h>
 #include <libraw/libraw.h>
 
 #include "core/error.h"
+#include "core/file_io.h"
 #include "core/limits.h"
 
 namespace ct::analyzer {
@@ -72,14 +74,15 @@ void check_tiff_not_truncated(const std::string& file) {
 }
 
 void open_raw(const std::string& file, OpenRaw& r) {
-  if (!std::filesystem::is_regular_file(file)) throw InputError(fmt::format("{}: cannot open file", file));
+  const std::uintmax_t bytes = check_input_file(file, InputAccess::Seekable, std::numeric_limits<std::uintmax_t>::max());
   r.raw->set_dataerror_handler(record_data_error, &r.errors);
   if (const int code = r.raw->open_file(file.c_str()); code != LIBRAW_SUCCESS) {
     check_tiff_not_truncated(file);
     check(file, code, "open");
   }
   const libraw_image_sizes_t& s = r.raw->imgdata.sizes;
-  check_image_size(file, s.width, s.height, 3);
+  check_image_size(file, s.raw_width, s.raw_height, 1, bytes, 1);  // the mosaic as stored: one sample a pixel
+  check_image_size(file, s.width, s.height, 4);                       // as LibRaw unpacks it: four per pixel
   check(file, r.raw->unpack(), "decode");
   if (r.errors.count > 0 || r.raw->error_count() > 0)
     throw InputError(fmt::format("{}: the raw data {} (LibRaw)", file,
