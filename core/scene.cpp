@@ -834,6 +834,15 @@ Series load_series(const std::filesystem::path& file, int threads) {
     node.expect_object({"name", "description", "extends", "patch", "sensor", "figure", "expect"});
     SeriesVariant variant;
     variant.name = node["name"].non_empty_string();
+    // The name becomes the variant's directory in series' output: one plain name inside it, none of the names
+    // series writes at its top.
+    try {
+      check_file_name(variant.name, "");
+    } catch (const InputError& e) {
+      node["name"].fail(e.what());
+    }
+    if (variant.name == "renders" || variant.name == "series.json" || variant.name == "index.html")
+      node["name"].fail(fmt::format("\"{}\" is a name series writes at the top of its output directory", variant.name));
     if (find_by_name(series.variants, variant.name))
       node["name"].fail(fmt::format("\"{}\" is already the name of an earlier variant", variant.name));
     if (const auto description = node.find("description")) variant.description = description->string();
