@@ -15,6 +15,8 @@
 #include "core/csv.h"
 #include "core/embedded_data.h"
 #include "core/error.h"
+#include "core/file_io.h"
+#include "core/limits.h"
 #include "core/parallel.h"
 #include "core/ply.h"
 #include "core/rgb_to_spectrum.h"
@@ -226,7 +228,7 @@ RenderSettings read_render(const JsonNode& node) {
   node.expect_object({"samples", "max_bounces", "seed", "pixel_filter", "bands", "spectral_mode", "tessellation"});
   RenderSettings render;
   if (const auto n = node.find("samples")) render.samples = static_cast<int>(n->integer_in(1, kMaxIntSetting));
-  if (const auto n = node.find("max_bounces")) render.max_bounces = static_cast<int>(n->integer_in(0, kMaxIntSetting));
+  if (const auto n = node.find("max_bounces")) render.max_bounces = static_cast<int>(n->integer_in(0, kMaxBounces));
   if (const auto n = node.find("seed"))
     render.seed = static_cast<std::uint64_t>(n->integer_in(0, std::numeric_limits<std::int64_t>::max()));
   if (const auto n = node.find("pixel_filter"))
