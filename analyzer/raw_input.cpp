@@ -167,6 +167,14 @@ RgbImage demosaiced(LibRaw& raw, int quality, const std::string& file) {
   std::unique_ptr<libraw_processed_image_t, void (*)(libraw_processed_image_t*)> image(
       raw.dcraw_make_mem_image(&code), LibRaw::dcraw_clear_mem);
   if (!image) check(file, code == LIBRAW_SUCCESS ? LIBRAW_UNSPECIFIED_ERROR : code, "process");
+  // What is read below: three 16-bit values a pixel. A monochrome or 8-bit result (found by fuzzing: a DNG that
+  // LibRaw processes to one colour was read three times past its end) is refused.
+  const std::size_t values = static_cast<std::size_t>(image->width) * image->height * 3;
+  if (image->type != LIBRAW_IMAGE_BITMAP || image->colors != 3 || image->bits != 16 ||
+      image->data_size < values * sizeof(std::uint16_t))
+    throw InputError(fmt::format("{}: LibRaw decodes it to {} colour{} of {} bits, not the 3 colours of 16 bits "
+                                 "analysed as camera RGB",
+                                 file, image->colors, image->colors == 1 ? "" : "s", image->bits));
   // After processing, LibRaw's maximum is the white level less the black it subtracted.
   const double range = raw.imgdata.color.maximum;
   RgbImage out{image->width, image->height, {}};
