@@ -1,21 +1,28 @@
 #!/usr/bin/env bash
 # Runs every test of the build ./setup.sh made (build/): CTest (unit, end-to-end, Blender, Slurm and browser
-# tests). CI (.ci/run) runs ./setup.sh and then this. Arguments go to CTest (./test.sh -R core runs a subset).
+# tests), then the sanitised parsers (.ci/sanitize-parsers): the readers of bad input and their unit tests built
+# with AddressSanitizer and UndefinedBehaviorSanitizer into build-asan/, and each fuzz harness for 30 s. CI
+# (.ci/run) runs ./setup.sh and then this.
 #
-#   ./test.sh --sanitize [CTEST ARGS]   also runs .ci/sanitize afterwards: the core, sensor and analyzer unit
-#                                       tests built with AddressSanitizer and UndefinedBehaviorSanitizer into
-#                                       build-asan/, and each fuzz harness for FUZZ_SECONDS (30 by default).
-#                                       It needs a second, sanitised build (about 20 minutes more on 2 cores),
-#                                       which is why CI does not run it.
+#   ./test.sh                           CTest, then the sanitised parsers (about 10 minutes more on 2 cores)
+#   ./test.sh CTEST ARGS                CTest only, with these arguments (./test.sh -R core runs a subset)
+#   ./test.sh --sanitize [CTEST ARGS]   CTest, then the full sanitised check (.ci/sanitize): the core, sensor and
+#                                       analyzer unit tests under the sanitisers as well, and every fuzz harness
+#                                       for FUZZ_SECONDS (30 by default); about 40 minutes more on 2 cores
 # Exit status 1 when anything failed.
 set -uo pipefail
 cd "$(dirname "$0")"
-sanitize=0
+sanitize=parsers
 if [ "${1:-}" = "--sanitize" ]; then
-  sanitize=1
+  sanitize=full
   shift
+elif [ $# -gt 0 ]; then
+  sanitize=none
 fi
 status=0
 ctest --test-dir build --output-on-failure -j2 "$@" || status=1
-if [ $sanitize -eq 1 ]; then .ci/sanitize || status=1; fi
+case $sanitize in
+  parsers) .ci/sanitize-parsers || status=1 ;;
+  full) .ci/sanitize || status=1 ;;
+esac
 exit $status

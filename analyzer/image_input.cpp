@@ -7,6 +7,7 @@
 #include <cstdlib>
 #include <fstream>
 #include <limits>
+#include <memory>
 #include <sstream>
 #include <string_view>
 
@@ -18,6 +19,8 @@
 #include "core/colour.h"
 #include "core/error.h"
 #include "core/exr_vocabulary.h"
+#include "core/file_io.h"
+#include "core/library_output.h"
 #include "core/limits.h"
 
 namespace ct::analyzer {
@@ -98,8 +101,12 @@ std::string conversion_note(const OIIO::ImageSpec& spec, const std::string& form
 
 RawImage read_raw(const std::filesystem::path& file) {
   const std::string name = file.string();
-  if (!std::filesystem::is_regular_file(file)) throw InputError(fmt::format("{}: cannot open file", name));
-  auto in = OIIO::ImageInput::open(name);
+  const std::uintmax_t bytes = check_input_file(file, InputAccess::Seekable, std::numeric_limits<std::uintmax_t>::max());
+  std::unique_ptr<OIIO::ImageInput> in;
+  {
+    const LibraryStderrSilenced quiet;  // libpng prints its errors itself, which OpenImageIO reports again below
+    in = OIIO::ImageInput::open(name);
+  }
   if (!in) {
     std::string why = OIIO::geterror();
     std::replace(why.begin(), why.end(), '\n', ' ');
@@ -111,6 +118,13 @@ RawImage read_raw(const std::filesystem::path& file) {
   raw.height = spec.height;
   raw.channels = spec.nchannels;
   raw.names = spec.channelnames;
+  // Some readers (GIF) name no channels: OpenImageIO's default names then, so that every index has a name
+  // (an alpha channel's name was once read past the end: analyze any.gif crashed).
+  if (raw.names.size() != static_cast<std::size_t>(raw.channels)) {
+    OIIO::ImageSpec named(spec.width, spec.height, spec.nchannels, spec.format);
+    named.default_channel_names();
+    raw.names = named.channelnames;
+  }
   const OIIO::TypeDesc type = spec.format;
   if (type.basetype == OIIO::TypeDesc::UINT8 || type.basetype == OIIO::TypeDesc::UINT16 ||
       type.basetype == OIIO::TypeDesc::UINT32) {
@@ -121,16 +135,21 @@ RawImage read_raw(const std::filesystem::path& file) {
   raw.objects_attribute = spec.get_string_attribute(exr::kObjectsAttribute);
   raw.components_attribute = spec.get_string_attribute(exr::kComponentsAttribute);
   read_camera_metadata(spec, raw);
-  raw.alpha = spec.alpha_channel;
+  raw.alpha = spec.alpha_channel < raw.channels ? spec.alpha_channel : -1;
   raw.colour_space = spec.get_string_attribute("oiio:ColorSpace");
   raw.display_gamma = spec.get_float_attribute("oiio:Gamma", 0.0f);
   raw.conversion = conversion_note(spec, in->format_name(), file);
   if (raw.width < 1 || raw.height < 1) throw InputError(fmt::format("{}: image has no pixels", name));
-  check_image_size(name, raw.width, raw.height, raw.channels);
+  check_image_size(name, raw.width, raw.height, raw.channels, bytes, static_cast<int>(type.size()));
   raw.values.resize(static_cast<std::size_t>(raw.width) * static_cast<std::size_t>(raw.height) *
                     static_cast<std::size_t>(raw.channels));
   // OpenImageIO hands integer samples over as fractions of full scale; scaling back keeps digital numbers.
-  if (!in->read_image(0, 0, 0, raw.channels, OIIO::TypeDesc::FLOAT, raw.values.data())) {
+  bool read = false;
+  {
+    const LibraryStderrSilenced quiet;
+    read = in->read_image(0, 0, 0, raw.channels, OIIO::TypeDesc::FLOAT, raw.values.data());
+  }
+  if (!read) {
     std::string why = in->geterror();
     std::replace(why.begin(), why.end(), '\n', ' ');
     throw InputError(fmt::format("{}: cannot read pixels: {}", name, why));

@@ -5,12 +5,14 @@
 #include <cctype>
 #include <cmath>
 #include <fstream>
+#include <limits>
 #include <memory>
 
 #include <fmt/format.h>
 #include <libraw/libraw.h>
 
 #include "core/error.h"
+#include "core/file_io.h"
 #include "core/limits.h"
 
 namespace ct::analyzer {
@@ -72,14 +74,15 @@ void check_tiff_not_truncated(const std::string& file) {
 }
 
 void open_raw(const std::string& file, OpenRaw& r) {
-  if (!std::filesystem::is_regular_file(file)) throw InputError(fmt::format("{}: cannot open file", file));
+  const std::uintmax_t bytes = check_input_file(file, InputAccess::Seekable, std::numeric_limits<std::uintmax_t>::max());
   r.raw->set_dataerror_handler(record_data_error, &r.errors);
   if (const int code = r.raw->open_file(file.c_str()); code != LIBRAW_SUCCESS) {
     check_tiff_not_truncated(file);
     check(file, code, "open");
   }
   const libraw_image_sizes_t& s = r.raw->imgdata.sizes;
-  check_image_size(file, s.width, s.height, 3);
+  check_image_size(file, s.raw_width, s.raw_height, 1, bytes, 1);  // the mosaic as stored: one sample a pixel
+  check_image_size(file, s.width, s.height, 4);                       // as LibRaw unpacks it: four per pixel
   check(file, r.raw->unpack(), "decode");
   if (r.errors.count > 0 || r.raw->error_count() > 0)
     throw InputError(fmt::format("{}: the raw data {} (LibRaw)", file,
@@ -164,6 +167,14 @@ RgbImage demosaiced(LibRaw& raw, int quality, const std::string& file) {
   std::unique_ptr<libraw_processed_image_t, void (*)(libraw_processed_image_t*)> image(
       raw.dcraw_make_mem_image(&code), LibRaw::dcraw_clear_mem);
   if (!image) check(file, code == LIBRAW_SUCCESS ? LIBRAW_UNSPECIFIED_ERROR : code, "process");
+  // What is read below: three 16-bit values a pixel. A monochrome or 8-bit result (found by fuzzing: a DNG that
+  // LibRaw processes to one colour was read three times past its end) is refused.
+  const std::size_t values = static_cast<std::size_t>(image->width) * image->height * 3;
+  if (image->type != LIBRAW_IMAGE_BITMAP || image->colors != 3 || image->bits != 16 ||
+      image->data_size < values * sizeof(std::uint16_t))
+    throw InputError(fmt::format("{}: LibRaw decodes it to {} colour{} of {} bits, not the 3 colours of 16 bits "
+                                 "analysed as camera RGB",
+                                 file, image->colors, image->colors == 1 ? "" : "s", image->bits));
   // After processing, LibRaw's maximum is the white level less the black it subtracted.
   const double range = raw.imgdata.color.maximum;
   RgbImage out{image->width, image->height, {}};

@@ -1,6 +1,7 @@
 #include "cli/app.h"
 
 #include <array>
+#include <csignal>
 #include <cstdio>
 #include <exception>
 #include <stdexcept>
@@ -58,7 +59,29 @@ CLI::App* add_command(CLI::App& app, std::string_view name) {
   throw std::logic_error(fmt::format("add_command: no subcommand {}", name));
 }
 
+namespace {
+
+// The subcommand a command line names: its first argument when that is not an option. Checked before CLI11
+// parses, which would take an unknown name for an extra argument and, with --help, print the general help and
+// exit 0 (`chromatrace calibrate --help`).
+std::optional<int> refuse_unknown_command(int argc, char** argv) {
+  if (argc < 2 || argv[1][0] == '-') return std::nullopt;
+  const std::string_view name = argv[1];
+  std::string known;
+  for (const CommandInfo& c : command_list()) {
+    if (c.name == name) return std::nullopt;
+    known += known.empty() ? "" : ", ";
+    known += c.name;
+  }
+  fmt::print(stderr, "chromatrace: error: unknown command \"{}\" (the commands: {}; chromatrace --help)\n",
+             one_line(name), known);
+  return 2;
+}
+
+}  // namespace
+
 std::optional<int> parse_command_line(CLI::App& app, int argc, char** argv) {
+  if (const auto code = refuse_unknown_command(argc, argv)) return code;
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
@@ -68,22 +91,26 @@ std::optional<int> parse_command_line(CLI::App& app, int argc, char** argv) {
   } catch (const CLI::CallForVersion& e) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
-    fmt::print(stderr, "chromatrace: error: {}\n", e.what());
+    fmt::print(stderr, "chromatrace: error: {}\n", one_line(e.what()));
     return 2;
   }
   return std::nullopt;
 }
 
 int run_parsed(const std::vector<std::pair<CLI::App*, Action>>& commands) {
+  // A file-size limit (ulimit -f) then fails the write with EFBIG, which the writers report (exit 1, the temporary
+  // file removed), instead of killing the process with the temporary file left behind.
+  std::signal(SIGXFSZ, SIG_IGN);
   for (const auto& [sub, action] : commands) {
     if (!sub->parsed()) continue;
+    // Every message one line: a file or object name with a line break in it, or a library's own lines, escaped.
     try {
       return action();
     } catch (const ct::InputError& e) {
-      fmt::print(stderr, "chromatrace {}: error: {}\n", sub->get_name(), e.what());
+      fmt::print(stderr, "chromatrace {}: error: {}\n", sub->get_name(), one_line(e.what()));
       return 2;
     } catch (const std::exception& e) {
-      fmt::print(stderr, "chromatrace {}: failed: {}\n", sub->get_name(), e.what());
+      fmt::print(stderr, "chromatrace {}: failed: {}\n", sub->get_name(), one_line(e.what()));
       return 1;
     }
   }

@@ -140,7 +140,7 @@ Action add_analyze(CLI::App& app) {
       analysis.segmentation = std::move(segmentation);
     }
     // Written aside and moved into place when complete: a full disk leaves no partial analysis behind.
-    StagedDirectory output(o->output);
+    StagedDirectory output(o->output, {"analysis.json"});
     analyzer::write_analysis(output.path(), input, analysis, {!o->no_plots, !o->no_report, o->report_points, plot_limit});
     output.commit();
     if (!o->quiet) {

@@ -211,6 +211,7 @@ void emit_variant(const Options& options, const Series& series) {
   inputs.push_back(options.file);
   for (const std::string& output : {options.emit, options.emit_sensor})
     if (!output.empty()) check_output_file(output, inputs);
+  check_distinct_outputs({options.emit, options.emit_sensor});
   if (!options.emit.empty()) {
     const std::filesystem::path out = std::filesystem::absolute(options.emit);
     const Json scene = rebase_scene_paths(variant->scene.json, {}, out.parent_path());

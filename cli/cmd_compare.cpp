@@ -1,6 +1,7 @@
 // chromatrace compare A.exr B.exr -o DIR: cross-validation of two spectral renders of one scene.
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -10,6 +11,7 @@
 #include "cli/command.h"
 #include "compare/compare.h"
 #include "core/error.h"
+#include "core/file_io.h"
 
 namespace ct::cli {
 
@@ -81,6 +83,9 @@ Action add_compare(CLI::App& app) {
     options.camera = o->camera;
     options.colour = o->colour;
     if (o->output.empty()) throw InputError("--output: no directory name");
+    std::vector<std::filesystem::path> inputs(options.a.begin(), options.a.end());
+    inputs.insert(inputs.end(), options.b.begin(), options.b.end());
+    check_output_directory(o->output, inputs);  // before the comparison, which reads every pixel
     const cmp::Comparison c = cmp::compare(options);
     cmp::write_outputs(c, o->output);
     if (!o->quiet) fmt::print(stderr, "{}", cmp::verdict(c));

@@ -226,17 +226,22 @@ nlohmann::json to_json(const SpectralExrInfo& info, const std::optional<Spectral
   return j;
 }
 
-// A bad file is one line on stderr (exit 2), after the description.
-void fail_on_bad_pixels(const SpectralExrInfo& info, const SpectralExrScan& scan) {
-  if (!scan.non_finite.empty()) {
-    const NonFiniteCount& first = scan.non_finite.front();
-    const std::size_t others = scan.non_finite.size() - 1;
+// NaN/Inf values: one line on stderr (exit 2), after the description.
+void fail_on_non_finite(const SpectralExrInfo& info, const std::vector<NonFiniteCount>& non_finite) {
+  if (!non_finite.empty()) {
+    const NonFiniteCount& first = non_finite.front();
+    const std::size_t others = non_finite.size() - 1;
     const std::string more = others == 0   ? ""
                              : others == 1 ? "; 1 more channel has NaN/Inf"
                                            : fmt::format("; {} more channels have NaN/Inf", others);
     throw InputError(fmt::format("{}: {} NaN/Inf values in channel {} (first at {},{}){}", info.file, first.count,
                                  first.channel, first.first_x, first.first_y, more));
   }
+}
+
+// A bad file is one line on stderr (exit 2), after the description.
+void fail_on_bad_pixels(const SpectralExrInfo& info, const SpectralExrScan& scan) {
+  fail_on_non_finite(info, scan.non_finite);
   for (const ComponentSumCheck& check : scan.component_sums)
     if (!check.passed())
       throw InputError(
@@ -287,6 +292,7 @@ int run_info(const InfoOptions& options) {
   else
     print_text(info, scan, options.check);
   if (scan) fail_on_bad_pixels(info, *scan);
+  else fail_on_non_finite(info, scan_non_finite(reader));  // any image: a camera RGB one from sensor too
   return 0;
 }
 

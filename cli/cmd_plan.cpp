@@ -45,13 +45,11 @@ Action add_plan(CLI::App& app) {
       throw InputError(fmt::format("--preview-size: must be >= 1, got {}", o->plan.preview_size));
     if (o->plan.preview_samples < 1)
       throw InputError(fmt::format("--preview-spp: must be >= 1, got {}", o->plan.preview_samples));
-    for (const std::string* out : {&o->output, &o->report}) {
-      if (out->empty()) continue;
-      const std::filesystem::path parent = std::filesystem::absolute(*out).parent_path();
-      if (!std::filesystem::is_directory(parent))
-        throw InputError(fmt::format("{}: directory {} does not exist", *out, parent.string()));
-    }
     const Scene scene = load_scene(o->scene);
+    // Before the preview render: neither output may be an input (the scene, its meshes and tables) or the other.
+    for (const std::string* out : {&o->output, &o->report})
+      if (!out->empty()) check_output_file(*out, scene.files);
+    check_distinct_outputs({o->output, o->report});
     const plan::Plan p = plan::make_plan(scene, o->plan);
     const Json report = plan::report_document(p, scene, o->plan);
     if (!o->output.empty()) write_file_atomically(o->output, plan::bands_document(p).dump(2) + "\n");

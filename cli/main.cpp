@@ -5,11 +5,19 @@
 #include <utility>
 #include <vector>
 
+#include <OpenImageIO/imageio.h>
+#include <tiffio.h>
+
 #include "cli/app.h"
 #include "cli/command.h"
 
 int main(int argc, char** argv) {
   using namespace ct::cli;
+  // Errors reach the user as one line each, through the commands' own messages: the image libraries print
+  // nothing themselves (OpenImageIO would print the errors of a reader it tried and dropped, libtiff its warnings).
+  OIIO::attribute("oiio:print_uncaught_errors", 0);
+  TIFFSetWarningHandler(nullptr);
+  TIFFSetErrorHandler(nullptr);
   const std::map<std::string_view, Action (*)(CLI::App&)> add = {
       {"info", add_info},         {"check-scene", add_check_scene},
       {"render", add_render},     {"analyze", add_analyze},

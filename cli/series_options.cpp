@@ -8,6 +8,7 @@
 #include "cli/options.h"
 #include "core/band_plan.h"
 #include "core/error.h"
+#include "core/limits.h"
 
 namespace ct::cli {
 namespace fs = std::filesystem;
@@ -35,8 +36,8 @@ series::RunOptions series_run_options(const SeriesRenderOptions& o, int threads,
   if (o.spp && *o.spp < 1) throw InputError(fmt::format("--spp: must be >= 1, got {}", *o.spp));
   r.spp = o.spp;
   r.seed = o.seed;
-  if (o.max_bounces && *o.max_bounces < 0)
-    throw InputError(fmt::format("--max-bounces: must be >= 0, got {}", *o.max_bounces));
+  if (o.max_bounces && (*o.max_bounces < 0 || *o.max_bounces > kMaxBounces))
+    throw InputError(fmt::format("--max-bounces: must be in [0, {}], got {}", kMaxBounces, *o.max_bounces));
   r.max_bounces = o.max_bounces;
   if (!o.plan.empty()) {
     r.bands = read_band_plan(o.plan);

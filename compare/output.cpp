@@ -209,20 +209,19 @@ object ids left out); tolerance {tolerance}, plus {sigmas:g} standard errors.</p
 }  // namespace
 
 void write_outputs(const Comparison& c, const std::filesystem::path& dir) {
-  namespace fs = std::filesystem;
-  const fs::path parent = fs::absolute(dir).parent_path();
-  if (!fs::is_directory(parent))
-    throw InputError(fmt::format("{}: directory {} does not exist", dir.string(), parent.string()));
-  if (fs::exists(dir) && !fs::is_directory(dir))
-    throw InputError(fmt::format("{}: exists and is not a directory", dir.string()));
-  // Everything is formed before anything is written; each file then appears whole or not at all.
+  std::vector<std::filesystem::path> inputs(c.a.files.begin(), c.a.files.end());
+  inputs.insert(inputs.end(), c.b.files.begin(), c.b.files.end());
+  check_output_directory(dir, inputs);
+  // Everything is formed before anything is written, into a staging directory moved into place when complete
+  // (compare.json last), so that no run leaves compare.json without its page.
   const std::string json_text = to_json(c).dump(1) + "\n";
   const std::string png_bytes = png(c);
   const std::string html_text = html(c, png_bytes);
-  fs::create_directories(dir);
-  write_file_atomically(dir / "compare.json", json_text);
-  write_file_atomically(dir / "compare.png", png_bytes);
-  write_file_atomically(dir / "compare.html", html_text);
+  StagedDirectory staged(dir, {"compare.json"});
+  write_file_atomically(staged.path() / "compare.png", png_bytes);
+  write_file_atomically(staged.path() / "compare.html", html_text);
+  write_file_atomically(staged.path() / "compare.json", json_text);
+  staged.commit();
 }
 
 std::string verdict(const Comparison& c, std::size_t max_lines) {

@@ -8,6 +8,7 @@
 
 #include <stdexcept>
 #include <string>
+#include <string_view>
 
 namespace ct {
 
@@ -15,5 +16,9 @@ class InputError : public std::runtime_error {
  public:
   using std::runtime_error::runtime_error;
 };
+
+// `text` as one printable line: a newline becomes \n, a tab \t, any other control character (and DEL)
+// \xHH, so that a file name or a library's message with line breaks in it stays one line of an error.
+std::string one_line(std::string_view text);
 
 }  // namespace ct

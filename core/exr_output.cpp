@@ -15,18 +15,11 @@
 #include <ImfOutputFile.h>
 #include <ImfThreading.h>
 
+#include "core/error.h"
 #include "core/file_io.h"
 
 namespace ct {
 namespace {
-
-// OpenEXR's messages can span lines; ours are one line.
-std::string one_line(std::string_view text) {
-  std::string line(text);
-  std::replace(line.begin(), line.end(), '\n', ' ');
-  while (!line.empty() && line.back() == ' ') line.pop_back();
-  return line;
-}
 
 // An OpenEXR output stream on a file descriptor that remembers its first failure: OpenEXR writes the line
 // offset table from OutputFile's destructor and swallows errors there, so finish() asks the stream instead.

@@ -1,13 +1,16 @@
 #include "core/file_io.h"
 
 #include <fcntl.h>
+#include <limits.h>
+#include <poll.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstring>
-#include <fstream>
-#include <sstream>
+#include <map>
+#include <mutex>
 #include <stdexcept>
 #include <utility>
 #include <vector>
@@ -21,6 +24,9 @@ namespace ct {
 namespace fs = std::filesystem;
 
 namespace {
+
+// How long read_file waits for a FIFO's first bytes (or its writer's end).
+constexpr int kFifoGraceMs = 2000;
 
 // "a FIFO", "a character device", …: what a path is when it is not a regular file.
 std::string kind_of(mode_t mode) {
@@ -52,15 +58,84 @@ void check_writable_directory(const fs::path& output, const fs::path& directory)
 
 }  // namespace
 
-std::string read_file(const fs::path& file) {
-  std::error_code error;
-  if (fs::is_directory(file, error)) throw InputError(fmt::format("{}: is a directory, not a file", file.string()));
-  std::ifstream in(file, std::ios::binary);
-  if (!in) throw InputError(fmt::format("{}: cannot open file", file.string()));
-  std::ostringstream bytes;
-  bytes << in.rdbuf();
-  if (in.bad()) throw InputError(fmt::format("{}: cannot read file", file.string()));
-  return bytes.str();
+std::uintmax_t check_input_file(const fs::path& file, InputAccess access, std::uintmax_t max_bytes) {
+  const std::string name = file.string();
+  struct stat st{};
+  if (::stat(file.c_str(), &st) != 0) {
+    if (errno == ENOENT || errno == ENOTDIR) throw InputError(fmt::format("{}: cannot open file", name));
+    throw InputError(fmt::format("{}: cannot open file: {}", name, std::strerror(errno)));
+  }
+  if (S_ISDIR(st.st_mode)) throw InputError(fmt::format("{}: is a directory, not a file", name));
+  const bool stream = S_ISFIFO(st.st_mode) || S_ISCHR(st.st_mode);
+  if (!S_ISREG(st.st_mode) && !(stream && access == InputAccess::Sequential))
+    throw InputError(fmt::format("{}: is {}; {}", name, kind_of(st.st_mode),
+                                 access == InputAccess::Seekable
+                                     ? "this file is read only from a regular file"
+                                     : "inputs are read from regular files or streams (pipes, character devices)"));
+  if (::access(file.c_str(), R_OK) != 0)
+    throw InputError(fmt::format("{}: cannot open file: {}", name, std::strerror(errno)));
+  if (S_ISREG(st.st_mode) && static_cast<std::uintmax_t>(st.st_size) > max_bytes)
+    throw InputError(fmt::format("{}: {} bytes, more than the limit of {} bytes ({} MiB) for this kind of file", name,
+                                 static_cast<std::uintmax_t>(st.st_size), max_bytes, max_bytes >> 20));
+  return S_ISREG(st.st_mode) ? static_cast<std::uintmax_t>(st.st_size) : 0;
+}
+
+std::string read_file(const fs::path& file, std::uintmax_t max_bytes) {
+  check_input_file(file, InputAccess::Sequential, max_bytes);
+  const std::string name = file.string();
+  // Without blocking: opening a FIFO that nothing writes to would wait for a writer forever.
+  const int fd = ::open(file.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+  if (fd < 0) throw InputError(fmt::format("{}: cannot open file: {}", name, std::strerror(errno)));
+  struct Closer {
+    int fd;
+    ~Closer() { ::close(fd); }
+  } closer{fd};
+  struct stat st{};
+  const bool fifo = ::fstat(fd, &st) == 0 && S_ISFIFO(st.st_mode);
+  // A pipe can be read once: a command that reads its input twice (check-scene looks at the format, then loads)
+  // gets the same bytes the second time.
+  static std::mutex read_pipes_mutex;
+  static std::map<std::pair<dev_t, ino_t>, std::string> read_pipes;
+  const std::lock_guard lock(read_pipes_mutex);
+  if (fifo)
+    if (const auto known = read_pipes.find({st.st_dev, st.st_ino}); known != read_pipes.end()) return known->second;
+  if (fifo) {
+    // A pipe's writer (a shell's `<(…)`) is there before the reader; a FIFO made by mkfifo may get one a moment
+    // later. Nothing within the grace period is a FIFO that nothing writes to, not a wait without end.
+    pollfd ready{fd, POLLIN, 0};
+    if (::poll(&ready, 1, kFifoGraceMs) == 0)
+      throw InputError(fmt::format("{}: is a FIFO that nothing writes to (nothing arrived within {} s)", name,
+                                   kFifoGraceMs / 1000));
+  }
+  ::fcntl(fd, F_SETFL, ::fcntl(fd, F_GETFL) & ~O_NONBLOCK);  // from here on, a stream is read to its end
+  std::string bytes;
+  char buffer[65536];
+  for (;;) {
+    const ssize_t n = ::read(fd, buffer, sizeof buffer);
+    if (n == 0) break;
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      throw InputError(fmt::format("{}: cannot read file: {}", name, std::strerror(errno)));
+    }
+    if (bytes.size() + static_cast<std::size_t>(n) > max_bytes)
+      throw InputError(fmt::format("{}: more than the limit of {} bytes ({} MiB) for this kind of file", name,
+                                   max_bytes, max_bytes >> 20));
+    bytes.append(buffer, static_cast<std::size_t>(n));
+  }
+  if (fifo) read_pipes[{st.st_dev, st.st_ino}] = bytes;
+  return bytes;
+}
+
+void check_file_name(std::string_view name, std::string_view what) {
+  const auto refuse = [&](std::string_view why) {
+    throw InputError(fmt::format("{}{}\"{}\" cannot be a file name: {}", what, what.empty() ? "" : ": ", one_line(name), why));
+  };
+  if (name.empty()) refuse("it is empty");
+  if (name == "." || name == "..") refuse("it names a directory, not a file in the output directory");
+  if (name.find('/') != std::string_view::npos) refuse("it holds a \"/\"; names are written inside the output directory");
+  for (const char c : name)
+    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) refuse("it holds a control character");
+  if (name.size() > NAME_MAX) refuse(fmt::format("it is longer than {} bytes", NAME_MAX));
 }
 
 bool same_file(const fs::path& a, const fs::path& b) {
@@ -88,7 +163,38 @@ fs::path follow_links(const fs::path& path) {
   throw InputError(fmt::format("{}: too many levels of symbolic links", path.string()));
 }
 
+namespace {
+
+// InputError when the system could not open `output` for its length: a path of 4096 bytes or more, or a
+// component of more than 255.
+void check_name_length(const fs::path& output) {
+  const std::string text = output.string();
+  if (text.size() >= PATH_MAX)
+    throw InputError(fmt::format("{}...: the output path is {} bytes long, more than the {} the system takes",
+                                 one_line(text.substr(0, 60)), text.size(), PATH_MAX - 1));
+  for (const fs::path& part : output)
+    if (part.string().size() > NAME_MAX)
+      throw InputError(fmt::format("{}...: a name in the output path is {} bytes long, more than the {} the system "
+                                   "takes", one_line(text.substr(0, 60)), part.string().size(), NAME_MAX));
+}
+
+}  // namespace
+
+void check_distinct_outputs(const std::vector<fs::path>& outputs) {
+  for (std::size_t i = 0; i < outputs.size(); ++i)
+    for (std::size_t j = i + 1; j < outputs.size(); ++j) {
+      if (outputs[i].empty() || outputs[j].empty()) continue;
+      const bool same = same_file(outputs[i], outputs[j]) ||
+                        fs::absolute(follow_links(outputs[i])).lexically_normal() ==
+                            fs::absolute(follow_links(outputs[j])).lexically_normal();
+      if (same)
+        throw InputError(fmt::format("{}: is the same file as the output {}; each output needs a file of its own",
+                                     outputs[j].string(), outputs[i].string()));
+    }
+}
+
 void check_output_file(const fs::path& output, const std::vector<fs::path>& inputs) {
+  check_name_length(output);
   check_not_an_input(output, inputs);
   const fs::path resolved = follow_links(output);
   struct stat st{};
@@ -102,6 +208,7 @@ void check_output_file(const fs::path& output, const std::vector<fs::path>& inpu
 }
 
 void check_output_directory(const fs::path& directory, const std::vector<fs::path>& inputs) {
+  check_name_length(directory);
   check_not_an_input(directory, inputs);
   std::error_code error;
   if (fs::exists(directory, error) && !fs::is_directory(directory, error))
@@ -155,7 +262,8 @@ void AtomicFile::commit() {
   temporary_.clear();
 }
 
-StagedDirectory::StagedDirectory(fs::path target) : target_(std::move(target)) {
+StagedDirectory::StagedDirectory(fs::path target, std::vector<std::string> last)
+    : target_(std::move(target)), last_(std::move(last)) {
   fs::path absolute = fs::absolute(target_);
   if (!absolute.has_filename()) absolute = absolute.parent_path();  // "out/"
   for (int attempt = 0;; ++attempt) {
@@ -186,8 +294,12 @@ void StagedDirectory::commit() {
     staging_.clear();
     return;
   }
-  // Listed first, then moved; directories come before the files in them.
-  const std::vector<fs::directory_entry> entries(fs::recursive_directory_iterator(staging_), {});
+  // Listed first, then moved; directories come before the files in them, the summaries in last_ after all.
+  std::vector<fs::directory_entry> entries(fs::recursive_directory_iterator(staging_), {});
+  std::stable_partition(entries.begin(), entries.end(), [&](const fs::directory_entry& entry) {
+    return entry.path().parent_path() != staging_ ||
+           std::find(last_.begin(), last_.end(), entry.path().filename().string()) == last_.end();
+  });
   for (const fs::directory_entry& entry : entries) {
     const fs::path relative = entry.path().lexically_relative(staging_);
     const fs::path destination = target_ / relative;

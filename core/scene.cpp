@@ -16,6 +16,8 @@
 #include "core/csv.h"
 #include "core/embedded_data.h"
 #include "core/error.h"
+#include "core/file_io.h"
+#include "core/limits.h"
 #include "core/parallel.h"
 #include "core/ply.h"
 #include "core/rgb_to_spectrum.h"
@@ -227,7 +229,7 @@ RenderSettings read_render(const JsonNode& node) {
   node.expect_object({"samples", "max_bounces", "seed", "pixel_filter", "bands", "spectral_mode", "tessellation"});
   RenderSettings render;
   if (const auto n = node.find("samples")) render.samples = static_cast<int>(n->integer_in(1, kMaxIntSetting));
-  if (const auto n = node.find("max_bounces")) render.max_bounces = static_cast<int>(n->integer_in(0, kMaxIntSetting));
+  if (const auto n = node.find("max_bounces")) render.max_bounces = static_cast<int>(n->integer_in(0, kMaxBounces));
   if (const auto n = node.find("seed"))
     render.seed = static_cast<std::uint64_t>(n->integer_in(0, std::numeric_limits<std::int64_t>::max()));
   if (const auto n = node.find("pixel_filter"))
@@ -853,6 +855,15 @@ Series load_series(const std::filesystem::path& file, int threads) {
     node.expect_object({"name", "description", "extends", "patch", "sensor", "figure", "components", "expect"});
     SeriesVariant variant;
     variant.name = node["name"].non_empty_string();
+    // The name becomes the variant's directory in series' output: one plain name inside it, none of the names
+    // series writes at its top.
+    try {
+      check_file_name(variant.name, "");
+    } catch (const InputError& e) {
+      node["name"].fail(e.what());
+    }
+    if (variant.name == "renders" || variant.name == "series.json" || variant.name == "index.html")
+      node["name"].fail(fmt::format("\"{}\" is a name series writes at the top of its output directory", variant.name));
     if (find_by_name(series.variants, variant.name))
       node["name"].fail(fmt::format("\"{}\" is already the name of an earlier variant", variant.name));
     if (const auto description = node.find("description")) variant.description = description->string();

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <limits>
 #include <set>
 #include <stdexcept>
 #include <utility>
@@ -60,14 +61,6 @@ using exr::kObjectsAttribute;
 // unit conversions (1e-16), so "S0.550,0nm" and "S0.0,55um" collide and neighbouring bands never do.
 bool same_wavelength(double a, double b) { return std::abs(a - b) <= 1e-10 * std::max(std::abs(a), std::abs(b)); }
 
-// OpenEXR's messages can span lines; ours are one line.
-std::string one_line(std::string_view text) {
-  std::string line(text);
-  std::replace(line.begin(), line.end(), '\n', ' ');
-  while (!line.empty() && line.back() == ' ') line.pop_back();
-  return line;
-}
-
 std::string join(const std::vector<std::string>& items, std::string_view separator) {
   std::string text;
   for (const std::string& item : items) {
@@ -106,8 +99,7 @@ ExrPixelType pixel_type(Imf::PixelType type) {
 
 // Missing, unreadable and non-EXR files get their own message before OpenEXR sees them.
 void check_openable_exr(const fs::path& path, const std::string& file) {
-  std::error_code error;
-  if (fs::is_directory(path, error)) throw InputError(fmt::format("{}: is a directory, not an OpenEXR file", file));
+  check_input_file(path, InputAccess::Seekable, std::numeric_limits<std::uintmax_t>::max());
   std::FILE* stream = std::fopen(file.c_str(), "rb");
   if (stream == nullptr) throw InputError(fmt::format("{}: cannot open: {}", file, std::strerror(errno)));
   char magic[4] = {};

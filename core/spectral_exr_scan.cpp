@@ -177,4 +177,28 @@ SpectralExrScan scan_spectral_exr(SpectralExrReader& reader, const ScanOptions& 
   return scan;
 }
 
+std::vector<NonFiniteCount> scan_non_finite(SpectralExrReader& reader) {
+  const SpectralExrInfo& info = reader.info();
+  std::vector<std::string> channels;
+  for (const ExrChannel& c : info.channels) channels.push_back(c.name);
+  const std::size_t width = static_cast<std::size_t>(info.width);
+  std::vector<std::uint64_t> count(channels.size(), 0);
+  std::vector<std::pair<int, int>> first(channels.size());
+  const int rows_per_block = block_rows(info, channels.size());
+  std::vector<float> block(static_cast<std::size_t>(rows_per_block) * width * channels.size());
+  for (int y0 = 0; y0 < info.height; y0 += rows_per_block) {
+    const int y1 = std::min(info.height, y0 + rows_per_block);
+    const std::size_t pixels = static_cast<std::size_t>(y1 - y0) * width;
+    reader.read_channels(channels, y0, y1, std::span<float>(block.data(), pixels * channels.size()));
+    for (std::size_t p = 0; p < pixels; ++p)
+      for (std::size_t c = 0; c < channels.size(); ++c)
+        if (!std::isfinite(block[p * channels.size() + c]) && count[c]++ == 0)
+          first[c] = {static_cast<int>(p % width), y0 + static_cast<int>(p / width)};
+  }
+  std::vector<NonFiniteCount> found;
+  for (std::size_t c = 0; c < channels.size(); ++c)
+    if (count[c] > 0) found.push_back({channels[c], count[c], first[c].first, first[c].second});
+  return found;
+}
+
 }  // namespace ct

@@ -61,6 +61,10 @@ struct ScanOptions {
   std::function<void(int rows_done)> progress;  // after each block of rows
 };
 
+// NaN and Inf values in every channel of any OpenEXR file, spectral or not (a camera RGB image from `sensor`):
+// per channel with a value that is not finite, how many and the first pixel, in the file's channel order.
+std::vector<NonFiniteCount> scan_non_finite(SpectralExrReader& reader);
+
 // Reads every spectral channel and object_id once, block by block (R, G, B and other channels are not
 // spectral data and are skipped). A file without spectral channels is an InputError.
 SpectralExrScan scan_spectral_exr(SpectralExrReader& reader, const ScanOptions& options = {});

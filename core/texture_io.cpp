@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <memory>
 
 #include <OpenImageIO/imageio.h>
@@ -11,21 +12,21 @@
 
 #include "core/colour.h"
 #include "core/error.h"
+#include "core/file_io.h"
+#include "core/library_output.h"
 #include "core/limits.h"
 
 namespace ct {
 namespace {
 
-std::string one_line(std::string text) {
-  std::replace(text.begin(), text.end(), '\n', ' ');
-  while (!text.empty() && text.back() == ' ') text.pop_back();
-  return text;
-}
-
 std::unique_ptr<OIIO::ImageInput> open_image(const std::filesystem::path& path) {
   const std::string name = path.string();
-  if (!std::filesystem::is_regular_file(path)) throw InputError(fmt::format("{}: no such image file", name));
-  auto in = OIIO::ImageInput::open(name);
+  const std::uintmax_t bytes = check_input_file(path, InputAccess::Seekable, std::numeric_limits<std::uintmax_t>::max());
+  std::unique_ptr<OIIO::ImageInput> in;
+  {
+    const LibraryStderrSilenced quiet;  // libpng prints its errors itself, which OpenImageIO reports again below
+    in = OIIO::ImageInput::open(name);
+  }
   if (!in) {
     const std::string why = one_line(OIIO::geterror());
     throw InputError(fmt::format("{}: cannot read image: {}", name, why.empty() ? "unknown format" : why));
@@ -33,7 +34,7 @@ std::unique_ptr<OIIO::ImageInput> open_image(const std::filesystem::path& path) 
   const OIIO::ImageSpec& spec = in->spec();
   if (spec.width < 1 || spec.height < 1 || spec.nchannels < 1)
     throw InputError(fmt::format("{}: image has no pixels", name));
-  check_image_size(name, spec.width, spec.height, spec.nchannels);
+  check_image_size(name, spec.width, spec.height, spec.nchannels, bytes, static_cast<int>(spec.format.size()));
   return in;
 }
 
@@ -102,7 +103,12 @@ ImageTexture read_image_texture(const std::filesystem::path& path, const std::st
 
   const int channels = spec.nchannels;
   std::vector<float> pixels(texture.texel_count() * static_cast<std::size_t>(channels));
-  if (!in->read_image(0, 0, 0, channels, OIIO::TypeDesc::FLOAT, pixels.data()))
+  bool read = false;
+  {
+    const LibraryStderrSilenced quiet;
+    read = in->read_image(0, 0, 0, channels, OIIO::TypeDesc::FLOAT, pixels.data());
+  }
+  if (!read)
     throw InputError(fmt::format("{}: cannot read pixels: {}", name, one_line(in->geterror())));
   // R, G, B by name when the image names them so; otherwise the first channels (one: grey; two: grey, alpha).
   std::array<int, 3> source = {0, 0, 0};

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <limits>
 #include <string_view>
 
 #include <ImfChannelList.h>
@@ -152,8 +153,7 @@ TexturePrepResult prepare_texture(const TexturePrepRequest& request, const std::
     throw InputError(fmt::format("replicate: needs one band per render, not {}", request.bands_per_render));
   if (!(request.scale >= 0.0) || !std::isfinite(request.scale))
     throw InputError(fmt::format("scale: must be a finite number >= 0, got {}", request.scale));
-  if (!std::filesystem::is_regular_file(request.image))
-    throw InputError(fmt::format("{}: no such image file", request.image.string()));
+  check_input_file(request.image, InputAccess::Seekable, std::numeric_limits<std::uintmax_t>::max());
   TexturePrepResult result;
   result.groups = band_groups(request.bands.size(), request.bands_per_render);
   result.colour_space = resolved_colour_space(request);

@@ -31,6 +31,14 @@ std::optional<double> optional_number(const JsonNode& node, double above) {
   return node.number_above(above);
 }
 
+// A positive number no larger than `most`: exposure, pixel size and gains whose product the linear signal forms
+// in floats (1e308 once overflowed into Inf and NaN pixels).
+double positive_at_most(const JsonNode& node, double most) {
+  const double value = node.number_above(0);
+  if (value > most) node.fail(fmt::format("must be at most {:g}, got {:g}", most, value));
+  return value;
+}
+
 std::uint64_t seed(const JsonNode& node) {
   return static_cast<std::uint64_t>(node.integer_in(0, std::numeric_limits<std::int64_t>::max()));
 }
@@ -99,7 +107,7 @@ void read_optics(const JsonNode& node, OpticsConfig& o) {
   node.expect_object({"enabled", "f_number", "cos4", "fov_deg", "transmittance", "flare"});
   read_key(node, "flare", [&](const JsonNode& n) { o.flare = n.number_in(0, 1); });
   read_key(node, "enabled", [&](const JsonNode& n) { o.enabled = n.boolean(); });
-  read_key(node, "f_number", [&](const JsonNode& n) { o.f_number = n.number_above(0); });
+  read_key(node, "f_number", [&](const JsonNode& n) { o.f_number = positive_at_most(n, 1e4); });
   read_key(node, "cos4", [&](const JsonNode& n) { o.cos4 = n.boolean(); });
   read_key(node, "fov_deg", [&](const JsonNode& n) {
     o.fov_deg = optional_number(n, 0);
@@ -118,10 +126,10 @@ void read_exposure(const JsonNode& node, ExposureConfig& e) {
       if (n.string() != "auto") n.fail(fmt::format("must be a time in seconds or \"auto\", got \"{}\"", n.string()));
       e.time_s.reset();
     } else {
-      e.time_s = n.number_above(0);
+      e.time_s = positive_at_most(n, 1e6);
     }
   });
-  read_key(node, "scale", [&](const JsonNode& n) { e.scale = n.number_above(0); });
+  read_key(node, "scale", [&](const JsonNode& n) { e.scale = positive_at_most(n, 1e6); });
   read_key(node, "auto_percentile", [&](const JsonNode& n) {
     e.auto_percentile = n.number_in(0, 100);
     if (e.auto_percentile == 0) n.fail("must be > 0");
@@ -132,7 +140,7 @@ void read_exposure(const JsonNode& node, ExposureConfig& e) {
 
 void read_pixel(const JsonNode& node, PixelConfig& p) {
   node.expect_object({"pitch_um", "fill_factor", "supersample"});
-  read_key(node, "pitch_um", [&](const JsonNode& n) { p.pitch_um = n.number_above(0); });
+  read_key(node, "pitch_um", [&](const JsonNode& n) { p.pitch_um = positive_at_most(n, 1e4); });
   read_key(node, "fill_factor", [&](const JsonNode& n) {
     p.fill_factor = n.number_in(0, 1);
     if (p.fill_factor == 0) n.fail("must be > 0");
@@ -186,13 +194,13 @@ void read_noise(const JsonNode& node, NoiseConfig& z) {
 void read_full_well(const JsonNode& node, FullWellConfig& f) {
   node.expect_object({"enabled", "electrons"});
   read_key(node, "enabled", [&](const JsonNode& n) { f.enabled = n.boolean(); });
-  read_key(node, "electrons", [&](const JsonNode& n) { f.electrons = n.number_above(0); });
+  read_key(node, "electrons", [&](const JsonNode& n) { f.electrons = positive_at_most(n, 1e12); });
 }
 
 void read_adc(const JsonNode& node, AdcConfig& a) {
   node.expect_object({"enabled", "gain_dn_per_e", "black_level_dn", "bits"});
   read_key(node, "enabled", [&](const JsonNode& n) { a.enabled = n.boolean(); });
-  read_key(node, "gain_dn_per_e", [&](const JsonNode& n) { a.gain_dn_per_e = n.number_above(0); });
+  read_key(node, "gain_dn_per_e", [&](const JsonNode& n) { a.gain_dn_per_e = positive_at_most(n, 1e6); });
   read_key(node, "black_level_dn", [&](const JsonNode& n) { a.black_level_dn = n.number_at_least(0); });
   read_key(node, "bits", [&](const JsonNode& n) { a.bits = static_cast<int>(n.integer_in(1, 32)); });
 }

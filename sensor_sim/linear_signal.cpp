@@ -1,6 +1,11 @@
 #include "sensor_sim/linear_signal.h"
 
+#include <cmath>
 #include <stdexcept>
+
+#include <fmt/core.h>
+
+#include "core/error.h"
 
 #include "sensor_sim/spectral_response.h"
 
@@ -57,7 +62,17 @@ void linear_signal(const LinearModel& model, std::span<const float> spectral, in
           for (int c = 0; c < 3; ++c) sum[c] += falloff * e[c];
         }
       }
-      for (std::size_t c = 0; c < 3; ++c) out[(r * width + x) * 3 + c] = static_cast<float>(sum[c] * inv_area);
+      for (std::size_t c = 0; c < 3; ++c) {
+        const float electrons = static_cast<float>(sum[c] * inv_area);
+        // Radiance near a float's largest value times the exposure and pixel area: refused here, at the stage
+        // that overflows, rather than carried on as Inf and NaN pixels.
+        if (!std::isfinite(electrons))
+          throw InputError(fmt::format("the photo-electrons of pixel ({}, {}) are {:g}, beyond a float: the image's "
+                                       "radiance times exposure.time_s, exposure.scale, the pixel area and the "
+                                       "aperture overflows; lower the exposure or check the image",
+                                       x, y0 + static_cast<int>(r), sum[c] * inv_area));
+        out[(r * width + x) * 3 + c] = electrons;
+      }
     }
   }
 }

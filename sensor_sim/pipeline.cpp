@@ -510,6 +510,9 @@ bool display_png(const fs::path& output, const SensorConfig& c) {
 
 // The file's layout: TIFF/PNG need integer codes, which the final image has only with the rendering intent
 // (values in [0, 1]), as the display rendering (PNG), or as digital numbers that fit the file.
+// The smallest side of an image that raw readers take for a raw image (LibRaw's identify()).
+constexpr int kMinDngSide = 22;
+
 OutputLayout output_layout(const fs::path& output, const SensorConfig& c, int width, int height) {
   OutputLayout layout;
   layout.width = width;
@@ -523,6 +526,12 @@ OutputLayout output_layout(const fs::path& output, const SensorConfig& c, int wi
           "{}: a DNG holds a Bayer mosaic of at most 16-bit digital numbers: it needs cfa.enabled and adc.enabled "
           "with adc.bits <= 16 and rendering.enabled false (are {}, {}, {}, {}); a camera preset sets them",
           file, c.cfa.enabled, c.adc.enabled, c.adc.bits, c.rendering.enabled));
+    // LibRaw (and dcraw, which it follows) takes an image under 22 pixels a side for no raw image: such a DNG
+    // would be one that `info` and `analyze` refuse.
+    if (width < kMinDngSide || height < kMinDngSide)
+      throw InputError(fmt::format("{}: a DNG of {} x {} pixels: raw readers (LibRaw, dcraw) read none under {} pixels "
+                                   "a side; write a larger image, or an EXR, TIFF or PNG",
+                                   file, width, height, kMinDngSide));
     layout.code_scale = 1.0;
     return layout;
   }

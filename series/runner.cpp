@@ -324,7 +324,10 @@ Json finding_json(const Finding& f) {
 
 std::string_view renderer_name(Renderer renderer) { return renderer == Renderer::Tracer ? "tracer" : "cycles"; }
 
-fs::path variant_dir(const fs::path& dir, const std::string& variant) { return dir / variant; }
+fs::path variant_dir(const fs::path& dir, const std::string& variant) {
+  check_file_name(variant, "variant name");  // load_series refuses such names; never a path outside `dir`
+  return dir / variant;
+}
 
 void check_renderer(RunOptions& options) {
   if (options.renderer != Renderer::Cycles) return;

@@ -227,9 +227,9 @@ TEST_F(PrepareTexture, BadInputIsOneLineExitTwo) {
     std::string must_mention;
   };
   const std::vector<Case> cases = {
-      {{(dir_ / "missing.png").string(), "--bands", "400:700:10", "--kind", "reflectance"}, "missing.png: no such image file"},
+      {{(dir_ / "missing.png").string(), "--bands", "400:700:10", "--kind", "reflectance"}, "missing.png: cannot open file"},
       {{(dir_ / "missing.exr").string(), "--bands", "400:700:10", "--kind", "radiance", "--colour-space", "linear"},
-       "missing.exr: no such image file"},
+       "missing.exr: cannot open file"},
       {{png.string(), "--bands", "400:700:10", "--kind", "albedo"}, "--kind"},
       {{png.string(), "--bands", "400:700:7", "--kind", "reflectance"}, "--bands"},
       {{png.string(), "--bands", "400:700:10", "--kind", "reflectance", "--colour-space", "ACES"}, "--colour-space"},

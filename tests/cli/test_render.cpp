@@ -126,7 +126,7 @@ TEST_F(RenderCommand, BadTexturesAndEnvironmentsGetExitTwoAndOneLineNamingTheFil
     std::vector<std::string> must_mention;
   };
   const std::vector<Case> cases = {
-      {"missing_texture.json", {"materials.wood.reflectance.texture", "textures/wood.png", "no such image file"}},
+      {"missing_texture.json", {"materials.wood.reflectance.texture", "textures/wood.png", "cannot open file"}},
       {"texture_on_mesh_without_uvs.json", {"objects[0].shape.file", "tetrahedron_no_uvs.ply", "tetra", "texture"}},
       {"environment_not_an_image.json", {"environment.radiance.texture", "wavelengths_not_increasing.csv"}},
       {"environment_rotation_without_texture.json", {"environment.rotation_deg"}},

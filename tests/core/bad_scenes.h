@@ -42,7 +42,7 @@ inline const std::vector<BadScene>& bad_scenes() {
       {"sensor_in_metres.json", "camera.sensor_width_mm: must be a width in mm within [1, 1000], got 0.036"},
       {"missing_mesh.json", "objects[0].shape.file: {dir}/meshes/bunny.ply: cannot open file"},
       {"no_light.json", "lights: a scene needs at least one light or an \"environment\""},
-      {"missing_texture.json", "materials.wood.reflectance.texture: {dir}/textures/wood.png: no such image file"},
+      {"missing_texture.json", "materials.wood.reflectance.texture: {dir}/textures/wood.png: cannot open file"},
       {"texture_on_mesh_without_uvs.json",
        "objects[0].shape.file: {dir}/tetrahedron_no_uvs.ply has no texture coordinates (vertex properties u, v or "
        "s, t), but object \"tetra\" has material \"wood\" whose reflectance is a texture"},
