@@ -185,7 +185,8 @@ TEST(CameraRawDng, ColourFieldsOfTheCieCameraAndTheExposure) {
   const Bands bands = Bands::uniform(380, 780, 5);
   const std::vector<double> d65 = band_averages(cie::illuminant("D65"), bands);
   const fs::path input = dir.file("d65.exr"), dng = dir.file("d65.dng");
-  test::write_radiance(input, bands, 8, 8, [&](int, int, std::size_t b) { return static_cast<float>(d65[b] * 0.01); }, {});
+  // 24 x 24: raw readers take no smaller image for a raw one, and sensor refuses a smaller DNG.
+  test::write_radiance(input, bands, 24, 24, [&](int, int, std::size_t b) { return static_cast<float>(d65[b] * 0.01); }, {});
   const test::CommandResult r =
       run_chromatrace({"sensor", input.string(), "-o", dng.string(), "--preset", "canon_eos_5d_mkiii", "--camera",
                        "cie1931", "--exposure-s", "0.004", "--f-number", "5.6", "--no-noise", "--quiet"});
