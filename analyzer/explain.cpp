@@ -129,6 +129,17 @@ std::optional<Explanation> explain_region(const AnalysisImage& input, const Regi
   return e;
 }
 
+double noise_across(const OffStructure& off, const ClusterShape& shape) {
+  const Vec3& n = shape.noise_sigma;
+  return off.structure == "dichromatic plane" ? n[2] : std::hypot(n[1], n[2]);
+}
+
+bool thickened_by_interreflection(const Explanation& explanation, const ClusterShape& shape) {
+  const std::optional<OffStructure>& off = explanation.off_structure;
+  return off && off->indirect_share >= kThickeningIndirectShare &&
+         off->rms_total > ShapeCriteria{}.noise_factor * noise_across(*off, shape);
+}
+
 std::vector<int> dominant_component_map(const AnalysisImage& input) {
   for (const ComponentFamily f : kFamilies) {
     const std::vector<std::size_t> m = members(input, f);

@@ -53,6 +53,17 @@ struct Explanation {
   std::vector<std::string> notes;
 };
 
+struct ClusterShape;
+
+// The image noise across the direct light's structure, from the cluster's noise along its principal axes: off its
+// principal plane (σ3's noise) for a dichromatic plane, off its principal line (σ2's and σ3's) for a body line.
+double noise_across(const OffStructure& off, const ClusterShape& shape);
+
+// Interreflection thickens the cluster when the indirect light makes at least half of its spread off the direct
+// light's line or plane, and that spread is more than noise_factor × the noise across it (the paper's thickening).
+inline constexpr double kThickeningIndirectShare = 0.5;
+bool thickened_by_interreflection(const Explanation& explanation, const ClusterShape& shape);
+
 // nullopt when the file has no component layers.
 std::optional<Explanation> explain_region(const AnalysisImage& input, const Region& region);
 

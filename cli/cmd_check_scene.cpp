@@ -173,12 +173,13 @@ void print_scene(const Json& s) {
 Json expect_json(const std::vector<Expectation>& expect) {
   Json out = Json::object();
   for (const Expectation& e : expect) {
-    if (e.bent_by.empty() && e.paper.empty()) {
+    if (e.bent_by.empty() && e.thickened_by.empty() && e.paper.empty()) {
       out[e.target] = e.any_of;
       continue;
     }
     out[e.target] = {{"classes", e.any_of}};
     if (!e.bent_by.empty()) out[e.target]["bent_by"] = e.bent_by;
+    if (!e.thickened_by.empty()) out[e.target]["thickened_by"] = e.thickened_by;
     if (!e.paper.empty()) out[e.target]["paper"] = e.paper;
   }
   return out;
@@ -191,8 +192,9 @@ void print_variant(const Json& v) {
   std::vector<std::string> expects;
   for (const auto& [target, words] : v["expect"].items()) {
     const Json& classes = words.is_object() ? words["classes"] : words;
-    std::string text = fmt::format("{} {}", target, fmt::join(classes.get<std::vector<std::string>>(), "|"));
-    if (words.is_object() && words.contains("bent_by")) text += " bent by " + bend_cause_phrase(words["bent_by"].get<std::string>());
+    auto cause = [&](const char* key) { return words.is_object() && words.contains(key) ? words[key].get<std::string>() : std::string(); };
+    const std::string text =
+        fmt::format("{} {}", target, expectation_phrase(classes.get<std::vector<std::string>>(), "|", cause("bent_by"), cause("thickened_by")));
     expects.push_back(std::move(text));
   }
   const auto figure = v["figure"].get<std::vector<std::string>>();

@@ -61,7 +61,7 @@ void print_summary(const series::SeriesResult& result, const fs::path& dir) {
       for (const series::Finding& f : e.findings)
         found.push_back(e.findings.size() == 1 ? f.found : fmt::format("{} {}", f.object, f.found));
       fmt::print("{:<24} {:<7} {:<10} {:<16} {} {}\n", first ? v.name : "", first ? figure : "", e.expected.target,
-                 fmt::format("{}{}", fmt::join(e.expected.any_of, "|"), e.expected.bent_by.empty() ? "" : ", bent by " + bend_cause_phrase(e.expected.bent_by)),
+                 expectation_phrase(e.expected.any_of, "|", e.expected.bent_by, e.expected.thickened_by),
                  e.ok ? "✔" : "✗",
                  fmt::join(found, ", "));
       first = false;

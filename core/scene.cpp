@@ -772,13 +772,18 @@ Expectation read_expectation(const std::string& target, const JsonNode& node, co
     add_words(node);
     return e;
   }
-  // {"classes": …, "bent_by": cause, "paper": word}
-  node.expect_object({"classes", "bent_by", "paper"});
+  // {"classes": …, "bent_by": cause, "thickened_by": cause, "paper": word}
+  node.expect_object({"classes", "bent_by", "thickened_by", "paper"});
   add_words(node["classes"]);
   if (const auto bent_by = node.find("bent_by")) {
     e.bent_by = bent_by->non_empty_string();
     if (std::find(kBendCauses.begin(), kBendCauses.end(), e.bent_by) == kBendCauses.end())
       bent_by->fail(fmt::format("unknown cause \"{}\" (causes: {})", e.bent_by, fmt::join(kBendCauses, ", ")));
+  }
+  if (const auto thickened_by = node.find("thickened_by")) {
+    e.thickened_by = thickened_by->non_empty_string();
+    if (std::find(kThickeningCauses.begin(), kThickeningCauses.end(), e.thickened_by) == kThickeningCauses.end())
+      thickened_by->fail(fmt::format("unknown cause \"{}\" (causes: {})", e.thickened_by, fmt::join(kThickeningCauses, ", ")));
   }
   if (const auto paper = node.find("paper")) {
     e.paper = paper->non_empty_string();

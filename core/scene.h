@@ -206,13 +206,15 @@ std::vector<TriangleMesh> scene_meshes(const Scene& scene);
 
 // What a variant expects of one object, a group of objects or the whole image: the class the analyzer
 // gives it (each object of a group on its own) is one of `any_of`, words of core/structures.h; with `bent_by`,
-// the analyzer also names that cause of its bend (analyzer/bend_cause.h). `paper` is the paper's own word, when the
-// scene shows something else (a finding, stated with its numbers on the figure page).
+// the analyzer also names that cause of its bend (analyzer/bend_cause.h); with `thickened_by`, that cause of its
+// spread off the direct light's line or plane (analyzer/explain.h). `paper` is the paper's own word, when the scene
+// shows something else (a finding, stated with its numbers on the figure page).
 struct Expectation {
   std::string target;                // as written: an object's name, a group's name, or "image"
   std::vector<std::string> objects;  // the objects it covers, in scene order; empty for "image"
   std::vector<std::string> any_of;
   std::string bent_by;               // "", "camera curve", "mixing at edges", "highlight lobe" or "interreflection"
+  std::string thickened_by;          // "" or "interreflection"
   std::string paper;                 // "" when the expectation is the paper's
 };
 inline constexpr std::array<std::string_view, 4> kBendCauses = {"camera curve", "mixing at edges", "highlight lobe",
@@ -221,6 +223,16 @@ inline constexpr std::array<std::string_view, 4> kBendCauses = {"camera curve", 
 // "mixing at edges".
 inline std::string bend_cause_phrase(std::string_view cause) {
   return (cause == "highlight lobe" || cause == "camera curve" ? "the " : "") + std::string(cause);
+}
+inline constexpr std::array<std::string_view, 1> kThickeningCauses = {"interreflection"};
+// An expectation in words: its classes joined by `separator`, then ", bent by …" and ", thickened by …".
+inline std::string expectation_phrase(const std::vector<std::string>& any_of, std::string_view separator, std::string_view bent_by,
+                                      std::string_view thickened_by) {
+  std::string text;
+  for (std::size_t i = 0; i < any_of.size(); ++i) text += (i ? std::string(separator) : "") + any_of[i];
+  if (!bent_by.empty()) text += ", bent by " + bend_cause_phrase(bent_by);
+  if (!thickened_by.empty()) text += ", thickened by " + std::string(thickened_by);
+  return text;
 }
 
 struct SeriesVariant {

@@ -79,6 +79,7 @@ std::vector<VariantView> read_variants(const Json& result) {
             f.target = string_at(e, "target");
             f.any_of = strings_at(e, "any_of");
             f.bent_by = string_at(e, "bent_by");
+            f.thickened_by = string_at(e, "thickened_by");
             f.paper = string_at(e, "paper");
             f.object = string_at(o, "object");
             f.found = string_at(o, "found");
@@ -160,8 +161,7 @@ std::string thumbnail_png(const fs::path& dir, const VariantView& variant, int s
 }
 
 std::string expected_text(const FindingView& f) {
-  std::string text = fmt::format("{}", fmt::join(f.any_of, " or "));
-  if (!f.bent_by.empty()) text += ", bent by " + bend_cause_phrase(f.bent_by);
+  std::string text = expectation_phrase(f.any_of, " or ", f.bent_by, f.thickened_by);
   if (!f.paper.empty()) text += fmt::format(" (the paper: {})", f.paper);
   return text;
 }

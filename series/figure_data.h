@@ -21,6 +21,7 @@ struct FindingView {
   std::string object;                // the object judged
   std::vector<std::string> any_of;   // the classes expected
   std::string bent_by;               // the cause of its bend expected, or ""
+  std::string thickened_by;          // the cause of its spread off the direct light's structure expected, or ""
   std::string paper;                 // the paper's word, when the series expects what the scene shows instead
   std::string found;                 // the analyzer's class, or "absent"
   bool ok = false;

@@ -165,7 +165,7 @@ void render_with_cycles(const Scene& scene, const fs::path& scene_file, const fs
 
 // Which light paths built a region's cluster, in one line: the path types that carry most of its energy,
 // and how much of its spread off the direct light's structure the indirect light explains.
-std::string explain(const std::optional<analyzer::Explanation>& explanation) {
+std::string explain(const std::optional<analyzer::Explanation>& explanation, const analyzer::ClusterShape& shape) {
   if (!explanation) return "";
   std::vector<std::string> parts;
   for (const analyzer::FamilyShares& family : explanation->families) {
@@ -180,8 +180,9 @@ std::string explain(const std::optional<analyzer::Explanation>& explanation) {
   }
   if (const auto& off = explanation->off_structure;
       off && off->rms_total > 0 && explanation->indirect_share.value_or(0) >= 0.01)
-    parts.push_back(fmt::format("indirect light makes {:.0f} % of the spread off the {}", 100 * off->indirect_share,
-                                off->structure));
+    parts.push_back(fmt::format("indirect light makes {:.0f} % of the spread off the {} ({:.1f} × the noise across it)",
+                                100 * off->indirect_share, off->structure,
+                                off->rms_total / std::max(1e-300, analyzer::noise_across(*off, shape))));
   return fmt::format("{}", fmt::join(parts, "; "));
 }
 
@@ -195,15 +196,22 @@ std::vector<ExpectationResult> judge(const SeriesVariant& variant, const analyze
   for (const Expectation& e : variant.expect) {
     ExpectationResult result{e, {}, true};
     auto add = [&](const std::string& object, int region) {
-      Finding f{object, region, "absent", false, "", {}};
+      Finding f{object, region, "absent", false, "", {}, {}};
       if (region >= 0) {
         const auto& shape = analysis.results[static_cast<std::size_t>(region)].shape;
         f.found = std::string(analyzer::class_name(shape.shape));
         if (const auto& bend = analysis.results[static_cast<std::size_t>(region)].bend) f.bent_by = bend->causes;
-        f.ok = std::find(e.any_of.begin(), e.any_of.end(), f.found) != e.any_of.end() &&
-               (e.bent_by.empty() || std::find(f.bent_by.begin(), f.bent_by.end(), e.bent_by) != f.bent_by.end());
+        const auto& explanation = static_cast<std::size_t>(region) < analysis.explanations.size()
+                                      ? analysis.explanations[static_cast<std::size_t>(region)]
+                                      : std::optional<analyzer::Explanation>();
+        if (explanation && analyzer::thickened_by_interreflection(*explanation, shape)) f.thickened_by = {"interreflection"};
+        auto named = [](const std::vector<std::string>& causes, const std::string& cause) {
+          return cause.empty() || std::find(causes.begin(), causes.end(), cause) != causes.end();
+        };
+        f.ok = std::find(e.any_of.begin(), e.any_of.end(), f.found) != e.any_of.end() && named(f.bent_by, e.bent_by) &&
+               named(f.thickened_by, e.thickened_by);
         if (static_cast<std::size_t>(region) < analysis.explanations.size())
-          f.explanation = explain(analysis.explanations[static_cast<std::size_t>(region)]);
+          f.explanation = explain(analysis.explanations[static_cast<std::size_t>(region)], shape);
         const analyzer::RegionAnalysis& result = analysis.results[static_cast<std::size_t>(region)];
         if (result.bend) f.explanation += (f.explanation.empty() ? "" : "; ") + result.bend->summary;
         if (const auto& g = result.declared_gamma; g && result.shape.gamma)
@@ -317,6 +325,7 @@ Json finding_json(const Finding& f) {
   if (f.region >= 0) j["region"] = f.region;
   if (!f.explanation.empty()) j["explanation"] = f.explanation;
   if (!f.bent_by.empty()) j["bent_by"] = f.bent_by;
+  if (!f.thickened_by.empty()) j["thickened_by"] = f.thickened_by;
   return j;
 }
 
@@ -418,6 +427,7 @@ Json result_json(const SeriesResult& result) {
       for (const Finding& f : e.findings) findings.push_back(finding_json(f));
       Json row = {{"target", e.expected.target}, {"any_of", e.expected.any_of}, {"ok", e.ok}, {"objects", findings}};
       if (!e.expected.bent_by.empty()) row["bent_by"] = e.expected.bent_by;
+      if (!e.expected.thickened_by.empty()) row["thickened_by"] = e.expected.thickened_by;
       if (!e.expected.paper.empty()) row["paper"] = e.expected.paper;
       expect.push_back(std::move(row));
       met += e.ok ? 1 : 0;

@@ -66,6 +66,7 @@ struct Finding {
   bool ok = false;
   std::string explanation;  // which light paths built it, in one line; empty without component layers
   std::vector<std::string> bent_by;  // what bends it (analyzer/bend_cause.h); empty when it is not bent
+  std::vector<std::string> thickened_by;  // what spreads it off the direct light's structure (analyzer/explain.h)
 };
 
 struct ExpectationResult {

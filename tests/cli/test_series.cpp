@@ -11,9 +11,12 @@
 #include <set>
 #include <string>
 
+#include <Eigen/Dense>
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 #include <OpenImageIO/imagebuf.h>
 
+#include "analyzer/cluster_shape.h"
 #include "core/json_input.h"
 #include "core/scene.h"
 #include "tests/cli/run_command.h"
@@ -317,6 +320,111 @@ TEST_F(SeriesCommand, Figure4cIsThePowerLawAloneAndKeepsLinesThroughBlack) {
   }
 }
 
+// A camera file's R, G, B and object ids, with the names of its objects (chromatrace.objects).
+struct CameraPixels {
+  int width = 0;
+  std::vector<float> rgb;
+  std::vector<int> id;
+  std::map<int, std::string> names;
+};
+CameraPixels camera_pixels(const fs::path& exr) {
+  const OIIO::ImageBuf image(exr.string());
+  const OIIO::ImageSpec& spec = image.spec();
+  CameraPixels c;
+  c.width = spec.width;
+  for (OIIO::ImageBuf::ConstIterator<float> p(image); !p.done(); ++p) {
+    for (const char* channel : {"R", "G", "B"}) c.rgb.push_back(p[spec.channelindex(channel)]);
+    c.id.push_back(static_cast<int>(std::lround(p[spec.channelindex("object_id")])));
+  }
+  const Json objects = Json::parse(spec.get_string_attribute("chromatrace.objects"));
+  for (const auto& [key, name] : objects.items())
+    c.names[std::stoi(key)] = name.get<std::string>();
+  return c;
+}
+
+// The width of one bin of a 64-bin histogram over the figure's range: the 99.95th percentile of the brightest channel
+// of every pixel but the lamps' (series/figure_plots.cpp draws the cube over that range).
+double figure_bin(const CameraPixels& c) {
+  std::vector<float> top;
+  for (std::size_t p = 0; p < c.id.size(); ++p)
+    if (c.names.count(c.id[p]) && !c.names.at(c.id[p]).ends_with("lamp"))
+      top.push_back(std::max({c.rgb[3 * p], c.rgb[3 * p + 1], c.rgb[3 * p + 2]}));
+  std::sort(top.begin(), top.end());
+  return top[static_cast<std::size_t>(0.9995 * static_cast<double>(top.size() - 1))] / 64;
+}
+
+// The principal line through black of an object's pixels in the columns [from, to), and the rms angle of its
+// pixels off it (rms distance off the line over rms length along it).
+struct BlackLine {
+  Eigen::Vector3d direction;
+  double spread_rad = 0;
+};
+BlackLine black_line(const CameraPixels& c, int id, int from, int to) {
+  Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
+  std::vector<Eigen::Vector3d> xs;
+  for (std::size_t p = 0; p < c.id.size(); ++p) {
+    const int column = static_cast<int>(p % static_cast<std::size_t>(c.width));
+    if (c.id[p] != id || column < from || column >= to) continue;
+    xs.emplace_back(c.rgb[3 * p], c.rgb[3 * p + 1], c.rgb[3 * p + 2]);
+    scatter += xs.back() * xs.back().transpose();
+  }
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(scatter);
+  BlackLine line{eigen.eigenvectors().col(2), 0};
+  double along = 0, off = 0;
+  for (const Eigen::Vector3d& x : xs) {
+    const double t = x.dot(line.direction);
+    along += t * t;
+    off += (x - t * line.direction).squaredNorm();
+  }
+  line.spread_rad = std::sqrt(off / along);
+  return line;
+}
+
+// Figure 3c as the paper describes it: interreflection thickens "many histogram features" visibly. At least half of the
+// lit surfaces spread off their line by more than one bin of a 64-bin histogram over the figure's range and by more
+// than 3 × the noise (noise_factor), and the series names interreflection as the cause. And the fork where two coloured
+// walls feed one surface: the back wall's third nearest the red wall and its third nearest the green wall are two lines
+// from black whose angle is more than twice their combined spread (two branches, not one thick line).
+TEST_F(SeriesCommand, Figure3cIsVisiblyThickenedByInterreflectionAndForksWhereTwoWallsFeedOneSurface) {
+  const std::vector<std::string> lit = {"floor", "back_wall", "left_wall", "right_wall", "sphere", "cylinder"};
+  for (const std::string size : {"64x64", "96x96"})
+    for (const std::string seed : {"1", "2", "3"}) {
+      const fs::path out = dir_ / (size + "-" + seed);
+      const auto r = run_chromatrace({"paper", "-o", out.string(), "--variant", "6a-diffuse-global", "--resolution", size, "--seed", seed, "--quiet"});
+      ASSERT_EQ(r.exit_code, 0) << r.err;
+      const Json v = read_result(out)["variants"][0];
+      for (const Json& e : v["expect"]) EXPECT_TRUE(e["ok"].get<bool>()) << size << " seed " << seed << ": " << e.dump();
+
+      const CameraPixels camera = camera_pixels(out / "6a-diffuse-global" / "camera.exr");
+      const double bin = figure_bin(camera);
+      int thick = 0;
+      std::string widths;
+      const Json analysis = read_json(out / "6a-diffuse-global" / "analysis" / "analysis.json");
+      for (const Json& region : analysis["regions"])
+        for (const std::string& name : lit)
+          if (region["name"].get<std::string>().ends_with("(" + name + ")")) {
+            const double sigma2 = region["shape"]["sigma"][1].get<double>(), noise2 = region["shape"]["noise_sigma"][1].get<double>();
+            thick += sigma2 > bin && sigma2 > analyzer::ShapeCriteria{}.noise_factor * noise2 ? 1 : 0;
+            widths += fmt::format(" {} {:.2f} bin ({:.1f} x noise)", name, sigma2 / bin, sigma2 / noise2);
+          }
+      EXPECT_GE(2 * thick, static_cast<int>(lit.size())) << size << " seed " << seed << ":" << widths;
+
+      int back = 0, red = 0, green = 0;
+      for (const auto& [id, name] : camera.names) {
+        if (name == "back_wall") back = id;
+        if (name == "left_wall") red = id;
+        if (name == "right_wall") green = id;
+      }
+      ASSERT_TRUE(back && red && green);
+      const BlackLine near_red = black_line(camera, back, 0, camera.width / 3);
+      const BlackLine near_green = black_line(camera, back, camera.width - camera.width / 3, camera.width);
+      const double angle = std::acos(std::clamp(std::abs(near_red.direction.dot(near_green.direction)), 0.0, 1.0));
+      EXPECT_GT(angle, 2 * std::hypot(near_red.spread_rad, near_green.spread_rad))
+          << size << " seed " << seed << ": fork " << angle * 180 / M_PI << " deg, branches " << near_red.spread_rad * 180 / M_PI << " and "
+          << near_green.spread_rad * 180 / M_PI << " deg thick";
+    }
+}
+
 // The banana built for the paper's mechanism (6c-banana: a tube of one paint lit from one end): its wall is curved
 // whatever the seed and the size, the analyzer names interreflection as what bends it, and its direct light alone
 // (the diffuse_direct and bounce.1 layers: no interreflected light) is a straight line.
@@ -332,10 +440,14 @@ TEST_F(SeriesCommand, TheBananaIsCurvedByInterreflectionAndALineWithoutIt) {
       for (const std::string layer : {"diffuse_direct", "bounce.1"}) {
         const fs::path analysis = out / ("direct-" + layer);
         ASSERT_EQ(run_chromatrace({"analyze", camera.string(), "--layer", layer, "-o", analysis.string(), "--no-plots", "--no-report", "-q"}).exit_code, 0);
-        for (const Json& region : read_json(analysis / "analysis.json")["regions"])
+        const Json regions = read_json(analysis / "analysis.json")["regions"];
+        int found = 0;
+        for (const Json& region : regions)
           if (region["name"] == "object 1 (tube)") {
+            ++found;
             EXPECT_EQ(region["shape"]["class"], "linear") << size << " seed " << seed << ", " << layer << ": " << region["shape"]["reason"];
           }
+        EXPECT_EQ(found, 1) << size << " seed " << seed << ", " << layer;
       }
     }
 }

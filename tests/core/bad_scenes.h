@@ -58,6 +58,8 @@ inline const std::vector<BadScene>& bad_scenes() {
       {"series_unknown_bend_cause.json",
        "variants[0].expect.ball.bent_by: unknown cause \"the lamp\" (causes: camera curve, mixing at edges, highlight lobe, "
        "interreflection)"},
+      {"series_unknown_thickening_cause.json",
+       "variants[0].expect.ball.thickened_by: unknown cause \"noise\" (causes: interreflection)"},
       {"series_unknown_components.json",
        "variants[0].components: unknown component family \"passes\" (known: paths, lights, bounces, all)"},
       {"series_unknown_target.json",
