@@ -47,13 +47,7 @@ void refuse_textures_and_environment(const Scene& scene) {
                                    scene.source, where, ref.texture->file));
   };
   for (const Material& m : scene.materials)
-    std::visit(
-        [&](const auto& model) {
-          using M = std::decay_t<decltype(model)>;
-          if constexpr (std::is_same_v<M, DichromaticMaterial>) refuse(model.diffuse, "materials." + m.name + ".diffuse");
-          else refuse(model.reflectance, "materials." + m.name + ".reflectance");
-        },
-        m.model);
+    refuse(m.reflectance_spectrum(), fmt::format("materials.{}.{}", m.name, m.reflectance_key()));
   for (std::size_t i = 0; i < scene.lights.size(); ++i) refuse(scene.lights[i].radiance, fmt::format("lights[{}].radiance", i));
   if (scene.environment)
     throw InputError(fmt::format("{}: environment: scene-bands does not report the environment yet", scene.source));

@@ -15,6 +15,8 @@
 #include "core/colour.h"
 #include "core/error.h"
 #include "core/spectral_exr.h"
+#include "core/render_delta_e.h"
+#include "core/statistics.h"
 #include "sensor_sim/spectral_response.h"
 
 namespace ct::cmp {
@@ -231,13 +233,9 @@ std::pair<double, double> side_stats(const std::vector<const std::vector<float>*
     for (std::size_t p : region.pixels) s += (*values)[p * bands + band];
     means.push_back(s / static_cast<double>(region.pixels.size()));
   }
-  const double k = static_cast<double>(means.size());
-  const double mean = std::accumulate(means.begin(), means.end(), 0.0) / k;
-  if (means.size() >= 2) {
-    double ss = 0;
-    for (double m : means) ss += (m - mean) * (m - mean);
-    return {mean, std::sqrt(ss / (k - 1) / k)};
-  }
+  const MeanAndError seeds = mean_and_standard_error(means);
+  const double mean = seeds.mean;
+  if (means.size() >= 2) return {mean, seeds.standard_error};
   const std::vector<float>& v = *layers.front();
   double variance = 0;
   if (!region.pairs.empty()) {
@@ -270,17 +268,7 @@ double paired_se(const std::vector<const std::vector<float>*>& la, const std::ve
     for (const auto* v : lb) b += (*v)[at];
     d[i] = a / double(la.size()) - b / double(lb.size());
   }
-  const double mean = std::accumulate(d.begin(), d.end(), 0.0) / double(n);
-  double ss = 0;
-  for (double x : d) ss += (x - mean) * (x - mean);
-  return std::sqrt(ss / double(n - 1) / double(n));
-}
-
-double percentile(std::vector<double> v, double q) {
-  if (v.empty()) return 0;
-  const std::size_t k = std::min(v.size() - 1, static_cast<std::size_t>(q * static_cast<double>(v.size() - 1) + 0.5));
-  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(k), v.end());
-  return v[k];
+  return mean_and_standard_error(d).standard_error;
 }
 
 SideSummary summary(const std::vector<Render>& side) {
@@ -296,86 +284,76 @@ SideSummary summary(const std::vector<Render>& side) {
   return s;
 }
 
-}  // namespace
+// The camera's responses (tristimulus values) of each pixel of `spectra` ([pixel][band] on `bands`).
+template <typename T>
+std::vector<Vec3d> responses(const std::vector<T>& spectra, const Bands& bands, const sensor::CameraCurves& curves,
+                             std::size_t pixels) {
+  return sensor::camera_tristimulus(std::span<const T>(spectra), bands, curves, pixels);
+}
 
-Comparison compare(const CompareOptions& options) {
+// D65 through the camera over `bands` (the white's chromaticity: compare does not know the scene's light).
+Vec3d d65_response(const Bands& bands, const sensor::CameraCurves& curves) {
+  const std::vector<double> d65 = band_averages(cie::illuminant("D65"), bands);
+  return responses(d65, bands, curves, 1).front();
+}
+
+// With --colour own: each side through the camera over its own bands, before the finer side is averaged into the
+// coarser (so the coarser plan's colour error counts); the mean of the side's renders.
+std::vector<Vec3d> own_responses(const std::vector<Render>& side, const sensor::CameraCurves& curves) {
+  const Bands& bands = side.front().info.bands;
+  const std::size_t n = static_cast<std::size_t>(side.front().info.width) * side.front().info.height;
+  std::vector<Vec3d> out(n, Vec3d{0, 0, 0});
+  for (const Render& r : side) {
+    const std::vector<Vec3d> x = responses(r.layers.at("total"), bands, curves, n);
+    for (std::size_t p = 0; p < n; ++p)
+      for (int k = 0; k < 3; ++k) out[p][k] += x[p][k] / static_cast<double>(side.size());
+  }
+  return out;
+}
+
+void check_options(const CompareOptions& options) {
   if (options.a.empty() || options.b.empty()) throw InputError("compare: needs two renders, A and B");
   if (options.pixels != "matched" && options.pixels != "interior")
     throw InputError(fmt::format("--pixels: must be matched or interior, got \"{}\"", options.pixels));
   if (options.tolerance && !(*options.tolerance >= 0 && *options.tolerance < 1))
     throw InputError(fmt::format("--tolerance: must be in [0, 100) %, got {:g} %", *options.tolerance * 100));
   if (!(options.sigmas >= 0)) throw InputError(fmt::format("--sigmas: must be >= 0, got {:g}", options.sigmas));
-  const sensor::CameraCurves curves = sensor::camera_curves(options.camera, {"r", "g", "b"}, "--camera");
+  if (options.colour != "common" && options.colour != "own")
+    throw InputError(fmt::format("--colour: must be common or own, got \"{}\"", options.colour));
+}
 
+// Load: each side's renders, checked against each other and across the sides.
+std::pair<std::vector<Render>, std::vector<Render>> load_sides(const CompareOptions& options) {
   std::vector<Render> A, B;
   for (const std::string& f : options.a) A.push_back(load(f));
   for (const std::string& f : options.b) B.push_back(load(f));
   check_side(A);
   check_side(B);
   check_comparable(A.front(), B.front());
+  return {std::move(A), std::move(B)};
+}
 
-  if (options.colour != "common" && options.colour != "own")
-    throw InputError(fmt::format("--colour: must be common or own, got \"{}\"", options.colour));
-  // The image level's colours, with --colour own: each side through the camera over its own bands, before the
-  // finer side is averaged into the coarser (so the coarser plan's colour error counts).
-  auto own_responses = [&](const std::vector<Render>& side) {
-    const Bands& bands = side.front().info.bands;
-    const auto q = sensor::photon_response(bands, curves, sensor::ResponseBasis::Energy, 1.0,
-                                           PiecewiseLinearSpectrum::constant(1.0));
-    const std::size_t nb = bands.size(), n = static_cast<std::size_t>(side.front().info.width) * side.front().info.height;
-    std::vector<Vec3d> out(n, Vec3d{0, 0, 0});
-    for (const Render& r : side) {
-      const auto& v = r.layers.at("total");
-      for (std::size_t p = 0; p < n; ++p)
-        for (int k = 0; k < 3; ++k) {
-          double sum = 0;
-          for (std::size_t b = 0; b < nb; ++b) sum += q[k][b] * v[p * nb + b];
-          out[p][k] += sum / static_cast<double>(side.size());
-        }
-    }
-    return out;
-  };
-  std::vector<Vec3d> own_a, own_b;
-  if (options.colour == "own") {
-    own_a = own_responses(A);
-    own_b = own_responses(B);
-  }
-  const Bands own_bands_b = B.front().info.bands;
-
-  Comparison c;
-  c.colour = options.colour;
-  c.a = summary(A);
-  c.b = summary(B);
-  c.sigmas = options.sigmas;
-  c.camera = curves.name;
-  c.pixels_mode = options.pixels;
-  c.tolerance_mode = options.tolerance ? fmt::format("fixed {:g} %", *options.tolerance * 100)
-                                       : std::string("by BRDF type (Lambert and emitters 1 %, glossy 2 %)");
-  c.width = A.front().info.width;
-  c.height = A.front().info.height;
-  const json scene = parse_meta(A.front().info, "chromatrace.scene");
-  c.scene_name = scene.is_object() ? scene.value("name", "") : "";
-
-  // The common band plan: the coarser of the two, the finer averaged into it.
+// Unify bands: the common band plan is the coarser of the two; the finer side's layers are averaged into it.
+Bands unify_bands(std::vector<Render>& A, std::vector<Render>& B) {
   const Bands &ba = A.front().info.bands, &bb = B.front().info.bands;
-  if (same_edges(ba, bb)) {
-    c.bands = ba;
-  } else {
-    const bool a_coarse = ba.size() <= bb.size();
-    const Bands& coarse = a_coarse ? ba : bb;
-    const Bands& fine = a_coarse ? bb : ba;
-    const auto rebin = nest(coarse, fine);
-    if (!rebin)
-      throw InputError(fmt::format("{}: bands {} do not nest with {}'s {} (every edge of the coarser plan must be an "
-                                   "edge of the finer)",
-                                   B.front().file, describe_bands(bb), A.front().file, describe_bands(ba)));
-    c.bands = coarse;
-    for (Render& r : a_coarse ? B : A)
-      for (auto& [name, values] : r.layers) values = rebinned(values, fine.size(), *rebin);
-  }
-  const std::size_t nb = c.bands.size();
+  if (same_edges(ba, bb)) return ba;
+  const bool a_coarse = ba.size() <= bb.size();
+  const Bands& coarse = a_coarse ? ba : bb;
+  const Bands& fine = a_coarse ? bb : ba;
+  const auto rebin = nest(coarse, fine);
+  if (!rebin)
+    throw InputError(fmt::format("{}: bands {} do not nest with {}'s {} (every edge of the coarser plan must be an "
+                                 "edge of the finer)",
+                                 B.front().file, describe_bands(bb), A.front().file, describe_bands(ba)));
+  const Bands common = coarse;
+  const std::size_t fine_size = fine.size();
+  for (Render& r : a_coarse ? B : A)
+    for (auto& [name, values] : r.layers) values = rebinned(values, fine_size, *rebin);
+  return common;
+}
 
-  // Components both sides have.
+// The components both sides have ("total" first), and those only one has.
+void shared_components(Comparison& c, const std::vector<Render>& A, const std::vector<Render>& B) {
   const auto ca = component_names(A.front().info), cb = component_names(B.front().info);
   c.components.push_back("total");
   for (const std::string& n : ca)
@@ -383,10 +361,13 @@ Comparison compare(const CompareOptions& options) {
     else c.only_a.push_back(n);
   for (const std::string& n : cb)
     if (std::find(ca.begin(), ca.end(), n) == ca.end()) c.only_b.push_back(n);
+}
 
-  // Regions: each object's pixels (ids equal in both renders), and the whole image.
+// Regions: the whole image, then each object's pixels (ids equal in both renders; with "interior", also every
+// 8-neighbour's), each with its pairs of neighbouring pixels.
+std::vector<Region> object_regions(Comparison& c, const Render& a, const Render& b, const std::string& pixels,
+                                   const std::map<std::string, std::string>& types) {
   const std::size_t W = static_cast<std::size_t>(c.width), H = static_cast<std::size_t>(c.height), N = W * H;
-  const auto types = brdf_types(scene);
   std::vector<Region> regions;
   {
     Region image;
@@ -396,8 +377,8 @@ Comparison compare(const CompareOptions& options) {
     for (std::size_t p = 0; p < N; ++p) image.pixels.push_back(p);
     regions.push_back(std::move(image));
   }
-  const std::vector<std::int32_t>& ida = A.front().ids;
-  const std::vector<std::int32_t>& idb = B.front().ids;
+  const std::vector<std::int32_t>& ida = a.ids;
+  const std::vector<std::int32_t>& idb = b.ids;
   if (!ida.empty() && !idb.empty()) {
     std::vector<std::int32_t> label(N, -1);  // the object of each pixel used, or -1
     for (std::size_t p = 0; p < N; ++p) {
@@ -407,7 +388,7 @@ Comparison compare(const CompareOptions& options) {
       }
       if (ida[p] == 0) continue;
       bool keep = true;
-      if (options.pixels == "interior") {
+      if (pixels == "interior") {
         const std::size_t x = p % W, y = p / W;
         for (int dy = -1; dy <= 1 && keep; ++dy)
           for (int dx = -1; dx <= 1 && keep; ++dx) {
@@ -424,8 +405,8 @@ Comparison compare(const CompareOptions& options) {
       if (label[p] >= 0) by_id[label[p]].pixels.push_back(p);
     for (auto& [id, region] : by_id) {
       region.id = id;
-      auto it = A.front().info.object_names.find(id);
-      region.name = it != A.front().info.object_names.end() ? it->second : fmt::format("id {}", id);
+      auto it = a.info.object_names.find(id);
+      region.name = it != a.info.object_names.end() ? it->second : fmt::format("id {}", id);
       auto t = types.find(region.name);
       region.brdf = t != types.end() ? t->second : "unknown";
       for (std::size_t p : region.pixels) {
@@ -442,11 +423,51 @@ Comparison compare(const CompareOptions& options) {
         if ((p % W) + 1 < W) r.pairs.emplace_back(p, p + 1);
         if (p + W < N) r.pairs.emplace_back(p, p + W);
       }
+  return regions;
+}
+
+// One cell: a region's means on both sides for one component and band, their standard errors, z and the test.
+Cell compare_cell(const Region& region, const std::string& component, std::size_t band, const Comparison& c,
+                  const std::vector<const std::vector<float>*>& la, const std::vector<const std::vector<float>*>& lb,
+                  bool seeds, double tol, double sigmas) {
+  const std::size_t nb = c.bands.size();
+  Cell cell;
+  cell.object_id = region.id;
+  cell.object = region.name;
+  cell.brdf = region.brdf;
+  cell.component = component;
+  cell.band = band;
+  cell.lo_nm = c.bands.lo(band);
+  cell.hi_nm = c.bands.hi(band);
+  cell.pixels = region.pixels.size();
+  std::tie(cell.mean_a, cell.se_a) = side_stats(la, nb, band, region);
+  std::tie(cell.mean_b, cell.se_b) = side_stats(lb, nb, band, region);
+  const double diff = cell.mean_a - cell.mean_b;
+  cell.se = seeds || region.pixels.size() < 2 ? std::hypot(cell.se_a, cell.se_b) : paired_se(la, lb, nb, band, region);
+  const double se = cell.se;
+  const double scale = std::max(std::abs(cell.mean_a), std::abs(cell.mean_b));
+  // Exact values on both sides (a lamp seen directly): a difference within float rounding is z = 0.
+  cell.z = se > 0                            ? diff / se
+           : std::abs(diff) <= 1e-5 * scale ? 0.0
+                                            : std::copysign(std::numeric_limits<double>::infinity(), diff);
+  if (cell.mean_b != 0) {
+    const double r = cell.mean_a / cell.mean_b;
+    cell.ratio = r;
+    cell.se_ratio = cell.mean_a != 0 ? std::abs(r) * std::hypot(cell.se_a / cell.mean_a, cell.se_b / cell.mean_b)
+                                     : cell.se_a / std::abs(cell.mean_b);
+  }
+  cell.tolerance = tol;
+  // Float rounding (band values pass through single-precision colours in Cycles) is never a disagreement.
+  cell.pass = std::abs(diff) <= tol * std::abs(cell.mean_b) + sigmas * se + 1e-5 * scale;
+  return cell;
+}
+
+// Cells: per region × component × band.
+void compare_cells(Comparison& c, const std::vector<Render>& A, const std::vector<Render>& B,
+                   const std::vector<Region>& regions, const CompareOptions& options) {
   double max_tolerance = 0.01;
   for (const Region& r : regions)
     if (r.id >= 0) max_tolerance = std::max(max_tolerance, default_tolerance(r.brdf));
-
-  // Cells.
   const bool seeds = A.size() >= 2 && B.size() >= 2;
   c.se_method = seeds ? "seeds" : "paired pixels";
   for (const Region& region : regions) {
@@ -458,43 +479,20 @@ Comparison compare(const CompareOptions& options) {
       std::vector<const std::vector<float>*> la, lb;
       for (const Render& r : A) la.push_back(&r.layers.at(component));
       for (const Render& r : B) lb.push_back(&r.layers.at(component));
-      for (std::size_t band = 0; band < nb; ++band) {
-        Cell cell;
-        cell.object_id = region.id;
-        cell.object = region.name;
-        cell.brdf = region.brdf;
-        cell.component = component;
-        cell.band = band;
-        cell.lo_nm = c.bands.lo(band);
-        cell.hi_nm = c.bands.hi(band);
-        cell.pixels = region.pixels.size();
-        std::tie(cell.mean_a, cell.se_a) = side_stats(la, nb, band, region);
-        std::tie(cell.mean_b, cell.se_b) = side_stats(lb, nb, band, region);
-        const double diff = cell.mean_a - cell.mean_b;
-        cell.se = seeds || region.pixels.size() < 2 ? std::hypot(cell.se_a, cell.se_b)
-                                                    : paired_se(la, lb, nb, band, region);
-        const double se = cell.se;
-        const double scale = std::max(std::abs(cell.mean_a), std::abs(cell.mean_b));
-        // Exact values on both sides (a lamp seen directly): a difference within float rounding is z = 0.
-        cell.z = se > 0                            ? diff / se
-                 : std::abs(diff) <= 1e-5 * scale ? 0.0
-                                                  : std::copysign(std::numeric_limits<double>::infinity(), diff);
-        if (cell.mean_b != 0) {
-          const double r = cell.mean_a / cell.mean_b;
-          cell.ratio = r;
-          cell.se_ratio = cell.mean_a != 0 ? std::abs(r) * std::hypot(cell.se_a / cell.mean_a, cell.se_b / cell.mean_b)
-                                           : cell.se_a / std::abs(cell.mean_b);
-        }
-        cell.tolerance = tol;
-        // Float rounding (band values pass through single-precision colours in Cycles) is never a disagreement.
-        cell.pass = std::abs(diff) <= tol * std::abs(cell.mean_b) + options.sigmas * se + 1e-5 * scale;
-        if (!cell.pass) ++c.failed;
-        c.cells.push_back(std::move(cell));
+      for (std::size_t band = 0; band < c.bands.size(); ++band) {
+        c.cells.push_back(compare_cell(region, component, band, c, la, lb, seeds, tol, options.sigmas));
+        if (!c.cells.back().pass) ++c.failed;
       }
     }
   }
+}
 
-  // Image level: ΔE00 through the camera, between the sides' average images.
+// Image level: ΔE00 through the camera between the sides' average images (core/render_delta_e.h), under D65 at
+// the level of A's surfaces (pixels on or next to an emitter left out); the linear previews of both sides.
+void image_level(Comparison& c, const std::vector<Render>& A, const std::vector<Render>& B,
+                 const std::vector<Region>& regions, const sensor::CameraCurves& curves,
+                 const std::vector<Vec3d>& own_a, const std::vector<Vec3d>& own_b) {
+  const std::size_t N = static_cast<std::size_t>(c.width) * static_cast<std::size_t>(c.height), nb = c.bands.size();
   auto average = [&](const std::vector<Render>& side) {
     std::vector<double> out(N * nb, 0.0);
     for (const Render& r : side) {
@@ -504,53 +502,27 @@ Comparison compare(const CompareOptions& options) {
     for (double& v : out) v /= static_cast<double>(side.size());
     return out;
   };
-  const auto q = sensor::photon_response(c.bands, curves, sensor::ResponseBasis::Energy, 1.0,
-                                         PiecewiseLinearSpectrum::constant(1.0));
-  auto responses = [&](const std::vector<double>& img) {
-    std::vector<Vec3d> out(N);
-    for (std::size_t p = 0; p < N; ++p)
-      for (int k = 0; k < 3; ++k) {
-        double s = 0;
-        for (std::size_t b = 0; b < nb; ++b) s += q[k][b] * img[p * nb + b];
-        out[p][k] = s;
-      }
-    return out;
-  };
-  const auto xa = own_a.empty() ? responses(average(A)) : own_a, xb = own_b.empty() ? responses(average(B)) : own_b;
-  // White: the camera's response to D65, scaled to the 99th percentile of A's second channel over pixels not
-  // on an emitter (emitters would set it otherwise).
+  const bool own = !own_b.empty();
+  const std::vector<Vec3d> xa = own ? own_a : responses(average(A), c.bands, curves, N);
+  const std::vector<Vec3d> xb = own ? own_b : responses(average(B), c.bands, curves, N);
   std::set<std::int32_t> emitters;
   for (const Region& r : regions)
     if (r.brdf == "emitter") emitters.insert(r.id);
-  std::vector<double> ys;
-  for (std::size_t p = 0; p < N; ++p)
-    if (ida.empty() || !emitters.count(ida[p])) ys.push_back(xa[p][1]);
-  double yw = percentile(ys, 0.99);
-  if (!(yw > 0)) {
-    yw = 0;
-    for (const auto& v : xa) yw = std::max(yw, v[1]);
-  }
-  if (!(yw > 0)) yw = 1;
-  Vec3d white{};
-  if (own_b.empty()) {
-    const std::vector<double> d65 = band_averages(cie::illuminant("D65"), c.bands);
-    for (int k = 0; k < 3; ++k)
-      for (std::size_t b = 0; b < nb; ++b) white[k] += q[k][b] * d65[b];
-  } else {
-    const auto qb = sensor::photon_response(own_bands_b, curves, sensor::ResponseBasis::Energy, 1.0,
-                                            PiecewiseLinearSpectrum::constant(1.0));
-    const std::vector<double> d65 = band_averages(cie::illuminant("D65"), own_bands_b);
-    for (int k = 0; k < 3; ++k)
-      for (std::size_t b = 0; b < own_bands_b.size(); ++b) white[k] += qb[k][b] * d65[b];
-  }
-  const double wscale = white[1] > 0 ? yw / white[1] : 1.0;
-  for (double& v : white) v = std::max(v * wscale, 1e-300);
-  c.delta_e.resize(N);
+  WhitePolicy policy;
+  policy.light = d65_response(own ? B.front().info.bands : c.bands, curves);
+  const Vec3d white = white_point(
+      xa, near_emitters(A.front().ids, c.width, c.height, [&](std::int32_t id) { return emitters.count(id) > 0; }),
+      policy);
+  RenderDeltaE de = delta_e_between(xa, xb, white);
+  c.delta_e = std::move(de.per_pixel);
+  c.delta_e_mean = de.mean;
+  c.delta_e_p95 = de.p95;
+  c.delta_e_max = de.max;
+  const double yw = white[1];
   c.rgb_a.resize(N * 3);
   c.rgb_b.resize(N * 3);
   const bool cie = curves.name == "cie1931";
-  for (std::size_t p = 0; p < N; ++p) {
-    c.delta_e[p] = delta_e_2000(xyz_to_lab(xa[p], white), xyz_to_lab(xb[p], white));
+  for (std::size_t p = 0; p < N; ++p)
     for (int side = 0; side < 2; ++side) {
       const Vec3d& x = side == 0 ? xa[p] : xb[p];
       Vec3d rgb;
@@ -559,10 +531,39 @@ Comparison compare(const CompareOptions& options) {
       auto& out = side == 0 ? c.rgb_a : c.rgb_b;
       for (int k = 0; k < 3; ++k) out[p * 3 + k] = static_cast<float>(rgb[k]);
     }
+}
+
+}  // namespace
+
+Comparison compare(const CompareOptions& options) {
+  check_options(options);
+  const sensor::CameraCurves curves = sensor::camera_curves(options.camera, {"r", "g", "b"}, "--camera");
+  auto [A, B] = load_sides(options);
+  std::vector<Vec3d> own_a, own_b;
+  if (options.colour == "own") {
+    own_a = own_responses(A, curves);
+    own_b = own_responses(B, curves);
   }
-  c.delta_e_mean = std::accumulate(c.delta_e.begin(), c.delta_e.end(), 0.0) / static_cast<double>(N);
-  c.delta_e_p95 = percentile(c.delta_e, 0.95);
-  c.delta_e_max = *std::max_element(c.delta_e.begin(), c.delta_e.end());
+
+  Comparison c;
+  c.colour = options.colour;
+  c.a = summary(A);
+  c.b = summary(B);
+  c.sigmas = options.sigmas;
+  c.camera = curves.name;
+  c.pixels_mode = options.pixels;
+  c.tolerance_mode = options.tolerance ? fmt::format("fixed {:g} %", *options.tolerance * 100)
+                                       : std::string("by BRDF type (Lambert and emitters 1 %, glossy 2 %)");
+  c.width = A.front().info.width;
+  c.height = A.front().info.height;
+  const json scene = parse_meta(A.front().info, "chromatrace.scene");
+  c.scene_name = scene.is_object() ? scene.value("name", "") : "";
+
+  c.bands = unify_bands(A, B);
+  shared_components(c, A, B);
+  const std::vector<Region> regions = object_regions(c, A.front(), B.front(), options.pixels, brdf_types(scene));
+  compare_cells(c, A, B, regions, options);
+  image_level(c, A, B, regions, curves, own_a, own_b);
   return c;
 }
 

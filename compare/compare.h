@@ -23,6 +23,7 @@
 #include <vector>
 
 #include "core/spectrum.h"
+#include "core/statistics.h"
 
 namespace ct::cmp {
 
@@ -31,7 +32,7 @@ struct CompareOptions {
   std::vector<std::string> b;
   // Relative tolerance for every cell; unset: by BRDF type (Lambert and emitters 1 %, anything glossy 2 %).
   std::optional<double> tolerance;
-  double sigmas = 4.0;  // a cell passes when |mean_a − mean_b| ≤ tolerance·|mean_b| + sigmas·se
+  double sigmas = kSigmasPerItem;  // a cell passes when |mean_a − mean_b| ≤ tolerance·|mean_b| + sigmas·se
   // Pixels of an object: "matched" (the id is the same in both renders) or "interior" (also every
   // 8-neighbour has that id in both).
   std::string pixels = "matched";
@@ -74,7 +75,7 @@ struct Comparison {
   std::size_t id_mismatch_pixels = 0;  // pixels whose object id differs between A and B
   std::vector<Cell> cells;
   std::size_t failed = 0;
-  double sigmas = 4.0;
+  double sigmas = kSigmasPerItem;
   std::string tolerance_mode;  // "by BRDF type" or "fixed 1%"
   std::string pixels_mode;
   // "seeds" (both sides several renders: the spread of their means) or "paired pixels" (the spread of the

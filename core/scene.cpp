@@ -653,6 +653,16 @@ const char* material_type_name(const Material& material) {
   return names[material.model.index()];
 }
 
+const SpectrumRef& Material::reflectance_spectrum() const {
+  if (const auto* d = std::get_if<DichromaticMaterial>(&model)) return d->diffuse;
+  if (const auto* m = std::get_if<MirrorMaterial>(&model)) return m->reflectance;
+  return std::get<LambertMaterial>(model).reflectance;
+}
+
+const char* Material::reflectance_key() const {
+  return std::holds_alternative<DichromaticMaterial>(model) ? "diffuse" : "reflectance";
+}
+
 const Material* Scene::find_material(std::string_view name) const { return find_by_name(materials, name); }
 const NamedSpectrum* Scene::find_spectrum(std::string_view name) const { return find_by_name(spectra, name); }
 

@@ -84,6 +84,12 @@ struct MirrorMaterial {
 struct Material {
   std::string name;
   std::variant<LambertMaterial, DichromaticMaterial, MirrorMaterial> model;
+
+  // The one spectrum that colours what the material reflects: a Lambert or mirror material's reflectance, a
+  // dichromatic material's diffuse (body) reflectance (its specular lobe is flat). reflectance_key() names its
+  // field in the scene file ("reflectance" or "diffuse").
+  const SpectrumRef& reflectance_spectrum() const;
+  const char* reflectance_key() const;
 };
 
 // "lambert", "dichromatic" or "mirror".

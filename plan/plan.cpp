@@ -15,6 +15,9 @@
 #include "core/error.h"
 #include "core/geometry.h"
 #include "core/random.h"
+#include "core/statistics.h"
+#include "core/render_delta_e.h"
+#include "plan/radiosity.h"
 #include "plan/spectral_check.h"
 #include "reference_tracer/accel.h"
 #include "reference_tracer/render.h"
@@ -22,222 +25,7 @@
 
 namespace ct::plan {
 
-double percentile(std::vector<double> v, double q) {
-  if (v.empty()) return 0;
-  const std::size_t k = std::min(v.size() - 1, static_cast<std::size_t>(q * static_cast<double>(v.size() - 1) + 0.5));
-  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(k), v.end());
-  return v[k];
-}
-
-bool near_light(const std::vector<std::int32_t>& ids, int w, int h, std::size_t p, std::int32_t first_light) {
-  const int x = static_cast<int>(p % static_cast<std::size_t>(w)), y = static_cast<int>(p / static_cast<std::size_t>(w));
-  for (int dy = -1; dy <= 1; ++dy)
-    for (int dx = -1; dx <= 1; ++dx) {
-      const int xx = x + dx, yy = y + dy;
-      if (xx < 0 || yy < 0 || xx >= w || yy >= h) continue;
-      if (ids[static_cast<std::size_t>(yy) * static_cast<std::size_t>(w) + static_cast<std::size_t>(xx)] >= first_light)
-        return true;
-    }
-  return false;
-}
-
 namespace {
-
-// A spectrum sampled every 1 nm on the model's grid, with its running integral (trapezoids).
-struct Sampled {
-  std::vector<double> v, cum;
-};
-
-// The 1 nm grid [lo, hi] (whole nm) on which the model evaluates spectra.
-struct Grid {
-  int lo = 380, hi = 780;
-  std::size_t n() const { return static_cast<std::size_t>(hi - lo + 1); }
-
-  Sampled sample(const std::function<double(double)>& f) const {
-    Sampled s;
-    s.v.resize(n());
-    for (std::size_t i = 0; i < n(); ++i) s.v[i] = f(lo + static_cast<double>(i));
-    finish(s);
-    return s;
-  }
-  static void finish(Sampled& s) {
-    s.cum.assign(s.v.size(), 0.0);
-    for (std::size_t i = 1; i < s.v.size(); ++i) s.cum[i] = s.cum[i - 1] + 0.5 * (s.v[i - 1] + s.v[i]);
-  }
-  // Average over [a, b] (grid indices).
-  static double average(const Sampled& s, int a, int b) { return (s.cum[b] - s.cum[a]) / (b - a); }
-  static double integral(const Sampled& s, int a, int b) { return s.cum[b] - s.cum[a]; }
-};
-
-// Tristimulus values of a sampled spectrum through the observer (trapezoids on the 1 nm grid).
-Vec3d tristimulus(const std::vector<double>& f, const std::array<Sampled, 3>& obs) {
-  Vec3d out{};
-  for (int c = 0; c < 3; ++c) {
-    double s = 0;
-    for (std::size_t i = 0; i < f.size(); ++i) {
-      const double w = (i == 0 || i + 1 == f.size()) ? 0.5 : 1.0;
-      s += w * f[i] * obs[c].v[i];
-    }
-    out[c] = s;
-  }
-  return out;
-}
-
-// Where light leaving each surface goes: for every object id o (objects, then lights), cosine-weighted rays
-// from points spread uniformly over its area, on the side of its surface that receives the most light
-// (then: that sees the most of the scene). hits[o][j]: the fraction reaching surface id j (0: none, the
-// ray escapes); lit[o][l]: the fraction reaching the emitting side of light l. Radiosity with one patch per
-// object: the irradiance on o after k bounces is Σ_j hits[o][j]·B_k−1,j (radiance units, a Lambertian
-// sender), and the direct irradiance Σ_l lit[o][l]·E_l.
-struct Transfer {
-  std::vector<std::vector<double>> hits, lit;
-};
-
-Transfer transfer(const Scene& scene, const std::vector<TriangleMesh>& meshes, int samples) {
-  std::vector<const TriangleMesh*> ptrs;
-  for (const TriangleMesh& m : meshes) ptrs.push_back(&m);
-  const rt::Accelerator accel(ptrs);
-  const std::size_t ids = meshes.size() + 1, objects = scene.objects.size();
-  Transfer t;
-  t.hits.assign(ids, std::vector<double>(ids, 0.0));
-  t.lit.assign(ids, std::vector<double>(scene.lights.size(), 0.0));
-  for (std::size_t m = 0; m < meshes.size(); ++m) {
-    const TriangleMesh& mesh = meshes[m];
-    std::vector<double> cdf;
-    double area = 0;
-    for (std::size_t tri = 0; tri < mesh.triangles.size(); ++tri) cdf.push_back(area += triangle_area(mesh, tri));
-    if (!(area > 0)) continue;
-    std::array<std::vector<double>, 2> hits{std::vector<double>(ids, 0.0), std::vector<double>(ids, 0.0)};
-    std::array<std::vector<double>, 2> lit{std::vector<double>(scene.lights.size(), 0.0),
-                                           std::vector<double>(scene.lights.size(), 0.0)};
-    Random rng(0x706c616eull, m);
-    for (int i = 0; i < samples; ++i) {
-      const double pick = rng.uniform() * area;
-      const std::size_t tri = std::min<std::size_t>(
-          static_cast<std::size_t>(std::upper_bound(cdf.begin(), cdf.end(), pick) - cdf.begin()), cdf.size() - 1);
-      double u = rng.uniform(), v = rng.uniform();
-      if (u + v > 1) u = 1 - u, v = 1 - v;
-      const auto& ix = mesh.triangles[tri];
-      const Vec3 p = (1 - u - v) * mesh.positions[ix[0]] + u * mesh.positions[ix[1]] + v * mesh.positions[ix[2]];
-      const Vec3 n = face_normal(mesh, tri);
-      if (n.squaredNorm() == 0) continue;
-      const Vec3 a = std::abs(n.x()) > 0.5 ? Vec3(0, 1, 0) : Vec3(1, 0, 0);
-      const Vec3 tx = n.cross(a).normalized(), ty = n.cross(tx);
-      const double r1 = rng.uniform(), r2 = rng.uniform();
-      const double rad = std::sqrt(r1), phi = 2 * M_PI * r2, z = std::sqrt(std::max(0.0, 1 - r1));
-      for (int side = 0; side < 2; ++side) {
-        const Vec3 ns = side == 0 ? n : Vec3(-n);
-        const Vec3 dir = (rad * std::cos(phi) * tx + rad * std::sin(phi) * ty + z * ns).normalized();
-        const auto hit = accel.intersect(rt::offset_origin(p, n, ns, accel.scale()), dir,
-                                         std::numeric_limits<double>::infinity());
-        if (!hit) {
-          hits[side][0] += 1;
-          continue;
-        }
-        const std::size_t id = hit->mesh + 1;
-        hits[side][id] += 1;
-        if (hit->mesh >= objects) {
-          const std::size_t l = hit->mesh - objects;
-          const Vec3 ln = face_normal(meshes[hit->mesh], hit->triangle);
-          if (scene.lights[l].two_sided || dir.dot(ln) < 0) lit[side][l] += 1;
-        }
-      }
-    }
-    auto score = [&](int side) {
-      double s = 0, seen = 0;
-      for (double x : lit[side]) s += x;
-      for (std::size_t j = 1; j < ids; ++j) seen += hits[side][j];
-      return s + 1e-3 * seen;
-    };
-    const int side = score(1) > score(0) ? 1 : 0;
-    for (std::size_t j = 0; j < ids; ++j) t.hits[m + 1][j] = hits[side][j] / samples;
-    for (std::size_t l = 0; l < scene.lights.size(); ++l) t.lit[m + 1][l] = lit[side][l] / samples;
-  }
-  return t;
-}
-
-// What a surface of the scene contributes to the model.
-struct Surface {
-  Sampled emission;     // zero unless a light
-  Sampled diffuse;      // R_o
-  Sampled glossy;       // what a glossy bounce multiplies by
-  Sampled albedo;       // what the surface sends on (diffuse + specular)
-  bool emitter = false;
-};
-
-// The spectra of the model in one basis: 1 nm samples (exact) or band averages (a plan), with each basis
-// element's weight in each observer channel.
-struct Basis {
-  std::array<std::vector<double>, 3> weight;
-  std::vector<std::vector<double>> emission, diffuse, glossy, albedo;  // per surface id
-  std::vector<double> light, mean_albedo, environment;
-  std::size_t size() const { return light.size(); }
-};
-
-// The spectra behind the templates (in the basis), [id][k][lobe].
-using TemplateSpectra = std::vector<std::vector<std::array<std::vector<double>, 2>>>;
-
-// Tristimulus values of every (id, k, lobe) template: k = 0 the surface's own emission; k >= 1 what it reflects
-// after k scattering events, by radiosity over the transfer factors; where that gives no light (a surface no
-// sampled ray lit), the mean-albedo model E·R·ρ̄^(k−1). With `spectra`, also the spectrum behind each.
-
-std::vector<std::vector<std::array<Vec3d, 2>>> templates(const Basis& b, const Transfer& t, int kmax,
-                                                         TemplateSpectra* spectra = nullptr) {
-  const std::size_t ids = b.emission.size(), n = b.size(), lights = t.lit.empty() ? 0 : t.lit[0].size();
-  const std::size_t first_light = ids - lights;
-  std::vector<std::vector<std::array<Vec3d, 2>>> out(ids, std::vector<std::array<Vec3d, 2>>(kmax + 1));
-  auto project = [&](const std::vector<double>& f) {
-    Vec3d x{};
-    for (int c = 0; c < 3; ++c)
-      for (std::size_t i = 0; i < n; ++i) x[c] += f[i] * b.weight[c][i];
-    return x;
-  };
-  std::vector<std::vector<double>> irr(ids, std::vector<double>(n, 0.0)), sent(ids, std::vector<double>(n, 0.0));
-  std::vector<double> f(n), fallback(n);
-  if (spectra) spectra->assign(ids, std::vector<std::array<std::vector<double>, 2>>(kmax + 1, {std::vector<double>(n, 0.0), std::vector<double>(n, 0.0)}));
-  for (std::size_t id = 0; id < ids; ++id) {
-    out[id][0][0] = project(b.emission[id]);
-    if (spectra) (*spectra)[id][0][0] = b.emission[id];
-  }
-  for (int k = 1; k <= kmax; ++k) {
-    for (std::size_t o = 1; o < ids; ++o) {
-      std::fill(irr[o].begin(), irr[o].end(), 0.0);
-      if (k == 1) {
-        for (std::size_t l = 0; l < lights; ++l)
-          for (std::size_t i = 0; i < n; ++i) irr[o][i] += t.lit[o][l] * b.emission[first_light + l][i];
-        if (!b.environment.empty())
-          for (std::size_t i = 0; i < n; ++i) irr[o][i] += t.hits[o][0] * b.environment[i];
-      } else {
-        for (std::size_t j = 1; j < ids; ++j)
-          if (t.hits[o][j] > 0)
-            for (std::size_t i = 0; i < n; ++i) irr[o][i] += t.hits[o][j] * sent[j][i];
-      }
-    }
-    for (std::size_t o = 0; o < ids; ++o)
-      for (int lobe = 0; lobe < 2; ++lobe) {
-        const auto& r = lobe == 0 ? b.diffuse[o] : b.glossy[o];
-        for (std::size_t i = 0; i < n; ++i) {
-          f[i] = o == 0 ? 0.0 : r[i] * irr[o][i];
-          fallback[i] = b.light[i] * (o == 0 ? b.mean_albedo[i] : r[i]) * std::pow(b.mean_albedo[i], k - 1);
-        }
-        Vec3d x = project(f);
-        const bool fell_back = !(x[1] > 0);
-        if (fell_back) x = project(fallback);
-        out[o][k][lobe] = x;
-        if (spectra) (*spectra)[o][k][lobe] = fell_back ? fallback : f;
-      }
-    for (std::size_t o = 1; o < ids; ++o)
-      for (std::size_t i = 0; i < n; ++i) sent[o][i] = b.albedo[o][i] * irr[o][i];
-  }
-  return out;
-}
-
-const SpectrumRef* diffuse_ref(const Material& m) {
-  if (auto* l = std::get_if<LambertMaterial>(&m.model)) return &l->reflectance;
-  if (auto* d = std::get_if<DichromaticMaterial>(&m.model)) return &d->diffuse;
-  if (auto* r = std::get_if<MirrorMaterial>(&m.model)) return &r->reflectance;
-  return nullptr;
-}
 
 // A pixel of the preview: its object id and the luminance of each (bounce order, lobe).
 struct Pixel {
@@ -245,13 +33,32 @@ struct Pixel {
   std::size_t index = 0;  // in the preview image
   std::vector<std::array<double, 2>> y;  // [k][lobe]: lobe 0 diffuse (k = 0: emission), 1 glossy
   double total = 0;
-  bool near_light = false;  // on or next to a light (near_light())
+  bool near_light = false;  // on or next to a light (core/render_delta_e.h, near_emitters)
 };
 
 // A reference depth's tail: 1 % of the luminance is a mean ΔE00 of about 0.25 at mid grey (L* ∝ Y^⅓, so
 // ΔL* ≈ (L* + 16)/3 · ΔY/Y ≈ 25 · ΔY/Y), the quarter of a target of 1 that plan gives the bounce limit.
 constexpr double kNegligibleShare = 0.01;
 constexpr int kMaxReferenceBounces = 64;
+// Rays per surface and side for the transfer factors: a factor's standard error is at most 1/(2·√4096) ≈ 0.008.
+constexpr int kTransferRays = 4096;
+
+// The low-resolution preview render (bands mode, every component) and the observer's weights of its bands.
+struct Preview {
+  Scene scene;  // the scene at the preview's size and the model's depth
+  rt::RenderOptions options;
+  rt::RenderedImage image;
+  std::array<std::vector<double>, 3> weights;  // [channel][band]
+  std::size_t pixels() const { return static_cast<std::size_t>(image.width) * static_cast<std::size_t>(image.height); }
+  // Tristimulus values of pixel p of a layer.
+  Vec3d colour(const std::vector<float>& layer, std::size_t p) const {
+    const std::size_t nb = image.bands.size();
+    Vec3d x{};
+    for (int c = 0; c < 3; ++c)
+      for (std::size_t b = 0; b < nb; ++b) x[c] += weights[c][b] * layer[p * nb + b];
+    return x;
+  }
+};
 
 class Model {
  public:
@@ -282,18 +89,29 @@ class Model {
   double mean_albedo() const { return mean_albedo_; }
 
  private:
-  std::pair<double, double> score(const std::vector<std::vector<std::array<Vec3d, 2>>>& templates, int max_bounces) const;
+  // The steps of the constructor, in order.
+  sensor::CameraCurves set_grid(const Scene& scene, const PlanOptions& options, std::vector<std::string>& notes,
+                                int reference_bounces);
+  void set_surfaces(const Scene& scene, const std::vector<TriangleMesh>& meshes, const PlanOptions& options,
+                    std::vector<std::string>& notes, int reference_bounces);
+  void set_exact_templates();
+  Preview render_preview(const Scene& scene, const PlanOptions& options, const sensor::CameraCurves& curves) const;
+  void read_preview(const Preview& preview, const std::vector<bool>& near_light);
+  void set_white(const Preview& preview, const std::vector<bool>& near_light);
+  void measure_preview_noise(const Preview& preview);
+
+  std::pair<double, double> score(const Templates& templates, int max_bounces) const;
   std::optional<BandReconstruction> fit_reconstruction(const TemplateSpectra& banded, const std::vector<int>& edges,
                                                        int max_bounces) const;
 
   Grid grid_;
   int kmax_ = 0;
-  std::array<Sampled, 3> obs_;
+  Observer obs_;
   Sampled light_, albedo_, environment_;
   bool has_environment_ = false;
   std::vector<Surface> surfaces_;  // by object id (0: background)
   Transfer transfer_;
-  std::vector<std::vector<std::array<Vec3d, 2>>> exact_;  // [id][k][lobe], scaled to Y = 1
+  Templates exact_;  // [id][k][lobe], scaled to Y = 1
   std::vector<std::vector<std::array<double, 2>>> exact_y_;
   TemplateSpectra exact_spectra_;                         // [id][k][lobe], 1 nm samples
   std::vector<std::vector<std::array<double, 2>>> share_;  // [id][k][lobe]: Σ over pixels of the luminance share
@@ -308,134 +126,85 @@ class Model {
 };
 
 Model::Model(const Scene& scene, const PlanOptions& options, std::vector<std::string>& notes, int reference_bounces) {
+  const sensor::CameraCurves curves = set_grid(scene, options, notes, reference_bounces);
+  const std::vector<TriangleMesh> meshes = scene_meshes(scene);
+  set_surfaces(scene, meshes, options, notes, reference_bounces);
+  transfer_ = transfer_factors(scene, meshes, kTransferRays);
+  set_exact_templates();
+  const Preview preview = render_preview(scene, options, curves);
+  const auto first_light = static_cast<std::int32_t>(scene.objects.size()) + 1;
+  const std::vector<bool> near_light = near_emitters(preview.image.object_ids, preview.image.width, preview.image.height,
+                                                     [&](std::int32_t id) { return id >= first_light; });
+  read_preview(preview, near_light);
+  set_white(preview, near_light);
+  measure_preview_noise(preview);
+}
+
+// The 1 nm grid over the scene's bands, the truth's depth (before the mean albedo extends it), the observer on the
+// grid and the candidate band edges: the range's ends and the multiples of the edge step inside it.
+sensor::CameraCurves Model::set_grid(const Scene& scene, const PlanOptions& options, std::vector<std::string>& notes,
+                                     int reference_bounces) {
   const Bands& sb = scene.render.bands;
   grid_.lo = static_cast<int>(std::ceil(sb.min_wavelength() - 1e-9));
   grid_.hi = static_cast<int>(std::floor(sb.max_wavelength() + 1e-9));
   if (grid_.hi - grid_.lo < 2) throw InputError(fmt::format("{}: render.bands: range too narrow to plan", scene.source));
   kmax_ = reference_bounces > 0 ? reference_bounces : scene.render.max_bounces;
 
-  const sensor::CameraCurves curves = sensor::camera_curves(options.camera, {"r", "g", "b"}, "--camera");
+  sensor::CameraCurves curves = sensor::camera_curves(options.camera, {"r", "g", "b"}, "--camera");
   if (sb.min_wavelength() < curves.min_wavelength() - 1e-9 || sb.max_wavelength() > curves.max_wavelength() + 1e-9)
     notes.push_back(fmt::format("the camera {} has curves over {:g}-{:g} nm only: it sees nothing of the bands beyond",
                                 curves.name, curves.min_wavelength(), curves.max_wavelength()));
   for (int c = 0; c < 3; ++c) obs_[c] = grid_.sample([&](double nm) { return curves.curves[c](nm); });
 
-  // Candidate edges: the range's ends and the multiples of the step inside it.
   const double step = options.edge_step_nm;
   grid_edges_.push_back(0);
   for (double nm = std::ceil((grid_.lo + 1e-9) / step) * step; nm < grid_.hi - 1e-9; nm += step)
     if (nm > grid_.lo + 1e-9) grid_edges_.push_back(static_cast<int>(std::lround(nm)) - grid_.lo);
   grid_edges_.push_back(grid_.hi - grid_.lo);
+  return curves;
+}
 
-  reconstruct_ = options.reconstruction;
-  auto spectrum_of = [&](const SpectrumRef& ref, const std::string& what) -> Sampled {
-    if (ref.texture) {
-      if (reconstruct_)
-        notes.push_back(fmt::format("{} is an image texture, whose spectra the model does not hold: no reconstruction "
-                                    "is fitted (the bands' values are read as a step function)", what));
-      reconstruct_ = false;
-      notes.push_back(fmt::format("{} is an image texture: modelled as a flat reflectance of 0.5", what));
-      return grid_.sample([](double) { return 0.5; });
-    }
-    return grid_.sample([&](double nm) { return ref.spectrum(nm); });
-  };
-  const Sampled zero = grid_.sample([](double) { return 0.0; });
-  const Sampled one = grid_.sample([](double) { return 1.0; });
-
-  // The light spectrum and the mean albedo.
+// The light, the surfaces (plan/radiosity.h), the mean albedo and, for a reference depth, how deep the truth goes.
+void Model::set_surfaces(const Scene& scene, const std::vector<TriangleMesh>& meshes, const PlanOptions& options,
+                         std::vector<std::string>& notes, int reference_bounces) {
   const PiecewiseLinearSpectrum light = scene_light_spectrum(scene);
   light_ = grid_.sample([&](double nm) { return light(nm); });
-  const std::vector<TriangleMesh> meshes = scene_meshes(scene);
-  std::vector<double> albedo(grid_.n(), 0.0);
-  double area_sum = 0;
-  surfaces_.assign(static_cast<std::size_t>(scene.id_count()) + 1, Surface{zero, zero, zero, zero, false});
-  surfaces_[0] = Surface{zero, zero, zero, zero, false};
-  auto add_material = [&](std::size_t id, const Material& m, double area) {
-    Surface& s = surfaces_[id];
-    s.diffuse = spectrum_of(*diffuse_ref(m), fmt::format("materials.{}", m.name));
-    double ks = 0;
-    bool mirror = false;
-    if (auto* d = std::get_if<DichromaticMaterial>(&m.model)) {
-      ks = d->specular;
-      s.glossy = one;
-    } else if (std::holds_alternative<MirrorMaterial>(m.model)) {
-      s.glossy = s.diffuse;
-      s.diffuse = zero;
-      mirror = true;
-    }
-    s.albedo.v.resize(albedo.size());
-    for (std::size_t i = 0; i < albedo.size(); ++i) {
-      s.albedo.v[i] = s.diffuse.v[i] + ks + (mirror ? s.glossy.v[i] : 0);
-      albedo[i] += area * s.albedo.v[i];
-    }
-    Grid::finish(s.albedo);
-    area_sum += area;
-  };
-  for (std::size_t o = 0; o < scene.objects.size(); ++o)
-    add_material(o + 1, scene.materials[scene.objects[o].material], surface_area(meshes[o]));
-  for (std::size_t l = 0; l < scene.lights.size(); ++l) {
-    const std::size_t id = scene.objects.size() + l + 1;
-    const Light& light_l = scene.lights[l];
-    if (light_l.material) add_material(id, scene.materials[*light_l.material], surface_area(meshes[id - 1]));
-    surfaces_[id].emitter = true;
-    if (light_l.radiance.texture) {
-      notes.push_back(fmt::format("lights[{}].radiance is an image texture: modelled as the scene's light", l));
-      surfaces_[id].emission = light_;
-    } else {
-      const PiecewiseLinearSpectrum e = light_l.emitted_radiance();
-      surfaces_[id].emission = grid_.sample([&](double nm) { return e(nm); });
-    }
-  }
-  albedo_.v = albedo;
-  for (double& a : albedo_.v) a /= std::max(area_sum, 1e-300);
-  Grid::finish(albedo_);
-  {
-    const double ysum = std::accumulate(obs_[1].v.begin(), obs_[1].v.end(), 0.0);
-    double s = 0;
-    for (std::size_t i = 0; i < albedo_.v.size(); ++i) s += albedo_.v[i] * obs_[1].v[i];
-    mean_albedo_ = ysum > 0 ? s / ysum : 0;
-  }
+  SceneSurfaces s = scene_surfaces(scene, meshes, grid_, light_, options.reconstruction, notes);
+  reconstruct_ = options.reconstruction && !s.textured;
+  surfaces_ = std::move(s.surfaces);
+  albedo_ = std::move(s.mean_albedo);
+  environment_ = std::move(s.environment);
+  has_environment_ = s.has_environment;
+  const double ysum = std::accumulate(obs_[1].v.begin(), obs_[1].v.end(), 0.0);
+  double y = 0;
+  for (std::size_t i = 0; i < albedo_.v.size(); ++i) y += albedo_.v[i] * obs_[1].v[i];
+  mean_albedo_ = ysum > 0 ? y / ysum : 0;
   if (reference_bounces > 0 && mean_albedo_ > 0 && mean_albedo_ < 1)
     kmax_ = std::clamp(static_cast<int>(std::ceil(std::log(kNegligibleShare) / std::log(mean_albedo_))), kmax_,
                        std::max(kmax_, kMaxReferenceBounces));
   else if (reference_bounces > 0 && mean_albedo_ >= 1)
     kmax_ = std::max(kmax_, kMaxReferenceBounces);
-  // The background: what the environment (or, in edge pixels, any surface) sends.
-  surfaces_[0].emission = light_;
-  surfaces_[0].diffuse = albedo_;
-  surfaces_[0].glossy = albedo_;
+}
 
-  if (scene.environment) {
-    has_environment_ = true;
-    if (scene.environment->radiance.texture) {
-      notes.push_back("environment.radiance is an image texture: modelled as the scene's light spectrum");
-      environment_ = light_;
-    } else {
-      const PiecewiseLinearSpectrum e = scene.environment->radiance.spectrum.scaled(scene.environment->scale);
-      environment_ = grid_.sample([&](double nm) { return e(nm); });
-    }
-    surfaces_[0].emission = environment_;
-  }
-  transfer_ = transfer(scene, meshes, 4096);
-
-  // Exact templates, scaled so that their luminance (second channel) is 1.
+// Exact templates (1 nm samples), scaled so that their luminance (second channel) is 1.
+void Model::set_exact_templates() {
   const std::size_t ids = surfaces_.size();
   Basis exact;
   for (int c = 0; c < 3; ++c) {
     exact.weight[c] = obs_[c].v;
-    exact.weight[c].front() *= 0.5;
-    exact.weight[c].back() *= 0.5;
+    for (std::size_t i = 0; i < exact.weight[c].size(); ++i) exact.weight[c][i] *= trapezoid_weight(i, exact.weight[c].size());
   }
+  const std::vector<double> zero(grid_.n(), 0.0);
   for (const Surface& s : surfaces_) {
     exact.emission.push_back(s.emission.v);
     exact.diffuse.push_back(s.diffuse.v);
     exact.glossy.push_back(s.glossy.v);
-    exact.albedo.push_back(s.albedo.v.empty() ? zero.v : s.albedo.v);
+    exact.albedo.push_back(s.albedo.v.empty() ? zero : s.albedo.v);
   }
   exact.light = light_.v;
   exact.mean_albedo = albedo_.v;
   if (has_environment_) exact.environment = environment_.v;
-  exact_ = templates(exact, transfer_, kmax_, &exact_spectra_);
+  exact_ = bounce_templates(exact, transfer_, kmax_, &exact_spectra_);
   exact_y_.assign(ids, std::vector<std::array<double, 2>>(static_cast<std::size_t>(kmax_) + 1, {0.0, 0.0}));
   for (std::size_t id = 0; id < ids; ++id)
     for (int k = 0; k <= kmax_; ++k)
@@ -445,29 +214,39 @@ Model::Model(const Scene& scene, const PlanOptions& options, std::vector<std::st
         if (x[1] > 0) x = {x[0] / x[1], 1.0, x[2] / x[1]};
         else x = {0.0, 0.0, 0.0};
       }
+}
 
-  // The preview render.
-  Scene preview = scene;
-  preview.render.max_bounces = kmax_;
+// The preview: the scene at options.preview_size pixels on its longer side, to the model's depth, every component.
+Preview Model::render_preview(const Scene& scene, const PlanOptions& options, const sensor::CameraCurves& curves) const {
+  Preview p{scene, {}, {}, {}};
+  p.scene.render.max_bounces = kmax_;
   const int w = scene.camera.width, h = scene.camera.height;
   const int size = std::max(1, options.preview_size);
+  Camera& camera = p.scene.camera;
   if (w >= h) {
-    preview.camera.width = std::min(w, size);
-    preview.camera.height = std::max(1, static_cast<int>(std::lround(static_cast<double>(h) * preview.camera.width / w)));
+    camera.width = std::min(w, size);
+    camera.height = std::max(1, static_cast<int>(std::lround(static_cast<double>(h) * camera.width / w)));
   } else {
-    preview.camera.height = std::min(h, size);
-    preview.camera.width = std::max(1, static_cast<int>(std::lround(static_cast<double>(w) * preview.camera.height / h)));
+    camera.height = std::min(h, size);
+    camera.width = std::max(1, static_cast<int>(std::lround(static_cast<double>(w) * camera.height / h)));
   }
-  rt::RenderOptions ro;
-  ro.samples = options.preview_samples;
-  ro.mode = SpectralMode::Bands;
-  ro.components = rt::ComponentSelection::parse("all");
-  ro.threads = options.threads;
-  ro.progress = false;
-  const rt::RenderedImage img = rt::render(preview, ro);
-  const auto q = sensor::photon_response(img.bands, curves, sensor::ResponseBasis::Energy, 1.0,
+  p.options.samples = options.preview_samples;
+  p.options.mode = SpectralMode::Bands;
+  p.options.components = rt::ComponentSelection::parse("all");
+  p.options.threads = options.threads;
+  p.options.progress = false;
+  p.image = rt::render(p.scene, p.options);
+  const auto q = sensor::photon_response(p.image.bands, curves, sensor::ResponseBasis::Energy, 1.0,
                                          PiecewiseLinearSpectrum::constant(1.0));
-  const std::size_t nb = img.bands.size(), N = static_cast<std::size_t>(img.width) * img.height;
+  for (int c = 0; c < 3; ++c) p.weights[c].assign(q[c].begin(), q[c].end());
+  return p;
+}
+
+// Each lit pixel's object and luminance per (bounce order, lobe), from the preview's components; the share of
+// each template in the image.
+void Model::read_preview(const Preview& preview, const std::vector<bool>& near_light) {
+  const rt::RenderedImage& img = preview.image;
+  const std::size_t nb = img.bands.size(), N = preview.pixels(), ids = surfaces_.size();
   auto layer = [&](const std::string& name) -> const std::vector<float>* {
     for (std::size_t i = 0; i < img.components.size(); ++i)
       if (img.components[i] == name) return &img.layers[i + 1];
@@ -476,19 +255,18 @@ Model::Model(const Scene& scene, const PlanOptions& options, std::vector<std::st
   auto lum = [&](const std::vector<float>* l, std::size_t p) {
     if (!l) return 0.0;
     double s = 0;
-    for (std::size_t b = 0; b < nb; ++b) s += q[1][b] * (*l)[p * nb + b];
+    for (std::size_t b = 0; b < nb; ++b) s += preview.weights[1][b] * (*l)[p * nb + b];
     return s;
   };
   const auto *dd = layer("diffuse_direct"), *gd = layer("glossy_direct"), *di = layer("diffuse_indirect"),
              *gi = layer("glossy_indirect");
   pixel_count_ = N;
-  const auto first_light = static_cast<std::int32_t>(scene.objects.size()) + 1;
   std::size_t hits = 0;
   for (std::size_t p = 0; p < N; ++p) {
     Pixel px;
     px.index = p;
     px.id = img.object_ids[p];
-    px.near_light = near_light(img.object_ids, img.width, img.height, p, first_light);
+    px.near_light = near_light[p];
     if (px.id < 0 || static_cast<std::size_t>(px.id) >= ids) px.id = 0;
     if (px.id != 0) ++hits;
     px.y.assign(static_cast<std::size_t>(kmax_) + 1, {0.0, 0.0});
@@ -516,10 +294,13 @@ Model::Model(const Scene& scene, const PlanOptions& options, std::vector<std::st
   for (const Pixel& px : pixels_)
     for (int k = 0; k <= kmax_; ++k)
       for (int lobe = 0; lobe < 2; ++lobe) share_[px.id][k][lobe] += px.y[k][lobe] / px.total;
+}
 
-  // The exact colours and the white.
+// The exact colours of the preview's pixels and the white (core/render_delta_e.h: the scene's light at the level of
+// the exact image, unlit pixels black, lights and their neighbours left out).
+void Model::set_white(const Preview& preview, const std::vector<bool>& near_light) {
   std::vector<Vec3d> xyz(pixels_.size());
-  std::vector<double> ys;
+  std::vector<Vec3d> level(preview.pixels(), Vec3d{});
   for (std::size_t p = 0; p < pixels_.size(); ++p) {
     const Pixel& px = pixels_[p];
     Vec3d x{};
@@ -527,45 +308,34 @@ Model::Model(const Scene& scene, const PlanOptions& options, std::vector<std::st
       for (int lobe = 0; lobe < 2; ++lobe)
         for (int c = 0; c < 3; ++c) x[c] += px.y[k][lobe] * exact_[px.id][k][lobe][c];
     xyz[p] = x;
-    if (!px.near_light) ys.push_back(x[1]);
+    level[px.index] = x;
   }
-  // Pixels with no light count as values of zero.
-  for (std::size_t p = 0, lit = 0; p < N; ++p) {
-    if (lit < pixels_.size() && pixels_[lit].index == p) {
-      ++lit;
-      continue;
-    }
-    if (!near_light(img.object_ids, img.width, img.height, p, first_light)) ys.push_back(0.0);
-  }
-  double yw = percentile(ys, 0.99);
-  if (!(yw > 0)) yw = 1;
-  white_ = tristimulus(light_.v, obs_);
-  const double ws = white_[1] > 0 ? yw / white_[1] : 1.0;
-  for (double& v : white_) v = std::max(v * ws, 1e-300);
+  WhitePolicy policy;
+  policy.light = tristimulus(light_.v, obs_);
+  white_ = white_point(level, near_light, policy);
   lab_exact_.resize(pixels_.size());
   for (std::size_t p = 0; p < pixels_.size(); ++p) lab_exact_[p] = xyz_to_lab(xyz[p], white_);
-
-  // Noise: a second preview with the next seed. The two differ by noise alone, of twice the variance of either;
-  // while noise is small against the colour, ΔE00 grows in proportion to its standard deviation, so one render's
-  // noise is the mean ΔE00 between the two / √2 and falls as 1/√(paths per pixel).
-  rt::RenderOptions ro2 = ro;
-  ro2.seed = scene.render.seed + 1;
-  ro2.components = rt::ComponentSelection::parse("none");
-  const rt::RenderedImage img2 = rt::render(preview, ro2);
-  auto colour = [&](const std::vector<float>& l, std::size_t p) {
-    Vec3d x{};
-    for (int c = 0; c < 3; ++c)
-      for (std::size_t b = 0; b < nb; ++b) x[c] += q[c][b] * l[p * nb + b];
-    return xyz_to_lab(x, white_);
-  };
-  double noise = 0;
-  for (std::size_t p = 0; p < N; ++p) noise += delta_e_2000(colour(img.layers[0], p), colour(img2.layers[0], p));
-  preview_noise_ = N ? noise / static_cast<double>(N) / std::sqrt(2.0) : 0.0;
-  preview_samples_ = img.samples;
 }
 
-std::pair<double, double> Model::score(const std::vector<std::vector<std::array<Vec3d, 2>>>& templates,
-                                       int max_bounces) const {
+// Noise: a second preview with the next seed. The two differ by noise alone, of twice the variance of either;
+// while noise is small against the colour, ΔE00 grows in proportion to its standard deviation, so one render's
+// noise is the mean ΔE00 between the two / √2 and falls as 1/√(paths per pixel).
+void Model::measure_preview_noise(const Preview& preview) {
+  rt::RenderOptions options = preview.options;
+  options.seed = preview.scene.render.seed + 1;
+  options.components = rt::ComponentSelection::parse("none");
+  const rt::RenderedImage second = rt::render(preview.scene, options);
+  const std::size_t N = preview.pixels();
+  std::vector<Vec3d> a(N), b(N);
+  for (std::size_t p = 0; p < N; ++p) {
+    a[p] = preview.colour(preview.image.layers[0], p);
+    b[p] = preview.colour(second.layers[0], p);
+  }
+  preview_noise_ = N ? delta_e_between(a, b, white_).mean / std::sqrt(2.0) : 0.0;
+  preview_samples_ = preview.image.samples;
+}
+
+std::pair<double, double> Model::score(const Templates& templates, int max_bounces) const {
   std::vector<double> de(pixels_.size());
   for (std::size_t p = 0; p < pixels_.size(); ++p) {
     const Pixel& px = pixels_[p];
@@ -577,7 +347,7 @@ std::pair<double, double> Model::score(const std::vector<std::vector<std::array<
   }
   const double sum = std::accumulate(de.begin(), de.end(), 0.0);
   de.resize(pixel_count_, 0.0);  // unlit pixels: no error
-  return {pixel_count_ ? sum / static_cast<double>(pixel_count_) : 0.0, percentile(de, 0.95)};
+  return {pixel_count_ ? sum / static_cast<double>(pixel_count_) : 0.0, quantile(de, 0.95)};
 }
 
 std::pair<double, double> Model::evaluate_exact(int max_bounces) const { return score(exact_, max_bounces); }
@@ -675,7 +445,7 @@ std::pair<double, double> Model::evaluate(const std::vector<int>& edges, int max
   banded.mean_albedo = averages(albedo_);
   if (has_environment_) banded.environment = averages(environment_);
   TemplateSpectra spectra;
-  auto t = templates(banded, transfer_, K, reconstruct ? &spectra : nullptr);
+  auto t = bounce_templates(banded, transfer_, K, reconstruct ? &spectra : nullptr);
   const std::optional<BandReconstruction> fit = reconstruct ? fit_reconstruction(spectra, edges, K) : std::nullopt;
   if (fit) {
     // The observer's weights of the reconstructed spectrum (band_weights with 1 nm fine bands), and the templates

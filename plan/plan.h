@@ -11,9 +11,9 @@
 // spectrum. A pixel's spectrum is Σ_k Y_p,k · (that spectrum scaled to unit luminance). A band plan computes the
 // same recursion on band averages, as the tracer's bands mode and Cycles do, and drops k > K for a bounce limit
 // K. Both go through the observer (the CIE 1931 curves or a shipped camera's) to tristimulus values, to CIELAB
-// under the light's white (scaled to the 99th percentile of the luminance of pixels not on or next to a light),
-// and the predicted error is the mean over pixels of their ΔE00. measure_delta_e() computes the same statistic
-// between two renders. docs/plan.md has the details and the measured accuracy.
+// under the light's white at the level of the exact preview (core/render_delta_e.h, the white policy every
+// render comparison uses), and the predicted error is the mean over pixels of their ΔE00. measure_delta_e()
+// computes the same statistic between two renders. The model itself is plan/radiosity.h. docs/plan.md has the details and the measured accuracy.
 //
 // Band edges for a band count are fitted to that prediction by coordinate descent over a grid of edge
 // positions (whole nm by default), coarse to fine, from the uniform plan and from the previous count's plan with
@@ -27,6 +27,7 @@
 #include <vector>
 
 #include "core/json_input.h"
+#include "core/render_delta_e.h"
 #include "core/scene.h"
 #include "core/spectrum.h"
 
@@ -108,23 +109,11 @@ Json report_document(const Plan& plan, const Scene& scene, const PlanOptions& op
 // uniform environment by 4π·R², R the scene's bounding radius), as a 1 nm table.
 PiecewiseLinearSpectrum scene_light_spectrum(const Scene& scene);
 
-// The q-quantile of v (nearest rank), 0 for none.
-double percentile(std::vector<double> v, double q);
-// Whether pixel p of a w × h id image or one of its 8 neighbours shows a light (an id >= first_light): with a box
-// pixel filter such a pixel may hold light from the emitter itself, so it does not set the white.
-bool near_light(const std::vector<std::int32_t>& ids, int w, int h, std::size_t p, std::int32_t first_light);
-
-struct Measurement {
-  double mean = 0, p95 = 0, max = 0;
-  double rms = 0;  // root mean square: independent errors add in it as squares (to first order)
-  std::size_t pixels = 0;
-  std::vector<double> per_pixel;  // ΔE00 of each pixel, row by row
-};
-// ΔE00 between the totals of two spectral EXR renders of `scene` (same size; any band plans), each turned into
-// tristimulus values through `camera`'s curves over its own bands, in CIELAB under the white of
-// scene_light_spectrum() scaled to the 99th percentile of `reference`'s luminance over pixels not on or next to a
-// light. With `white_from`, the white is that render's instead (so that two noisy renders compare on the scale of
-// a third, converged one).
+using Measurement = RenderDeltaE;
+// ΔE00 (core/render_delta_e.h) between the totals of two spectral EXR renders of `scene` (same size; any band
+// plans), each turned into tristimulus values through `camera`'s curves over its own bands, under the white of
+// scene_light_spectrum() at the level of `reference` (lights: the scene's). With `white_from`, the level is that
+// render's instead (so that two noisy renders compare on the scale of a third, converged one).
 Measurement measure_delta_e(const std::filesystem::path& test, const std::filesystem::path& reference,
                             const Scene& scene, const std::string& camera = "cie1931",
                             const std::filesystem::path& white_from = {});

@@ -9,6 +9,7 @@
 
 #include "core/cie.h"
 #include "core/colour.h"
+#include "plan/spectral_grid.h"
 
 namespace ct::plan {
 namespace {
@@ -16,10 +17,8 @@ namespace {
 // A spectrum on the 1 nm grid [lo, hi].
 using Samples = std::vector<double>;
 
-Samples sample(const PiecewiseLinearSpectrum& s, int lo, int hi) {
-  Samples out(static_cast<std::size_t>(hi - lo + 1));
-  for (std::size_t i = 0; i < out.size(); ++i) out[i] = s(lo + static_cast<double>(i));
-  return out;
+Samples sample(const PiecewiseLinearSpectrum& s, const Grid& grid) {
+  return grid.sample([&](double nm) { return s(nm); }).v;
 }
 
 // The samples band b holds: [a, e) of `count` samples starting at `lo` nm (the last band also holds the last).
@@ -44,7 +43,7 @@ std::vector<double> band_values(const Samples& s, const Bands& bands, int lo) {
 }
 
 // The spectrum as the band plan holds it: each band's average, flat over the band. Sample i stands for
-// [i − ½, i + ½] nm (as xyz() sums), so a band [lo, hi) holds the samples lo … hi − 1 (the last also hi), and bands
+// [i − ½, i + ½] nm (as tristimulus() sums, the two ends halved), so a band [lo, hi) holds the samples lo … hi − 1 (the last also hi), and bands
 // of 1 nm hold every sample as it is.
 Samples banded(const Samples& s, const Bands& bands, int lo) {
   Samples out(s.size(), 0.0);
@@ -56,24 +55,10 @@ Samples banded(const Samples& s, const Bands& bands, int lo) {
   return out;
 }
 
-Vec3d xyz(const Samples& s, const std::array<Samples, 3>& cmf) {
-  Vec3d out{};
-  for (int c = 0; c < 3; ++c)
-    for (std::size_t i = 0; i < s.size(); ++i) out[c] += s[i] * cmf[c][i];
-  return out;
-}
-
 Samples product(const Samples& a, const Samples& b) {
   Samples out(a.size());
   for (std::size_t i = 0; i < a.size(); ++i) out[i] = a[i] * b[i];
   return out;
-}
-
-const SpectrumRef* diffuse_of(const Material& m) {
-  if (auto* l = std::get_if<LambertMaterial>(&m.model)) return &l->reflectance;
-  if (auto* d = std::get_if<DichromaticMaterial>(&m.model)) return &d->diffuse;
-  if (auto* r = std::get_if<MirrorMaterial>(&m.model)) return &r->reflectance;
-  return nullptr;
 }
 
 std::string describe(const Bands& bands) {
@@ -92,22 +77,23 @@ std::vector<SpectralWarning> check_band_plan(const Scene& scene, const Bands& ba
   const int lo = static_cast<int>(std::ceil(bands.min_wavelength() - 1e-9));
   const int hi = static_cast<int>(std::floor(bands.max_wavelength() + 1e-9));
   if (hi - lo < 2) return out;
+  const Grid grid{lo, hi};
   const std::array<const PiecewiseLinearSpectrum*, 3> curves = {&cie::x_bar(), &cie::y_bar(), &cie::z_bar()};
-  std::array<Samples, 3> cmf;
-  for (int c = 0; c < 3; ++c) cmf[c] = sample(*curves[c], lo, hi);
-  const Samples flat(static_cast<std::size_t>(hi - lo + 1), 1.0);
+  Observer cmf;
+  for (int c = 0; c < 3; ++c) cmf[c] = grid.sample([&](double nm) { return (*curves[c])(nm); });
+  const Samples flat = grid.constant(1.0).v;
 
   std::vector<std::pair<std::string, Samples>> lights;
   for (const Light& l : scene.lights)
-    if (!l.radiance.texture) lights.emplace_back(l.name, sample(l.radiance.spectrum, lo, hi));
+    if (!l.radiance.texture) lights.emplace_back(l.name, sample(l.radiance.spectrum, grid));
   if (scene.environment && !scene.environment->radiance.texture)
-    lights.emplace_back("environment", sample(scene.environment->radiance.spectrum, lo, hi));
+    lights.emplace_back("environment", sample(scene.environment->radiance.spectrum, grid));
 
   // ΔE00 of reflectance `r` lit by `e`: banded against exact, under the white of `e`.
   auto error = [&](const Samples& r, const Samples& e) {
-    Vec3d white = xyz(e, cmf);
+    Vec3d white = tristimulus(e, cmf);
     if (!(white[1] > 0)) return 0.0;
-    const Vec3d exact = xyz(product(r, e), cmf);
+    const Vec3d exact = tristimulus(product(r, e), cmf);
     Vec3d approx;
     if (bands.reconstruction()) {
       // The render's band values ⟨R⟩⟨E⟩, turned into a colour through the bands' reconstruction.
@@ -116,7 +102,7 @@ std::vector<SpectralWarning> check_band_plan(const Scene& scene, const Bands& ba
       for (std::size_t b = 0; b < v.size(); ++b) v[b] *= ve[b];
       approx = bands_to_xyz(v, bands);
     } else {
-      approx = xyz(product(banded(r, bands, lo), banded(e, bands, lo)), cmf);
+      approx = tristimulus(product(banded(r, bands, lo), banded(e, bands, lo)), cmf);
     }
     return delta_e_2000(xyz_to_lab(approx, white), xyz_to_lab(exact, white));
   };
@@ -130,9 +116,9 @@ std::vector<SpectralWarning> check_band_plan(const Scene& scene, const Bands& ba
                                  "where it peaks{}",
                                  light, describe(bands), direct, continuous)});
     for (const Material& m : scene.materials) {
-      const SpectrumRef* ref = diffuse_of(m);
-      if (!ref || ref->texture) continue;
-      const Samples r = sample(ref->spectrum, lo, hi);
+      const SpectrumRef& ref = m.reflectance_spectrum();
+      if (ref.texture) continue;
+      const Samples r = sample(ref.spectrum, grid);
       const double de = error(r, e);
       if (!(de > threshold) || !(de > direct)) continue;
       // Whose spectrum the bands cannot follow: the reflectance, if it is off under flat light too.

@@ -18,6 +18,7 @@
 #include "core/parallel.h"
 #include "core/progress.h"
 #include "core/spectral_exr.h"
+#include "core/statistics.h"
 #include "sensor_sim/adc.h"
 #include "sensor_sim/cfa.h"
 #include "sensor_sim/display.h"
@@ -316,14 +317,6 @@ Survey survey_image(SpectralExrReader& reader, const Run& unit_run, const Spectr
   return s;
 }
 
-// The value at `percentile` (nearest rank below) of `values`, which it reorders.
-double percentile_of(std::vector<float>& values, double percentile) {
-  const std::size_t rank =
-      static_cast<std::size_t>(std::floor(percentile / 100.0 * static_cast<double>(values.size() - 1)));
-  std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(rank), values.end());
-  return values[rank];
-}
-
 // Exposure time that puts the `auto_percentile` of the brightest channel's noise-free signal of the surfaces
 // (every pixel unless emitters are excluded, or when nothing else is in view) at `auto_level` of the
 // saturation signal (1 e⁻ for an ideal sensor).
@@ -340,7 +333,8 @@ double auto_exposure(Survey& survey, const SensorConfig& config, const std::stri
     what = fmt::format("of the brightest channel of the surfaces ({} emitter pixel{} left out)", survey.emitters.size(),
                        survey.emitters.size() == 1 ? "" : "s");
   }
-  const double per_second = percentile_of(values, e.auto_percentile);
+  // The configuration says percentiles (0–100); core/statistics.h takes quantiles (0–1), by the same rule.
+  const double per_second = quantile_in_place(values, e.auto_percentile / 100.0);
   if (!(per_second > 0))
     throw InputError(fmt::format("{}: exposure.time_s \"auto\": the image is black (its {}th percentile is {})", file,
                                  e.auto_percentile, per_second));
@@ -402,7 +396,7 @@ DisplayRendering display_rendering(const Survey& survey, const LinearModel& unit
     const Eigen::Vector3d c(survey.display_samples[i], survey.display_samples[i + 1], survey.display_samples[i + 2]);
     brightest.push_back(static_cast<float>(std::max(0.0, (d.matrix * c).maxCoeff())));
   }
-  const double p = brightest.empty() ? 0.0 : percentile_of(brightest, config.display.percentile);
+  const double p = brightest.empty() ? 0.0 : quantile_in_place(brightest, config.display.percentile / 100.0);
   if (p > 0) {
     d.scale = config.display.level / p;
   } else {

@@ -111,4 +111,32 @@ std::array<std::vector<double>, 3> photon_response(const Bands& bands, const Cam
   return q;
 }
 
+namespace {
+
+template <typename T>
+std::vector<std::array<double, 3>> tristimulus_of(std::span<const T> spectra, const Bands& bands,
+                                                  const CameraCurves& camera, std::size_t pixels) {
+  const auto q = photon_response(bands, camera, ResponseBasis::Energy, 1.0, PiecewiseLinearSpectrum::constant(1.0));
+  const std::size_t nb = bands.size();
+  std::vector<std::array<double, 3>> out(pixels);
+  for (std::size_t p = 0; p < pixels; ++p)
+    for (int c = 0; c < 3; ++c) {
+      double s = 0;
+      for (std::size_t b = 0; b < nb; ++b) s += q[c][b] * spectra[p * nb + b];
+      out[p][c] = s;
+    }
+  return out;
+}
+
+}  // namespace
+
+std::vector<std::array<double, 3>> camera_tristimulus(std::span<const float> spectra, const Bands& bands,
+                                                      const CameraCurves& camera, std::size_t pixels) {
+  return tristimulus_of(spectra, bands, camera, pixels);
+}
+std::vector<std::array<double, 3>> camera_tristimulus(std::span<const double> spectra, const Bands& bands,
+                                                      const CameraCurves& camera, std::size_t pixels) {
+  return tristimulus_of(spectra, bands, camera, pixels);
+}
+
 }  // namespace ct::sensor

@@ -12,6 +12,7 @@
 // to ∫ E(λ)·s_c(λ) dλ exactly.
 
 #include <array>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -50,5 +51,13 @@ void check_band_coverage(const Bands& bands, const CameraCurves& camera, const s
 // μ_e,c = A·T·Σ_b E_b·Q[c][b] electrons. Exact for piecewise-linear τ and curves (bands are step functions).
 std::array<std::vector<double>, 3> photon_response(const Bands& bands, const CameraCurves& camera, ResponseBasis basis,
                                                    double peak_qe, const PiecewiseLinearSpectrum& transmittance);
+
+// Each pixel's tristimulus values through the camera's curves (photon_response in the energy basis, unit QE, no
+// filter): `spectra` holds `pixels` × bands.size() values, [pixel][band]. What render comparisons (compare, plan's
+// measured ΔE00) turn a spectral image into.
+std::vector<std::array<double, 3>> camera_tristimulus(std::span<const float> spectra, const Bands& bands,
+                                                      const CameraCurves& camera, std::size_t pixels);
+std::vector<std::array<double, 3>> camera_tristimulus(std::span<const double> spectra, const Bands& bands,
+                                                      const CameraCurves& camera, std::size_t pixels);
 
 }  // namespace ct::sensor

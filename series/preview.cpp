@@ -37,13 +37,6 @@ const analyzer::RgbImage* find_layer(const analyzer::AnalysisImage& input, std::
   return nullptr;
 }
 
-double quantile(std::vector<float> values, double q) {
-  if (values.empty()) return 0;
-  const auto k = static_cast<std::ptrdiff_t>(std::clamp(q, 0.0, 1.0) * static_cast<double>(values.size() - 1));
-  std::nth_element(values.begin(), values.begin() + k, values.end());
-  return values[static_cast<std::size_t>(k)];
-}
-
 cv::Mat preview_image(const analyzer::AnalysisImage& input) {
   if (input.display) {
     const float ones[3] = {1, 1, 1};

@@ -12,14 +12,12 @@
 #include <opencv2/core.hpp>
 
 #include "analyzer/image_input.h"
+#include "core/statistics.h"  // quantile, which the figure's plots use too
 
 namespace ct::series {
 
 // A component layer of the file by name (`emission`, `light.key` …); nullptr when it has none.
 const analyzer::RgbImage* find_layer(const analyzer::AnalysisImage& input, std::string_view name);
-
-// The q-quantile of `values` (0 ≤ q ≤ 1, the nearest rank below); 0 for none.
-double quantile(std::vector<float> values, double q);
 
 // 8-bit BGR (OpenCV's order).
 cv::Mat preview_image(const analyzer::AnalysisImage& input);

@@ -22,6 +22,7 @@
 #include "plan/plan.h"
 #include "reference_tracer/render.h"
 #include "tests/cli/run_command.h"
+#include "core/statistics.h"
 
 namespace ct {
 namespace {
@@ -257,7 +258,7 @@ TEST_F(Plan, PlannedSettingsKeepEveryClassAndTheIlluminant) {
       const double norms = std::hypot(planned.rgb[0], planned.rgb[1], planned.rgb[2]) *
                            std::hypot(reference.rgb[0], reference.rgb[1], reference.rgb[2]);
       const double angle = std::acos(std::min(1.0, dot / norms)) * 180 / M_PI;
-      const double tolerance = reference.uncertainty ? 3 * std::max(*reference.uncertainty, planned.uncertainty.value_or(0)) : 1.0;
+      const double tolerance = reference.uncertainty ? kSigmasOneCheck * std::max(*reference.uncertainty, planned.uncertainty.value_or(0)) : 1.0;
       EXPECT_LE(angle, tolerance) << planned.method;
     }
   }

@@ -23,6 +23,7 @@
 #include "reference_tracer/render.h"
 #include "tests/reference_tracer/lobe_albedo.h"
 #include "tests/common/view_factor.h"
+#include "core/statistics.h"
 
 namespace ct::rt {
 namespace {
@@ -297,7 +298,7 @@ TEST(GgxMasking, RendersAgreeWhereTheyMustAndDifferWhereTheyMust) {
     const double t = view_deg * kPi / 180;
     return test::directional_albedo(GgxLobe{roughness * roughness, correlated}, Vec3(std::sin(t), 0, std::cos(t)), 400000, 19);
   };
-  const auto near = [](const Stats& a, const Stats& b) { return std::abs(a.mean - b.mean) <= 4 * std::hypot(a.se, b.se); };
+  const auto near = [](const Stats& a, const Stats& b) { return std::abs(a.mean - b.mean) <= kSigmasPerItem * std::hypot(a.se, b.se); };
 
   const Stats normal_separable = render_plane(1.0, "separable", 0), normal_correlated = render_plane(1.0, "height-correlated", 0);
   EXPECT_TRUE(near(normal_separable, normal_correlated)) << normal_separable.mean << " vs " << normal_correlated.mean;
@@ -305,7 +306,7 @@ TEST(GgxMasking, RendersAgreeWhereTheyMustAndDifferWhereTheyMust) {
   EXPECT_TRUE(near(smooth_separable, smooth_correlated)) << smooth_separable.mean << " vs " << smooth_correlated.mean;
 
   const Stats grazing_separable = render_plane(1.0, "separable", 80), grazing_correlated = render_plane(1.0, "height-correlated", 80);
-  EXPECT_GT(grazing_correlated.mean - grazing_separable.mean, 4 * std::hypot(grazing_correlated.se, grazing_separable.se))
+  EXPECT_GT(grazing_correlated.mean - grazing_separable.mean, kSigmasPerItem * std::hypot(grazing_correlated.se, grazing_separable.se))
       << grazing_separable.mean << " vs " << grazing_correlated.mean;
   // Each render holds its lobe's albedo (the camera's 1° field of view changes θo by ±0.5°).
   EXPECT_NEAR(normal_separable.mean, albedo(1.0, false, 0).mean, 0.01 * normal_separable.mean + 4 * normal_separable.se);

@@ -10,6 +10,7 @@
 #include "sensor_sim/noise.h"
 #include "tests/core/spectral_exr_fixtures.h"
 #include "tests/sensor_sim/sensor_test_util.h"
+#include "core/statistics.h"
 
 namespace ct {
 namespace {
@@ -154,8 +155,8 @@ TEST(Noise, PoissonHasItsMeanAsMeanAndVariance) {
     }
     const double m = sum / n, v = sum2 / n - m * m;
     // Standard errors: of the mean √(μ/n), of the variance ≈ μ√(2/n) (plus the fourth cumulant μ/n, small).
-    EXPECT_NEAR(m, mean, 5 * std::sqrt(mean / n)) << mean;
-    EXPECT_NEAR(v, mean, 5 * mean * std::sqrt(2.0 / n + 1.0 / (mean * n))) << mean;
+    EXPECT_NEAR(m, mean, kSigmasManyChecks * std::sqrt(mean / n)) << mean;
+    EXPECT_NEAR(v, mean, kSigmasManyChecks * mean * std::sqrt(2.0 / n + 1.0 / (mean * n))) << mean;
   }
 }
 
@@ -168,8 +169,8 @@ TEST(Noise, NormalIsStandard) {
     sum += z;
     sum2 += z * z;
   }
-  EXPECT_NEAR(sum / n, 0.0, 5 / std::sqrt(double(n)));
-  EXPECT_NEAR(sum2 / n, 1.0, 5 * std::sqrt(2.0 / n));
+  EXPECT_NEAR(sum / n, 0.0, kSigmasManyChecks / std::sqrt(double(n)));
+  EXPECT_NEAR(sum2 / n, 1.0, kSigmasManyChecks * std::sqrt(2.0 / n));
 }
 
 TEST(Noise, SameSeedSameFrameOtherSeedOtherFrameSamePattern) {

@@ -17,6 +17,7 @@
 #include "study/charts.h"
 #include "study/study.h"
 #include "tests/cli/run_command.h"
+#include "core/statistics.h"
 
 namespace ct {
 namespace {
@@ -78,7 +79,7 @@ void check_noise_law(const Json& study) {
   const double a = few.at("noise_rms_de00"), sa = few.at("noise_rms_de00_se");
   const double b = base.at("noise_rms_de00"), sb = base.at("noise_rms_de00_se");
   const double ratio = a / b, se = ratio * std::hypot(sa / a, sb / b);
-  EXPECT_NEAR(ratio, 4.0, 3 * se) << a << " / " << b;
+  EXPECT_NEAR(ratio, 4.0, kSigmasOneCheck * se) << a << " / " << b;
   EXPECT_LT(se, 0.25 * ratio);  // the test has power
 }
 
