@@ -14,7 +14,7 @@
 namespace ct::cli {
 
 std::span<const CommandInfo> command_list() {
-  static constexpr std::array<CommandInfo, 16> kCommands = {{
+  static constexpr std::array<CommandInfo, 17> kCommands = {{
       {"info", "Describe an image: kind, size, bands, layers, components, object ids, metadata, per-band statistics"},
       {"check-scene",
        "Validate a scene (chromatrace-scene/1) or an experiment series (chromatrace-series/1) and summarise it"},
@@ -41,6 +41,9 @@ std::span<const CommandInfo> command_list() {
       {"combine", "Combine reference-tracer renders of one scene with different seeds, weighted by their samples"},
       {"farm", "Split work into Slurm jobs on a cluster: tasks in a job array, then an assembly"},
       {"compare", "Cross-validate two spectral renders of one scene: per object, band and component, and ΔE00"},
+      {"calibrate",
+       "A camera's EMVA 1288 parameters (gain, dark noise, saturation, dark current, DSNU, PRNU, linearity) from flat and "
+       "dark frames, as sensor settings"},
       {"prepare-texture",
        "Per-band-group EXR textures (R, G, B = band averages of each texel's spectrum) of an image texture or HDRI, "
        "for Cycles through the Blender add-on; cached by content"},
@@ -63,7 +66,7 @@ namespace {
 
 // The subcommand a command line names: its first argument when that is not an option. Checked before CLI11
 // parses, which would take an unknown name for an extra argument and, with --help, print the general help and
-// exit 0 (`chromatrace calibrate --help`).
+// exit 0 (`chromatrace develop --help`).
 std::optional<int> refuse_unknown_command(int argc, char** argv) {
   if (argc < 2 || argv[1][0] == '-') return std::nullopt;
   const std::string_view name = argv[1];

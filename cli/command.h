@@ -30,6 +30,7 @@ Action add_combine(CLI::App& app);
 // Work split into Slurm jobs on a cluster (docs/farm.md).
 Action add_farm(CLI::App& app);
 Action add_compare(CLI::App& app);
+Action add_calibrate(CLI::App& app);
 Action add_prepare_texture(CLI::App& app);
 
 }  // namespace ct::cli

@@ -26,7 +26,7 @@ int main(int argc, char** argv) {
       {"study", add_study},       {"scene-bands", add_scene_bands},
       {"export-meshes", add_export_meshes}, {"assemble", add_assemble},
       {"combine", add_combine},   {"farm", add_farm},
-      {"compare", add_compare},   {"prepare-texture", add_prepare_texture},
+      {"compare", add_compare},   {"calibrate", add_calibrate},   {"prepare-texture", add_prepare_texture},
   };
   CLI::App app{kAppDescription};
   setup_app(app);

@@ -177,7 +177,8 @@ void read_cfa(const JsonNode& node, CfaConfig& c) {
 }
 
 void read_noise(const JsonNode& node, NoiseConfig& z) {
-  node.expect_object({"enabled", "shot", "dark_current_e_per_s", "read_e", "dsnu_e", "prnu", "seed", "pattern_seed"});
+  node.expect_object({"enabled", "shot", "dark_current_e_per_s", "read_e", "dsnu_e", "prnu", "dsnu_row_e", "dsnu_column_e", "prnu_row",
+                      "prnu_column", "seed", "pattern_seed"});
   read_key(node, "enabled", [&](const JsonNode& n) { z.enabled = n.boolean(); });
   read_key(node, "shot", [&](const JsonNode& n) { z.shot = n.boolean(); });
   read_key(node, "dark_current_e_per_s", [&](const JsonNode& n) { z.dark_current_e_per_s = n.number_at_least(0); });
@@ -187,6 +188,10 @@ void read_noise(const JsonNode& node, NoiseConfig& z) {
     z.prnu = n.number_in(0, 1);
     if (z.prnu == 1) n.fail("must be below 1");
   });
+  read_key(node, "dsnu_row_e", [&](const JsonNode& n) { z.dsnu_row_e = n.number_at_least(0); });
+  read_key(node, "dsnu_column_e", [&](const JsonNode& n) { z.dsnu_column_e = n.number_at_least(0); });
+  read_key(node, "prnu_row", [&](const JsonNode& n) { z.prnu_row = n.number_in(0, 0.5); });
+  read_key(node, "prnu_column", [&](const JsonNode& n) { z.prnu_column = n.number_in(0, 0.5); });
   read_key(node, "seed", [&](const JsonNode& n) { z.seed = seed(n); });
   read_key(node, "pattern_seed", [&](const JsonNode& n) { z.pattern_seed = seed(n); });
 }
@@ -429,7 +434,7 @@ Json config_json(const SensorConfig& c) {
     matrix.push_back(
         {c.rendering.colour_matrix(i, 0), c.rendering.colour_matrix(i, 1), c.rendering.colour_matrix(i, 2)});
   const Eigen::Vector3d& g = c.rendering.white_balance;
-  return {
+  Json json = {
       {"format", kSensorFormat},
       {"preset", c.preset},
       {"description", c.description},
@@ -491,6 +496,11 @@ Json config_json(const SensorConfig& c) {
         {"level", c.display.level}}},
       {"notes", c.notes},
   };
+  // The row and column patterns are written only when set, so that the settings of every other sensor read as before.
+  for (const auto& [key, value] : {std::pair{"dsnu_row_e", c.noise.dsnu_row_e}, std::pair{"dsnu_column_e", c.noise.dsnu_column_e},
+                                   std::pair{"prnu_row", c.noise.prnu_row}, std::pair{"prnu_column", c.noise.prnu_column}})
+    if (value > 0) json["noise"][key] = value;
+  return json;
 }
 
 }  // namespace ct::sensor

@@ -88,6 +88,8 @@ struct NoiseConfig {
   double read_e = 0.0;                // σ of the Normal read noise, e⁻
   double dsnu_e = 0.0;                // σ of the fixed dark-signal offset per pixel, e⁻
   double prnu = 0.0;                  // σ of the fixed relative gain per pixel (0.01 = 1 %)
+  double dsnu_row_e = 0.0, dsnu_column_e = 0.0;  // σ of a fixed offset shared by a row, by a column, e⁻
+  double prnu_row = 0.0, prnu_column = 0.0;      // σ of a fixed relative gain shared by a row, by a column
   std::uint64_t seed = 0;             // temporal noise: one frame
   std::uint64_t pattern_seed = 0;     // DSNU and PRNU: one sensor
 };

@@ -66,8 +66,20 @@ double standard_normal(Random& random) {
   return std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * std::numbers::pi * u2);
 }
 
+// The fixed-pattern draws of a whole row or column (gain, then offset), on streams no pixel uses (pixel streams lie
+// below 2^62 for any image the pixel budget allows).
+std::pair<double, double> line_pattern(const NoiseConfig& noise, bool column, std::uint32_t line, int channel, double gain,
+                                       double offset) {
+  if (gain <= 0 && offset <= 0) return {0.0, 0.0};
+  const std::uint64_t base = column ? (std::uint64_t{3} << 62) : (std::uint64_t{2} << 62);
+  Random random(noise.pattern_seed, base + 3 * std::uint64_t{line} + static_cast<std::uint64_t>(channel));
+  const double g = gain * standard_normal(random);
+  return {g, offset * standard_normal(random)};
+}
+
 double read_out_electrons(const NoiseConfig& noise, const FullWellConfig& full_well, double exposure_s, double photo_e,
-                          std::uint64_t pixel, int channel) {
+                          const PixelSite& site, int channel) {
+  const std::uint64_t pixel = site.index;
   const double dark_e = noise.dark_current_e_per_s * exposure_s;
   double e = photo_e + dark_e;
   double read = 0;
@@ -78,6 +90,10 @@ double read_out_electrons(const NoiseConfig& noise, const FullWellConfig& full_w
       prnu = noise.prnu * standard_normal(pattern);
       dsnu = noise.dsnu_e * standard_normal(pattern);
     }
+    const auto [row_gain, row_offset] = line_pattern(noise, false, site.row, channel, noise.prnu_row, noise.dsnu_row_e);
+    const auto [column_gain, column_offset] = line_pattern(noise, true, site.column, channel, noise.prnu_column, noise.dsnu_column_e);
+    prnu += row_gain + column_gain;
+    dsnu += row_offset + column_offset;
     Random temporal(noise.seed, stream(pixel, channel, false));
     const double mean = (1.0 + prnu) * photo_e + dark_e;
     e = (noise.shot ? static_cast<double>(poisson(mean, temporal)) : mean) + dsnu;

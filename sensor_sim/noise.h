@@ -19,11 +19,19 @@ std::uint64_t poisson(double mean, Random& random);
 // A standard normal variate (Box–Muller).
 double standard_normal(Random& random);
 
-// The electrons read from channel `channel` of sensor pixel `pixel` (its index y·width + x) whose noise-free
-// mean photo-electron count is `photo_e`, exposed for `exposure_s`:
-//   e = Poisson((1 + prnu·z₁)·photo_e + I_d·T) + dsnu·z₂, clipped to the full well, + Normal(0, σ_read)
-// with z₁, z₂ the pixel's fixed-pattern normal variates. Without noise: e = min(photo_e + I_d·T, full well).
+// A sensor pixel: its index y·width + x, its row y and its column x.
+struct PixelSite {
+  std::uint64_t index = 0;
+  std::uint32_t row = 0, column = 0;
+};
+
+// The electrons read from channel `channel` of sensor pixel `site` whose noise-free mean photo-electron count is
+// `photo_e`, exposed for `exposure_s`:
+//   e = Poisson((1 + prnu·z₁ + prnu_row·r₁ + prnu_column·c₁)·photo_e + I_d·T) + dsnu·z₂ + dsnu_row·r₂ + dsnu_column·c₂,
+// clipped to the full well, + Normal(0, σ_read), with z the pixel's fixed-pattern normal variates, r its row's and c
+// its column's (EMVA 1288 Release 4.0 splits the non-uniformities the same way). Without noise:
+// e = min(photo_e + I_d·T, full well).
 double read_out_electrons(const NoiseConfig& noise, const FullWellConfig& full_well, double exposure_s, double photo_e,
-                          std::uint64_t pixel, int channel);
+                          const PixelSite& site, int channel);
 
 }  // namespace ct::sensor

@@ -102,9 +102,10 @@ std::vector<float> read_out_rows(const Run& run, std::span<const float> linear, 
   const std::size_t width = to_size(run.width());
   const std::size_t rows = to_size(y1 - y0);
   const auto value = [&](std::size_t r, std::size_t x, int channel) {
-    const std::uint64_t pixel = (to_size(y0) + r) * width + x;
+    const std::size_t y = to_size(y0) + r;
+    const sensor::PixelSite site{y * width + x, static_cast<std::uint32_t>(y), static_cast<std::uint32_t>(x)};
     const double e = read_out_electrons(c.noise, c.full_well, run.exposure_s,
-                                        linear[(r * width + x) * 3 + to_size(channel)], pixel, channel);
+                                        linear[(r * width + x) * 3 + to_size(channel)], site, channel);
     return static_cast<float>(c.adc.enabled ? digitise(c.adc, e) : e);
   };
   std::vector<float> rgb(rows * width * 3);

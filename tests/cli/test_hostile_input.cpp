@@ -449,7 +449,7 @@ TEST(HostileInput, AQuadFarAwayIsRefusedBeforeRendering) {
 TEST(HostileInput, AnUnknownCommandIsAnErrorNamingItAlsoWithHelp) {
   for (const std::string& exe : {std::string(CHROMATRACE_EXE), std::string(CHROMATRACE_FULL_EXE)})
     for (const std::vector<std::string>& args : std::vector<std::vector<std::string>>{
-             {"calibrate"}, {"calibrate", "--help"}, {"calibrate", "info", "x.exr"}, {"Render", "-h"}}) {
+             {"develop"}, {"develop", "--help"}, {"develop", "info", "x.exr"}, {"Render", "-h"}}) {
       const auto r = test::run_program(exe, args);
       EXPECT_EQ(r.exit_code, 2) << exe << " " << args[0] << ": " << r.err;
       EXPECT_EQ(r.out, "") << exe << " " << args[0];

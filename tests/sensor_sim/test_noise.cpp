@@ -179,17 +179,17 @@ TEST(Noise, SameSeedSameFrameOtherSeedOtherFrameSamePattern) {
   noise.read_e = 3;
   noise.prnu = 0.05;
   const sensor::FullWellConfig well;
-  const double a = sensor::read_out_electrons(noise, well, 1, 1000, 42, 1);
-  EXPECT_EQ(a, sensor::read_out_electrons(noise, well, 1, 1000, 42, 1));
-  EXPECT_NE(a, sensor::read_out_electrons(noise, well, 1, 1000, 43, 1));
-  EXPECT_NE(a, sensor::read_out_electrons(noise, well, 1, 1000, 42, 2));
+  const double a = sensor::read_out_electrons(noise, well, 1, 1000, {42, 0, 42}, 1);
+  EXPECT_EQ(a, sensor::read_out_electrons(noise, well, 1, 1000, {42, 0, 42}, 1));
+  EXPECT_NE(a, sensor::read_out_electrons(noise, well, 1, 1000, {43, 0, 43}, 1));
+  EXPECT_NE(a, sensor::read_out_electrons(noise, well, 1, 1000, {42, 0, 42}, 2));
   noise.seed = 1;
-  EXPECT_NE(a, sensor::read_out_electrons(noise, well, 1, 1000, 42, 1));
+  EXPECT_NE(a, sensor::read_out_electrons(noise, well, 1, 1000, {42, 0, 42}, 1));
   // Without noise a pixel reads its mean, dark current included, clipped to the full well.
   noise.enabled = false;
   noise.dark_current_e_per_s = 10;
-  EXPECT_EQ(sensor::read_out_electrons(noise, well, 2, 1000, 42, 1), 1020);
-  EXPECT_EQ(sensor::read_out_electrons(noise, {true, 500}, 2, 1000, 42, 1), 500);
+  EXPECT_EQ(sensor::read_out_electrons(noise, well, 2, 1000, {42, 0, 42}, 1), 1020);
+  EXPECT_EQ(sensor::read_out_electrons(noise, {true, 500}, 2, 1000, {42, 0, 42}, 1), 500);
 }
 
 TEST(Adc, RoundsAndClipsToTheCodeRange) {

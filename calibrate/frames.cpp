@@ -1,0 +1,74 @@
+#include "calibrate/frames.h"
+
+#include <cmath>
+
+#include <fmt/format.h>
+#include <OpenImageIO/imageio.h>
+
+#include "analyzer/image_input.h"
+#include "analyzer/raw_input.h"
+#include "core/error.h"
+#include "core/json_input.h"
+
+namespace ct::calibrate {
+namespace {
+
+// The exposure time a file records: EXIF's ExposureTime (camera raw, DNG), else the simulator's settings.
+std::optional<double> recorded_exposure(const std::filesystem::path& file) {
+  auto in = OIIO::ImageInput::open(file.string());
+  if (!in) {
+    (void)OIIO::geterror();
+    return std::nullopt;
+  }
+  const OIIO::ImageSpec& spec = in->spec();
+  if (const float t = spec.get_float_attribute("ExposureTime", 0.0f); t > 0) return static_cast<double>(t);
+  const std::string sensor = spec.get_string_attribute("chromatrace.sensor");
+  if (!sensor.empty()) {
+    const Json j = Json::parse(sensor, nullptr, false);
+    if (j.is_object() && j.contains("exposure") && j["exposure"].contains("time_s") && j["exposure"]["time_s"].is_number())
+      return j["exposure"]["time_s"].get<double>();
+  }
+  return std::nullopt;
+}
+
+}  // namespace
+
+Frame read_frame(const std::filesystem::path& file) {
+  const std::string name = file.string();
+  const bool raw = analyzer::is_camera_raw(file);
+  analyzer::RawOptions options;
+  options.half_size = true;
+  const analyzer::AnalysisImage image = analyzer::read_analysis_image(file, "auto", options);
+  const analyzer::ImageEncoding& e = image.encoding;
+  if (!raw && e.demosaiced != false)
+    throw InputError(fmt::format("{}: its pixels {} interpolated from a colour filter array, so neighbours share their noise; "
+                                 "calibrate from the camera raw (or the simulator's DNG) or from frames written without a CFA",
+                                 name, e.demosaiced ? "were" : "may have been"));
+  if (e.curve && !e.curve->linear())
+    throw InputError(fmt::format("{}: its values are encoded with a response curve ({}); calibration needs linear digital numbers", name,
+                                 e.curve->describe()));
+  const std::optional<double> exposure = recorded_exposure(file);
+  if (!exposure)
+    throw InputError(fmt::format("{}: no exposure time (EXIF ExposureTime, or exposure.time_s in chromatrace.sensor)", name));
+  Frame f;
+  f.file = name;
+  f.exposure_s = *exposure;
+  f.adc_bits = e.adc_bits;
+  f.white_level_dn = e.white_level;
+  const double black = e.black_subtracted && e.black_level ? *e.black_level : 0.0;
+  const analyzer::RgbImage& rgb = image.image;
+  for (int c = 0; c < 3; ++c) {
+    Plane& p = f.channels[static_cast<std::size_t>(c)];
+    p.width = rgb.width;
+    p.height = rgb.height;
+    p.values.resize(rgb.pixel_count());
+    for (std::size_t i = 0; i < p.values.size(); ++i) {
+      const float v = rgb.rgb[3 * i + static_cast<std::size_t>(c)];
+      if (!std::isfinite(v)) throw InputError(fmt::format("{}: pixel {} has a value that is not a number", name, i));
+      p.values[i] = static_cast<double>(v) + black;
+    }
+  }
+  return f;
+}
+
+}  // namespace ct::calibrate

@@ -1,0 +1,283 @@
+#include "calibrate/photon_transfer.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+
+#include <fmt/format.h>
+
+#include "core/error.h"
+
+namespace ct::calibrate {
+namespace {
+
+constexpr double kQuantisationVariance = 1.0 / 12.0;  // σ_q², DN²
+constexpr double kGainFitTop = 0.7;                    // the gain is fitted up to this share of saturation
+constexpr double kLinearityLow = 0.05, kLinearityHigh = 0.95;
+
+double mean_of(const std::vector<double>& v) { return std::accumulate(v.begin(), v.end(), 0.0) / static_cast<double>(v.size()); }
+
+double variance_of(const std::vector<double>& v) {
+  const double m = mean_of(v);
+  double s = 0;
+  for (const double x : v) s += (x - m) * (x - m);
+  return s / static_cast<double>(v.size() - 1);
+}
+
+// The standard error of a variance s² estimated from n values (Gaussian: var(s²) = 2σ⁴/(n − 1)).
+double variance_se(double variance, std::size_t n) { return variance * std::sqrt(2.0 / static_cast<double>(n - 1)); }
+
+// Temporal statistics of a set of frames of one scene: the mean over every frame, and the temporal variance from
+// the differences of consecutive pairs, var(A − B)/2, averaged over the pairs (the fixed pattern cancels).
+struct Temporal {
+  double mean = 0, variance = 0;
+};
+Temporal temporal(const std::vector<Plane>& frames) {
+  Temporal t;
+  for (const Plane& f : frames) t.mean += mean_of(f.values);
+  t.mean /= static_cast<double>(frames.size());
+  std::size_t pairs = 0;
+  for (std::size_t k = 0; k + 1 < frames.size(); k += 2, ++pairs) {
+    std::vector<double> d(frames[k].values.size());
+    for (std::size_t p = 0; p < d.size(); ++p) d[p] = frames[k].values[p] - frames[k + 1].values[p];
+    t.variance += variance_of(d) / 2;
+  }
+  t.variance /= static_cast<double>(pairs);
+  return t;
+}
+
+// The mean of the frames, pixel by pixel: what the spatial non-uniformity is measured on.
+Plane average(const std::vector<Plane>& frames) {
+  Plane m{frames[0].width, frames[0].height, std::vector<double>(frames[0].values.size(), 0.0)};
+  for (const Plane& f : frames)
+    for (std::size_t p = 0; p < m.values.size(); ++p) m.values[p] += f.values[p];
+  for (double& v : m.values) v /= static_cast<double>(frames.size());
+  return m;
+}
+
+// Spatial variance of a mean image split into row, column and pixel parts (DN²), less the temporal variance the
+// mean still holds (temporal_variance / frames). With y_ij = μ + a_i + b_j + e_ij: var(row means) = s_row² + X/N,
+// var(column means) = s_col² + X/M and var(y) = s_row² + s_col² + X, X the pixel part with the temporal rest, for
+// M rows of N columns.
+struct SpatialVariance {
+  double total = 0, row = 0, column = 0, pixel = 0;
+  double total_se = 0, row_se = 0, column_se = 0, pixel_se = 0;  // var(s²) = 2σ⁴/(n − 1) of what each is measured on
+};
+SpatialVariance spatial_variance(const Plane& mean, double temporal_variance, std::size_t frames) {
+  const auto M = static_cast<std::size_t>(mean.height), N = static_cast<std::size_t>(mean.width);
+  std::vector<double> rows(M, 0.0), columns(N, 0.0);
+  for (std::size_t i = 0; i < M; ++i)
+    for (std::size_t j = 0; j < N; ++j) {
+      rows[i] += mean.values[i * N + j] / static_cast<double>(N);
+      columns[j] += mean.values[i * N + j] / static_cast<double>(M);
+    }
+  const double all = variance_of(mean.values), vr = variance_of(rows), vc = variance_of(columns);
+  const double rest = temporal_variance / static_cast<double>(frames);
+  const double x = (all - vr - vc) / (1.0 - 1.0 / static_cast<double>(N) - 1.0 / static_cast<double>(M));
+  SpatialVariance s;
+  s.row = std::max(0.0, vr - x / static_cast<double>(N));
+  s.column = std::max(0.0, vc - x / static_cast<double>(M));
+  s.pixel = std::max(0.0, x - rest);
+  s.total = s.row + s.column + s.pixel;
+  s.total_se = s.pixel_se = variance_se(all, mean.values.size());
+  s.row_se = variance_se(vr, M);
+  s.column_se = variance_se(vc, N);
+  return s;
+}
+
+// Least squares y = a + b·x (or y = b·x through the origin) with the standard errors from the residuals.
+struct LineFit {
+  double intercept = 0, slope = 0, intercept_se = 0, slope_se = 0;
+};
+LineFit fit_line(const std::vector<double>& x, const std::vector<double>& y, bool through_origin) {
+  const auto n = static_cast<double>(x.size());
+  LineFit f;
+  if (through_origin) {
+    double sxx = 0, sxy = 0;
+    for (std::size_t i = 0; i < x.size(); ++i) sxx += x[i] * x[i], sxy += x[i] * y[i];
+    f.slope = sxy / sxx;
+    double r = 0;
+    for (std::size_t i = 0; i < x.size(); ++i) r += std::pow(y[i] - f.slope * x[i], 2);
+    f.slope_se = n > 1 ? std::sqrt(r / (n - 1) / sxx) : 0.0;
+    return f;
+  }
+  const double mx = mean_of(x), my = mean_of(y);
+  double sxx = 0, sxy = 0;
+  for (std::size_t i = 0; i < x.size(); ++i) sxx += (x[i] - mx) * (x[i] - mx), sxy += (x[i] - mx) * (y[i] - my);
+  f.slope = sxy / sxx;
+  f.intercept = my - f.slope * mx;
+  double r = 0;
+  for (std::size_t i = 0; i < x.size(); ++i) r += std::pow(y[i] - f.intercept - f.slope * x[i], 2);
+  const double s2 = n > 2 ? r / (n - 2) : 0.0;
+  f.slope_se = std::sqrt(s2 / sxx);
+  f.intercept_se = std::sqrt(s2 * (1.0 / n + mx * mx / sxx));
+  return f;
+}
+
+void check_steps(const std::vector<ExposureStep>& steps) {
+  if (steps.empty()) throw InputError("no frames");
+  const int w = steps[0].flats.empty() ? 0 : steps[0].flats[0].width, h = steps[0].flats.empty() ? 0 : steps[0].flats[0].height;
+  for (const ExposureStep& s : steps) {
+    if (s.flats.size() < 2 || s.darks.size() < 2)
+      throw InputError(fmt::format("exposure {} s has {} flat and {} dark frames; every exposure needs at least two of each "
+                                   "(a pair: their difference cancels the fixed pattern)",
+                                   s.exposure_s, s.flats.size(), s.darks.size()));
+    for (const std::vector<Plane>* set : {&s.flats, &s.darks})
+      for (const Plane& p : *set)
+        if (p.width != w || p.height != h)
+          throw InputError(fmt::format("frames of different sizes: {} x {} and {} x {}", w, h, p.width, p.height));
+  }
+  if (w < 8 || h < 8) throw InputError(fmt::format("frames of {} x {} pixels per channel are too small (at least 8 x 8)", w, h));
+}
+
+}  // namespace
+
+ChannelCalibration calibrate_channel(const std::string& channel, const std::vector<ExposureStep>& input) {
+  check_steps(input);
+  std::vector<ExposureStep> steps = input;
+  std::sort(steps.begin(), steps.end(), [](const ExposureStep& a, const ExposureStep& b) { return a.exposure_s < b.exposure_s; });
+  ChannelCalibration c;
+  c.channel = channel;
+  const std::size_t n = steps[0].flats[0].values.size();
+
+  std::vector<Temporal> flat, dark;
+  for (const ExposureStep& s : steps) {
+    flat.push_back(temporal(s.flats));
+    dark.push_back(temporal(s.darks));
+    c.points.push_back({s.exposure_s, s.photons_per_pixel, flat.back().mean, flat.back().variance, dark.back().mean, dark.back().variance});
+  }
+
+  // Saturation: where the temporal variance of the flats is largest. A series whose last step is the largest has
+  // not shown it.
+  const auto top = static_cast<std::size_t>(std::max_element(flat.begin(), flat.end(), [](const Temporal& a, const Temporal& b) {
+                                              return a.variance < b.variance;
+                                            }) - flat.begin());
+  if (top + 1 == steps.size())
+    throw InputError(fmt::format("channel {}: no exposure saturates (the flats' temporal variance still grows at the longest, "
+                                 "{} s); add exposures up to and beyond saturation",
+                                 channel, steps.back().exposure_s));
+  const double signal_sat = flat[top].mean - dark[top].mean;
+  c.saturation_mean_dn = flat[top].mean;
+
+  // The system gain K from the photon transfer below 70 % of saturation.
+  std::vector<double> x, y;
+  for (std::size_t k = 0; k < top; ++k) {
+    const double signal = flat[k].mean - dark[k].mean;
+    if (signal > 0 && signal <= kGainFitTop * signal_sat) {
+      x.push_back(signal);
+      y.push_back(flat[k].variance - dark[k].variance);
+    }
+  }
+  if (x.size() < 3)
+    throw InputError(fmt::format("channel {}: {} exposure{} between black and 70 % of saturation; the gain needs at least three",
+                                 channel, x.size(), x.size() == 1 ? "" : "s"));
+  const LineFit gain = fit_line(x, y, true);
+  const double K = gain.slope;
+  c.gain_dn_per_e = {K, gain.slope_se};
+  auto relative = [](double se, double value) { return value != 0 ? se / std::abs(value) : 0.0; };
+  const double rK = relative(gain.slope_se, K);
+
+  c.saturation_capacity_e = {signal_sat / K, signal_sat / K * rK};
+
+  // Dark signal against exposure time: the dark current (slope / K), the black level (intercept), and the dark
+  // noise from the intercept of the dark variance.
+  std::vector<double> times, dark_means, dark_variances;
+  for (std::size_t k = 0; k < steps.size(); ++k) {
+    times.push_back(steps[k].exposure_s);
+    dark_means.push_back(dark[k].mean);
+    dark_variances.push_back(dark[k].variance);
+  }
+  const bool several_times = times.front() < times.back();
+  double dark_variance_0 = dark[0].variance, dark_variance_0_se = variance_se(dark[0].variance, n);
+  if (several_times) {
+    const LineFit dm = fit_line(times, dark_means, false);
+    c.dark_current_e_per_s = {dm.slope / K, std::hypot(dm.slope_se / K, dm.slope / K * rK)};
+    c.black_level_dn = {dm.intercept, dm.intercept_se};
+    const LineFit dv = fit_line(times, dark_variances, false);
+    dark_variance_0 = dv.intercept;
+    dark_variance_0_se = std::max(dv.intercept_se, variance_se(dark[0].variance, n) / std::sqrt(double(steps.size())));
+  } else {
+    c.black_level_dn = {dark[0].mean, std::sqrt(dark[0].variance / double(n))};
+    c.notes.push_back("every dark frame has one exposure time: no dark current measured");
+  }
+  const double read_variance = std::max(0.0, dark_variance_0 - kQuantisationVariance);
+  const double sigma_d = std::sqrt(read_variance) / K;
+  c.dark_noise_e = {sigma_d, sigma_d * std::hypot(read_variance > 0 ? dark_variance_0_se / (2 * read_variance) : 0.0, rK)};
+
+  // DSNU at the shortest exposure, PRNU at the flat level nearest half of saturation. A spread √v from a variance v
+  // with standard error se has the standard error se / (2√v), or, where v is not above its error, is bounded by √se.
+  auto spread = [](double variance, double se, double scale, double scale_relative_se) {
+    if (variance <= se) return Estimate{std::sqrt(std::max(0.0, variance)) * scale, std::sqrt(se) * scale};
+    const double v = std::sqrt(variance) * scale;
+    return Estimate{v, v * std::hypot(se / (2 * variance), scale_relative_se)};
+  };
+  const SpatialVariance ds = spatial_variance(average(steps[0].darks), dark[0].variance, steps[0].darks.size());
+  c.dsnu_e = {spread(ds.total, ds.total_se, 1 / K, rK), spread(ds.row, ds.row_se, 1 / K, rK),
+              spread(ds.column, ds.column_se, 1 / K, rK), spread(ds.pixel, ds.pixel_se, 1 / K, rK)};
+
+  std::size_t half = 0;
+  for (std::size_t k = 0; k < top; ++k)
+    if (std::abs(flat[k].mean - dark[k].mean - 0.5 * signal_sat) < std::abs(flat[half].mean - dark[half].mean - 0.5 * signal_sat)) half = k;
+  const double signal_half = flat[half].mean - dark[half].mean;
+  c.prnu_level_fraction = signal_half / signal_sat;
+  const SpatialVariance fs = spatial_variance(average(steps[half].flats), flat[half].variance, steps[half].flats.size());
+  const SpatialVariance dh = spatial_variance(average(steps[half].darks), dark[half].variance, steps[half].darks.size());
+  auto prnu_part = [&](double flat_part, double flat_se, double dark_part, double dark_se) {
+    return spread(flat_part - dark_part, std::hypot(flat_se, dark_se), 1 / signal_half, 0.0);
+  };
+  c.prnu = {prnu_part(fs.total, fs.total_se, dh.total, dh.total_se), prnu_part(fs.row, fs.row_se, dh.row, dh.row_se),
+            prnu_part(fs.column, fs.column_se, dh.column, dh.column_se), prnu_part(fs.pixel, fs.pixel_se, dh.pixel, dh.pixel_se)};
+
+  // The clip level, from the exposures beyond saturation at which every pixel is clipped.
+  double clipped_sum = 0;
+  std::size_t clipped = 0;
+  for (std::size_t k = top + 1; k < steps.size(); ++k)
+    if (flat[k].variance <= 2 * dark[k].variance) clipped_sum += flat[k].mean, ++clipped;
+  if (clipped > 0) {
+    const double level = (clipped_sum / double(clipped) - c.black_level_dn.value) / K;
+    c.clip_level_e = Estimate{level, level * std::hypot(rK, c.black_level_dn.standard_error / (level * K))};
+  } else {
+    c.notes.push_back("no exposure clips every pixel: no clip level (the full well written is EMVA's saturation capacity)");
+  }
+
+  // Linearity between 5 % and 95 % of saturation, against the photons (or the exposure time).
+  const bool photons = std::all_of(steps.begin(), steps.end(), [](const ExposureStep& s) { return s.photons_per_pixel.has_value(); });
+  std::vector<double> u, signal;
+  for (std::size_t k = 0; k < top; ++k) {
+    const double s = flat[k].mean - dark[k].mean;
+    if (s >= kLinearityLow * signal_sat && s <= kLinearityHigh * signal_sat) {
+      u.push_back(photons ? *steps[k].photons_per_pixel : steps[k].exposure_s);
+      signal.push_back(s);
+    }
+  }
+  if (u.size() >= 3 && u.front() < u.back()) {
+    const LineFit lin = fit_line(u, signal, false);
+    double lo = 0, hi = 0;
+    for (std::size_t i = 0; i < u.size(); ++i) {
+      const double fitted = lin.intercept + lin.slope * u[i];
+      const double d = (signal[i] - fitted) / fitted;
+      lo = std::min(lo, d), hi = std::max(hi, d);
+    }
+    c.linearity_error = (hi - lo) / 2;
+  } else {
+    c.notes.push_back("fewer than three exposures between 5 % and 95 % of saturation: no linearity error");
+  }
+  if (!photons) c.notes.push_back("the photons per pixel were not given (--photons-per-s): no quantum efficiency, linearity against exposure time");
+
+  // Quantum efficiency η = R / K, R the responsivity (DN per photon) over the gain's range.
+  if (photons) {
+    std::vector<double> p, s;
+    for (std::size_t k = 0; k < top; ++k) {
+      const double v = flat[k].mean - dark[k].mean;
+      if (v > 0 && v <= kGainFitTop * signal_sat) {
+        p.push_back(*steps[k].photons_per_pixel);
+        s.push_back(v);
+      }
+    }
+    const LineFit r = fit_line(p, s, true);
+    c.quantum_efficiency = Estimate{r.slope / K, r.slope / K * std::hypot(relative(r.slope_se, r.slope), rK)};
+  }
+  return c;
+}
+
+}  // namespace ct::calibrate

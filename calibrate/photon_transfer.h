@@ -1,0 +1,89 @@
+#pragma once
+// A camera's EMVA 1288 "Linear" parameters from a photon-transfer series (EMVA Standard 1288, Release 4.0 Linear,
+// sections 6–8): pairs of flat fields at increasing exposure and pairs of dark frames at the same exposure times,
+// each colour channel of the mosaic on its own.
+//
+// Per exposure time t, with A, B the two flats and C, D the two darks (digital numbers, black not subtracted):
+//   μ_y = mean(A + B)/2, σ_y² = var(A − B)/2 (the fixed pattern cancels in the difference), and μ_y.dark, σ_y.dark²
+//   likewise from C, D. Then
+//   - the overall system gain K: the slope of σ_y² − σ_y.dark² against μ_y − μ_y.dark, a line through the origin
+//     fitted from the darkest flat up to 70 % of saturation;
+//   - saturation: the flat level at which σ_y² is largest; the saturation capacity μ_e.sat = (μ_y − μ_y.dark)/K there;
+//   - the temporal dark noise σ_d = √(σ_y.dark² − σ_q²)/K at the shortest exposure, σ_q² = 1/12 DN²;
+//   - the dark current: the slope of μ_y.dark against t, over K (e⁻/s);
+//   - DSNU and PRNU: the spatial variance of the mean of the frames less the temporal variance left in it
+//     (σ²/L for L frames), split into row, column and pixel parts as Release 4.0 does (the variance of the row
+//     means and of the column means, each less what the pixel part leaves in a mean); DSNU = s_y.dark/K (e⁻),
+//     PRNU = √(s_y.50² − s_y.dark²)/(μ_y.50 − μ_y.dark) at the flat level nearest half of saturation;
+//   - the linearity error: the half range of the relative deviations of μ_y − μ_y.dark from a line through the
+//     flats between 5 % and 95 % of saturation, against the photons per pixel (or the exposure time when the
+//     irradiance is not given: proportional to the photons at constant irradiance);
+//   - the quantum efficiency η = R/K, R the slope of μ_y − μ_y.dark against μ_p, when the photons per pixel are known.
+// Each estimate comes with its standard error: regression slopes from their residuals, variances from
+// var(s²) = 2σ⁴/(n − 1) for n pixels (the Gaussian value), propagated to first order.
+
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace ct::calibrate {
+
+// One frame of one colour channel: its values in digital numbers (black included), row-major.
+struct Plane {
+  int width = 0, height = 0;
+  std::vector<double> values;
+};
+
+// All the frames taken at one exposure time, one plane per frame, for one channel.
+struct ExposureStep {
+  double exposure_s = 0;
+  std::optional<double> photons_per_pixel;  // μ_p, when the irradiance is known
+  std::vector<Plane> flats, darks;
+};
+
+struct Estimate {
+  double value = 0;
+  double standard_error = 0;
+};
+
+// Spatial non-uniformity split into row, column and pixel parts (Release 4.0): total² = row² + column² + pixel².
+struct Nonuniformity {
+  Estimate total, row, column, pixel;
+};
+
+// The measured curve, per exposure step (for the photon-transfer and SNR plots).
+struct TransferPoint {
+  double exposure_s = 0;
+  std::optional<double> photons_per_pixel;
+  double mean_dn = 0, variance_dn2 = 0;            // μ_y, σ_y²
+  double dark_mean_dn = 0, dark_variance_dn2 = 0;  // μ_y.dark, σ_y.dark²
+};
+
+struct ChannelCalibration {
+  std::string channel;
+  std::vector<TransferPoint> points;
+  Estimate gain_dn_per_e;           // K
+  Estimate dark_noise_e;            // σ_d
+  Estimate saturation_capacity_e;   // μ_e.sat
+  double saturation_mean_dn = 0;    // μ_y at saturation
+  // Where every pixel is clipped (the flats' temporal variance no more than twice the dark frames'): the full well
+  // (or the ADC's top code) the pixels stop at, (μ_y − black) / K. EMVA's saturation capacity lies a little below it,
+  // where the brightest pixels of a frame start to clip. Absent when no exposure clips every pixel.
+  std::optional<Estimate> clip_level_e;
+  Estimate dark_current_e_per_s;    // from μ_y.dark against t
+  Estimate black_level_dn;          // μ_y.dark extrapolated to t = 0
+  Nonuniformity dsnu_e;             // DSNU, e⁻
+  Nonuniformity prnu;               // PRNU, a fraction
+  double prnu_level_fraction = 0;   // the flat level PRNU was measured at, as a share of saturation
+  double linearity_error = 0;       // a fraction (EMVA's LE / 100)
+  std::optional<Estimate> quantum_efficiency;
+  std::vector<std::string> notes;   // what could not be estimated, and why
+};
+
+// Estimates one channel's parameters. InputError (message without a file name; the caller adds it) when the
+// steps cannot support the estimates: fewer than two flats or two darks at a step, frames of different sizes,
+// fewer than three exposure steps below saturation, or no step that saturates (the saturation capacity and the
+// 70 % range of the gain fit need it).
+ChannelCalibration calibrate_channel(const std::string& channel, const std::vector<ExposureStep>& steps);
+
+}  // namespace ct::calibrate

@@ -1,0 +1,61 @@
+// chromatrace calibrate --flat F… --dark D… -o CAMERA.json: a camera's EMVA 1288 parameters from a photon-transfer
+// series, as sensor settings the simulator takes and (--report) every estimate per channel with its standard error.
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <fmt/core.h>
+
+#include "calibrate/calibration.h"
+#include "cli/app.h"
+#include "cli/command.h"
+#include "core/error.h"
+#include "core/file_io.h"
+
+namespace ct::cli {
+
+Action add_calibrate(CLI::App& app) {
+  auto* cmd = add_command(app, "calibrate");
+  struct Options {
+    std::vector<std::string> flats, darks;
+    std::string output, report;
+    double photons_per_s = 0;
+    bool quiet = false;
+  };
+  auto o = std::make_shared<Options>();
+  cmd->add_option("--flat", o->flats, "Flat-field frames: at least two at each exposure time (camera raw, or linear EXR/TIFF)")
+      ->required();
+  cmd->add_option("--dark", o->darks, "Dark frames: at least two at each exposure time of the flats")->required();
+  cmd->add_option("-o,--output", o->output, "Sensor settings written (chromatrace-sensor/1), for chromatrace sensor --config")
+      ->required();
+  cmd->add_option("--report", o->report, "Every estimate per channel with its standard error, and the measured curves (JSON)");
+  cmd->add_option("--photons-per-s", o->photons_per_s,
+                  "Photons per pixel and second reaching the sensor in the flats (for the quantum efficiency)");
+  cmd->add_flag("-q,--quiet", o->quiet, "No summary on stderr");
+
+  return [o, cmd] {
+    calibrate::CalibrationInput input;
+    for (const std::string& f : o->flats) input.flats.emplace_back(f);
+    for (const std::string& f : o->darks) input.darks.emplace_back(f);
+    if (cmd->count("--photons-per-s") > 0) input.photons_per_s = o->photons_per_s;
+    std::vector<std::filesystem::path> inputs = input.flats;
+    inputs.insert(inputs.end(), input.darks.begin(), input.darks.end());
+    std::vector<std::filesystem::path> outputs = {o->output};
+    if (!o->report.empty()) outputs.emplace_back(o->report);
+    check_distinct_outputs(outputs);
+    for (const auto& out : outputs) check_output_file(out, inputs);
+    const calibrate::Calibration c = calibrate::calibrate(input);
+    write_file_atomically(o->output, c.sensor.dump(2) + "\n");
+    if (!o->report.empty()) write_file_atomically(o->report, c.report.dump(2) + "\n");
+    if (!o->quiet)
+      for (const calibrate::ChannelCalibration& ch : c.channels)
+        fmt::print(stderr, "{}: K {:.5g} ± {:.2g} DN/e-, dark noise {:.4g} ± {:.2g} e-, saturation {:.6g} e-, dark current {:.4g} e-/s, "
+                           "DSNU {:.3g} e-, PRNU {:.3g} %, linearity error {:.2g} %\n",
+                   ch.channel, ch.gain_dn_per_e.value, ch.gain_dn_per_e.standard_error, ch.dark_noise_e.value,
+                   ch.dark_noise_e.standard_error, ch.saturation_capacity_e.value, ch.dark_current_e_per_s.value,
+                   ch.dsnu_e.total.value, 100 * ch.prnu.total.value, 100 * ch.linearity_error);
+    return 0;
+  };
+}
+
+}  // namespace ct::cli
