@@ -49,5 +49,15 @@ for v in "${bpy_versions[@]}"; do
   fi
 done
 
+# The EMVA 1288 reference implementation (PyPI's emva1288 and what it needs, pinned), a test-only oracle for
+# chromatrace calibrate (tests/calibrate).
+emva="build/emva1288-venv"
+if ! cmp -s tests/calibrate/emva1288-requirements.txt "$emva/requirements.txt" 2>/dev/null; then
+  rm -rf "$emva"
+  /usr/bin/python3 -m venv "$emva"
+  "$emva/bin/pip" install --quiet --disable-pip-version-check -r tests/calibrate/emva1288-requirements.txt
+  cp tests/calibrate/emva1288-requirements.txt "$emva/requirements.txt"
+fi
+
 cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release "-DCHROMATRACE_BPY_VERSIONS=$(IFS=';'; echo "${bpy_versions[*]}")"
 cmake --build build

@@ -1,0 +1,41 @@
+"""The EMVA 1288 reference implementation (PyPI's emva1288, pinned in setup.sh) on a descriptor file: prints its
+results as JSON, for tests/calibrate/test_calibrate.cpp to compare with chromatrace calibrate.
+
+Usage: python emva1288_reference.py DESCRIPTOR
+"""
+import json
+import logging
+import sys
+
+from emva1288.process import Data1288, LoadImageData, ParseEmvaDescriptorFile, Results1288
+
+
+def main(descriptor):
+    parser = ParseEmvaDescriptorFile(descriptor, loglevel=logging.ERROR)
+    images = LoadImageData(parser.images, loglevel=logging.ERROR)
+    data = Data1288(images.data, loglevel=logging.ERROR)
+    r = Results1288(data.data, loglevel=logging.ERROR)
+    out = {
+        "K": r.K,
+        "QE": r.QE / 100.0,
+        "sigma_y_dark": r.sigma_y_dark,
+        "sigma_d": r.sigma_d,
+        "u_e_sat": r.u_e_sat,
+        "dark_current_mean": r.u_I_mean,
+        "DSNU": r.DSNU1288,
+        "DSNU_row": r.DSNU1288_row,
+        "DSNU_col": r.DSNU1288_col,
+        "DSNU_pixel": r.DSNU1288_pixel,
+        "PRNU": r.PRNU1288 / 100.0,
+        "PRNU_row": r.PRNU1288_row / 100.0,
+        "PRNU_col": r.PRNU1288_col / 100.0,
+        "PRNU_pixel": r.PRNU1288_pixel / 100.0,
+        "LE_min": r.LE_min / 100.0,
+        "LE_max": r.LE_max / 100.0,
+    }
+    # NaN (a part the reference cannot split off) as null.
+    print(json.dumps({k: (None if v != v else float(v)) for k, v in out.items()}))
+
+
+if __name__ == "__main__":
+    main(sys.argv[1])
