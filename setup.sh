@@ -8,7 +8,7 @@ packages=(
   build-essential cmake ninja-build pkg-config
   libopenexr-dev libopenimageio-dev openimageio-tools libopencv-dev
   libtiff-dev libraw-dev  # DNG output (libtiff) and camera raw input (LibRaw)
-  dcraw libraw-bin rawtherapee  # independent raw readers the DNG test checks against (tests/cli/test_camera_raw.cpp)
+  dcraw libraw-bin rawtherapee libimage-exiftool-perl  # independent raw readers the DNG test checks against (tests/cli/test_camera_raw.cpp)
   libembree-dev libtbb-dev libeigen3-dev
   nlohmann-json3-dev libcli11-dev libfmt-dev libgtest-dev
   chromium  # the browser test of analyze's report.html (tests/browser)

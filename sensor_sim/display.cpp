@@ -60,8 +60,13 @@ Eigen::Vector3d white_response(const std::array<std::vector<double>, 3>& weights
   return c;
 }
 
-Eigen::Matrix3d camera_to_xyz(const std::array<std::vector<double>, 3>& weights, const Bands& bands,
-                              const std::vector<double>& illuminant) {
+namespace {
+
+// M: white-balanced camera signals of the training reflectances lit by `illuminant` (band values) → `targets`, the
+// white-preserving least-squares fit (M·(1, 1, 1) = target_white).
+Eigen::Matrix3d fit_white_preserving(const std::array<std::vector<double>, 3>& weights, const Bands& bands,
+                                     const std::vector<double>& illuminant, const std::vector<Eigen::Vector3d>& targets,
+                                     const Vec3d& target_white) {
   if (illuminant.size() != bands.size() || weights[0].size() != bands.size())
     throw std::invalid_argument("camera_to_xyz: band counts differ");
   const Eigen::Vector3d white = white_response(weights, illuminant);
@@ -70,7 +75,6 @@ Eigen::Matrix3d camera_to_xyz(const std::array<std::vector<double>, 3>& weights,
         "display: the illuminant gives no signal in some camera channel over the image's bands ({:g}-{:g} nm)",
         bands.min_wavelength(), bands.max_wavelength()));
   const auto& reflectances = display_training_reflectances();
-  const auto& targets = training_targets();
   const Eigen::Index n = static_cast<Eigen::Index>(reflectances.size());
   Eigen::MatrixXd x(n, 3), y(n, 3);
   for (Eigen::Index i = 0; i < n; ++i) {
@@ -80,9 +84,8 @@ Eigen::Matrix3d camera_to_xyz(const std::array<std::vector<double>, 3>& weights,
     x.row(i) = white_response(weights, lit).cwiseQuotient(white).transpose();
     y.row(i) = targets[static_cast<std::size_t>(i)].transpose();
   }
-  // Each row m of M: min ‖x·m − y_r‖² subject to (1, 1, 1)·m = W_r, W the XYZ of sRGB white (white stays
-  // white). The KKT system [2xᵀx 1; 1ᵀ 0]·[m; ν] = [2xᵀy_r; W_r].
-  const Vec3d w = linear_srgb_to_xyz({1, 1, 1});
+  // Each row m of M: min ‖x·m − y_r‖² subject to (1, 1, 1)·m = W_r (white stays white). The KKT system
+  // [2xᵀx 1; 1ᵀ 0]·[m; ν] = [2xᵀy_r; W_r].
   Eigen::Matrix4d kkt = Eigen::Matrix4d::Zero();
   kkt.topLeftCorner<3, 3>() = 2 * x.transpose() * x;
   kkt.block<3, 1>(0, 3).setOnes();
@@ -92,10 +95,29 @@ Eigen::Matrix3d camera_to_xyz(const std::array<std::vector<double>, 3>& weights,
   for (int r = 0; r < 3; ++r) {
     Eigen::Vector4d rhs;
     rhs.head<3>() = 2 * x.transpose() * y.col(r);
-    rhs[3] = w[static_cast<std::size_t>(r)];
+    rhs[3] = target_white[static_cast<std::size_t>(r)];
     m.row(r) = lu.solve(rhs).head<3>().transpose();
   }
   return m;
+}
+
+}  // namespace
+
+Eigen::Matrix3d camera_to_xyz(const std::array<std::vector<double>, 3>& weights, const Bands& bands,
+                              const std::vector<double>& illuminant) {
+  // Targets: the reflectances lit by D65; white: the XYZ of sRGB white.
+  return fit_white_preserving(weights, bands, illuminant, training_targets(), linear_srgb_to_xyz({1, 1, 1}));
+}
+
+Eigen::Matrix3d camera_to_xyz_unadapted(const std::array<std::vector<double>, 3>& weights, const Bands& bands,
+                                        const PiecewiseLinearSpectrum& illuminant) {
+  std::vector<Eigen::Vector3d> targets;
+  for (const PiecewiseLinearSpectrum& r : display_training_reflectances()) {
+    const Vec3d xyz = reflectance_to_xyz(r, illuminant);
+    targets.emplace_back(xyz[0], xyz[1], xyz[2]);
+  }
+  const Vec3d white = reflectance_to_xyz(PiecewiseLinearSpectrum::constant(1.0), illuminant);
+  return fit_white_preserving(weights, bands, band_averages(illuminant, bands), targets, white);
 }
 
 Eigen::Matrix3d display_matrix(const std::array<std::vector<double>, 3>& weights, const Bands& bands,

@@ -37,6 +37,11 @@ Eigen::Vector3d white_response(const std::array<std::vector<double>, 3>& weights
 Eigen::Matrix3d camera_to_xyz(const std::array<std::vector<double>, 3>& weights, const Bands& bands,
                               const std::vector<double>& illuminant);
 
+// The same fit against the XYZ of the reflectances lit by the illuminant itself (no adaptation to daylight), white
+// preserved as the illuminant's own white (Y = 1): what a DNG ColorMatrix for that calibration illuminant inverts.
+Eigen::Matrix3d camera_to_xyz_unadapted(const std::array<std::vector<double>, 3>& weights, const Bands& bands,
+                                        const PiecewiseLinearSpectrum& illuminant);
+
 struct DisplayRendering {
   Eigen::Matrix3d matrix = Eigen::Matrix3d::Identity();  // S·M·diag(1/c_w): camera signal → linear sRGB
   double scale = 1.0;                                      // s

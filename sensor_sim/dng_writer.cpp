@@ -33,10 +33,14 @@ Eigen::Vector3d dng_neutral(const std::array<std::vector<double>, 3>& weights, c
   return white / white.maxCoeff();
 }
 
-Eigen::Matrix3d dng_colour_matrix(const std::array<std::vector<double>, 3>& weights, const Bands& bands) {
-  const std::vector<double> d65 = band_averages(cie::illuminant("D65"), bands);
-  const Eigen::Vector3d white = white_response(weights, d65);
-  const Eigen::Matrix3d m = camera_to_xyz(weights, bands, d65);
+Eigen::Matrix3d dng_colour_matrix(const std::array<std::vector<double>, 3>& weights, const Bands& bands,
+                                  const std::string& illuminant) {
+  const std::vector<double> light = band_averages(cie::illuminant(illuminant), bands);
+  const Eigen::Vector3d white = white_response(weights, light);
+  // Under D65 the display's fit (objects as they look in daylight) is the unadapted one; under another illuminant
+  // the matrix must map the XYZ of objects lit by it.
+  const Eigen::Matrix3d m = illuminant == "D65" ? camera_to_xyz(weights, bands, light)
+                                                : camera_to_xyz_unadapted(weights, bands, cie::illuminant(illuminant));
   return (white / white.maxCoeff()).asDiagonal() * m.inverse();
 }
 
@@ -87,13 +91,30 @@ DngWriter::DngWriter(const std::filesystem::path& path, int width, int height, D
   TIFFSetField(tif, TIFFTAG_BLACKLEVEL, 1, &black);
   TIFFSetField(tif, TIFFTAG_WHITELEVEL, 1, &white);
 
-  float neutral[3], matrix[9];
+  float neutral[3];
   for (int c = 0; c < 3; ++c) neutral[c] = static_cast<float>(m.as_shot_neutral[c]);
-  for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 3; ++c) matrix[3 * r + c] = static_cast<float>(m.colour_matrix(r, c));
   TIFFSetField(tif, TIFFTAG_ASSHOTNEUTRAL, 3, neutral);
-  TIFFSetField(tif, TIFFTAG_COLORMATRIX1, 9, matrix);
-  TIFFSetField(tif, TIFFTAG_CALIBRATIONILLUMINANT1, kDngCalibrationIlluminant);
+  const auto set_matrix = [&](int tag, int illuminant_tag, const Eigen::Matrix3d& matrix, int illuminant) {
+    float values[9];
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c) values[3 * r + c] = static_cast<float>(matrix(r, c));
+    TIFFSetField(tif, tag, 9, values);
+    TIFFSetField(tif, illuminant_tag, illuminant);
+  };
+  if (m.colour_matrix_a) {
+    set_matrix(TIFFTAG_COLORMATRIX1, TIFFTAG_CALIBRATIONILLUMINANT1, *m.colour_matrix_a, kDngCalibrationIlluminantA);
+    set_matrix(TIFFTAG_COLORMATRIX2, TIFFTAG_CALIBRATIONILLUMINANT2, m.colour_matrix, kDngCalibrationIlluminant);
+  } else {
+    set_matrix(TIFFTAG_COLORMATRIX1, TIFFTAG_CALIBRATIONILLUMINANT1, m.colour_matrix, kDngCalibrationIlluminant);
+  }
+  if (m.noise_profile) {
+    // libtiff does not know DNG 1.3's NoiseProfile: a variable count of doubles.
+    static const TIFFFieldInfo noise_profile{kDngNoiseProfileTag, TIFF_VARIABLE, TIFF_VARIABLE, TIFF_DOUBLE, FIELD_CUSTOM, 1, 1,
+                                             const_cast<char*>("NoiseProfile")};
+    TIFFMergeFieldInfo(tif, &noise_profile, 1);
+    const double profile[2] = {m.noise_profile->first, m.noise_profile->second};
+    TIFFSetField(tif, kDngNoiseProfileTag, std::uint16_t{2}, profile);
+  }
   // The EXIF directory's offset is known only once it is written (finish()); a placeholder keeps its slot.
   TIFFSetField(tif, TIFFTAG_EXIFIFD, std::uint64_t{0});
   file_ = std::move(file);

@@ -653,6 +653,14 @@ DngMetadata dng_metadata(const SensorConfig& c, const Run& run, const Bands& ban
   m.white_level = layout.number_attributes.at("chromatrace.white_level");
   m.as_shot_neutral = dng_neutral(run.model.weights, scene_light);
   m.colour_matrix = dng_colour_matrix(run.model.weights, bands);
+  m.colour_matrix_a = dng_colour_matrix(run.model.weights, bands, "A");
+  // The temporal noise of the model (docs/sensor.md, stage 5) in values normalised to [0, 1] over D = white − black:
+  // σ² = K·x/D (shot noise) + (K²(σ_read² + I_d·T) + 1/12)/D² (read noise, dark current shot noise, quantisation).
+  if (c.noise.enabled && c.adc.enabled) {
+    const double K = c.adc.gain_dn_per_e, D = m.white_level - m.black_level;
+    const double dark_e2 = c.noise.read_e * c.noise.read_e + (c.noise.shot ? c.noise.dark_current_e_per_s * run.exposure_s : 0.0);
+    m.noise_profile = std::pair{c.noise.shot ? K / D : 0.0, (K * K * dark_e2 + 1.0 / 12.0) / (D * D)};
+  }
   m.camera = c.response.camera;
   m.exposure_s = run.exposure_s;
   if (c.optics.enabled) m.f_number = c.optics.f_number;

@@ -201,12 +201,27 @@ TEST(CameraRawDng, ColourFieldsOfTheCieCameraAndTheExposure) {
   ASSERT_TRUE(TIFFGetField(tif, TIFFTAG_ASSHOTNEUTRAL, &count, &values));
   ASSERT_EQ(count, 3);
   for (int c = 0; c < 3; ++c) EXPECT_NEAR(values[c], white[c] / top, 1e-3) << "AsShotNeutral " << c;
+  // As Adobe's converter writes them: ColorMatrix1 under illuminant A, ColorMatrix2 under D65 (a reader that takes
+  // one matrix, as dcraw does, takes the last). D65's, for an XYZ camera: the identity over the largest value of
+  // D65's white.
+  ASSERT_TRUE(TIFFGetField(tif, TIFFTAG_COLORMATRIX2, &count, &values));
+  ASSERT_EQ(count, 9);
+  for (int i = 0; i < 9; ++i) EXPECT_NEAR(values[i], i % 4 == 0 ? 1.0 / top : 0.0, 1e-3) << "ColorMatrix2 " << i;
+  std::uint16_t illuminant = 0;
+  ASSERT_TRUE(TIFFGetField(tif, TIFFTAG_CALIBRATIONILLUMINANT2, &illuminant));
+  EXPECT_EQ(illuminant, 21);  // D65
+  // A's: the identity over the largest value of A's white point through the same bands, (1.0985, 1, 0.3559) as the
+  // standard gives it.
+  const Vec3d a_white = bands_to_xyz(band_averages(cie::illuminant("A"), bands), bands);
+  const double a_top = a_white[0] / a_white[1];
+  EXPECT_NEAR(a_top, 1.09850, 1e-4);
   ASSERT_TRUE(TIFFGetField(tif, TIFFTAG_COLORMATRIX1, &count, &values));
   ASSERT_EQ(count, 9);
-  for (int i = 0; i < 9; ++i) EXPECT_NEAR(values[i], i % 4 == 0 ? 1.0 / top : 0.0, 1e-3) << "ColorMatrix1 " << i;
-  std::uint16_t illuminant = 0;
+  // Tolerance 2·10⁻³: the fit's XYZ are integrals at 1 nm of reflectance × A, the camera's signals sums over the 5 nm
+  // bands of the reflectance's band average × A's, which differ by up to 0.15 % where A is steep (its blue end).
+  for (int i = 0; i < 9; ++i) EXPECT_NEAR(values[i], i % 4 == 0 ? 1.0 / a_top : 0.0, 2e-3) << "ColorMatrix1 " << i;
   ASSERT_TRUE(TIFFGetField(tif, TIFFTAG_CALIBRATIONILLUMINANT1, &illuminant));
-  EXPECT_EQ(illuminant, 21);  // D65
+  EXPECT_EQ(illuminant, 17);  // standard light A
   std::uint64_t exif = 0;
   ASSERT_TRUE(TIFFGetField(tif, TIFFTAG_EXIFIFD, &exif));
   ASSERT_TRUE(TIFFReadEXIFDirectory(tif, exif));
@@ -216,6 +231,60 @@ TEST(CameraRawDng, ColourFieldsOfTheCieCameraAndTheExposure) {
   EXPECT_NEAR(exposure, 0.004, 0.004 * 1e-6);
   EXPECT_NEAR(f_number, 5.6, 5.6 * 1e-6);
   TIFFClose(tif);
+}
+
+// What raw developers read from the DNG beyond the mosaic, by two readers that do not share its writer's code: LibRaw
+// (raw-identify) reads both colour matrices with their illuminants, and ExifTool the noise profile, which is the
+// sensor model's temporal noise in values normalised over white − black: scale K/D (shot noise), offset
+// (K²(σ_read² + I_d·T) + 1/12)/D² (read noise, dark current shot noise, quantisation), from the capture's own settings.
+TEST_F(CameraRaw, DevelopersReadBothColourMatricesAndTheNoiseProfile) {
+  const fs::path dng = dir_.file("capture.dng"), exr = dir_.file("capture.exr");
+  ASSERT_EQ(capture(dng).exit_code, 0);
+  ASSERT_EQ(capture(exr, {"--cfa", "none"}).exit_code, 0);
+  const OIIO::ImageBuf image(exr.string());
+  const nlohmann::json settings = nlohmann::json::parse(image.spec().get_string_attribute("chromatrace.sensor"));
+  const double K = settings["adc"]["gain_dn_per_e"], read = settings["noise"]["read_e"];
+  const double dark = settings["noise"]["dark_current_e_per_s"], T = settings["exposure"]["time_s"];
+  const double D = image.spec().get_float_attribute("chromatrace.white_level") - image.spec().get_float_attribute("chromatrace.black_level");
+  ASSERT_GT(D, 0);
+  const double scale = K / D, offset = (K * K * (read * read + dark * T) + 1.0 / 12.0) / (D * D);
+
+  const std::string identify = find_program("raw-identify"), exiftool = find_program("exiftool");
+  if (identify.empty() || exiftool.empty()) {
+    ADD_FAILURE() << "raw-identify / exiftool are not installed (libraw-bin, libimage-exiftool-perl; setup.sh installs them)";
+    return;
+  }
+  const test::CommandResult id = run_program(identify, {"-v", dng.string()});
+  ASSERT_EQ(id.exit_code, 0) << id.err;
+  EXPECT_NE(id.out.find("DNG Illuminant 1: Illuminant A"), std::string::npos) << id.out;
+  EXPECT_NE(id.out.find("DNG Illuminant 2: D65"), std::string::npos) << id.out;
+  // LibRaw's matrix 2 is the one written: the TIFF field, to the 4 decimals raw-identify prints.
+  TIFF* tif = TIFFOpen(dng.c_str(), "r");
+  ASSERT_NE(tif, nullptr);
+  std::uint16_t count = 0;
+  float* m2 = nullptr;
+  ASSERT_TRUE(TIFFGetField(tif, TIFFTAG_COLORMATRIX2, &count, &m2));
+  const std::size_t at = id.out.find("DNG color matrix 2:");
+  ASSERT_NE(at, std::string::npos) << id.out;
+  std::istringstream printed(id.out.substr(at + std::string("DNG color matrix 2:").size()));
+  for (int i = 0; i < 9; ++i) {
+    double v = 0;
+    printed >> v;
+    EXPECT_NEAR(v, m2[i], 6e-5) << "matrix 2, element " << i;
+  }
+  TIFFClose(tif);
+
+  const test::CommandResult noise = run_program(exiftool, {"-n", "-s3", "-NoiseProfile", dng.string()});
+  ASSERT_EQ(noise.exit_code, 0) << noise.err;
+  std::istringstream profile(noise.out);
+  double s = 0, o = 0;
+  profile >> s >> o;
+  EXPECT_NEAR(s, scale, 1e-9 * scale) << noise.out;
+  EXPECT_NEAR(o, offset, 1e-9 * offset) << noise.out;
+  // Without noise there is no profile.
+  const fs::path clean = dir_.file("clean.dng");
+  ASSERT_EQ(capture(clean, {"--no-noise"}).exit_code, 0);
+  EXPECT_EQ(run_program(exiftool, {"-n", "-s3", "-NoiseProfile", clean.string()}).out, "");
 }
 
 // The half-size reading keeps each tile's red, first green and blue exactly: the whole image's mean is the mean of
