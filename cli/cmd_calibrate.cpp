@@ -7,6 +7,7 @@
 #include <fmt/core.h>
 
 #include "calibrate/calibration.h"
+#include "calibrate/report.h"
 #include "cli/app.h"
 #include "cli/command.h"
 #include "core/error.h"
@@ -28,7 +29,9 @@ Action add_calibrate(CLI::App& app) {
   cmd->add_option("--dark", o->darks, "Dark frames: at least two at each exposure time of the flats")->required();
   cmd->add_option("-o,--output", o->output, "Sensor settings written (chromatrace-sensor/1), for chromatrace sensor --config")
       ->required();
-  cmd->add_option("--report", o->report, "Every estimate per channel with its standard error, and the measured curves (JSON)");
+  cmd->add_option("--report", o->report,
+                  "Report directory: index.html (the datasheet's curves and table), calibration.json (every estimate per "
+                  "channel with its standard error, the measured points), the plots as SVG");
   cmd->add_option("--photons-per-s", o->photons_per_s,
                   "Photons per pixel and second reaching the sensor in the flats (for the quantum efficiency)");
   cmd->add_flag("-q,--quiet", o->quiet, "No summary on stderr");
@@ -43,10 +46,11 @@ Action add_calibrate(CLI::App& app) {
     std::vector<std::filesystem::path> outputs = {o->output};
     if (!o->report.empty()) outputs.emplace_back(o->report);
     check_distinct_outputs(outputs);
-    for (const auto& out : outputs) check_output_file(out, inputs);
+    check_output_file(o->output, inputs);
+    if (!o->report.empty()) check_output_directory(o->report, inputs);
     const calibrate::Calibration c = calibrate::calibrate(input);
+    if (!o->report.empty()) calibrate::write_report(c, o->report);
     write_file_atomically(o->output, c.sensor.dump(2) + "\n");
-    if (!o->report.empty()) write_file_atomically(o->report, c.report.dump(2) + "\n");
     if (!o->quiet)
       for (const calibrate::ChannelCalibration& ch : c.channels)
         fmt::print(stderr, "{}: K {:.5g} ± {:.2g} DN/e-, dark noise {:.4g} ± {:.2g} e-, saturation {:.6g} e-, dark current {:.4g} e-/s, "

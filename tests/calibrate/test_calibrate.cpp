@@ -54,12 +54,15 @@ class Calibrate : public ::testing::Test {
   // Writes the series of a camera: two flats and two darks per exposure time. Returns the input and the photons
   // per pixel and second.
   calibrate::CalibrationInput series(const Camera& c, const std::string& name) { return series(c, name, kExposureShares, 2); }
-  calibrate::CalibrationInput series(const Camera& c, const std::string& name, const std::vector<double>& shares, int per_step) {
+  // As camera raw: DNGs of an RGGB mosaic of twice the size (each 2 × 2 tile's red, first green and blue are read).
+  calibrate::CalibrationInput series(const Camera& c, const std::string& name, const std::vector<double>& shares, int per_step,
+                                     bool dng = false) {
+    const int size = dng ? 2 * kSize : kSize;
     const double fill_s = 1.0;  // the flats' light fills the full well in one second
     const double radiance = c.full_well / c.qe / photons_per_radiance_second() / fill_s;
     const fs::path flat = dir_.file(name + "-flat.exr"), dark = dir_.file(name + "-dark.exr");
-    test::write_radiance(flat, kBand, kSize, kSize, [&](int, int, std::size_t) { return static_cast<float>(radiance); });
-    test::write_radiance(dark, kBand, kSize, kSize, [&](int, int, std::size_t) { return 0.0f; });
+    test::write_radiance(flat, kBand, size, size, [&](int, int, std::size_t) { return static_cast<float>(radiance); });
+    test::write_radiance(dark, kBand, size, size, [&](int, int, std::size_t) { return 0.0f; });
     calibrate::CalibrationInput input;
     input.photons_per_s = radiance * photons_per_radiance_second();
     std::uint64_t seed = 1;
@@ -83,7 +86,8 @@ class Calibrate : public ::testing::Test {
                         {"full_well", {{"enabled", true}, {"electrons", c.full_well}}},
                         {"adc", {{"enabled", true}, {"gain_dn_per_e", c.gain}, {"black_level_dn", c.black}, {"bits", c.bits}}},
                         {"display", {{"enabled", false}}}};
-          const fs::path out = dir_.file(fmt::format("{}-{}-{}-{}.exr", name, share, is_flat ? "flat" : "dark", k));
+          if (dng) patch["cfa"] = {{"enabled", true}, {"pattern", "RGGB"}};
+          const fs::path out = dir_.file(fmt::format("{}-{}-{}-{}.{}", name, share, is_flat ? "flat" : "dark", k, dng ? "dng" : "exr"));
           test::run_sensor(is_flat ? flat : dark, out, test::config_of(patch));
           (is_flat ? input.flats : input.darks).push_back(out);
         }
@@ -135,15 +139,17 @@ TEST_F(Calibrate, RecoversEveryParameterOfAScientificCamera) {
   expect_camera(cal, c);
 }
 
-TEST_F(Calibrate, RecoversAStrongColumnPatternApartFromThePixels) {
+// The frames a camera gives: DNGs of its Bayer mosaic, read as camera raw without demosaicing.
+TEST_F(Calibrate, RecoversAStrongColumnPatternApartFromThePixelsFromCameraRaw) {
   const Camera c{0.45, 0.5, 200, 15000, 3, 20, 1.5, 0.005, 1.0, 0.02, 14};
-  const calibrate::Calibration cal = calibrate::calibrate(series(c, "columns"));
+  const calibrate::Calibration cal = calibrate::calibrate(series(c, "columns", kExposureShares, 2, true));
   expect_camera(cal, c);
   // The settings written reproduce the camera: the sensor simulator takes them as they are.
   const Json& s = cal.sensor;
   EXPECT_NEAR(s["adc"]["gain_dn_per_e"].get<double>(), c.gain, 0.02 * c.gain);
   EXPECT_NEAR(s["noise"]["prnu_column"].get<double>(), c.prnu_column, 0.2 * c.prnu_column);
-  EXPECT_EQ(s["adc"]["bits"].get<int>(), 14);
+  // A DNG has no ADC bits, only its white level (here black + K × full well = 7700): the fewest bits that hold it.
+  EXPECT_EQ(s["adc"]["bits"].get<int>(), 13);
   EXPECT_NO_THROW(test::config_of(s));
 }
 
@@ -173,7 +179,7 @@ std::vector<fs::path> only(const std::vector<fs::path>& frames, const std::vecto
 TEST_F(Calibrate, TheCommandWritesSettingsTheSensorTakesAndRefusesSeriesThatCannotSupportThem) {
   const Camera c{0.6, 0.25, 100, 20000, 5, 100, 2, 0.01, 0, 0, 16};
   const calibrate::CalibrationInput in = series(c, "cli");
-  const fs::path out = dir_.file("camera.json"), report = dir_.file("calibration.json");
+  const fs::path out = dir_.file("camera.json"), report = dir_.file("report");
   std::vector<std::string> args = calibrate_args(in.flats, in.darks, out);
   args.insert(args.end(), {"--report", report.string(), "--photons-per-s", fmt::format("{}", *in.photons_per_s)});
   const auto ok = test::run_chromatrace(args);
@@ -181,7 +187,11 @@ TEST_F(Calibrate, TheCommandWritesSettingsTheSensorTakesAndRefusesSeriesThatCann
   const sensor::SensorConfig settings = test::config_of(read_json(out));
   EXPECT_NEAR(settings.adc.gain_dn_per_e, c.gain, 0.02 * c.gain);
   EXPECT_NEAR(settings.full_well.electrons, c.full_well, 0.02 * c.full_well);
-  EXPECT_EQ(read_json(report)["channels"].size(), 3u);
+  const Json written = read_json(report / "calibration.json");
+  ASSERT_EQ(written["channels"].size(), 3u);
+  EXPECT_NEAR(written["channels"][1]["gain_dn_per_e"]["value"].get<double>(), c.gain, 0.02 * c.gain);
+  for (const char* file : {"index.html", "photon_transfer.svg", "snr.svg", "linearity.svg", "dark_signal.svg"})
+    EXPECT_GT(fs::file_size(report / file), 1000u) << file;
 
   // Each bad series: exit 2, one line naming the option and what is missing, and no settings written.
   const fs::path bad = dir_.file("bad.json");

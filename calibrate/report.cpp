@@ -1,0 +1,280 @@
+#include "calibrate/report.h"
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <limits>
+
+#include <fmt/format.h>
+
+#include "core/file_io.h"
+#include "core/html_text.h"
+
+namespace ct::calibrate {
+namespace {
+
+// Channel colours (a colour-blind-safe set: vermillion, bluish green, blue).
+constexpr const char* kChannelColour[3] = {"#d55e00", "#009e73", "#0072b2"};
+
+// A nice step for about `count` ticks over a span.
+double nice_step(double span, int count) {
+  const double raw = span / count, p = std::pow(10.0, std::floor(std::log10(raw)));
+  for (const double m : {1.0, 2.0, 2.5, 5.0, 10.0})
+    if (m * p >= raw) return m * p;
+  return 10 * p;
+}
+
+std::string number(double v) {
+  if (v == 0) return "0";
+  const double a = std::abs(v);
+  if (a >= 1e5 || a < 1e-3) {  // 1e5, 2e-4
+    const int e = static_cast<int>(std::floor(std::log10(a) + 1e-9));
+    return fmt::format("{:g}e{}", v / std::pow(10.0, e), e);
+  }
+  return fmt::format("{:g}", v);
+}
+
+// An x–y plot: linear or logarithmic axes, series of points (markers) and of lines (the model), as SVG.
+class Plot {
+ public:
+  Plot(std::string title, std::string x_label, std::string y_label, bool log_x, bool log_y)
+      : title_(std::move(title)), x_label_(std::move(x_label)), y_label_(std::move(y_label)), log_x_(log_x), log_y_(log_y) {}
+
+  void points(const std::vector<std::pair<double, double>>& xy, const char* colour, std::string label) {
+    series_.push_back({xy, colour, std::move(label), false});
+  }
+  void line(const std::vector<std::pair<double, double>>& xy, const char* colour, std::string label) {
+    series_.push_back({xy, colour, std::move(label), true});
+  }
+
+  std::string svg() const {
+    double x0 = kInf, x1 = -kInf, y0 = kInf, y1 = -kInf;
+    for (const Series& s : series_)
+      for (const auto& [x, y] : s.xy)
+        if (usable(x, log_x_) && usable(y, log_y_)) x0 = std::min(x0, x), x1 = std::max(x1, x), y0 = std::min(y0, y), y1 = std::max(y1, y);
+    if (!(x0 < x1)) x0 = 0, x1 = 1;
+    if (!(y0 < y1)) y0 = 0, y1 = 1;
+    if (!log_x_) x0 = std::min(x0, 0.0);
+    if (!log_y_) y0 = std::min(y0, 0.0);
+    const Axis ax = axis(x0, x1, log_x_), ay = axis(y0, y1, log_y_);
+    auto X = [&](double v) { return kLeft + (ax.map(v)) * (kWidth - kLeft - kRight); };
+    auto Y = [&](double v) { return kHeight - kBottom - ay.map(v) * (kHeight - kTop - kBottom); };
+
+    std::string s = fmt::format(R"svg(<svg xmlns="http://www.w3.org/2000/svg" viewBox="0 0 {} {}" width="{}" height="{}" font-family="sans-serif" font-size="12">)svg",
+                                kWidth, kHeight, kWidth, kHeight);
+    s += fmt::format(R"svg(<rect width="{}" height="{}" fill="white"/>)svg", kWidth, kHeight);
+    s += fmt::format(R"svg(<text x="{}" y="18" font-size="14" font-weight="bold">{}</text>)svg", kLeft, escape_html(title_));
+    for (const double t : ax.ticks) {
+      s += fmt::format(R"svg(<line x1="{0:.1f}" y1="{1}" x2="{0:.1f}" y2="{2}" stroke="#e4e4e4"/>)svg", X(t), kTop, kHeight - kBottom);
+      s += fmt::format(R"svg(<text x="{:.1f}" y="{}" text-anchor="middle">{}</text>)svg", X(t), kHeight - kBottom + 16, number(t));
+    }
+    for (const double t : ay.ticks) {
+      s += fmt::format(R"svg(<line x1="{0}" y1="{1:.1f}" x2="{2}" y2="{1:.1f}" stroke="#e4e4e4"/>)svg", kLeft, Y(t), kWidth - kRight);
+      s += fmt::format(R"svg(<text x="{}" y="{:.1f}" text-anchor="end">{}</text>)svg", kLeft - 6, Y(t) + 4, number(t));
+    }
+    s += fmt::format(R"svg(<rect x="{}" y="{}" width="{}" height="{}" fill="none" stroke="#555"/>)svg", kLeft, kTop, kWidth - kLeft - kRight,
+                     kHeight - kTop - kBottom);
+    s += fmt::format(R"svg(<text x="{}" y="{}" text-anchor="middle">{}</text>)svg", (kLeft + kWidth - kRight) / 2, kHeight - 8, escape_html(x_label_));
+    s += fmt::format(R"svg(<text transform="translate(16 {}) rotate(-90)" text-anchor="middle">{}</text>)svg", (kTop + kHeight - kBottom) / 2,
+                     escape_html(y_label_));
+    int legend = 0;
+    for (const Series& series : series_) {
+      std::string path;
+      for (const auto& [x, y] : series.xy) {
+        if (!usable(x, log_x_) || !usable(y, log_y_)) continue;
+        if (series.is_line) {
+          path += fmt::format("{}{:.1f},{:.1f}", path.empty() ? "M" : " L", X(x), Y(y));
+        } else {
+          s += fmt::format(R"svg(<circle cx="{:.1f}" cy="{:.1f}" r="3" fill="none" stroke="{}"/>)svg", X(x), Y(y), series.colour);
+        }
+      }
+      if (series.is_line && !path.empty())
+        s += fmt::format(R"svg(<path d="{}" fill="none" stroke="{}" stroke-width="1.2"/>)svg", path, series.colour);
+      if (!series.label.empty()) {
+        const double ly = kTop + 14 + 16 * legend++;
+        s += series.is_line ? fmt::format(R"svg(<line x1="{}" y1="{:.1f}" x2="{}" y2="{:.1f}" stroke="{}"/>)svg", kLeft + 10, ly - 4, kLeft + 28, ly - 4, series.colour)
+                            : fmt::format(R"svg(<circle cx="{}" cy="{:.1f}" r="3" fill="none" stroke="{}"/>)svg", kLeft + 19, ly - 4, series.colour);
+        s += fmt::format(R"svg(<text x="{}" y="{:.1f}">{}</text>)svg", kLeft + 34, ly, escape_html(series.label));
+      }
+    }
+    return s + "</svg>\n";
+  }
+
+ private:
+  static constexpr double kInf = std::numeric_limits<double>::infinity();
+  static constexpr int kWidth = 520, kHeight = 360, kLeft = 70, kRight = 16, kTop = 30, kBottom = 46;
+  struct Series {
+    std::vector<std::pair<double, double>> xy;
+    const char* colour;
+    std::string label;
+    bool is_line;
+  };
+  struct Axis {
+    double lo, hi;
+    bool log;
+    std::vector<double> ticks;
+    double map(double v) const { return log ? (std::log10(v) - std::log10(lo)) / (std::log10(hi) - std::log10(lo)) : (v - lo) / (hi - lo); }
+  };
+  static bool usable(double v, bool log) { return std::isfinite(v) && (!log || v > 0); }
+  static Axis axis(double lo, double hi, bool log) {
+    Axis a{lo, hi, log, {}};
+    if (log) {
+      a.lo = std::pow(10.0, std::floor(std::log10(lo)));
+      a.hi = std::pow(10.0, std::ceil(std::log10(hi)));
+      for (double t = a.lo; t <= a.hi * 1.0001; t *= 10) a.ticks.push_back(t);
+    } else {
+      const double step = nice_step(hi - lo, 5);
+      a.lo = std::floor(lo / step) * step;
+      a.hi = std::ceil(hi / step) * step;
+      for (double t = a.lo; t <= a.hi + step * 1e-6; t += step) a.ticks.push_back(t);
+    }
+    return a;
+  }
+  std::string title_, x_label_, y_label_;
+  bool log_x_, log_y_;
+  std::vector<Series> series_;
+};
+
+// The x axis of the signal plots: photons per pixel when known, else the signal in electrons.
+bool have_photons(const ChannelCalibration& c) {
+  return std::all_of(c.points.begin(), c.points.end(), [](const TransferPoint& p) { return p.photons_per_pixel.has_value(); });
+}
+
+std::string photon_transfer(const Calibration& cal) {
+  Plot plot("Photon transfer", "mean signal above dark, μy − μy.dark (DN)", "temporal variance above dark, σ²y − σ²y.dark (DN²)", false, false);
+  for (std::size_t c = 0; c < 3; ++c) {
+    const ChannelCalibration& ch = cal.channels[c];
+    std::vector<std::pair<double, double>> xy;
+    double top = 0;
+    for (const TransferPoint& p : ch.points) {
+      xy.emplace_back(p.mean_dn - p.dark_mean_dn, p.variance_dn2 - p.dark_variance_dn2);
+      top = std::max(top, p.mean_dn - p.dark_mean_dn);
+    }
+    plot.points(xy, kChannelColour[c], fmt::format("{}: K = {:.4g} DN/e⁻", ch.channel, ch.gain_dn_per_e.value));
+    const double fit_top = 0.7 * (ch.saturation_mean_dn - ch.points.back().dark_mean_dn);
+    plot.line({{0.0, 0.0}, {fit_top, ch.gain_dn_per_e.value * fit_top}}, kChannelColour[c], "");
+  }
+  return plot.svg();
+}
+
+std::string snr(const Calibration& cal) {
+  const bool photons = have_photons(cal.channels[1]);
+  Plot plot("Signal-to-noise ratio", photons ? "photons per pixel, μp" : "signal, μe (e⁻)", "SNR", true, true);
+  for (std::size_t c = 0; c < 3; ++c) {
+    const ChannelCalibration& ch = cal.channels[c];
+    const double K = ch.gain_dn_per_e.value, eta = ch.quantum_efficiency ? ch.quantum_efficiency->value : 1.0;
+    std::vector<std::pair<double, double>> measured, model;
+    for (const TransferPoint& p : ch.points) {
+      const double signal = p.mean_dn - p.dark_mean_dn, x = photons ? *p.photons_per_pixel : signal / K;
+      if (p.mean_dn < ch.saturation_mean_dn) measured.emplace_back(x, signal / std::sqrt(p.variance_dn2));
+    }
+    // The EMVA 1288 model: SNR = η μp / √(σd² + σq²/K² + η μp), up to saturation.
+    const double x_sat = photons ? ch.saturation_capacity_e.value / eta : ch.saturation_capacity_e.value;
+    for (double x = x_sat / 1e4; x <= x_sat * 1.0001; x *= 1.2) {
+      const double e = photons ? eta * x : x;
+      model.emplace_back(x, e / std::sqrt(ch.dark_noise_e.value * ch.dark_noise_e.value + 1.0 / 12.0 / (K * K) + e));
+    }
+    plot.points(measured, kChannelColour[c], ch.channel + (photons ? fmt::format(": η = {:.3g}", eta) : ""));
+    plot.line(model, kChannelColour[c], "");
+  }
+  return plot.svg();
+}
+
+std::string linearity(const Calibration& cal) {
+  const bool photons = have_photons(cal.channels[1]);
+  Plot plot("Linearity", photons ? "photons per pixel, μp" : "exposure time (s)", "mean signal above dark (DN)", false, false);
+  for (std::size_t c = 0; c < 3; ++c) {
+    const ChannelCalibration& ch = cal.channels[c];
+    std::vector<std::pair<double, double>> xy;
+    for (const TransferPoint& p : ch.points) xy.emplace_back(photons ? *p.photons_per_pixel : p.exposure_s, p.mean_dn - p.dark_mean_dn);
+    plot.points(xy, kChannelColour[c], fmt::format("{}: linearity error {:.2g} %", ch.channel, 100 * ch.linearity_error));
+  }
+  return plot.svg();
+}
+
+std::string dark_signal(const Calibration& cal) {
+  Plot plot("Dark signal", "exposure time (s)", "mean dark signal, μy.dark (DN)", false, false);
+  for (std::size_t c = 0; c < 3; ++c) {
+    const ChannelCalibration& ch = cal.channels[c];
+    std::vector<std::pair<double, double>> xy;
+    for (const TransferPoint& p : ch.points) xy.emplace_back(p.exposure_s, p.dark_mean_dn);
+    plot.points(xy, kChannelColour[c], fmt::format("{}: {:.3g} e⁻/s", ch.channel, ch.dark_current_e_per_s.value));
+    const double t1 = ch.points.back().exposure_s;
+    plot.line({{0.0, ch.black_level_dn.value}, {t1, ch.black_level_dn.value + ch.gain_dn_per_e.value * ch.dark_current_e_per_s.value * t1}},
+              kChannelColour[c], "");
+  }
+  return plot.svg();
+}
+
+std::string cell(const Estimate& e, double scale = 1) {
+  const double v = e.value * scale, se = e.standard_error * scale;
+  return std::abs(v) >= 1000 ? fmt::format("{:.0f} ± {:.0f}", v, se) : fmt::format("{:.4g} ± {:.2g}", v, se);
+}
+
+std::string page(const Calibration& cal, const std::vector<std::pair<std::string, std::string>>& plots) {
+  std::string html = R"svg(<!DOCTYPE html><html lang="en"><head><meta charset="utf-8"><title>Camera calibration (EMVA 1288)</title>
+<style>body{font-family:sans-serif;margin:24px;color:#222;max-width:1120px}table{border-collapse:collapse;margin:12px 0}
+td,th{border-bottom:1px solid #ddd;padding:4px 10px;text-align:right}th:first-child,td:first-child{text-align:left}
+.plots{display:flex;flex-wrap:wrap;gap:12px}figure{margin:0}.note{color:#555;font-size:13px}</style></head><body>)svg";
+  html += "<h1>Camera calibration (EMVA 1288 Release 4.0, Linear)</h1>";
+  html += fmt::format("<p class=\"note\">{} flat and {} dark frames at {} exposure times; each estimate with its standard error. "
+                      "Every number, and the sensor settings for <code>chromatrace sensor --config</code> (its <code>sensor</code>), in "
+                      "<a href=\"calibration.json\">calibration.json</a>.</p>",
+                      cal.flats, cal.darks, cal.exposures);
+  html += "<table><tr><th>quantity</th>";
+  for (const ChannelCalibration& c : cal.channels) html += "<th>" + escape_html(c.channel) + "</th>";
+  html += "</tr>";
+  auto row = [&](const std::string& name, auto get) {
+    html += "<tr><td>" + name + "</td>";
+    for (const ChannelCalibration& c : cal.channels) html += "<td>" + get(c) + "</td>";
+    html += "</tr>";
+  };
+  row("system gain K (DN/e⁻)", [](const auto& c) { return cell(c.gain_dn_per_e); });
+  row("temporal dark noise σd (e⁻)", [](const auto& c) { return cell(c.dark_noise_e); });
+  row("saturation capacity μe.sat (e⁻)", [](const auto& c) { return cell(c.saturation_capacity_e); });
+  row("clip level (e⁻)", [](const auto& c) { return c.clip_level_e ? cell(*c.clip_level_e) : std::string("—"); });
+  row("dark current (e⁻/s)", [](const auto& c) { return cell(c.dark_current_e_per_s); });
+  row("black level (DN)", [](const auto& c) { return cell(c.black_level_dn); });
+  row("DSNU (e⁻): total", [](const auto& c) { return cell(c.dsnu_e.total); });
+  row("&nbsp;&nbsp;row / column / pixel", [](const auto& c) {
+    return fmt::format("{:.3g} / {:.3g} / {:.3g}", c.dsnu_e.row.value, c.dsnu_e.column.value, c.dsnu_e.pixel.value);
+  });
+  row("PRNU (%): total", [](const auto& c) { return cell(c.prnu.total, 100); });
+  row("&nbsp;&nbsp;row / column / pixel", [](const auto& c) {
+    return fmt::format("{:.3g} / {:.3g} / {:.3g}", 100 * c.prnu.row.value, 100 * c.prnu.column.value, 100 * c.prnu.pixel.value);
+  });
+  row("linearity error (%)", [](const auto& c) { return fmt::format("{:.2g}", 100 * c.linearity_error); });
+  row("quantum efficiency η", [](const auto& c) { return c.quantum_efficiency ? cell(*c.quantum_efficiency) : std::string("—"); });
+  html += "</table><div class=\"plots\">";
+  for (const auto& [name, svg] : plots) html += "<figure>" + svg + "</figure>";
+  html += "</div>";
+  for (const ChannelCalibration& c : cal.channels)
+    for (const std::string& n : c.notes) html += fmt::format("<p class=\"note\">{}: {}</p>", escape_html(c.channel), escape_html(n));
+  return html + "</body></html>\n";
+}
+
+void write_text(const std::filesystem::path& file, const std::string& text) {
+  std::ofstream out(file, std::ios::binary);
+  out << text;
+  if (!out.flush()) throw std::runtime_error(fmt::format("{}: cannot write", file.string()));
+}
+
+}  // namespace
+
+std::vector<std::pair<std::string, std::string>> report_plots(const Calibration& calibration) {
+  return {{"photon_transfer.svg", photon_transfer(calibration)},
+          {"snr.svg", snr(calibration)},
+          {"linearity.svg", linearity(calibration)},
+          {"dark_signal.svg", dark_signal(calibration)}};
+}
+
+void write_report(const Calibration& calibration, const std::filesystem::path& directory) {
+  StagedDirectory staged(directory, {"index.html"});
+  const auto plots = report_plots(calibration);
+  write_text(staged.path() / "calibration.json", calibration.report.dump(2) + "\n");
+  for (const auto& [name, svg] : plots) write_text(staged.path() / name, svg);
+  write_text(staged.path() / "index.html", page(calibration, plots));
+  staged.commit();
+}
+
+}  // namespace ct::calibrate
