@@ -3,7 +3,11 @@
 #include <fmt/core.h>
 #include <gtest/gtest.h>
 
+#include <random>
+
+#include "analyzer/highlight_branch.h"
 #include "analyzer/illuminant.h"
+#include "analyzer/moments.h"
 #include "tests/analyzer/synthetic.h"
 
 namespace ct::test {
@@ -26,7 +30,7 @@ TEST(Illuminant, NoiseFreeObjectsGiveTheIlluminantWithinOneDegree) {
   ASSERT_TRUE(a.planes);
   EXPECT_EQ(a.planes->regions.size(), 4u);
   EXPECT_LT(*a.planes->error_deg, 1.0);
-  EXPECT_EQ(a.best().method, "dichromatic planes");
+  EXPECT_EQ(a.best().method, "dichromatic planes") << a.planes->unreliable_reason;
   // Across a sphere's highlight the diffuse shading changes too, which tilts each highlight line a little
   // towards its body colour: that estimate is biased, the planes' is not.
   ASSERT_TRUE(a.highlight_lines);
@@ -105,6 +109,42 @@ TEST(Illuminant, OnePlaneIsNotEnough) {
   const auto v = intersect_planes({Vec3::UnitZ(), Vec3::UnitX()});
   ASSERT_TRUE(v);
   EXPECT_NEAR(angular_error_deg(*v, Vec3::UnitY()), 0.0, 1e-9);
+}
+
+}  // namespace
+}  // namespace ct::test
+
+namespace ct::test {
+namespace {
+
+// The highlight branch by regression (analyzer/highlight_branch.h): colours c = m_b·body + m_s·light with the
+// shading m_b spread across the highlight independently of its strength m_s, plus noise. The branch points to the
+// light within 3 of its standard errors; a total-least-squares line through the same colours is tilted towards
+// the body colour by the shading's spread.
+TEST(HighlightBranch, PointsToTheLightWhereTheShadingSpreadsAcrossTheHighlight) {
+  const Vec3 body = Vec3(0.9, 0.4, 0.1).normalized(), light = Vec3(0.6, 0.6, 0.5).normalized();
+  std::mt19937_64 random(7);
+  std::uniform_real_distribution<double> uniform(0, 1);
+  std::normal_distribution<double> noise(0, 0.003);
+  std::vector<Vec3> points;
+  std::vector<std::size_t> off;
+  for (int i = 0; i < 3000; ++i) points.push_back(uniform(random) * body + Vec3(noise(random), noise(random), noise(random)));
+  for (int i = 0; i < 600; ++i) {
+    const double m_b = 0.4 + 0.5 * uniform(random), m_s = 0.05 + 0.5 * uniform(random);
+    off.push_back(points.size());
+    points.push_back(m_b * body + m_s * light + Vec3(noise(random), noise(random), noise(random)));
+  }
+  const Line body_line{Vec3::Zero(), body, 0, 1, 3000, 0.003};
+  const std::optional<HighlightBranch> b = highlight_branch(points, body_line, off);
+  ASSERT_TRUE(b);
+  EXPECT_EQ(b->samples, 600u);
+  EXPECT_LE(angular_error_deg(b->direction, light), 3 * b->uncertainty_deg);
+  // The principal axis of the same colours leans towards the body colour.
+  const PrincipalAxes tls = principal_axes_of(points, About::Mean, off);
+  EXPECT_GT(angular_error_deg(tls.axes.col(0), light), 3 * b->uncertainty_deg);
+  EXPECT_LT(angular_error_deg(tls.axes.col(0), body), angular_error_deg(light, body));
+  // Too few samples: no branch.
+  EXPECT_FALSE(highlight_branch(points, body_line, {off.begin(), off.begin() + 9}));
 }
 
 }  // namespace
