@@ -247,12 +247,19 @@ IlluminantAnalysis estimate_illuminant(const std::vector<RegionAnalysis>& region
   std::string why_not;
   for (const auto* e : {out.planes ? &*out.planes : nullptr, out.highlight_lines ? &*out.highlight_lines : nullptr})
     if (e && !e->reliable) why_not += fmt::format("; the {} are not used: {}", e->method, e->unreliable_reason);
-  if (out.planes && &chosen == &*out.planes)
+  const bool planes_chosen = out.planes && &chosen == &*out.planes, lines_chosen = out.highlight_lines && &chosen == &*out.highlight_lines;
+  auto sigma = [](const std::optional<IlluminantEstimate>& e) { return e && e->uncertainty_deg ? *e->uncertainty_deg : 0.0; };
+  if (planes_chosen)
     out.choice = fmt::format("dichromatic planes: every dichromatic object's plane holds the light's colour, and {} planes "
-                             "meet in one direction{}", out.planes->regions.size(),
-                             out.highlight_lines ? ", which the highlight lines confirm" : "");
-  else if (out.highlight_lines && &chosen == &*out.highlight_lines)
-    out.choice = "highlight lines: a highlight branch adds the light's colour" + why_not;
+                             "meet in one direction (± {:.2f}°){}{}", out.planes->regions.size(), sigma(out.planes),
+                             out.highlight_lines && out.highlight_lines->reliable
+                                 ? fmt::format(", preferred to the highlight lines (± {:.2f}°), which tilt towards the body colours "
+                                               "where the shading follows the highlight", sigma(out.highlight_lines))
+                                 : "",
+                             why_not);
+  else if (lines_chosen)
+    out.choice = fmt::format("highlight lines: a highlight branch adds the light's colour (± {:.2f}°){}", sigma(out.highlight_lines),
+                             why_not);
   else
     out.choice = "grey world, a guess: no reliable dichromatic planes or highlight line" + why_not;
   return out;

@@ -43,7 +43,7 @@ struct IlluminantAnalysis {
   std::string choice;              // which estimate best() is, and why
 
   // The estimate to trust most: the planes' intersection (unbiased) when reliable, else the highlight lines
-  // (tilted towards the body colours when shading changes across a highlight) when reliable, else grey world
+  // (tilted towards the body colours where the shading follows the highlight) when reliable, else grey world
   // (a guess, never reliable).
   const IlluminantEstimate& best() const {
     if (planes && planes->reliable) return *planes;

@@ -192,22 +192,25 @@ Interpretation interpret_region(const RegionAnalysis& region, const Region& pixe
     }
     out.findings.push_back(sentence + ".");
   }
-  // A segment of the light's colour.
-  if (out.light_colour && light.reliable && s.moments.mean.norm() > 0) {
+  // A segment of the light's colour, and a segment of several separate areas.
+  if (region.source == "segment") out.separate_areas = separate_areas(pixels, width);
+  bool light_coloured = false;
+  if (out.light_colour && s.moments.mean.norm() > 0) {
     out.mean_light_angle_deg = angular_error_deg(s.moments.mean, *out.light_colour);
     const double near = std::max(criteria.min_line_angle_deg, light.reliable && light.uncertainty_deg ? 2 * *light.uncertainty_deg : 0.0);
-    if (region.source == "segment") out.separate_areas = separate_areas(pixels, width);
-    if (*out.mean_light_angle_deg <= near) {
-      std::string sentence = fmt::format("Its mean colour lies {:.1f}° from the light's colour (within {:.1f}°): the light "
-                                         "itself, or white and grey surfaces, glass and metal that return it unchanged",
-                                         *out.mean_light_angle_deg, near);
-      if (out.separate_areas > 1)
-        sentence += fmt::format("; this segment is {} separate areas, because the segmentation groups pixels by colour "
-                                "direction and objects of the light's colour all share that direction, so it cannot tell "
-                                "them apart", out.separate_areas);
-      out.findings.push_back(sentence + ".");
-    }
+    // Only a light known to within the angle that tells two directions apart can say a colour is the light's.
+    light_coloured = light.reliable && light.uncertainty_deg && *light.uncertainty_deg <= criteria.min_line_angle_deg &&
+                     *out.mean_light_angle_deg <= near;
+    if (light_coloured)
+      out.findings.push_back(fmt::format("Its mean colour lies {:.1f}° from the light's colour (within {:.1f}°): the light itself, "
+                                         "or white and grey surfaces, glass and metal that return it unchanged.",
+                                         *out.mean_light_angle_deg, near));
   }
+  if (out.separate_areas > 1)
+    out.findings.push_back(fmt::format("This segment is {} separate areas (each at least 1 % of it): the segmentation groups "
+                                       "pixels by colour direction, and {} share this one, so it joins them.", out.separate_areas,
+                                       light_coloured ? "objects of the light's colour — white cloth, glass, plates, the flames — all"
+                                                      : "several objects"));
   // γ.
   if (region.declared_gamma) {
     out.declared_gamma = region.declared_gamma->declared_gamma;
