@@ -60,7 +60,10 @@ double mean_direction_se_deg(const std::vector<Vec3>& directions, const std::vec
 // The standard error of the planes' intersection, in degrees: a normal tilted by δ moves the least eigenvector of
 // Σ n nᵀ by about δ / √λ₂ (two planes φ apart: λ₂ = 1 − cos φ, so √2 δ / φ for both tilted). δ is the
 // normals' rms standard error or, with more than two planes, their misfit — the rms angle by which the planes
-// miss the common direction, √(λ₃ / (k − 2)) — whichever is larger.
+// miss the common direction, √(λ₃ / (k − 2)) — whichever is larger. The fits' errors are independent and average
+// down over the k planes (λ₂ of the sum grows with k); a misfit beyond them is the model failing the same way in
+// many regions (saturated colours near a face of the cube, interreflection, a second light), which does not, so it
+// is taken against λ₂ of the mean, λ₂ / k.
 double intersection_se_deg(const std::vector<Vec3>& normals, const std::vector<double>& se, const Vec3& direction) {
   Mat3 m = Mat3::Zero();
   double tilt = 0, miss = 0;
@@ -75,9 +78,9 @@ double intersection_se_deg(const std::vector<Vec3>& normals, const std::vector<d
   Mat3 axes;
   principal_axes(m, values, axes);  // descending: the third is the intersection's
   const double lambda2 = std::max(values[1], 1e-12);
-  double delta = std::sqrt(tilt / k);
-  if (k > 2) delta = std::max(delta, std::sqrt(miss / (k - 2)));
-  return delta / std::sqrt(lambda2) * kDeg;
+  const double from_fits = std::sqrt(tilt / k) / std::sqrt(lambda2);
+  const double from_misfit = k > 2 ? std::sqrt(miss / (k - 2)) / std::sqrt(lambda2 / k) : 0.0;
+  return std::max(from_fits, from_misfit) * kDeg;
 }
 
 }  // namespace
@@ -99,7 +102,7 @@ std::optional<Vec3> intersect_planes(const std::vector<Vec3>& normals) {
 
 IlluminantAnalysis estimate_illuminant(const std::vector<RegionAnalysis>& regions, std::span<const float> rgb,
                                        const std::optional<Vec3>& known, const std::array<double, 3>& high_levels,
-                                       const std::optional<Vec3>& camera_white) {
+                                       const std::optional<Vec3>& camera_white, const std::string& assumed_curve) {
   IlluminantAnalysis out;
   if (known) out.known = known->normalized();
   if (camera_white) out.camera_white = camera_white->normalized();
@@ -229,6 +232,14 @@ IlluminantAnalysis estimate_illuminant(const std::vector<RegionAnalysis>& region
       out.planes->unreliable_reason = reason;
       if (normals.size() > 2) out.highlight_lines->reliable = false, out.highlight_lines->unreliable_reason = reason;
     }
+  }
+  // A plane through black is one only in the true linear light: a response curve that was guessed, not declared,
+  // tilts every plane alike when it is wrong, which their agreement cannot show.
+  if (out.planes && !assumed_curve.empty() && out.planes->reliable) {
+    out.planes->reliable = false;
+    out.planes->unreliable_reason = fmt::format("the response curve was assumed ({}), not declared: a dichromatic plane passes "
+                                                "through black only in the true linear light, and a wrong curve tilts every "
+                                                "plane alike, which their agreement cannot show", assumed_curve);
   }
   Vec3 mean = Vec3::Zero();
   std::size_t count = 0;

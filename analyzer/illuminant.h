@@ -55,11 +55,13 @@ struct IlluminantAnalysis {
 // From the regions other than the whole image (which mixes objects) when there are any. The grey world
 // averages `rgb`, the whole layer's finite pixels. A highlight line whose bright end lies within 2τ of a
 // clipping level (`high_levels`, +∞ where none is known) is left out: past the level the highlight is cut off,
-// and what remains bends towards the face of the cube, not along the light.
+// and what remains bends towards the face of the cube, not along the light. `assumed_curve` names a response curve
+// that was guessed rather than declared ("" when declared or none): the planes' estimate is then unreliable.
 IlluminantAnalysis estimate_illuminant(const std::vector<RegionAnalysis>& regions, std::span<const float> rgb,
                                        const std::optional<Vec3>& known,
                                        const std::array<double, 3>& high_levels = {kNoLevel, kNoLevel, kNoLevel},
-                                       const std::optional<Vec3>& camera_white = std::nullopt);
+                                       const std::optional<Vec3>& camera_white = std::nullopt,
+                                       const std::string& assumed_curve = "");
 
 // The angle between two colour directions, in degrees.
 double angular_error_deg(const Vec3& a, const Vec3& b);
