@@ -195,16 +195,24 @@ Interpretation interpret_region(const RegionAnalysis& region, const Region& pixe
   // A segment of the light's colour, and a segment of several separate areas.
   if (region.source == "segment") out.separate_areas = separate_areas(pixels, width);
   bool light_coloured = false;
-  if (out.light_colour && s.moments.mean.norm() > 0) {
-    out.mean_light_angle_deg = angular_error_deg(s.moments.mean, *out.light_colour);
-    const double near = std::max(criteria.min_line_angle_deg, light.reliable && light.uncertainty_deg ? 2 * *light.uncertainty_deg : 0.0);
-    // Only a light known to within the angle that tells two directions apart can say a colour is the light's.
-    light_coloured = light.reliable && light.uncertainty_deg && *light.uncertainty_deg <= criteria.min_line_angle_deg &&
-                     *out.mean_light_angle_deg <= near;
+  if (out.light_colour && s.moments.mean.norm() > 0) out.mean_light_angle_deg = angular_error_deg(s.moments.mean, *out.light_colour);
+  // Only a light known to within the angle that tells two directions apart can say a colour is the light's: the
+  // most precise reliable measurement, if its standard error is that small.
+  const IlluminantEstimate* sharp = nullptr;
+  for (const auto* e : {illuminant.planes ? &*illuminant.planes : nullptr, illuminant.highlight_lines ? &*illuminant.highlight_lines : nullptr})
+    if (e && e->reliable && e->uncertainty_deg && *e->uncertainty_deg <= criteria.min_line_angle_deg &&
+        (!sharp || *e->uncertainty_deg < *sharp->uncertainty_deg))
+      sharp = e;
+  if (sharp && out.body_colour && region.source != "image") {
+    const double apart = angular_error_deg(*out.body_colour, sharp->rgb);
+    const double near = std::max(criteria.min_line_angle_deg, 2 * *sharp->uncertainty_deg);
+    light_coloured = apart <= near;
     if (light_coloured)
-      out.findings.push_back(fmt::format("Its mean colour lies {:.1f}° from the light's colour (within {:.1f}°): the light itself, "
-                                         "or white and grey surfaces, glass and metal that return it unchanged.",
-                                         *out.mean_light_angle_deg, near));
+      out.findings.push_back(fmt::format("Its body colour lies {:.1f}° from the light's colour as the {} measure it (± {:.1f}°): it "
+                                         "is the light itself, or surfaces that return it unchanged — white and grey cloth, "
+                                         "plates, glass and metal — which all share one colour direction, so a segment of this "
+                                         "colour may hold several of them, touching or not.",
+                                         apart, sharp->method, *sharp->uncertainty_deg));
   }
   if (out.separate_areas > 1)
     out.findings.push_back(fmt::format("This segment is {} separate areas (each at least 1 % of it): the segmentation groups "

@@ -421,6 +421,45 @@ TEST(Photographs, ClippedFacesAreNamedWithTheirChannels) {
   if (checked == 0) GTEST_SKIP() << "none of the photographs' packages is installed";
 }
 
+// White cloth, plates, glass and the flames return the light's colour unchanged, so the segmentation, which groups
+// by colour direction, joins them: the segment holding most of a white reference says its colour is the light's and
+// that it may hold several objects — measured against the light of a glossy object's highlight branch (its segment,
+// or its mask when it is left out), where that is known to within 3°.
+TEST(Photographs, ASegmentOfTheLightsColourSaysItMayHoldSeveralObjects) {
+  int checked = 0;
+  std::string missing;
+  for (const Photo& photo : photos()) {
+    if (photo.light.empty() || !available(photo)) continue;
+    for (const auto& [glossy, white] : photo.light) {
+      SCOPED_TRACE(photo.file + ": " + white);
+      const Read& r = read(photo);
+      const Segmentation& s = r.segmented.s;
+      std::vector<analyzer::Region> regions = r.segmented.regions;
+      regions.push_back(analyse_object(photo, glossy).region);
+      if (regions.back().source == "segment") regions.pop_back();
+      const analyzer::ImageAnalysis a = analyzer::analyse_image(r.input, "", regions, analyzer::AnalyzeOptions{}, std::nullopt, false);
+      const auto& lines = a.illuminant.highlight_lines;
+      if (!lines || !lines->reliable || !lines->uncertainty_deg || *lines->uncertainty_deg > 3) {
+        missing += fmt::format("{}: no highlight branch known to 3°. ", photo.file);
+        continue;
+      }
+      const Match m = best_segment(s, rasterise(named(photo, white), s.width, s.height, 1.0));
+      for (std::size_t i = 0; i < a.regions.size(); ++i) {
+        if (a.regions[i].source != "segment" || a.regions[i].label != m.label) continue;
+        const analyzer::Interpretation& in = a.interpretations[i];
+        const bool says = std::any_of(in.findings.begin(), in.findings.end(), [](const std::string& f) {
+          return f.find("the light itself") != std::string::npos && f.find("several of them") != std::string::npos;
+        });
+        EXPECT_TRUE(says) << a.regions[i].name << ": " << analyzer::interpretation_text(in);
+        std::cerr << fmt::format("{}: {} (IoU {:.2f} with {}): {}\n", photo.file, a.regions[i].name, m.iou, white,
+                                 analyzer::interpretation_text(in));
+        ++checked;
+      }
+    }
+  }
+  if (checked == 0) GTEST_SKIP() << missing;
+}
+
 // Each photograph analysed whole, as `analyze --segment` does: the image, its segments and the unassigned pixels.
 const analyzer::ImageAnalysis& analysed(const Photo& photo) {
   static std::map<std::string, analyzer::ImageAnalysis> cache;
