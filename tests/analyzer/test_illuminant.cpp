@@ -3,6 +3,7 @@
 #include <fmt/core.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <random>
 
 #include "analyzer/highlight_branch.h"
@@ -101,6 +102,59 @@ TEST(Illuminant, HighlightLinesEndingAtAClippingLevelAreLeftOut) {
   EXPECT_EQ(static_cast<std::size_t>(said), all - kept);
   ASSERT_TRUE(cut.planes);  // the planes do not depend on where a highlight ends
   EXPECT_EQ(cut.planes->rgb, open.planes->rgb);
+}
+
+// A cluster pressed onto a face of the cube lost what lay beyond it, and its plane through black is partly the face:
+// clipping red below one object's brightest red takes that object out of the planes' estimate, with a note.
+TEST(Illuminant, APlaneOnAClippingFaceIsLeftOut) {
+  Scene scene = dichromatic_scene(kWarm);
+  const std::vector<Region> objects = label_regions(scene.ids, "object", scene.names, {0});
+  // The red level: half the brightest red of the first object's pixels.
+  double red = 0;
+  for (const std::uint32_t p : objects.front().pixels) red = std::max(red, static_cast<double>(scene.image.rgb[p * 3]));
+  for (std::size_t i = 0; i < scene.image.rgb.size(); i += 3)
+    scene.image.rgb[i] = std::min(scene.image.rgb[i], static_cast<float>(red / 2));
+  const LayerContext context = layer_context(scene.image, {}, 64);
+  std::vector<RegionAnalysis> regions;
+  for (const Region& r : objects) regions.push_back(analyse_region(scene.image, context, r, AnalyzeOptions{}));
+  const IlluminantAnalysis a = estimate_illuminant(regions, scene.image.rgb, kWarm, context.high_levels);
+  std::size_t faced = 0, said = 0;
+  auto holds_a_plane = [](ShapeClass c) {
+    return c == ShapeClass::L || c == ShapeClass::SkewedT || c == ShapeClass::P || c == ShapeClass::Planar || c == ShapeClass::Thickened;
+  };
+  for (const RegionAnalysis& r : regions)
+    if (!r.shape.clipping.faces.empty() && r.shape.black_plane) {
+      faced += holds_a_plane(r.shape.shape);
+      if (a.planes) {
+        EXPECT_EQ(std::count(a.planes->regions.begin(), a.planes->regions.end(), r.name), 0) << r.name;
+      }
+    }
+  for (const std::string& n : a.notes) said += n.find("partly the cube's face") != std::string::npos;
+  EXPECT_GE(faced, 1u);
+  EXPECT_EQ(said, faced);
+}
+
+// Two planes meet in a line whatever made them: without a highlight line to check them, the planes' estimate is
+// marked unreliable (and grey world, a guess, is never reliable), so the chosen estimate says it is not trusted.
+TEST(Illuminant, TwoPlanesAloneAreUnreliable) {
+  const Scene scene = dichromatic_scene(kWarm);
+  const LayerContext context = layer_context(scene.image, {}, 64);
+  std::vector<RegionAnalysis> regions;
+  for (const Region& r : label_regions(scene.ids, "object", scene.names, {0})) {
+    regions.push_back(analyse_region(scene.image, context, r, AnalyzeOptions{}));
+    ClusterShape& s = regions.back().shape;
+    s.shape = ShapeClass::Planar;  // the planes without their highlight lines
+    s.two_lines.reset();
+    s.highlight_branch.reset();
+    if (regions.size() == 2) break;
+  }
+  const IlluminantAnalysis a = estimate_illuminant(regions, scene.image.rgb, kWarm);
+  ASSERT_TRUE(a.planes);
+  EXPECT_FALSE(a.planes->reliable);
+  EXPECT_NE(a.planes->unreliable_reason.find("two planes"), std::string::npos);
+  EXPECT_FALSE(a.best().reliable);
+  EXPECT_EQ(a.best().method, "grey world");
+  EXPECT_NE(a.choice.find("the dichromatic planes are not used"), std::string::npos) << a.choice;
 }
 
 TEST(Illuminant, OnePlaneIsNotEnough) {
