@@ -5,6 +5,9 @@
 //    reported and consistent with the label map;
 //  - a glossy object's highlight branch points to the light's colour measured on a white object of the same
 //    photograph, within 3 times the estimate's own standard error;
+//  - the chosen illuminant estimate lies within 2 of its standard errors of every white object's colour, or is
+//    marked unreliable with the reason; every region's interpretation carries its own numbers; a camera raw's
+//    as-shot white balance stands beside each estimate;
 //  - an over-exposed object's clipped faces are named with their channels.
 // A photograph whose package is not installed is skipped with a message naming the package.
 #include <algorithm>
@@ -366,8 +369,9 @@ TEST(Photographs, LabelsDoNotDependOnTheThreadCount) {
 }
 
 // A glossy object's highlight adds the light's colour: the highlight branch of its segment's cluster (in linear
-// light) points to the colour of a white object lit by the same light, within 3 standard errors of the
-// highlight-line estimate (its uncertainty_deg: the line's spread across it, its extent, its pixel count).
+// light; its mask's when the segmentation leaves it out) points to the colour of a white object lit by the same
+// light, within 3 standard errors of the highlight-line estimate (its uncertainty_deg: the branch's regression, its
+// spread and its two halves' agreement, analyzer/highlight_branch.h) and within 3°.
 // Where the analysis finds no highlight branch (the cluster is not classed L, skewed-T or P, or its highlight
 // line runs into a clipping level), nothing can be compared: the test says so and skips that object.
 TEST(Photographs, AGlossyObjectsHighlightBranchPointsToTheLightsColour) {
