@@ -34,7 +34,7 @@ Slope regress(const std::vector<double>& x, const std::vector<double>& y) {
   return s;
 }
 
-// The direction κ·body + e, unit, and the angle (radians) it turns by per unit of κ: d(atan(1/κ))/dκ.
+// The direction κ·body + e, unit, oriented with a positive component sum.
 Vec3 direction_of(double kappa, const Vec3& body, const Vec3& e) {
   const Vec3 v = (kappa * body + e).normalized();
   return v.sum() < 0 ? Vec3(-v) : v;
