@@ -179,14 +179,19 @@ ImageAnalysis analyse_image(const AnalysisImage& input, const std::string& layer
   if (curve) {
     std::vector<RegionAnalysis> light = a.results;
     for (RegionAnalysis& r : light) r.shape = *r.linear_light;
-    a.illuminant = estimate_illuminant(light, linear.rgb, known_illuminant, known_levels(linear_context));
+    a.illuminant = estimate_illuminant(light, linear.rgb, known_illuminant, known_levels(linear_context), input.camera_white);
     a.notes.push_back(fmt::format("R, G, B were encoded by {} ({}): classes are of the "
                                   "values as stored, each region's class in linear light is given beside it, and "
                                   "the illuminant is estimated in linear light", curve->describe(),
                                   a.encoding.curve_source.empty() ? "the file's chromatrace.curve_*" : a.encoding.curve_source));
   } else {
-    a.illuminant = estimate_illuminant(a.results, pixels.rgb, known_illuminant, known_levels(a.context));
+    a.illuminant = estimate_illuminant(a.results, pixels.rgb, known_illuminant, known_levels(a.context),
+                                       a.layer == "final" || a.layer == "linear" ? input.camera_white : std::nullopt);
   }
+  const std::optional<Explanation> no_explanation;
+  for (std::size_t i = 0; i < a.results.size(); ++i)
+    a.interpretations.push_back(interpret_region(a.results[i], a.regions[i], a.width, a.illuminant, a.encoding,
+                                                 i < a.explanations.size() ? a.explanations[i] : no_explanation, options.criteria));
   for (const std::string& note : input.notes) a.notes.push_back(note);
   // The whole image's left-out pixels, less those set aside while reading (said above).
   const std::size_t set_aside = a.layer == "final" ? input.transparent_pixels + input.negative_pixels : 0;

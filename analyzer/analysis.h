@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "analyzer/explain.h"
+#include "analyzer/interpretation.h"
 #include "analyzer/illuminant.h"
 #include "analyzer/region_analysis.h"
 #include "analyzer/segmentation.h"
@@ -41,6 +42,7 @@ struct ImageAnalysis {
   std::vector<RegionAnalysis> results;            // one per region
   std::vector<std::optional<Explanation>> explanations;  // one per region; empty without component layers
   IlluminantAnalysis illuminant;
+  std::vector<Interpretation> interpretations;  // one per region: what its cluster says, in words and numbers
   std::vector<std::string> notes;  // what a person should know (non-finite pixels, empty regions …)
   std::optional<Segmentation> segmentation;  // with --segment: the label map and its numbers
 };

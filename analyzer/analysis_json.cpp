@@ -38,7 +38,38 @@ json estimate_json(const IlluminantEstimate& e) {
   json j = {{"method", e.method}, {"rgb", vec(e.rgb)}, {"regions", e.regions}};
   j["error_deg"] = e.error_deg ? json(*e.error_deg) : json(nullptr);
   j["uncertainty_deg"] = e.uncertainty_deg ? json(*e.uncertainty_deg) : json(nullptr);
+  j["reliable"] = e.reliable;
+  j["unreliable_reason"] = e.reliable ? json(nullptr) : json(e.unreliable_reason);
+  j["camera_angle_deg"] = e.camera_angle_deg ? json(*e.camera_angle_deg) : json(nullptr);
   return j;
+}
+
+json interpretation_json(const Interpretation& i) {
+  auto opt = [](const std::optional<double>& v) { return v ? json(*v) : json(nullptr); };
+  auto opt_vec = [](const std::optional<Vec3>& v) { return v ? vec(*v) : json(nullptr); };
+  return {{"text", interpretation_text(i)},
+          {"class_in_linear_light", i.light_class},
+          {"class_as_stored", i.stored_class},
+          {"process", i.process},
+          {"body_colour", opt_vec(i.body_colour)},
+          {"light_colour", opt_vec(i.light_colour)},
+          {"light_method", i.light_method},
+          {"body_light_angle_deg", opt(i.body_light_angle_deg)},
+          {"light_off_plane_deg", opt(i.light_off_plane_deg)},
+          {"highlight_direction", opt_vec(i.highlight_direction)},
+          {"highlight_light_angle_deg", opt(i.highlight_light_angle_deg)},
+          {"highlight_reach", opt(i.highlight_reach)},
+          {"clipped_fraction", i.clipped_fraction},
+          {"clipped_faces", i.clipped_faces},
+          {"thickness_over_noise", opt(i.thickness_over_noise)},
+          {"mean_light_angle_deg", opt(i.mean_light_angle_deg)},
+          {"separate_areas", i.separate_areas},
+          {"curve", i.curve},
+          {"declared_gamma", opt(i.declared_gamma)},
+          {"fitted_gamma", opt(i.fitted_gamma)},
+          {"fitted_gamma_se", opt(i.fitted_gamma_se)},
+          {"findings", i.findings},
+          {"uncertain", i.uncertain}};
 }
 
 json explanation_json(const Explanation& e) {
@@ -156,6 +187,10 @@ json shape_to_json(const ClusterShape& s) {
                 {"body_fraction", t.body_fraction},
                 {"highlight_fraction", t.highlight_fraction}};
   });
+  j["highlight_branch"] = optional_json(s.highlight_branch, [](const HighlightBranch& b) {
+    return json{{"direction", vec(b.direction)}, {"samples", b.samples}, {"statistical_deg", b.statistical_deg},
+                {"halves_deg", b.halves_deg}, {"uncertainty_deg", b.uncertainty_deg}};
+  });
   j["plane"] = optional_json(s.plane, plane_json);
   j["dichromatic_plane"] = optional_json(s.black_plane, plane_json);
   if (s.plane) j["thickness_over_noise"] = s.sigma[2] / std::max(1e-300, s.noise_sigma[2]);
@@ -238,6 +273,7 @@ json analysis_to_json(const ImageAnalysis& a, const std::vector<bool>& plotted) 
                })},
               {"files", {{"histogram", "histograms/" + stem + ".json"},
                          {"plot", plotted.empty() || (i < plotted.size() && plotted[i]) ? json("plots/" + stem + ".png") : json(nullptr)}}}};
+    j["interpretation"] = i < a.interpretations.size() ? interpretation_json(a.interpretations[i]) : json(nullptr);
     j["explanation"] = i < a.explanations.size() ? optional_json(a.explanations[i], explanation_json) : json(nullptr);
     j["bend_cause"] = optional_json(r.bend, [](const BendCause& b) {
       json tests = json::array();
@@ -303,6 +339,7 @@ json analysis_to_json(const ImageAnalysis& a, const std::vector<bool>& plotted) 
             {"dichromatic_planes", optional_json(il.planes, estimate_json)},
             {"grey_world", estimate_json(il.grey_world)},
             {"known", optional_json(il.known, vec)},
+            {"camera_white_balance", optional_json(il.camera_white, vec)},
             {"notes", il.notes}}},
           {"notes", a.notes}};
 }

@@ -89,13 +89,31 @@ class ShapeDecision {
     find_body_and_highlight();
     if (nearly_all_on_the_body_line()) return std::move(s_);
     fit_curve();
-    if (two_lines_explain_it() || curve_explains_it() || thickened_plane() || thickened_line()) return std::move(s_);
-    if (s_.body_only && s_.two_lines && broad_highlight()) return std::move(s_);
+    if (two_lines_explain_it() || curve_explains_it() || thickened_plane() || thickened_line()) return measure_highlight_branch();
+    if (s_.body_only && s_.two_lines && broad_highlight()) return measure_highlight_branch();
     settle(ShapeClass::Planar, "a planar cluster that is neither two lines, a curve nor a P");
-    return std::move(s_);
+    return measure_highlight_branch();
   }
 
  private:
+  // The colour the highlight adds, for the classes that have a highlight branch: L, skewed-T and P, and a planar
+  // cluster whose body line holds p_body_fraction of it with the rest on one side of that line, as the highlights
+  // of a dichromatic surface lie (the body line and highlights of several objects of one body colour, which
+  // together make no single L, T or P).
+  ClusterShape measure_highlight_branch() {
+    const ShapeClass c = s_.shape;
+    if (!s_.body_only) return std::move(s_);
+    const std::vector<std::size_t> off = clearly_off_body();
+    bool has_branch = c == ShapeClass::L || c == ShapeClass::SkewedT || c == ShapeClass::P;
+    if (c == ShapeClass::Planar)
+      has_branch = all({test("highlight branch: body line fraction >= p_body_fraction", body_fraction_, k_.p_body_fraction,
+                             body_fraction_ >= k_.p_body_fraction),
+                        test("highlight branch: off-body pixels on one side >= p_one_side", one_side(off), k_.p_one_side,
+                             one_side(off) >= k_.p_one_side)});
+    if (has_branch) s_.highlight_branch = highlight_branch(points_, s_.body_only->line, off);
+    return std::move(s_);
+  }
+
   // Whether every one of the tests passed; each is evaluated (and recorded), in order, whatever the others gave.
   static bool all(std::initializer_list<bool> results) {
     return std::all_of(results.begin(), results.end(), [](bool passed) { return passed; });

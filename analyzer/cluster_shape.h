@@ -33,6 +33,7 @@
 #include "analyzer/clipping.h"
 #include "core/structures.h"
 #include "analyzer/gamma_fit.h"
+#include "analyzer/highlight_branch.h"
 #include "analyzer/line_fit.h"
 #include "analyzer/moments.h"
 #include "analyzer/noise_level.h"
@@ -115,6 +116,9 @@ struct ClusterShape {
   std::optional<LineSearch> body_only;  // the robust body line before the two-line model
   double line_tolerance = 0;            // τ: a sample within it of a line lies on the line
   std::optional<TwoLines> two_lines;
+  // L, skewed-T and P: the colour the highlight adds, from the samples clearly off the body line
+  // (analyzer/highlight_branch.h).
+  std::optional<HighlightBranch> highlight_branch;
   std::optional<Plane> plane;          // principal plane through the mean (normal = third axis)
   std::optional<Plane> black_plane;    // best plane through black: the dichromatic plane
   std::optional<PrincipalCurve> curve;

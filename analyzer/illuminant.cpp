@@ -12,6 +12,7 @@ namespace {
 Vec3 positive(const Vec3& v) { return v.sum() < 0 ? Vec3(-v) : v; }
 
 constexpr double kNegativeTolerance = 0.05;  // ≈ 3° towards a negative channel
+constexpr double kNoiseFactor = ShapeCriteria{}.noise_factor;  // a spread is beyond the noise past this many σ
 
 bool holds_a_plane(ShapeClass c) {
   return c == ShapeClass::L || c == ShapeClass::SkewedT || c == ShapeClass::P || c == ShapeClass::Planar ||
@@ -29,10 +30,14 @@ double line_direction_se(const Line& h) {
 }
 
 // Standard error (radians) of a plane's normal through black: the samples' distance from it (rms) against their
-// second spread within it (σ2; the normal tilts most readily about the longer axis), over √n.
-double plane_normal_se(const ClusterShape& s) {
+// second spread within it (σ2; the normal tilts most readily about the longer axis). Spread off the plane that is
+// noise averages out over the n samples (÷ √n); spread beyond the noise (thickness_over_noise above noise_factor) is
+// structure — interreflection, texture, a second light — that does not, and tilts the plane by up to rms / σ2.
+double plane_normal_se(const ClusterShape& s, double noise_factor) {
   const double n = static_cast<double>(std::max<std::size_t>(s.fit_points ? s.fit_points : s.samples, 3));
-  return s.black_plane->rms / (std::max(s.sigma[1], 1e-12) * std::sqrt(n));
+  const double tilt = s.black_plane->rms / std::max(s.sigma[1], 1e-12);
+  const bool thick = s.sigma[2] > noise_factor * s.noise_sigma[2];
+  return thick ? tilt : tilt / std::sqrt(n);
 }
 
 // The standard error of a weighted mean direction, in degrees: the propagated errors of the members and, with
@@ -55,7 +60,10 @@ double mean_direction_se_deg(const std::vector<Vec3>& directions, const std::vec
 // The standard error of the planes' intersection, in degrees: a normal tilted by δ moves the least eigenvector of
 // Σ n nᵀ by about δ / √λ₂ (two planes φ apart: λ₂ = 1 − cos φ, so √2 δ / φ for both tilted). δ is the
 // normals' rms standard error or, with more than two planes, their misfit — the rms angle by which the planes
-// miss the common direction, √(λ₃ / (k − 2)) — whichever is larger.
+// miss the common direction, √(λ₃ / (k − 2)) — whichever is larger. The fits' errors are independent and average
+// down over the k planes (λ₂ of the sum grows with k); a misfit beyond them is the model failing the same way in
+// many regions (saturated colours near a face of the cube, interreflection, a second light), which does not, so it
+// is taken against λ₂ of the mean, λ₂ / k.
 double intersection_se_deg(const std::vector<Vec3>& normals, const std::vector<double>& se, const Vec3& direction) {
   Mat3 m = Mat3::Zero();
   double tilt = 0, miss = 0;
@@ -70,9 +78,9 @@ double intersection_se_deg(const std::vector<Vec3>& normals, const std::vector<d
   Mat3 axes;
   principal_axes(m, values, axes);  // descending: the third is the intersection's
   const double lambda2 = std::max(values[1], 1e-12);
-  double delta = std::sqrt(tilt / k);
-  if (k > 2) delta = std::max(delta, std::sqrt(miss / (k - 2)));
-  return delta / std::sqrt(lambda2) * kDeg;
+  const double from_fits = std::sqrt(tilt / k) / std::sqrt(lambda2);
+  const double from_misfit = k > 2 ? std::sqrt(miss / (k - 2)) / std::sqrt(lambda2 / k) : 0.0;
+  return std::max(from_fits, from_misfit) * kDeg;
 }
 
 }  // namespace
@@ -93,13 +101,26 @@ std::optional<Vec3> intersect_planes(const std::vector<Vec3>& normals) {
 }
 
 IlluminantAnalysis estimate_illuminant(const std::vector<RegionAnalysis>& regions, std::span<const float> rgb,
-                                       const std::optional<Vec3>& known, const std::array<double, 3>& high_levels) {
+                                       const std::optional<Vec3>& known, const std::array<double, 3>& high_levels,
+                                       const std::optional<Vec3>& camera_white, const std::string& assumed_curve) {
   IlluminantAnalysis out;
   if (known) out.known = known->normalized();
-  IlluminantEstimate highlights{"highlight lines", {}, {}, {}, {}};
-  IlluminantEstimate planes{"dichromatic planes", {}, {}, {}, {}};
+  if (camera_white) out.camera_white = camera_white->normalized();
+  IlluminantEstimate highlights, planes;
+  highlights.method = "highlight lines";
+  planes.method = "dichromatic planes";
   std::vector<Vec3> line_directions, normals;
   std::vector<double> line_weights, line_se, normal_se;
+  // A highlight branch is evidence of the light's colour only when it can be told from the body colour: turned from
+  // the body line by more than 2 of its standard errors.
+  auto told_from_body = [&](const RegionAnalysis& r, const ClusterShape& s) {
+    const double turn = angular_error_deg(s.highlight_branch->direction, s.body_only->line.direction);
+    if (turn > 2 * s.highlight_branch->uncertainty_deg) return true;
+    out.notes.push_back(fmt::format("{}: its highlight branch turns {:.1f}° from its body colour, within 2 × its standard "
+                                    "error ({:.1f}°): it cannot be told from the body colour, so it is left out",
+                                    r.name, turn, s.highlight_branch->uncertainty_deg));
+    return false;
+  };
   // The whole image mixes objects; it stands in only when it is the one region.
   const bool parts = std::any_of(regions.begin(), regions.end(), [](const RegionAnalysis& r) { return r.source != "image"; });
   for (const RegionAnalysis& r : regions) {
@@ -117,6 +138,13 @@ IlluminantAnalysis estimate_illuminant(const std::vector<RegionAnalysis>& region
         out.notes.push_back(fmt::format("{}: its highlight line ends at the clipping level of {} ({:.4g}), so it is "
                                         "left out of the highlight-line estimate", r.name, "RGB"[clipped],
                                         high_levels[clipped]));
+      } else if (const auto& b = s.highlight_branch; b) {
+        // The branch's colour by regression (highlight_branch.h): not tilted by the shading across the highlight.
+        if (!told_from_body(r, s)) continue;
+        line_directions.push_back(positive(b->direction));
+        line_weights.push_back(static_cast<double>(b->samples));
+        line_se.push_back(b->uncertainty_deg / kDeg);
+        highlights.regions.push_back(r.name);
       } else {
         line_directions.push_back(positive(h.direction));
         line_weights.push_back(static_cast<double>(h.inliers));
@@ -124,11 +152,32 @@ IlluminantAnalysis estimate_illuminant(const std::vector<RegionAnalysis>& region
         highlights.regions.push_back(r.name);
       }
     }
-    if (holds_a_plane(s.shape) && s.black_plane) {
-      normals.push_back(s.black_plane->normal);
-      normal_se.push_back(plane_normal_se(s));
-      planes.regions.push_back(r.name);
+    // A planar cluster with a highlight branch (cluster_shape.h): several objects of one body colour with their
+    // highlights. Its branch counts when no channel of it reaches a clipping level.
+    if (s.shape == ShapeClass::Planar && s.highlight_branch && told_from_body(r, s)) {
+      if (std::none_of(s.clipping.faces.begin(), s.clipping.faces.end(), [](const ClippedFace& f) { return f.high; })) {
+        line_directions.push_back(positive(s.highlight_branch->direction));
+        line_weights.push_back(static_cast<double>(s.highlight_branch->samples));
+        line_se.push_back(s.highlight_branch->uncertainty_deg / kDeg);
+        highlights.regions.push_back(r.name);
+      } else {
+        out.notes.push_back(fmt::format("{}: its highlight branch reaches a clipping level, so it is left out of the "
+                                        "highlight-line estimate", r.name));
+      }
     }
+    if (!holds_a_plane(s.shape) || !s.black_plane) continue;
+    // A cluster that reaches a face of the cube lost what lay beyond it: its plane through black is partly the
+    // face's (a saturated colour clipped at 0 or at the top lies on the face), not the one its light made.
+    if (!s.clipping.faces.empty()) {
+      const ClippedFace& f = s.clipping.faces.front();
+      out.notes.push_back(fmt::format("{}: {:.1f} % of its pixels lie on clipping faces ({} {} at {:.4g} …), so its plane is "
+                                      "partly the cube's face: left out of the planes' estimate", r.name,
+                                      100 * s.clipping.fraction, "RGB"[f.channel], f.high ? "high" : "low", f.level));
+      continue;
+    }
+    normals.push_back(s.black_plane->normal);
+    normal_se.push_back(plane_normal_se(s, kNoiseFactor));
+    planes.regions.push_back(r.name);
   }
   // A light's colour has no negative channel: a direction with one (beyond a few degrees of rounding)
   // means the regions did not follow the dichromatic model (interreflection, noise, mixed objects).
@@ -140,6 +189,7 @@ IlluminantAnalysis estimate_illuminant(const std::vector<RegionAnalysis>& region
       return;
     }
     if (out.known) e.error_deg = angular_error_deg(e.rgb, *out.known);
+    if (out.camera_white) e.camera_angle_deg = angular_error_deg(e.rgb, *out.camera_white);
     slot = e;
   };
   if (!highlights.regions.empty()) {
@@ -148,15 +198,48 @@ IlluminantAnalysis estimate_illuminant(const std::vector<RegionAnalysis>& region
     highlights.uncertainty_deg = mean_direction_se_deg(line_directions, line_weights, line_se, sum.normalized());
     finish(highlights, sum, out.highlight_lines);
   } else if (line_directions.empty()) {
-    out.notes.push_back("no region is an L, skewed-T or P with a highlight line inside the clipping levels, so no "
-                        "highlight line gives the illuminant");
+    out.notes.push_back("no region is an L, skewed-T or P with a highlight line inside the clipping levels, nor a planar "
+                        "cluster with a highlight branch, so no highlight line gives the illuminant");
   }
   if (const auto v = intersect_planes(normals)) {
     planes.uncertainty_deg = intersection_se_deg(normals, normal_se, *v);
+    // Two planes always meet in a line, whatever made them; only a third plane, or the highlight lines, can show
+    // that they are dichromatic planes of one light.
+    if (normals.size() == 2 && !out.highlight_lines) {
+      planes.reliable = false;
+      planes.unreliable_reason = "two planes meet in a line whatever made them, and no third plane or highlight line "
+                                 "checks that both are dichromatic planes of one light";
+    }
     finish(planes, *v, out.planes);
   } else {
-    out.notes.push_back(fmt::format("{} region{} with a dichromatic plane; the intersection needs two distinct planes",
+    out.notes.push_back(fmt::format("{} region{} with a usable dichromatic plane; the intersection needs two distinct planes",
                                     normals.size(), normals.size() == 1 ? "" : "s"));
+  }
+  // Where both exist they must agree within their errors (3 σ combined); when they do not, the planes' estimate
+  // is not trusted (the highlight branch checks its own model on its two halves), and with three or more planes,
+  // which check each other, neither is.
+  if (out.planes && out.highlight_lines) {
+    const double apart = angular_error_deg(out.planes->rgb, out.highlight_lines->rgb);
+    const double sigma = std::hypot(out.planes->uncertainty_deg.value_or(0), out.highlight_lines->uncertainty_deg.value_or(0));
+    // Two planes are checked only as far as the highlight lines reach: no closer than their standard error.
+    if (normals.size() == 2)
+      planes.uncertainty_deg = out.planes->uncertainty_deg =
+          std::max(out.planes->uncertainty_deg.value_or(0), out.highlight_lines->uncertainty_deg.value_or(0));
+    if (apart > 3 * sigma) {
+      const std::string reason = fmt::format("the dichromatic planes and the highlight lines disagree by {:.1f}°, more than "
+                                             "3 × their combined standard error ({:.1f}°)", apart, sigma);
+      out.planes->reliable = false;
+      out.planes->unreliable_reason = reason;
+      if (normals.size() > 2) out.highlight_lines->reliable = false, out.highlight_lines->unreliable_reason = reason;
+    }
+  }
+  // A plane through black is one only in the true linear light: a response curve that was guessed, not declared,
+  // tilts every plane alike when it is wrong, which their agreement cannot show.
+  if (out.planes && !assumed_curve.empty() && out.planes->reliable) {
+    out.planes->reliable = false;
+    out.planes->unreliable_reason = fmt::format("the response curve was assumed ({}), not declared: a dichromatic plane passes "
+                                                "through black only in the true linear light, and a wrong curve tilts every "
+                                                "plane alike, which their agreement cannot show", assumed_curve);
   }
   Vec3 mean = Vec3::Zero();
   std::size_t count = 0;
@@ -164,17 +247,32 @@ IlluminantAnalysis estimate_illuminant(const std::vector<RegionAnalysis>& region
     if (std::isfinite(rgb[i]) && std::isfinite(rgb[i + 1]) && std::isfinite(rgb[i + 2]))
       mean += Vec3(rgb[i], rgb[i + 1], rgb[i + 2]), ++count;
   out.grey_world.method = "grey world";
+  out.grey_world.reliable = false;
+  out.grey_world.unreliable_reason = "a guess: the image's mean colour is the light's only if its surfaces average to grey";
   if (count > 0 && mean.norm() > 0) {
     out.grey_world.rgb = positive(mean.normalized());
     if (out.known) out.grey_world.error_deg = angular_error_deg(out.grey_world.rgb, *out.known);
+    if (out.camera_white) out.grey_world.camera_angle_deg = angular_error_deg(out.grey_world.rgb, *out.camera_white);
   } else out.notes.push_back("the image has no finite, non-black pixels: no grey-world estimate");
-  out.choice = out.planes ? fmt::format("dichromatic planes: every dichromatic object's plane holds the light's colour, "
-                                        "and {} planes meet in one direction; the highlight lines tilt towards the "
-                                        "body colours where the shading changes across a highlight", out.planes->regions.size())
-               : out.highlight_lines ? "highlight lines: fewer than two distinct dichromatic planes; a highlight line points "
-                                       "along the light but tilts towards its body colour where the shading changes"
-                                     : "grey world: no dichromatic plane pair and no highlight line; the image's mean colour "
-                                       "is the light's only if its surfaces average to grey, so treat it as a guess";
+  const IlluminantEstimate& chosen = out.best();
+  std::string why_not;
+  for (const auto* e : {out.planes ? &*out.planes : nullptr, out.highlight_lines ? &*out.highlight_lines : nullptr})
+    if (e && !e->reliable) why_not += fmt::format("; the {} are not used: {}", e->method, e->unreliable_reason);
+  const bool planes_chosen = out.planes && &chosen == &*out.planes, lines_chosen = out.highlight_lines && &chosen == &*out.highlight_lines;
+  auto sigma = [](const std::optional<IlluminantEstimate>& e) { return e && e->uncertainty_deg ? *e->uncertainty_deg : 0.0; };
+  if (planes_chosen)
+    out.choice = fmt::format("dichromatic planes: every dichromatic object's plane holds the light's colour, and {} planes "
+                             "meet in one direction (± {:.2f}°){}{}", out.planes->regions.size(), sigma(out.planes),
+                             out.highlight_lines && out.highlight_lines->reliable
+                                 ? fmt::format(", preferred to the highlight lines (± {:.2f}°), which tilt towards the body colours "
+                                               "where the shading follows the highlight", sigma(out.highlight_lines))
+                                 : "",
+                             why_not);
+  else if (lines_chosen)
+    out.choice = fmt::format("highlight lines: a highlight branch adds the light's colour (± {:.2f}°){}", sigma(out.highlight_lines),
+                             why_not);
+  else
+    out.choice = "grey world, a guess: no reliable dichromatic planes or highlight line" + why_not;
   return out;
 }
 

@@ -26,27 +26,42 @@ struct IlluminantEstimate {
   // planes' fits (their spread about the fit, their extent, their sample counts) and, with several regions,
   // from how far they disagree. None for grey world, which is a guess, not a measurement.
   std::optional<double> uncertainty_deg;
+  // Whether the evidence supports the estimate; when not, why (a person reads it beside the estimate).
+  bool reliable = true;
+  std::string unreliable_reason;
+  // The angle to the camera's as-shot white balance (camera raw files), a reference, not the truth.
+  std::optional<double> camera_angle_deg;
 };
 
 struct IlluminantAnalysis {
   std::optional<IlluminantEstimate> highlight_lines, planes;
   IlluminantEstimate grey_world;
   std::optional<Vec3> known;  // as given, normalised
+  // The light's colour the camera assumed (the inverse of a raw file's as-shot white-balance multipliers), unit.
+  std::optional<Vec3> camera_white;
   std::vector<std::string> notes;  // why an estimate is missing, and regions left out
   std::string choice;              // which estimate best() is, and why
 
-  // The estimate to trust most: the planes' intersection (unbiased), else the highlight lines (tilted
-  // towards the body colours when shading changes across a highlight), else grey world.
-  const IlluminantEstimate& best() const { return planes ? *planes : highlight_lines ? *highlight_lines : grey_world; }
+  // The estimate to trust most: the planes' intersection (unbiased) when reliable, else the highlight lines
+  // (tilted towards the body colours where the shading follows the highlight) when reliable, else grey world
+  // (a guess, never reliable).
+  const IlluminantEstimate& best() const {
+    if (planes && planes->reliable) return *planes;
+    if (highlight_lines && highlight_lines->reliable) return *highlight_lines;
+    return grey_world;
+  }
 };
 
 // From the regions other than the whole image (which mixes objects) when there are any. The grey world
 // averages `rgb`, the whole layer's finite pixels. A highlight line whose bright end lies within 2τ of a
 // clipping level (`high_levels`, +∞ where none is known) is left out: past the level the highlight is cut off,
-// and what remains bends towards the face of the cube, not along the light.
+// and what remains bends towards the face of the cube, not along the light. `assumed_curve` names a response curve
+// that was guessed rather than declared ("" when declared or none): the planes' estimate is then unreliable.
 IlluminantAnalysis estimate_illuminant(const std::vector<RegionAnalysis>& regions, std::span<const float> rgb,
                                        const std::optional<Vec3>& known,
-                                       const std::array<double, 3>& high_levels = {kNoLevel, kNoLevel, kNoLevel});
+                                       const std::array<double, 3>& high_levels = {kNoLevel, kNoLevel, kNoLevel},
+                                       const std::optional<Vec3>& camera_white = std::nullopt,
+                                       const std::string& assumed_curve = "");
 
 // The angle between two colour directions, in degrees.
 double angular_error_deg(const Vec3& a, const Vec3& b);

@@ -15,6 +15,8 @@
 #include <string>
 #include <vector>
 
+#include "analyzer/moments.h"  // Vec3
+
 namespace ct::analyzer {
 
 // Three channels per pixel, [y][x][channel], rows from the top.
@@ -98,6 +100,9 @@ struct AnalysisImage {
   std::size_t transparent_pixels = 0;
   std::size_t negative_pixels = 0;
   std::vector<std::string> notes;  // what was decided while reading (alpha, conversions)
+  // A camera raw's as-shot white balance as the light's colour it assumes: (1/m_R, 1/m_G, 1/m_B) of LibRaw's
+  // camera multipliers, in the file's linear camera RGB. A reference beside the estimates, not the truth.
+  std::optional<Vec3> camera_white;
 };
 
 // Stored values to linear light: a table for the integer codes of an integer file (exactly the curve's value

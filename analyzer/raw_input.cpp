@@ -230,6 +230,14 @@ AnalysisImage read_camera_raw(const std::filesystem::path& path, const RawOption
   e.curve_source = "a camera raw: linear camera RGB (no white balance, colour matrix or curve)";
   out.notes.push_back(fmt::format("camera raw, {}: {} Bayer mosaic, black level {:g} DN and white level {:g} DN from the file",
                                   camera_name(raw), pattern.empty() ? std::string("no") : pattern, black, white));
+  // The as-shot white balance: the multipliers make a white object grey, so the light they assume is their inverse.
+  const float* mul = raw.imgdata.color.cam_mul;
+  if (mul[0] > 0 && mul[1] > 0 && mul[2] > 0) {
+    out.camera_white = Vec3(1.0 / mul[0], 1.0 / mul[1], 1.0 / mul[2]).normalized();
+    out.notes.push_back(fmt::format("the camera's as-shot white balance multiplies R, G, B by {:.4g}, {:.4g}, {:.4g}: it takes the "
+                                    "light to be ({:.3f}, {:.3f}, {:.3f}) in camera RGB",
+                                    mul[0], mul[1], mul[2], (*out.camera_white)[0], (*out.camera_white)[1], (*out.camera_white)[2]));
+  }
   if (options.half_size)
     out.notes.push_back(
         "not demosaiced (--raw-half-size): each 2 x 2 tile gives its red, first green and blue as captured, less black");

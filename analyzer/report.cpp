@@ -157,7 +157,7 @@ json summary(const RegionAnalysis& r, const std::optional<Explanation>& e) {
                                                     c->difference_in_se, kGammaAgreement));
   if (r.bend) row("what bends it", r.bend->summary);
   if (!s.clipping.faces.empty()) row("clipped", percent(s.clipping.fraction));
-  if (r.linear_light) row("class in linear light (curve undone)", std::string(class_name(r.linear_light->shape)));
+  if (r.linear_light) row("class of the values as stored", std::string(class_name(r.shape.shape)));
   if (e) {
     if (e->direct_share) row("direct / indirect", percent(*e->direct_share) + " / " + percent(e->indirect_share.value_or(0)));
     if (e->diffuse_share) row("diffuse / glossy", percent(*e->diffuse_share) + " / " + percent(e->glossy_share.value_or(0)));
@@ -171,6 +171,7 @@ json summary(const RegionAnalysis& r, const std::optional<Explanation>& e) {
 json region_json(const RgbImage& layer, const ImageAnalysis& a, std::size_t i, const Display& d, const std::vector<int>& dominant,
                  std::size_t max_points) {
   const RegionAnalysis& r = a.results[i];
+  const ClusterShape& light = r.linear_light ? *r.linear_light : r.shape;  // the class in linear light leads
   const RegionSamples samples = gather_samples(layer, a.regions[i]);
   const HistogramSpec spec = display_range(a, samples);
   const std::size_t stride = std::max<std::size_t>(1, (samples.size() + max_points - 1) / std::max<std::size_t>(1, max_points));
@@ -202,8 +203,10 @@ json region_json(const RgbImage& layer, const ImageAnalysis& a, std::size_t i, c
           {"range", {spec.lo[0], spec.hi[0]}},
           {"ranges", {{spec.lo[0], spec.hi[0]}, {spec.lo[1], spec.hi[1]}, {spec.lo[2], spec.hi[2]}}},
           {"ticks", ticks},
-          {"class", class_name(r.shape.shape)},
-          {"reason", r.shape.reason},
+          {"class", class_name(light.shape)},
+          {"class_as_stored", r.linear_light ? json(class_name(r.shape.shape)) : json(nullptr)},
+          {"reason", light.reason},
+          {"explanation", i < a.interpretations.size() ? interpretation_text(a.interpretations[i]) : std::string()},
           {"points", points},
           {"fits", fits_json(r.shape, spec)},
           {"summary", summary(r, i < a.explanations.size() ? a.explanations[i] : none)}};
@@ -231,6 +234,7 @@ main { display: flex; gap: 16px; padding: 12px 16px; flex-wrap: wrap; }
 #details th, #details td, #illuminant th, #illuminant td { text-align: left; padding: 1px 10px 1px 0; font-weight: normal; }
 #details th, #illuminant th { color: #999; }
 .class { font-size: 18px; color: #fff; margin: 0; }
+.explanation { max-width: 60em; }
 .hint { color: #888; font-size: 12px; }
 )css";
 
@@ -249,11 +253,13 @@ std::string report_html(const AnalysisImage& input, const ImageAnalysis& a, std:
   }
   const ValueUnit unit = value_unit(a);
   // The regions by size, with their pixel counts: readable without the viewer.
-  std::string region_table = "<table id=\"region-table\"><tr><th>region</th><th>class</th><th>pixels</th><th>share of the image</th></tr>";
+  std::string region_table = "<table id=\"region-table\"><tr><th>region</th><th>class in linear light</th><th>as stored</th>"
+                             "<th>pixels</th><th>share of the image</th></tr>";
   for (const std::size_t i : regions_by_size(a.results)) {
     const RegionAnalysis& r = a.results[i];
-    region_table += fmt::format("<tr data-region=\"{}\"><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>", i, escape_html(r.name),
-                                class_name(r.shape.shape), r.pixels,
+    region_table += fmt::format("<tr data-region=\"{}\"><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>", i,
+                                escape_html(r.name), class_name(r.linear_light ? r.linear_light->shape : r.shape.shape),
+                                r.linear_light ? class_name(r.shape.shape) : "the same (linear values)", r.pixels,
                                 percent(static_cast<double>(r.pixels) / std::max(1.0, static_cast<double>(a.width) * a.height)));
   }
   region_table += "</table>";
@@ -266,13 +272,19 @@ std::string report_html(const AnalysisImage& input, const ImageAnalysis& a, std:
 
   std::string illuminant = "<table>";
   const IlluminantAnalysis& il = a.illuminant;
-  for (const auto* e : {il.planes ? &*il.planes : nullptr, il.highlight_lines ? &*il.highlight_lines : nullptr, &il.grey_world})
-    if (e)
-      illuminant += fmt::format("<tr><th>{}</th><td>{}</td><td>{}</td><td>{}</td></tr>", escape_html(e->method),
-                                rgb_text(e->rgb),
-                                e->uncertainty_deg ? fmt::format("± {:.2f}° (standard error)", *e->uncertainty_deg)
-                                                   : "a guess, no uncertainty",
-                                e->error_deg ? fmt::format("{:.2f}° from the known illuminant", *e->error_deg) : "");
+  for (const auto* e : {il.planes ? &*il.planes : nullptr, il.highlight_lines ? &*il.highlight_lines : nullptr, &il.grey_world}) {
+    if (!e) continue;
+    std::string against;
+    if (e->error_deg) against += fmt::format("{:.2f}° from the known illuminant. ", *e->error_deg);
+    if (e->camera_angle_deg) against += fmt::format("{:.2f}° from the camera's white balance. ", *e->camera_angle_deg);
+    illuminant += fmt::format("<tr><th>{}{}</th><td>{}</td><td>{}</td><td>{}{}</td></tr>", escape_html(e->method),
+                              e == &il.best() ? " (chosen)" : "", rgb_text(e->rgb),
+                              e->uncertainty_deg ? fmt::format("± {:.2f}° (standard error)", *e->uncertainty_deg) : "no uncertainty",
+                              e->reliable ? "reliable. " : "unreliable: " + escape_html(e->unreliable_reason) + ". ", against);
+  }
+  if (il.camera_white)
+    illuminant += fmt::format("<tr><th>camera's as-shot white balance</th><td>{}</td><td>a reference</td><td>the light the camera "
+                              "assumed, not a measurement</td></tr>", rgb_text(*il.camera_white));
   illuminant += "</table>";
   if (!il.choice.empty()) illuminant += "<p>Chosen: " + escape_html(il.choice) + "</p>";
   for (const std::string& n : il.notes) illuminant += "<p class=\"hint\">" + escape_html(n) + "</p>";

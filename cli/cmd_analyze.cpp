@@ -145,10 +145,14 @@ Action add_analyze(CLI::App& app) {
     output.commit();
     if (!o->quiet) {
       for (const analyzer::RegionAnalysis& r : analysis.results)
-        fmt::print(stderr, "{}: {} ({} px){}\n", r.name, analyzer::class_name(r.shape.shape), r.pixels,
+        fmt::print(stderr, "{}: {}{} ({} px){}\n", r.name,
+                   analyzer::class_name(r.linear_light ? r.linear_light->shape : r.shape.shape),
+                   r.linear_light ? fmt::format(" in linear light, {} as stored", analyzer::class_name(r.shape.shape)) : "", r.pixels,
                    r.shape.shape == analyzer::ShapeClass::None ? " — " + r.shape.reason : "");
       const auto& best = analysis.illuminant.best();
-      fmt::print(stderr, "illuminant ({}): ({:.4f}, {:.4f}, {:.4f}){}\n", best.method, best.rgb[0], best.rgb[1], best.rgb[2],
+      fmt::print(stderr, "illuminant ({}): ({:.4f}, {:.4f}, {:.4f}){}{}{}\n", best.method, best.rgb[0], best.rgb[1], best.rgb[2],
+                 best.uncertainty_deg ? fmt::format(" ± {:.2f}°", *best.uncertainty_deg) : "",
+                 best.reliable ? "" : ", unreliable: " + best.unreliable_reason,
                  best.error_deg ? fmt::format(", {:.2f}° from the known one", *best.error_deg) : "");
       fmt::print(stderr, "{}: analysis.json, report.html\n", o->output);
     }

@@ -88,7 +88,10 @@ function showDetails(r) {
   const ranges = r.ranges.map((lh, c) => `${'RGB'[c]} ${lh[0].toPrecision(4)} to ${lh[1].toPrecision(4)}`).join(', ');
   const range = `<tr><th>cube shown</th><td>${ranges} (${data.unit})</td></tr>`;
   const rows = range + r.summary.map(([k, v]) => `<tr><th>${k}</th><td>${v}</td></tr>`).join('');
-  details.innerHTML = `<h2>${r.name}</h2><p class="class">${r.class}</p><p>${r.reason}</p><table>${rows}</table>`;
+  const stored = r.class_as_stored ? `<p>As stored (the file's curve not undone): ${r.class_as_stored}</p>` : '';
+  const light = r.class_as_stored ? ' in linear light' : '';
+  details.innerHTML = `<h2>${r.name}</h2><p class="class">${r.class}${light}</p>${stored}<p>${r.reason}</p>` +
+    `<p class="explanation">${r.explanation ?? ''}</p><table>${rows}</table>`;
 }
 
 // ---- histogram pane ------------------------------------------------------------------------------

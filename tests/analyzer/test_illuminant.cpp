@@ -3,7 +3,12 @@
 #include <fmt/core.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <random>
+
+#include "analyzer/highlight_branch.h"
 #include "analyzer/illuminant.h"
+#include "analyzer/moments.h"
 #include "tests/analyzer/synthetic.h"
 
 namespace ct::test {
@@ -26,7 +31,7 @@ TEST(Illuminant, NoiseFreeObjectsGiveTheIlluminantWithinOneDegree) {
   ASSERT_TRUE(a.planes);
   EXPECT_EQ(a.planes->regions.size(), 4u);
   EXPECT_LT(*a.planes->error_deg, 1.0);
-  EXPECT_EQ(a.best().method, "dichromatic planes");
+  EXPECT_EQ(a.best().method, "dichromatic planes") << a.planes->unreliable_reason;
   // Across a sphere's highlight the diffuse shading changes too, which tilts each highlight line a little
   // towards its body colour: that estimate is biased, the planes' is not.
   ASSERT_TRUE(a.highlight_lines);
@@ -99,12 +104,101 @@ TEST(Illuminant, HighlightLinesEndingAtAClippingLevelAreLeftOut) {
   EXPECT_EQ(cut.planes->rgb, open.planes->rgb);
 }
 
+// A cluster pressed onto a face of the cube lost what lay beyond it, and its plane through black is partly the face:
+// clipping red below one object's brightest red takes that object out of the planes' estimate, with a note.
+TEST(Illuminant, APlaneOnAClippingFaceIsLeftOut) {
+  Scene scene = dichromatic_scene(kWarm);
+  const std::vector<Region> objects = label_regions(scene.ids, "object", scene.names, {0});
+  // The red level: half the brightest red of the first object's pixels.
+  double red = 0;
+  for (const std::uint32_t p : objects.front().pixels) red = std::max(red, static_cast<double>(scene.image.rgb[p * 3]));
+  for (std::size_t i = 0; i < scene.image.rgb.size(); i += 3)
+    scene.image.rgb[i] = std::min(scene.image.rgb[i], static_cast<float>(red / 2));
+  const LayerContext context = layer_context(scene.image, {}, 64);
+  std::vector<RegionAnalysis> regions;
+  for (const Region& r : objects) regions.push_back(analyse_region(scene.image, context, r, AnalyzeOptions{}));
+  const IlluminantAnalysis a = estimate_illuminant(regions, scene.image.rgb, kWarm, context.high_levels);
+  std::size_t faced = 0, said = 0;
+  auto holds_a_plane = [](ShapeClass c) {
+    return c == ShapeClass::L || c == ShapeClass::SkewedT || c == ShapeClass::P || c == ShapeClass::Planar || c == ShapeClass::Thickened;
+  };
+  for (const RegionAnalysis& r : regions)
+    if (!r.shape.clipping.faces.empty() && r.shape.black_plane) {
+      faced += holds_a_plane(r.shape.shape);
+      if (a.planes) {
+        EXPECT_EQ(std::count(a.planes->regions.begin(), a.planes->regions.end(), r.name), 0) << r.name;
+      }
+    }
+  for (const std::string& n : a.notes) said += n.find("partly the cube's face") != std::string::npos;
+  EXPECT_GE(faced, 1u);
+  EXPECT_EQ(said, faced);
+}
+
+// Two planes meet in a line whatever made them: without a highlight line to check them, the planes' estimate is
+// marked unreliable (and grey world, a guess, is never reliable), so the chosen estimate says it is not trusted.
+TEST(Illuminant, TwoPlanesAloneAreUnreliable) {
+  const Scene scene = dichromatic_scene(kWarm);
+  const LayerContext context = layer_context(scene.image, {}, 64);
+  std::vector<RegionAnalysis> regions;
+  for (const Region& r : label_regions(scene.ids, "object", scene.names, {0})) {
+    regions.push_back(analyse_region(scene.image, context, r, AnalyzeOptions{}));
+    ClusterShape& s = regions.back().shape;
+    s.shape = ShapeClass::Planar;  // the planes without their highlight lines
+    s.two_lines.reset();
+    s.highlight_branch.reset();
+    if (regions.size() == 2) break;
+  }
+  const IlluminantAnalysis a = estimate_illuminant(regions, scene.image.rgb, kWarm);
+  ASSERT_TRUE(a.planes);
+  EXPECT_FALSE(a.planes->reliable);
+  EXPECT_NE(a.planes->unreliable_reason.find("two planes"), std::string::npos);
+  EXPECT_FALSE(a.best().reliable);
+  EXPECT_EQ(a.best().method, "grey world");
+  EXPECT_NE(a.choice.find("the dichromatic planes are not used"), std::string::npos) << a.choice;
+}
+
 TEST(Illuminant, OnePlaneIsNotEnough) {
   EXPECT_FALSE(intersect_planes({Vec3::UnitZ()}));
   EXPECT_FALSE(intersect_planes({Vec3::UnitZ(), Vec3::UnitZ()}));
   const auto v = intersect_planes({Vec3::UnitZ(), Vec3::UnitX()});
   ASSERT_TRUE(v);
   EXPECT_NEAR(angular_error_deg(*v, Vec3::UnitY()), 0.0, 1e-9);
+}
+
+}  // namespace
+}  // namespace ct::test
+
+namespace ct::test {
+namespace {
+
+// The highlight branch by regression (analyzer/highlight_branch.h): colours c = m_b·body + m_s·light with the
+// shading m_b spread across the highlight independently of its strength m_s, plus noise. The branch points to the
+// light within 3 of its standard errors; a total-least-squares line through the same colours is tilted towards
+// the body colour by the shading's spread.
+TEST(HighlightBranch, PointsToTheLightWhereTheShadingSpreadsAcrossTheHighlight) {
+  const Vec3 body = Vec3(0.9, 0.4, 0.1).normalized(), light = Vec3(0.6, 0.6, 0.5).normalized();
+  std::mt19937_64 random(7);
+  std::uniform_real_distribution<double> uniform(0, 1);
+  std::normal_distribution<double> noise(0, 0.003);
+  std::vector<Vec3> points;
+  std::vector<std::size_t> off;
+  for (int i = 0; i < 3000; ++i) points.push_back(uniform(random) * body + Vec3(noise(random), noise(random), noise(random)));
+  for (int i = 0; i < 600; ++i) {
+    const double m_b = 0.4 + 0.5 * uniform(random), m_s = 0.05 + 0.5 * uniform(random);
+    off.push_back(points.size());
+    points.push_back(m_b * body + m_s * light + Vec3(noise(random), noise(random), noise(random)));
+  }
+  const Line body_line{Vec3::Zero(), body, 0, 1, 3000, 0.003};
+  const std::optional<HighlightBranch> b = highlight_branch(points, body_line, off);
+  ASSERT_TRUE(b);
+  EXPECT_EQ(b->samples, 600u);
+  EXPECT_LE(angular_error_deg(b->direction, light), 3 * b->uncertainty_deg);
+  // The principal axis of the same colours leans towards the body colour.
+  const PrincipalAxes tls = principal_axes_of(points, About::Mean, off);
+  EXPECT_GT(angular_error_deg(tls.axes.col(0), light), 3 * b->uncertainty_deg);
+  EXPECT_LT(angular_error_deg(tls.axes.col(0), body), angular_error_deg(light, body));
+  // Too few samples: no branch.
+  EXPECT_FALSE(highlight_branch(points, body_line, {off.begin(), off.begin() + 9}));
 }
 
 }  // namespace

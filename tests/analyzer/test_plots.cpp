@@ -61,7 +61,7 @@ TEST(Plots, ReportListsRegionsBySizeAndSaysTheUnit) {
   const nlohmann::json a = nlohmann::json::parse(read_file(dir.file("o") / "analysis.json"));
   EXPECT_EQ(a["regions_by_size"], nlohmann::json::array({0, 2, 3, 1}));  // the whole image (2,048 px) first
   const std::string html = read_file(dir.file("o") / "report.html");
-  const std::regex row(R"re(<tr data-region="(\d+)"><td>[^<]*</td><td>[^<]*</td><td>(\d+)</td>)re");
+  const std::regex row(R"re(<tr data-region="(\d+)"><td>[^<]*</td><td>[^<]*</td><td>[^<]*</td><td>(\d+)</td>)re");
   std::vector<int> order, counts;
   for (auto it = std::sregex_iterator(html.begin(), html.end(), row); it != std::sregex_iterator(); ++it)
     order.push_back(std::stoi((*it)[1])), counts.push_back(std::stoi((*it)[2]));
