@@ -62,14 +62,17 @@ Calibration calibrate(const CalibrationInput& input) {
   // Frames by exposure time.
   std::map<double, std::array<std::vector<Frame>, 2>> by_time;  // [0] flats, [1] darks
   int width = -1, height = -1;
-  std::string first;
+  std::string first, sensor;
   std::optional<int> bits;
   for (int kind = 0; kind < 2; ++kind)
     for (const auto& file : kind == 0 ? input.flats : input.darks) {
       Frame f = read_frame(file);
       const Plane& p = f.channels[0];
       if (width < 0) {
-        width = p.width, height = p.height, first = f.file;
+        width = p.width, height = p.height, first = f.file, sensor = f.sensor;
+      } else if (f.sensor != sensor) {
+        throw InputError(fmt::format("{}: {}, but {} is {}: every frame must come from the same camera and mosaic", f.file,
+                                     f.sensor, first, sensor));
       } else if (p.width != width || p.height != height) {
         throw InputError(fmt::format("{}: {} x {} values per channel, but {} has {} x {}: every frame must come from the same "
                                      "sensor area",

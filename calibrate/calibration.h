@@ -27,7 +27,7 @@ struct Calibration {
 
 // InputError, one line naming the file or the option, for a series that cannot support the estimates: no flats
 // or no darks, one exposure time only, an exposure with flats but fewer than two darks (or the reverse), frames of
-// different sizes, or a channel whose flats never saturate or leave fewer than three exposures below 70 % of
+// different sizes or from another camera or mosaic, or a channel whose flats never saturate or leave fewer than three exposures below 70 % of
 // saturation.
 Calibration calibrate(const CalibrationInput& input);
 

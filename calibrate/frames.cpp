@@ -53,6 +53,16 @@ Frame read_frame(const std::filesystem::path& file) {
   Frame f;
   f.file = name;
   f.exposure_s = *exposure;
+  if (raw) {
+    std::string camera, cfa;
+    for (const auto& [key, value] : analyzer::describe_camera_raw(file)) {
+      if (key == "camera") camera = value;
+      if (key == "cfa") cfa = value;
+    }
+    f.sensor = fmt::format("camera raw, {}, CFA {}", camera, cfa);
+  } else {
+    f.sensor = fmt::format("linear {}, no CFA", file.extension() == ".exr" || file.extension() == ".EXR" ? "EXR" : "TIFF");
+  }
   f.adc_bits = e.adc_bits;
   f.white_level_dn = e.white_level;
   const double black = e.black_subtracted && e.black_level ? *e.black_level : 0.0;

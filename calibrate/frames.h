@@ -17,6 +17,7 @@ struct Frame {
   std::string file;
   double exposure_s = 0;
   std::array<Plane, 3> channels;  // R, G, B in digital numbers, black level included
+  std::string sensor;             // what took it: "camera raw, <camera>, CFA <pattern>" or "linear <EXR|TIFF>, no CFA"
   std::optional<int> adc_bits;    // from the file, when it says
   std::optional<double> white_level_dn;
 };

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "calibrate/calibration.h"
+#include "core/error.h"
 #include "core/spectrum.h"
 #include "core/json_input.h"
 #include "core/statistics.h"
@@ -142,7 +143,8 @@ TEST_F(Calibrate, RecoversEveryParameterOfAScientificCamera) {
 // The frames a camera gives: DNGs of its Bayer mosaic, read as camera raw without demosaicing.
 TEST_F(Calibrate, RecoversAStrongColumnPatternApartFromThePixelsFromCameraRaw) {
   const Camera c{0.45, 0.5, 200, 15000, 3, 20, 1.5, 0.005, 1.0, 0.02, 14};
-  const calibrate::Calibration cal = calibrate::calibrate(series(c, "columns", kExposureShares, 2, true));
+  const calibrate::CalibrationInput in = series(c, "columns", kExposureShares, 2, true);
+  const calibrate::Calibration cal = calibrate::calibrate(in);
   expect_camera(cal, c);
   // The settings written reproduce the camera: the sensor simulator takes them as they are.
   const Json& s = cal.sensor;
@@ -151,6 +153,21 @@ TEST_F(Calibrate, RecoversAStrongColumnPatternApartFromThePixelsFromCameraRaw) {
   // A DNG has no ADC bits, only its white level (here black + K × full well = 7700): the fewest bits that hold it.
   EXPECT_EQ(s["adc"]["bits"].get<int>(), 13);
   EXPECT_NO_THROW(test::config_of(s));
+
+  // A frame of another mosaic (BGGR: its "red" plane holds other photosites) is refused by name.
+  Json patch = {{"exposure", {{"time_s", 0.04}}}, {"noise", {{"enabled", true}}}, {"adc", {{"enabled", true}}},
+                {"cfa", {{"enabled", true}, {"pattern", "BGGR"}}}, {"display", {{"enabled", false}}}};
+  const fs::path bggr = dir_.file("bggr.dng");
+  test::run_sensor(dir_.file("columns-dark.exr"), bggr, test::config_of(patch));
+  calibrate::CalibrationInput mixed = in;
+  mixed.darks.push_back(bggr);
+  try {
+    calibrate::calibrate(mixed);
+    ADD_FAILURE() << "a BGGR frame among RGGB frames was not refused";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find(bggr.string() + ": camera raw, "), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("CFA BGGR, but"), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace
