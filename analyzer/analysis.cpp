@@ -102,6 +102,7 @@ ImageAnalysis analyse_image(const AnalysisImage& input, const std::string& layer
   a.height = pixels.height;
   a.encoding = a.layer == "final" ? input.encoding : ImageEncoding{};
   a.context = layer_context(pixels, a.encoding, options.bins);
+  if (options.camera_noise && a.layer == "final") use_camera_noise(a.context.noise, pixels, *options.camera_noise);
   if (const HistogramSpec& spec = a.context.spec; spec.robust)
     a.notes.push_back(fmt::format("{} pixel{} ({:.3g} % of the image) reach {:.4g}, more than {} times the {:g}th "
                                   "percentile of the pixels' values: the histograms and plots end at {:.4g} and count "

@@ -240,6 +240,16 @@ static json image_noise_json(const ImageNoise& noise) {
     bands.push_back({{"brightness", {noise.bands[k].lo, noise.bands[k].hi}},
                      {"sigma", {std::max(noise.floor, noise.band_sigma(k, Vec3::UnitX())), std::max(noise.floor, noise.band_sigma(k, Vec3::UnitY())),
                                 std::max(noise.floor, noise.band_sigma(k, Vec3::UnitZ()))}}});
+  if (noise.camera)
+    return {{"estimator", fmt::format("the camera's calibration ({}): per channel K^2 (read^2 + DSNU^2) + 1/12 + K mu + (PRNU mu)^2 "
+                                      "at each brightness band's mean signal mu (DN above black)",
+                                      noise.camera->source)},
+            {"camera",
+             {{"gain_dn_per_e", noise.camera->gain_dn_per_e}, {"read_e", noise.camera->read_e}, {"dsnu_e", noise.camera->dsnu_e},
+              {"prnu", noise.camera->prnu}}},
+            {"brightness", "(R + G + B) / 3 in the analysed layer's units"},
+            {"floor", noise.floor},
+            {"bands", bands}};
   return {{"estimator", "Immerkaer 1996 over the whole image: 3x3 residuals of R, G, B, per brightness band the 3-sigma clipped "
                         "median of their projection (flat areas decide, not texture)"},
           {"spacing", noise.spacing},

@@ -1,5 +1,7 @@
 #include "analyzer/noise_level.h"
 
+#include <limits>
+
 #include <algorithm>
 #include <cmath>
 #include <numeric>
@@ -29,6 +31,7 @@ std::size_t ImageNoise::band_of(double brightness) const {
 }
 
 double ImageNoise::band_sigma(std::size_t band, const Vec3& u) const {
+  if (const auto& v = bands[band].model_variance) return std::sqrt(u.cwiseAbs2().dot(*v));
   const std::vector<float>& r = bands[band].residuals;
   std::vector<double> a(r.size() / 3);
   for (std::size_t i = 0; i < a.size(); ++i) a[i] = std::abs(r[i * 3] * u[0] + r[i * 3 + 1] * u[1] + r[i * 3 + 2] * u[2]);
@@ -128,6 +131,35 @@ std::vector<double> band_weights(const ImageNoise& noise, std::span<const float>
   for (std::size_t i = 0; i < n; ++i)
     weights[noise.band_of((double(rgb[i * 3]) + rgb[i * 3 + 1] + rgb[i * 3 + 2]) / 3.0)] += 1.0 / static_cast<double>(n);
   return weights;
+}
+
+void use_camera_noise(ImageNoise& noise, const RgbImage& layer, const CameraNoiseModel& model) {
+  const std::size_t n = layer.pixel_count();
+  if (noise.bands.empty()) {
+    ImageNoise::Band all;
+    all.lo = std::numeric_limits<double>::infinity(), all.hi = -all.lo;
+    for (std::size_t p = 0; p < n; ++p) {
+      const double b = (double(layer.rgb[3 * p]) + layer.rgb[3 * p + 1] + layer.rgb[3 * p + 2]) / 3;
+      if (std::isfinite(b)) all.lo = std::min(all.lo, b), all.hi = std::max(all.hi, b);
+    }
+    if (!(all.lo <= all.hi)) all.lo = all.hi = 0;
+    noise.bands.push_back(std::move(all));
+  }
+  std::vector<Vec3> sum(noise.bands.size(), Vec3::Zero());
+  std::vector<double> count(noise.bands.size(), 0.0);
+  for (std::size_t p = 0; p < n; ++p) {
+    const Vec3 v(layer.rgb[3 * p], layer.rgb[3 * p + 1], layer.rgb[3 * p + 2]);
+    if (!v.allFinite()) continue;
+    const std::size_t k = noise.band_of(v.mean());
+    sum[k] += v;
+    count[k] += 1;
+  }
+  for (std::size_t k = 0; k < noise.bands.size(); ++k) {
+    ImageNoise::Band& band = noise.bands[k];
+    const Vec3 mean = count[k] > 0 ? Vec3(sum[k] / count[k]) : Vec3::Constant((band.lo + band.hi) / 2);
+    band.model_variance = Vec3(model.variance(mean[0]), model.variance(mean[1]), model.variance(mean[2]));
+  }
+  noise.camera = model;
 }
 
 double noise_sigma(const ImageNoise& noise, std::span<const double> weights, const Vec3& u) {

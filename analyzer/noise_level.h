@@ -18,8 +18,11 @@
 // pixels apart (3: beyond the reach of a 3×3 interpolation, so the taps' noise is independent again) the mask
 // still cancels a planar signal, and gives each pixel's own noise σ for white and for interpolated noise alike.
 
+#include <algorithm>
 #include <array>
 #include <cstddef>
+#include <optional>
+#include <string>
 #include <span>
 #include <vector>
 
@@ -28,11 +31,26 @@
 
 namespace ct::analyzer {
 
+// A camera's own noise, from its calibration (chromatrace calibrate: a chromatrace-sensor/1 file), in digital numbers
+// above black: a value of mean signal μ varies by K²(σ_read² + DSNU²) + 1/12 + K·μ + (PRNU·μ)² — read noise, fixed
+// offsets, quantisation, shot noise and fixed gains, all of which spread one image's cluster (DSNU and PRNU with
+// their row and column parts). The dark current's shot noise is left out: the exposure time is not the model's.
+struct CameraNoiseModel {
+  double gain_dn_per_e = 1, read_e = 0, dsnu_e = 0, prnu = 0;
+  std::string source;  // the file it came from
+  double variance(double mean_dn) const {
+    return gain_dn_per_e * gain_dn_per_e * (read_e * read_e + dsnu_e * dsnu_e) + 1.0 / 12.0 + gain_dn_per_e * std::max(0.0, mean_dn) +
+           prnu * prnu * mean_dn * mean_dn;
+  }
+};
+
 struct ImageNoise {
   struct Band {
     double lo = 0, hi = 0;         // the brightness (mean of R, G, B) of its pixels
     std::vector<float> residuals;  // Immerkær residuals / 6, [i][channel]
+    std::optional<Vec3> model_variance;  // per channel, from the camera's calibration: used instead of the residuals
   };
+  std::optional<CameraNoiseModel> camera;  // the model the bands' variances come from, when one was given
   // By increasing brightness, each holding a sixteenth of the image's finite pixels (a band whose pixels have too
   // few residuals takes the nearest band's); empty when too few pixels were usable.
   std::vector<Band> bands;
@@ -54,6 +72,10 @@ struct ImageNoise {
 inline constexpr int kInterpolatedNoiseSpacing = 3;
 ImageNoise estimate_image_noise(const RgbImage& image, const std::array<double, 3>& low_levels, const std::array<double, 3>& high_levels,
                                 double floor, int spacing = 1, std::size_t max_pixels = std::size_t{1} << 18);
+
+// The camera's noise instead of the image's: each band of `noise` (one band over the whole image when it has none)
+// takes the model's variance at the mean R, G, B of the layer's pixels in it.
+void use_camera_noise(ImageNoise& noise, const RgbImage& layer, const CameraNoiseModel& model);
 
 // The share of samples [i][channel] in each band of `noise`.
 std::vector<double> band_weights(const ImageNoise& noise, std::span<const float> rgb);

@@ -21,6 +21,9 @@ struct AnalyzeOptions {
   int threads = 0;
   std::uint64_t seed = 1;
   ShapeCriteria criteria;
+  // The camera's calibrated noise for the final layer, in its digital numbers (cmd_analyze checks the units), instead
+  // of the noise measured on the image.
+  std::optional<CameraNoiseModel> camera_noise;
 };
 
 // What every region of a layer shares.

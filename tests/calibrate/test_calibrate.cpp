@@ -337,3 +337,71 @@ TEST_F(Calibrate, AgreesWithTheEmva1288ReferenceImplementation) {
 
 }  // namespace
 }  // namespace ct
+
+namespace ct {
+namespace {
+
+// analyze --camera-config: the clusters are judged against the camera's own noise. On a capture of two flat patches
+// by a camera with known settings, the noise σ along each principal axis of each patch's cluster is the model's,
+// √(Σ u_c² var_c), var_c = K²(σ_read² + DSNU²) + 1/12 + K·μ_c + (PRNU·μ_c)² at the patch's mean (within 1 %: the
+// noise bands' means lie near it); the noise measured on the image without the settings agrees with the model within
+// 10 % (Immerkær's estimator on ~2 000 pixels per band). A file not in digital numbers is refused.
+TEST_F(Calibrate, AnalyzeJudgesClustersAgainstTheCamerasCalibratedNoise) {
+  const Camera c{0.6, 0.25, 100, 20000, 5, 100, 2, 0.01, 0, 0, 16};
+  const double per_e = c.qe * photons_per_radiance_second() * 0.1;  // electrons per unit radiance in 0.1 s
+  const fs::path scene = dir_.file("patches.exr"), settings = dir_.file("camera.json"), capture = dir_.file("capture.exr");
+  test::write_radiance(scene, kBand, 128, 64, [&](int x, int, std::size_t) { return static_cast<float>((x < 64 ? 4000 : 12000) / per_e); });
+  const Json patch = {{"optics", {{"f_number", kFNumber}, {"cos4", false}}},
+                      {"exposure", {{"time_s", 0.1}}},
+                      {"pixel", {{"pitch_um", kPitchUm}}},
+                      {"spectral_response", {{"camera", flat_camera_.string()}, {"basis", "photon"}, {"peak_qe", c.qe}}},
+                      {"noise", {{"enabled", true}, {"read_e", c.read}, {"dsnu_e", c.dsnu}, {"prnu", c.prnu}, {"seed", 5}, {"pattern_seed", 7}}},
+                      {"full_well", {{"enabled", true}, {"electrons", c.full_well}}},
+                      {"adc", {{"enabled", true}, {"gain_dn_per_e", c.gain}, {"black_level_dn", c.black}, {"bits", c.bits}}},
+                      {"display", {{"enabled", false}}}};
+  { std::ofstream(settings) << patch.dump(); }
+  test::run_sensor(scene, capture, test::config_of(patch));
+
+  auto analyse = [&](const std::string& out, bool calibrated) {
+    std::vector<std::string> args = {"analyze", capture.string(), "-o", dir_.file(out).string(), "--rect", "4,4,56,56", "--rect", "68,4,56,56",
+                                      "--no-plots", "--no-report", "-q"};
+    if (calibrated) args.insert(args.end(), {"--camera-config", settings.string()});
+    const auto r = test::run_chromatrace(args);
+    EXPECT_EQ(r.exit_code, 0) << r.err;
+    return read_json(dir_.file(out) / "analysis.json");
+  };
+  const Json calibrated = analyse("calibrated", true), measured = analyse("measured", false);
+  EXPECT_NE(calibrated["image_noise"]["estimator"].get<std::string>().find("the camera's calibration"), std::string::npos);
+  int checked = 0;
+  for (std::size_t i = 0; i < calibrated["regions"].size(); ++i) {
+    const Json& region = calibrated["regions"][i];
+    if (region["source"] != "rect") continue;
+    const Json& shape = region["shape"];
+    for (int k = 0; k < 3; ++k) {
+      double variance = 0;
+      for (int ch = 0; ch < 3; ++ch) {
+        const double mu = shape["mean"][ch].get<double>(), u = shape["axes"][k][ch].get<double>();
+        variance += u * u * (c.gain * c.gain * (c.read * c.read + c.dsnu * c.dsnu) + 1.0 / 12 + c.gain * mu + std::pow(c.prnu * mu, 2));
+      }
+      const double model = std::sqrt(variance), ours = shape["noise_sigma"][k].get<double>();
+      EXPECT_NEAR(ours, model, 0.01 * model) << region["name"] << ", axis " << k;
+      const double estimated = measured["regions"][i]["shape"]["noise_sigma"][k].get<double>();
+      EXPECT_NEAR(estimated, model, 0.1 * model) << region["name"] << ", axis " << k << ": measured on the image";
+      ++checked;
+    }
+  }
+  EXPECT_EQ(checked, 6);
+
+  // The simulator's picture (normalised values) is not in the camera's digital numbers.
+  Json rendered = patch;
+  rendered["rendering"] = {{"enabled", true}};
+  const fs::path picture = dir_.file("picture.exr");
+  test::run_sensor(scene, picture, test::config_of(rendered));
+  const auto r = test::run_chromatrace({"analyze", picture.string(), "-o", dir_.file("refused").string(), "--camera-config", settings.string(), "-q"});
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("values are in normalised, but the camera's noise is in its digital numbers"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir_.file("refused")));
+}
+
+}  // namespace
+}  // namespace ct

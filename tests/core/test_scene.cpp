@@ -424,14 +424,17 @@ TEST(Series, PaperSeriesValidatesEveryStep) {
   std::sort(panels.begin(), panels.end());
   EXPECT_EQ(panels, (std::vector<std::string>{"3a", "3b", "3c", "3d", "3e", "4a", "4b", "4c", "4d"}));
 
-  // The object form of an expectation: classes, the cause of the bend and the paper's word; extra components.
+  // The object form of an expectation: classes, the causes of the bend and of the thickening, and the paper's word;
+  // extra components.
   const SeriesVariant& box_3d = variant("6b-dichromatic-global");
   ASSERT_EQ(box_3d.expect.size(), 4u);
   EXPECT_EQ(box_3d.expect[2].target, "sphere");
-  EXPECT_EQ(box_3d.expect[2].any_of, (std::vector<std::string>{"thickened", "P"}));
+  EXPECT_EQ(box_3d.expect[2].any_of, (std::vector<std::string>{"thickened", "volume", "P"}));
   EXPECT_EQ(box_3d.expect[2].bent_by, "highlight lobe");
+  EXPECT_EQ(box_3d.expect[2].thickened_by, "interreflection");
   EXPECT_EQ(box_3d.expect[2].paper, "curved");
   EXPECT_EQ(box_3d.expect[0].bent_by, "");
+  EXPECT_EQ(box_3d.expect[0].thickened_by, "interreflection");
   EXPECT_EQ(variant("6c-banana").components, "bounces");
   EXPECT_EQ(variant("6c-banana").scene.render.max_bounces, 12);
 
