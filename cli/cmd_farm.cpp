@@ -16,6 +16,7 @@
 #include "core/error.h"
 #include "core/file_io.h"
 #include "core/scene.h"
+#include "core/series_format.h"
 #include "farm/blender_preflight.h"
 #include "farm/slurm.h"
 #include "reference_tracer/integrator.h"
