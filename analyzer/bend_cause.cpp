@@ -8,7 +8,7 @@
 
 #include "analyzer/explain.h"
 #include "analyzer/principal_curve.h"
-#include "core/scene.h"
+#include "core/series_format.h"
 
 namespace ct::analyzer {
 namespace {

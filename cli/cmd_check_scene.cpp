@@ -19,6 +19,7 @@
 #include "core/geometry.h"
 #include "core/json_input.h"
 #include "core/scene.h"
+#include "core/series_format.h"
 #include "plan/render_check.h"
 #include "sensor_sim/config.h"
 

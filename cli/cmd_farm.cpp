@@ -15,11 +15,13 @@
 #include "core/band_plan.h"
 #include "core/error.h"
 #include "core/file_io.h"
-#include "core/json_input.h"
 #include "core/scene.h"
+#include "core/series_format.h"
+#include "farm/blender_preflight.h"
 #include "farm/slurm.h"
 #include "reference_tracer/integrator.h"
 #include "reference_tracer/seed_split.h"
+#include "series/blender_batch.h"
 #include "series/runner.h"
 
 namespace ct::cli {
@@ -172,14 +174,6 @@ CLI::App* add_cycles(CLI::App* farm, CyclesOptions& o) {
   return cmd;
 }
 
-// The last line of a program's stderr that says what went wrong (the batch's one-line error).
-std::string last_line(const std::string& text) {
-  const std::size_t end = text.find_last_not_of("\n");
-  if (end == std::string::npos) return "(no message)";
-  const std::size_t start = text.rfind('\n', end);
-  return text.substr(start == std::string::npos ? 0 : start + 1, end - (start == std::string::npos ? 0 : start + 1) + 1);
-}
-
 int run_cycles(CyclesOptions& o) {
   check_common(o.common);
   series::RunOptions renderer;
@@ -196,62 +190,34 @@ int run_cycles(CyclesOptions& o) {
   const fs::path parts = job.directory / "parts";
 
   // The batch's own options, the same for every task and the assembly.
-  std::vector<std::string> batch = {renderer.blender.string(), "--background", "--factory-startup"};
-  const std::size_t threads_at = batch.size();
-  batch.insert(batch.end(), {"--python", fs::absolute(renderer.batch_script).string(), "--",
-                             blend ? "--blend" : "--scene", fs::absolute(o.source).string()});
-  const auto pass = [&](const char* option, const std::string& value) {
-    if (value.empty()) return;
-    batch.push_back(option);
-    batch.push_back(value);
-  };
-  const auto number = [](const auto& value) { return value ? std::to_string(*value) : std::string(); };
-  pass("--samples", number(o.samples));
-  pass("--bands", o.bands);
-  pass("--bands-file", o.bands_file.empty() ? "" : fs::absolute(o.bands_file).string());
-  pass("--max-bounces", number(o.max_bounces));
-  pass("--components", o.components);
-  pass("--resolution", o.resolution);
-  pass("--seed", number(o.seed));
-  pass("--bands-per-render", number(o.bands_per_render));
-  pass("--on-mixing-nodes", o.on_mixing_nodes);
-  pass("--on-world", o.on_world);
+  series::BlenderBatchCommand batch(renderer.blender, fs::absolute(renderer.batch_script));
+  batch.option(blend ? "--blend" : "--scene", fs::absolute(o.source).string())
+      .option("--samples", o.samples)
+      .option("--bands", o.bands)
+      .option("--bands-file", o.bands_file.empty() ? "" : fs::absolute(o.bands_file).string())
+      .option("--max-bounces", o.max_bounces)
+      .option("--components", o.components)
+      .option("--resolution", o.resolution)
+      .option("--seed", o.seed)
+      .option("--bands-per-render", o.bands_per_render)
+      .option("--on-mixing-nodes", o.on_mixing_nodes)
+      .option("--on-world", o.on_world);
 
   // How many band groups: the batch's pre-flight check, here and now, which also refuses bad input before
-  // anything is submitted.
-  // Its summary goes to stdout; it lands in DIR/slurm/preflight.json only when something is submitted.
-  std::vector<std::string> explain = batch;
+  // anything is submitted. Its summary lands in DIR/slurm/preflight.json only when something is submitted.
+  std::vector<std::string> explain = batch.argv();
   explain.insert(explain.end(), {"--explain", "-"});
-  const farm::ProgramOutput checked = farm::run_program(explain, {{"CHROMATRACE_EXE", own_executable().string()}});
-  if (checked.status == 2) {
-    std::string message = last_line(checked.err);
-    for (const char* prefix : {"batch.py: error: "})
-      if (message.starts_with(prefix)) message.erase(0, std::string_view(prefix).size());
-    throw InputError(message);
-  }
-  // Blender prints its own lines too: the summary is the JSON object that starts a line.
-  const std::size_t at = checked.out.find("\n{");
-  const std::size_t first = checked.out.starts_with("{") ? 0 : at == std::string::npos ? at : at + 1;
-  const std::size_t last = first == std::string::npos ? first : checked.out.find("\n}", first);
-  if (checked.status != 0 || last == std::string::npos)
-    throw std::runtime_error(fmt::format("the pre-flight check in Blender failed: {}", last_line(checked.err)));
-  const Json summary = parse_json(checked.out.substr(first, last + 2 - first), "the Blender batch's pre-flight summary");
-  job.notes.emplace_back("preflight.json", summary.dump(1) + "\n");
-  if (!summary.value("ok", false)) {
-    for (const Json& owner : summary.at("owners"))
-      if (owner.value("status", "") == "refused" && !owner.at("reasons").empty())
-        throw InputError(fmt::format("{}: {}", o.source, owner.at("reasons")[0].get<std::string>()));
-    throw InputError(fmt::format("{}: the pre-flight check refuses it", o.source));
-  }
-  const int groups = summary.at("band_groups").get<int>();
+  const farm::BlenderPreflight preflight =
+      farm::run_blender_preflight(explain, series::BlenderBatchCommand::environment(own_executable()), o.source);
+  job.notes.emplace_back("preflight.json", preflight.summary.dump(1) + "\n");
+  const int groups = preflight.band_groups;
   // With the bounces components every group has a render per bounce limit: one task each.
-  const std::vector<std::string> variants = summary.at("render_variants").get<std::vector<std::string>>();
+  const std::vector<std::string>& variants = preflight.render_variants;
 
   // Blender's render threads: the task's CPUs (--threads before --python).
   const std::string start = "CHROMATRACE_EXE=" + farm::shell_quote(own_executable().string()) + " " +
-                            farm::shell_command({batch.begin(), batch.begin() + static_cast<std::ptrdiff_t>(threads_at)}) +
-                            " --threads \"$THREADS\" " +
-                            farm::shell_command({batch.begin() + static_cast<std::ptrdiff_t>(threads_at), batch.end()});
+                            farm::shell_command(batch.blender_words()) + " --threads \"$THREADS\" " +
+                            farm::shell_command(batch.batch_words());
   const auto command = [&](const std::vector<std::string>& more) { return start + " " + farm::shell_command(more); };
   for (int g = 0; g < groups; ++g)
     for (const std::string& variant : variants) {

@@ -20,7 +20,7 @@
 #include "core/band_plan.h"
 #include "core/error.h"
 #include "core/file_io.h"
-#include "core/scene.h"
+#include "core/series_format.h"
 #include "series/figure.h"
 #include "series/runner.h"
 

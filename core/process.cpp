@@ -1,5 +1,6 @@
 #include "core/process.h"
 
+#include <fcntl.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -23,6 +24,25 @@ std::vector<char*> pointers(std::vector<std::string>& strings) {
   return p;
 }
 
+std::string slurp(int fd) {
+  std::string text;
+  char buffer[4096];
+  lseek(fd, 0, SEEK_SET);
+  ssize_t n;
+  while ((n = read(fd, buffer, sizeof buffer)) > 0) text.append(buffer, static_cast<std::size_t>(n));
+  close(fd);
+  return text;
+}
+
+// An unlinked temporary file, open for reading and writing.
+int temporary_file() {
+  char name[] = "/tmp/chromatrace-run-XXXXXX";
+  const int fd = mkstemp(name);
+  if (fd < 0) throw std::runtime_error("cannot create a temporary file in /tmp");
+  unlink(name);
+  return fd;
+}
+
 }  // namespace
 
 int spawn_and_wait(const std::vector<std::string>& argv, const std::vector<std::pair<std::string, std::string>>& env,
@@ -43,6 +63,38 @@ int spawn_and_wait(const std::vector<std::string>& argv, const std::vector<std::
   while (waitpid(pid, &status, 0) < 0)
     if (errno != EINTR) throw std::runtime_error("waiting for a process failed");
   return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+}
+
+ProgramOutput run_program(const std::vector<std::string>& argv,
+                          const std::vector<std::pair<std::string, std::string>>& env,
+                          const std::filesystem::path& stdout_log) {
+  const bool capture = stdout_log.empty();
+  int out_fd = -1, err_fd = -1;
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  ProgramOutput result;
+  try {
+    if (capture) {
+      out_fd = temporary_file();
+      err_fd = temporary_file();
+      posix_spawn_file_actions_adddup2(&actions, out_fd, STDOUT_FILENO);
+      posix_spawn_file_actions_adddup2(&actions, err_fd, STDERR_FILENO);
+    } else {
+      posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, stdout_log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    }
+    result.status = spawn_and_wait(argv, env, &actions);
+  } catch (...) {
+    posix_spawn_file_actions_destroy(&actions);
+    if (out_fd >= 0) close(out_fd);
+    if (err_fd >= 0) close(err_fd);
+    throw;
+  }
+  posix_spawn_file_actions_destroy(&actions);
+  if (capture) {
+    result.out = slurp(out_fd);
+    result.err = slurp(err_fd);
+  }
+  return result;
 }
 
 }  // namespace ct

@@ -1,8 +1,5 @@
 #include "farm/slurm.h"
 
-#include <fcntl.h>
-#include <spawn.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <chrono>
@@ -30,48 +27,6 @@ namespace fs = std::filesystem;
 namespace {
 
 constexpr const char* kFormat = "chromatrace-farm/1";
-
-std::string slurp(int fd) {
-  std::string text;
-  char buffer[4096];
-  lseek(fd, 0, SEEK_SET);
-  ssize_t n;
-  while ((n = read(fd, buffer, sizeof buffer)) > 0) text.append(buffer, static_cast<std::size_t>(n));
-  close(fd);
-  return text;
-}
-
-}  // namespace
-
-// What the program prints goes through unlinked temporary files, so that no pipe can fill up.
-ProgramOutput run_program(const std::vector<std::string>& argv, const std::vector<std::pair<std::string, std::string>>& env) {
-  char out_name[] = "/tmp/chromatrace-farm-XXXXXX", err_name[] = "/tmp/chromatrace-farm-XXXXXX";
-  const int out_fd = mkstemp(out_name), err_fd = mkstemp(err_name);
-  if (out_fd < 0 || err_fd < 0) throw std::runtime_error("cannot create a temporary file in /tmp");
-  unlink(out_name);
-  unlink(err_name);
-  posix_spawn_file_actions_t actions;
-  posix_spawn_file_actions_init(&actions);
-  posix_spawn_file_actions_adddup2(&actions, out_fd, STDOUT_FILENO);
-  posix_spawn_file_actions_adddup2(&actions, err_fd, STDERR_FILENO);
-  int status = 0;
-  try {
-    status = spawn_and_wait(argv, env, &actions);
-  } catch (...) {
-    posix_spawn_file_actions_destroy(&actions);
-    close(out_fd);
-    close(err_fd);
-    throw;
-  }
-  posix_spawn_file_actions_destroy(&actions);
-  ProgramOutput result;
-  result.status = status;
-  result.out = slurp(out_fd);
-  result.err = slurp(err_fd);
-  return result;
-}
-
-namespace {
 
 std::string first_line(const std::string& text) {
   std::string line = text.substr(0, text.find('\n'));

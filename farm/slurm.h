@@ -32,15 +32,6 @@ struct SlurmOptions {
 // InputError naming the option when a value is not one Slurm takes.
 void check_options(const SlurmOptions& options);
 
-// Runs a program (found on PATH) with `env` added to this process's environment and waits; what it printed
-// is captured.
-struct ProgramOutput {
-  int status = -1;  // exit status, or 128 + the signal
-  std::string out, err;
-};
-ProgramOutput run_program(const std::vector<std::string>& argv,
-                          const std::vector<std::pair<std::string, std::string>>& env = {});
-
 // One word for bash, single-quoted where needed.
 std::string shell_quote(const std::string& word);
 // A command line for bash: each word quoted.

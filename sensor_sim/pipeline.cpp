@@ -3,9 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <future>
-#include <map>
 #include <optional>
 #include <set>
+#include <tuple>
 
 #include <fmt/core.h>
 #include <fmt/format.h>
@@ -18,17 +18,19 @@
 #include "core/parallel.h"
 #include "core/progress.h"
 #include "core/spectral_exr.h"
-#include "core/statistics.h"
 #include "sensor_sim/adc.h"
 #include "sensor_sim/cfa.h"
 #include "sensor_sim/display.h"
+#include "sensor_sim/display_rendering.h"
 #include "sensor_sim/dng_writer.h"
+#include "sensor_sim/exposure.h"
 #include "sensor_sim/illumination.h"
 #include "sensor_sim/linear_signal.h"
 #include "sensor_sim/noise.h"
 #include "sensor_sim/optics.h"
 #include "sensor_sim/output.h"
 #include "sensor_sim/rendering_intent.h"
+#include "sensor_sim/sensor_rows.h"
 
 namespace ct::sensor {
 namespace {
@@ -38,65 +40,11 @@ namespace fs = std::filesystem;
 // Input buffers of a block stay near this size (all layers read for it together; two blocks are in memory
 // at a time, one being read while the other is processed).
 constexpr std::size_t kBlockBudgetBytes = std::size_t{8} << 20;
-// OpenEXR's ZIP compression packs 16 scanlines per chunk; blocks of whole chunks decompress each chunk once.
-constexpr int kChunkRows = 16;
 
-std::size_t to_size(int n) { return static_cast<std::size_t>(n); }
-
-// What stays fixed over a run.
-struct Run {
-  SensorConfig config;
-  LinearModel model;
-  RenderingIntent intent;
-  double exposure_s = 0;
-  int threads = 0;
-  std::vector<double> lighting;  // a reflectance image's illuminant per band (empty for radiance)
-  int width() const { return model.width(); }
-  int height() const { return model.height(); }
-};
-
-// Rows [y0, y1) of a layer read for sensor rows: the rendered rows [k·y0, k·y1). A NaN or infinite radiance
-// has no photon count, and no surface emits or reflects a negative total radiance: both are bad input, named by
-// channel and pixel. (A component may dip below zero by rounding where it was taken as a difference.) A
-// reflectance image is lit: each band's value times the illuminant's band average `lighting` (illumination.h).
-std::vector<float> read_sensor_rows(SpectralExrReader& reader, const SpectralLayer& layer, int k, int y0, int y1,
-                                    const std::vector<double>& lighting) {
-  const SpectralExrInfo& info = reader.info();
-  std::vector<float> values(to_size(k * (y1 - y0)) * to_size(info.width) * layer.channels.size());
-  reader.read_rows(layer, k * y0, k * y1, values);
-  const bool total = layer.component.empty();
-  const auto bad = std::find_if(values.begin(), values.end(),
-                                [total](float v) { return !std::isfinite(v) || (total && v < 0.0f); });
-  if (bad != values.end()) {
-    const std::size_t i = static_cast<std::size_t>(bad - values.begin()), bands = layer.channels.size();
-    const std::size_t pixel = i / bands;
-    throw InputError(fmt::format("{}: channel {}: value {} at pixel ({}, {}) is {}", info.file,
-                                 layer.channels[i % bands], *bad, pixel % to_size(info.width),
-                                 to_size(k * y0) + pixel / to_size(info.width),
-                                 std::isfinite(*bad) ? "negative: a radiance is >= 0" : "not finite"));
-  }
-  if (!lighting.empty())
-    for (std::size_t i = 0; i < values.size(); ++i)
-      values[i] = static_cast<float>(values[i] * lighting[i % lighting.size()]);
-  return values;
-}
-
-// The linear signal of sensor rows [y0, y1) from their rendered rows, in parallel over rows.
-std::vector<float> linear_rows(const Run& run, std::span<const float> spectral, int y0, int y1) {
-  const std::size_t in_row = spectral.size() / to_size(y1 - y0);
-  const std::size_t out_row = to_size(run.width()) * 3;
-  std::vector<float> out(to_size(y1 - y0) * out_row);
-  parallel_for(to_size(y1 - y0), run.threads, [&](std::size_t r) {
-    const int y = y0 + static_cast<int>(r);
-    linear_signal(run.model, spectral.subspan(r * in_row, in_row), y, y + 1,
-                  std::span<float>(out).subspan(r * out_row, out_row));
-  });
-  return out;
-}
 
 // Stages 4–5 for sensor rows [y0, y1): what the sensor reads out (DN with the ADC, else e⁻), three channels
 // per pixel — with a CFA, one per pixel demosaiced into three, or (`mosaic_only`, for a DNG) the mosaic itself.
-std::vector<float> read_out_rows(const Run& run, std::span<const float> linear, int y0, int y1,
+std::vector<float> read_out_rows(const SensorRun& run, std::span<const float> linear, int y0, int y1,
                                  bool mosaic_only = false) {
   const SensorConfig& c = run.config;
   const std::size_t width = to_size(run.width());
@@ -137,29 +85,13 @@ struct BlockInput {
 };
 
 // Stage 6 in place: the rendering intent on the signal above black.
-void render_rows(const Run& run, std::span<float> rgb) {
+void render_rows(const SensorRun& run, std::span<float> rgb) {
   const double black = run.config.adc.enabled ? run.config.adc.black_level_dn : 0.0;
   parallel_for(rgb.size() / 3, run.threads, [&](std::size_t p) {
     float* v = rgb.data() + 3 * p;
     const Eigen::Vector3d out = render(run.intent, Eigen::Vector3d(v[0] - black, v[1] - black, v[2] - black));
     for (int c = 0; c < 3; ++c) v[c] = static_cast<float>(out[c]);
   });
-}
-
-// The object id of each sensor pixel: the most frequent of its k×k rendered pixels (the smallest id on a tie).
-std::vector<std::int32_t> sensor_ids(const std::vector<std::int32_t>& rendered, int in_width, int k, int width,
-                                     int rows) {
-  std::vector<std::int32_t> ids(to_size(width) * to_size(rows));
-  std::map<std::int32_t, int> count;
-  for (int r = 0; r < rows; ++r)
-    for (int x = 0; x < width; ++x) {
-      count.clear();
-      for (int sy = 0; sy < k; ++sy)
-        for (int sx = 0; sx < k; ++sx) ++count[rendered[to_size(r * k + sy) * to_size(in_width) + to_size(x * k + sx)]];
-      ids[to_size(r) * to_size(width) + to_size(x)] =
-          std::max_element(count.begin(), count.end(), [](auto& a, auto& b) { return a.second < b.second; })->first;
-    }
-  return ids;
 }
 
 // The input's path components (S0 layers), in the order its chromatrace.components lists them (the reader
@@ -217,206 +149,6 @@ int pixel_area(const SpectralExrInfo& info, const SensorConfig& config) {
   const bool point = j.is_object() && j.contains("render") && j["render"].is_object() && j["render"].contains("pixel_filter") &&
                      j["render"]["pixel_filter"] == "point";
   return point ? 0 : 1;
-}
-
-// Sensor rows the display's exposure statistics sample: every row of small images; of larger ones the rows
-// of every n-th group of 16 rendered rows (one ZIP chunk), n = ⌊groups / 8⌋, so that about 8 groups are read.
-bool display_sample_row(int y, int k, int height) {
-  const int groups = (k * height + kChunkRows - 1) / kChunkRows;
-  const int stride = std::max(1, groups / 8);
-  return (k * y / kChunkRows) % stride == 0;
-}
-
-// Sensor row ranges [first, last) to survey: every row in blocks when the exposure is automatic, else only the
-// rows the display samples.
-std::vector<RowRange> survey_rows(bool all_rows, int k, int height, int rows_per_block) {
-  std::vector<RowRange> ranges;
-  for (int y = 0; y < height;) {
-    if (!all_rows && !display_sample_row(y, k, height)) {
-      ++y;
-      continue;
-    }
-    int end = y + 1;
-    while (end < height && end - y < rows_per_block && (all_rows || display_sample_row(end, k, height))) ++end;
-    ranges.push_back({y, end});
-    y = end;
-  }
-  return ranges;
-}
-
-// What one pass over the image at unit exposure (T = 1 s) finds: the brightest channel of each pixel for the
-// automatic exposure (surfaces and emitters apart), the emitters' spectra, and the camera signal of the
-// surfaces in the display's sample rows.
-struct Survey {
-  std::vector<float> surfaces, emitters;  // brightest channel per pixel, e⁻/s
-  std::map<std::int32_t, std::pair<std::vector<double>, std::size_t>> emitter_spectra;  // by id: Σ bands, pixels
-  std::vector<float> display_samples;                                                  // surfaces, 3 per pixel
-  std::array<double, 3> signal_sum{};  // Σ linear signal over every surveyed pixel, emitters included (veiling glare)
-  std::size_t pixels = 0;
-};
-
-Survey survey_image(SpectralExrReader& reader, const Run& unit_run, const SpectralLayer& total,
-                    const SpectralLayer* emission, const std::set<std::int32_t>& lights,
-                    const std::vector<RowRange>& ranges, bool want_display, Progress& progress) {
-  const SpectralExrInfo& info = reader.info();
-  const int k = unit_run.model.supersample, width = unit_run.width(), height = unit_run.height();
-  const std::size_t bands = info.bands.size();
-  const bool ids_needed = info.has_object_ids && (!lights.empty() || want_display);
-  Survey s;
-  for (const RowRange& range : ranges) {
-    const int y0 = range.first, y1 = range.last;
-    const std::vector<float> total_spectra = read_sensor_rows(reader, total, k, y0, y1, unit_run.lighting);
-    const std::vector<float> linear = linear_rows(unit_run, total_spectra, y0, y1);
-    std::vector<float> emission_spectra, emission_linear;
-    if (emission != nullptr) {
-      emission_spectra = read_sensor_rows(reader, *emission, k, y0, y1, unit_run.lighting);
-      emission_linear = linear_rows(unit_run, emission_spectra, y0, y1);
-    }
-    std::vector<std::int32_t> ids;
-    if (ids_needed) {
-      std::vector<std::int32_t> rendered(to_size(k * (y1 - y0)) * to_size(info.width));
-      reader.read_object_ids(k * y0, k * y1, rendered);
-      ids = k == 1 ? rendered : sensor_ids(rendered, info.width, k, width, y1 - y0);
-    }
-    for (int r = 0; r < y1 - y0; ++r) {
-      const bool sampled = want_display && display_sample_row(y0 + r, k, height);
-      for (int x = 0; x < width; ++x) {
-        const std::size_t p = to_size(r) * to_size(width) + to_size(x);
-        const float* c = linear.data() + 3 * p;
-        const double sum = double(c[0]) + c[1] + c[2];
-        for (int ch = 0; ch < 3; ++ch) s.signal_sum[to_size(ch)] += c[ch];
-        ++s.pixels;
-        bool emitter = false;
-        if (!emission_linear.empty()) {
-          const float* e = emission_linear.data() + 3 * p;
-          emitter = sum > 0 && double(e[0]) + e[1] + e[2] > 0.5 * sum;
-        }
-        const std::int32_t id = ids.empty() ? -1 : ids[p];
-        if (!ids.empty() && lights.contains(id)) emitter = true;
-        (emitter ? s.emitters : s.surfaces).push_back(std::max({c[0], c[1], c[2]}));
-        if (!want_display) continue;
-        if (!emitter) {
-          if (sampled) s.display_samples.insert(s.display_samples.end(), c, c + 3);
-          continue;
-        }
-        // The emitter's spectrum as seen: its emission (or, without that layer, its total) over the k×k
-        // rendered pixels.
-        const std::vector<float>& spectra = emission_spectra.empty() ? total_spectra : emission_spectra;
-        auto& [sum_bands, count] = s.emitter_spectra[id];
-        sum_bands.resize(bands, 0.0);
-        for (int sy = 0; sy < k; ++sy)
-          for (int sx = 0; sx < k; ++sx) {
-            const float* l = spectra.data() +
-                             (to_size(r * k + sy) * to_size(info.width) + to_size(x * k + sx)) * bands;
-            for (std::size_t b = 0; b < bands; ++b) sum_bands[b] += l[b] / double(k * k);
-          }
-        ++count;
-      }
-    }
-    progress.advance();
-  }
-  return s;
-}
-
-// Exposure time that puts the `auto_percentile` of the brightest channel's noise-free signal of the surfaces
-// (every pixel unless emitters are excluded, or when nothing else is in view) at `auto_level` of the
-// saturation signal (1 e⁻ for an ideal sensor).
-double auto_exposure(Survey& survey, const SensorConfig& config, const std::string& file,
-                     std::vector<std::string>& notes) {
-  const ExposureConfig& e = config.exposure;
-  std::vector<float>& values = survey.surfaces;
-  std::string what = "of the brightest channel";
-  if (!e.auto_exclude_emitters || survey.surfaces.empty()) {
-    if (e.auto_exclude_emitters && !survey.emitters.empty())
-      notes.push_back("exposure.time_s \"auto\": every pixel is an emitter seen directly; the exposure is keyed on them");
-    values.insert(values.end(), survey.emitters.begin(), survey.emitters.end());
-  } else if (!survey.emitters.empty()) {
-    what = fmt::format("of the brightest channel of the surfaces ({} emitter pixel{} left out)", survey.emitters.size(),
-                       survey.emitters.size() == 1 ? "" : "s");
-  }
-  // The configuration says percentiles (0–100); core/statistics.h takes quantiles (0–1), by the same rule.
-  const double per_second = quantile_in_place(values, e.auto_percentile / 100.0);
-  if (!(per_second > 0))
-    throw InputError(fmt::format("{}: exposure.time_s \"auto\": the image is black (its {}th percentile is {})", file,
-                                 e.auto_percentile, per_second));
-  const double time = e.auto_level * saturation_electrons(config).value_or(1.0) / per_second;
-  notes.push_back(fmt::format(
-      "exposure.time_s \"auto\": {:.6g} s puts the {:g}th percentile {} at {:g} of {}", time, e.auto_percentile, what,
-      e.auto_level,
-      saturation_electrons(config) ? fmt::format("saturation ({:.6g} e-)", *saturation_electrons(config))
-                                   : std::string("1 e- (the ideal sensor does not saturate)")));
-  return time;
-}
-
-// The display rendering at unit exposure: the white balance's illuminant (display.white_balance, else the
-// illuminant lighting a reflectance image, else the brightest emitter the survey saw, else D65), its matrix, and
-// the scale that puts the display.percentile of the surfaces' brightest linear sRGB channel at display.level.
-// `description` says what was chosen, as JSON; `scene_light` is the illuminant's band values.
-DisplayRendering display_rendering(const Survey& survey, const LinearModel& unit_model, const SensorConfig& config,
-                                   const SpectralExrInfo& info, const std::string& lit_by, const std::vector<double>& lighting,
-                                   Json& description, std::vector<std::string>& notes, std::vector<double>& scene_light) {
-  const Bands& bands = info.bands;
-  std::vector<double> light;
-  std::string source;
-  if (config.display.white_balance) {
-    light = band_averages(cie::illuminant(*config.display.white_balance), bands);
-    source = fmt::format("illuminant {} (display.white_balance)", *config.display.white_balance);
-  } else if (!lighting.empty()) {
-    light = lighting;
-    source = fmt::format("illuminant {} lighting the reflectance image (--illuminant)", lit_by);
-  } else {
-    const std::array<std::vector<double>, 3> xyz = xyz_band_weights(bands);
-    double best = 0;
-    for (const auto& [id, entry] : survey.emitter_spectra) {
-      double y = 0;
-      for (std::size_t b = 0; b < bands.size(); ++b) y += entry.first[b] / double(entry.second) * xyz[1][b];
-      if (y > best) {
-        best = y;
-        light = entry.first;
-        for (double& v : light) v /= double(entry.second);
-        const auto name = info.object_names.find(id);
-        source = id < 0 ? fmt::format("the brightest emitter in view ({} pixels)", entry.second)
-                        : fmt::format("the brightest emitter in view, object {}{} ({} pixels)", id,
-                                      name == info.object_names.end() ? "" : " (" + name->second + ")", entry.second);
-      }
-    }
-  }
-  DisplayRendering d;
-  const auto matrix_for = [&](const std::vector<double>& l) { return display_matrix(unit_model.weights, bands, l); };
-  try {
-    if (light.empty()) throw InputError("no emitter in view");
-    d.matrix = matrix_for(light);
-  } catch (const InputError& e) {
-    if (!light.empty()) notes.push_back(fmt::format("display: white balance on D65: {} ({})", source, e.what()));
-    light = band_averages(cie::illuminant("D65"), bands);
-    source = "illuminant D65 (no emitter in view)";
-    d.matrix = matrix_for(light);
-  }
-  std::vector<float> brightest;
-  for (std::size_t i = 0; i + 2 < survey.display_samples.size(); i += 3) {
-    const Eigen::Vector3d c(survey.display_samples[i], survey.display_samples[i + 1], survey.display_samples[i + 2]);
-    brightest.push_back(static_cast<float>(std::max(0.0, (d.matrix * c).maxCoeff())));
-  }
-  const double p = brightest.empty() ? 0.0 : quantile_in_place(brightest, config.display.percentile / 100.0);
-  if (p > 0) {
-    d.scale = config.display.level / p;
-  } else {
-    d.scale = 1.0;
-    notes.push_back("display: the surfaces are black; the display layer's exposure is not normalised");
-  }
-  Json matrix = Json::array();
-  for (int r = 0; r < 3; ++r) matrix.push_back({d.matrix(r, 0), d.matrix(r, 1), d.matrix(r, 2)});
-  const Eigen::Vector3d white = white_response(unit_model.weights, light);
-  description = {{"channels", {"display.R", "display.G", "display.B"}},
-                 {"encoding", "sRGB (IEC 61966-2-1), clamped to [0, 1]"},
-                 {"white_balance", source},
-                 {"white_response", {white[0], white[1], white[2]}},
-                 {"percentile", config.display.percentile},
-                 {"level", config.display.level},
-                 {"samples", brightest.size()}};
-  description["matrix"] = matrix;  // camera e⁻ → linear sRGB, before the scale
-  scene_light = light;
-  return d;
 }
 
 // What the camera did, as numeric attributes (docs/sensor.md, "Output"): the black level, the white level at
@@ -611,7 +343,7 @@ std::optional<FieldOfView> cos4_field_of_view(const SpectralExrInfo& info, Senso
 
 // What the output says of itself: the renderer's description passed on, the sensor's configuration and units,
 // the components, the display layer's making, and the camera's numbers (black, white, curve, pixel area).
-void describe_output(const SpectralExrInfo& info, const SensorConfig& config, const Run& run, const RunReport& report,
+void describe_output(const SpectralExrInfo& info, const SensorConfig& config, const SensorRun& run, const RunReport& report,
                      const std::vector<std::string>& components, bool want_display, bool picture,
                      Json display_description, double display_scale, OutputLayout& layout) {
   if (layout.format == OutputFormat::Exr) {
@@ -645,7 +377,7 @@ void describe_output(const SpectralExrInfo& info, const SensorConfig& config, co
 // What a DNG says of the capture (docs/sensor.md, "DNG"): the levels as camera_levels() put them, the as-shot
 // neutral (the camera's signal of a white lit by the scene illuminant, largest channel 1), the D65 colour matrix
 // from the camera's curves, the exposure, the f-number and the camera's name.
-DngMetadata dng_metadata(const SensorConfig& c, const Run& run, const Bands& bands, const std::vector<double>& scene_light,
+DngMetadata dng_metadata(const SensorConfig& c, const SensorRun& run, const Bands& bands, const std::vector<double>& scene_light,
                          const OutputLayout& layout) {
   DngMetadata m;
   m.pattern = std::string(pattern_name(c.cfa.pattern));
@@ -667,38 +399,38 @@ DngMetadata dng_metadata(const SensorConfig& c, const Run& run, const Bands& ban
   return m;
 }
 
-// The display rendering of `count` pixels of linear signal from `linear`, into `out`.
-void display_pixels(const DisplayRendering& display, const float* linear, std::size_t count, int threads, float* out) {
-  parallel_for(count, threads, [&](std::size_t p) {
-    const float* c = linear + 3 * p;
-    const Eigen::Vector3d v = display_value(display, Eigen::Vector3d(c[0], c[1], c[2]));
-    for (int ch = 0; ch < 3; ++ch) out[3 * p + to_size(ch)] = static_cast<float>(v[ch]);
-  });
-}
+// What a run reads and writes, decided from the input, the output's name and the settings before any pixel is
+// read.
+struct RunPlan {
+  const SpectralLayer* total = nullptr;     // the radiance (or lit reflectance) the camera sees
+  const SpectralLayer* emission = nullptr;  // the emitters' own layer, when the input has one
+  std::vector<std::string> components;      // the path components carried through, and their layers
+  std::vector<const SpectralLayer*> component_layers;
+  std::set<std::int32_t> lights;  // the object ids of the scene's lights
+  OutputLayout layout;
+  std::optional<FieldOfView> fov;  // for stage 1's cos⁴ fall-off
+  int k = 1;  // rendered pixels per sensor pixel, each way
+  int rows_per_block = 1;
+  std::size_t blocks = 0;
+  bool exr = false, dng = false;
+  bool auto_time = false;     // exposure.time_s "auto"
+  bool picture = false;       // a PNG holding the display rendering
+  bool want_display = false;  // a display rendering is written
+  bool want_light = false;    // the scene illuminant is needed (the display's white balance, a DNG's neutral)
+};
 
-}  // namespace
-
-void check_output_path(const fs::path& output, const std::vector<fs::path>& inputs) {
-  check_output_file(output, inputs);  // first: "/dev/null: is a character device" says more than its format
-  output_format(output);
-}
-
-RunReport simulate_sensor(const fs::path& input, const fs::path& output, SensorConfig config,
-                          const RunOptions& options) {
-  check_output_path(output, {input});
-  SpectralExrReader reader(input);
-  const SpectralExrInfo& info = reader.info();
+// Plans the run and sets up `run` at unit exposure (its threads, lighting and linear model). Refuses a Bayer
+// mosaic on an image smaller than 2 × 2 sensor pixels.
+RunPlan plan_run(const SpectralExrInfo& info, const fs::path& output, SensorConfig& config, const RunOptions& options,
+                 SensorRun& run) {
+  RunPlan plan;
   const bool lit = !options.illuminant.empty();
-  const SpectralLayer* total = &total_radiance(info, config, lit);
-  const int k = config.pixel.supersample;
-  const std::optional<FieldOfView> fov = cos4_field_of_view(info, config);
-
+  plan.total = &total_radiance(info, config, lit);
+  plan.k = config.pixel.supersample;
+  plan.fov = cos4_field_of_view(info, config);
   // A lit reflectance image is one layer of light; emissive layers a file may hold beside it are not its light.
-  const auto component_list = lit ? decltype(component_layers_of(info)){} : component_layers_of(info);
-  const std::vector<std::string>& components = component_list.first;
-  const std::vector<const SpectralLayer*>& component_layers = component_list.second;
+  if (!lit) std::tie(plan.components, plan.component_layers) = component_layers_of(info);
 
-  Run run;
   run.threads = options.threads;
   if (lit) {
     const Illumination illumination = read_illumination(options.illuminant);
@@ -707,83 +439,85 @@ RunReport simulate_sensor(const fs::path& input, const fs::path& output, SensorC
         "reflectance lit by {}: radiance = reflectance x the illuminant's band average, 1 W/m2/sr/nm at 560 nm",
         illumination.name));
   }
-  run.model = linear_model(config, 1.0, info.bands, fov, info.width, info.height);
+  run.model = linear_model(config, 1.0, info.bands, plan.fov, info.width, info.height);
   const int height = run.height();
   if (config.cfa.enabled && (run.width() < 2 || height < 2))
     throw InputError(
         fmt::format("{}: cfa.enabled: a Bayer mosaic needs at least 2 x 2 sensor pixels, the image "
                     "has {} x {}",
                     info.file, run.width(), height));
-  OutputLayout layout = output_layout(output, config, run.width(), height);
-  const std::size_t layers_per_block = 1 + components.size();
-  const int rows_per_block = block_rows(info, layers_per_block, k, options.block_rows, height);
-  const std::size_t blocks = to_size((height + rows_per_block - 1) / rows_per_block);
-  const bool exr = layout.format == OutputFormat::Exr;
-  const bool dng = layout.format == OutputFormat::Dng;
-  const bool auto_time = !config.exposure.time_s;
-  const bool picture = display_png(output, config);  // the PNG holds the display rendering
-  const bool want_display = (exr && config.display.enabled) || picture;
-  const bool want_light = want_display || dng;  // a DNG's as-shot neutral is the scene illuminant's
-  const SpectralLayer* emission = lit ? nullptr : info.find_layer("emission", SpectralQuantity::S0);
-  const std::set<std::int32_t> lights = light_object_ids(info);
-  const std::vector<RowRange> surveyed =
-      auto_time || want_light || config.optics.flare > 0 ? survey_rows(auto_time, k, height, rows_per_block)
-                                                            : std::vector<RowRange>{};
-  Progress progress("sensor", blocks + surveyed.size(), options.progress);
+  plan.layout = output_layout(output, config, run.width(), height);
+  plan.rows_per_block = block_rows(info, 1 + plan.components.size(), plan.k, options.block_rows, height);
+  plan.blocks = to_size((height + plan.rows_per_block - 1) / plan.rows_per_block);
+  plan.exr = plan.layout.format == OutputFormat::Exr;
+  plan.dng = plan.layout.format == OutputFormat::Dng;
+  plan.auto_time = !config.exposure.time_s;
+  plan.picture = display_png(output, config);
+  plan.want_display = (plan.exr && config.display.enabled) || plan.picture;
+  plan.want_light = plan.want_display || plan.dng;  // a DNG's as-shot neutral is the scene illuminant's
+  plan.emission = lit ? nullptr : info.find_layer("emission", SpectralQuantity::S0);
+  plan.lights = light_object_ids(info);
+  return plan;
+}
 
-  // One pass at unit exposure: the automatic exposure time, the display's white balance and brightness.
+// What the pass at unit exposure decided besides the exposure time.
+struct Exposure {
+  DisplayRendering display;  // its scale for the chosen exposure
+  Json display_description;
+  std::vector<double> scene_light;  // the display's white-balance illuminant, per band
+  std::array<double, 3> glare{};    // veiling glare per channel at the chosen exposure
+};
+
+// One pass at unit exposure over the rows `surveyed`: the automatic exposure time (into `config`), the display's
+// white balance and brightness, the veiling glare. Leaves `run` with its linear model at the chosen exposure.
+Exposure expose(SpectralExrReader& reader, const RunPlan& plan, const std::vector<RowRange>& surveyed,
+                const std::string& lit_by, SensorConfig& config, SensorRun& run, Progress& progress) {
+  const SpectralExrInfo& info = reader.info();
   Survey survey;
   if (!surveyed.empty()) {
     run.config = config;
-    const bool exclude = auto_time && config.exposure.auto_exclude_emitters;
-    survey = survey_image(reader, run, *total, exclude || want_light ? emission : nullptr,
-                          exclude || want_light ? lights : std::set<std::int32_t>{}, surveyed, want_light, progress);
+    const bool exclude = plan.auto_time && config.exposure.auto_exclude_emitters;
+    survey = survey_image(reader, run, *plan.total, exclude || plan.want_light ? plan.emission : nullptr,
+                          exclude || plan.want_light ? plan.lights : std::set<std::int32_t>{}, surveyed,
+                          plan.want_light, progress);
   }
-  if (auto_time) config.exposure.time_s = auto_exposure(survey, config, info.file, config.notes);
-  Json display_description;
-  DisplayRendering display;
-  std::vector<double> scene_light;
-  if (want_light)
-    display = display_rendering(survey, run.model, config, info, options.illuminant, run.lighting, display_description,
-                                config.notes, scene_light);
+  if (plan.auto_time) config.exposure.time_s = auto_exposure(survey, config, info.file, config.notes);
+  Exposure exposure;
+  if (plan.want_light)
+    exposure.display = display_rendering(survey, run.model, config, info, lit_by, run.lighting,
+                                         exposure.display_description, config.notes, exposure.scene_light);
   // Veiling glare at unit exposure: flare × the image's mean signal, per channel.
-  std::array<double, 3> glare{};
   if (config.optics.flare > 0 && survey.pixels > 0)
-    for (std::size_t c = 0; c < 3; ++c) glare[c] = config.optics.flare * survey.signal_sum[c] / double(survey.pixels);
-  survey = Survey{};
+    for (std::size_t c = 0; c < 3; ++c)
+      exposure.glare[c] = config.optics.flare * survey.signal_sum[c] / double(survey.pixels);
   run.exposure_s = *config.exposure.time_s * config.exposure.scale;
-  for (double& g : glare) g *= run.exposure_s;
-  run.model = linear_model(config, run.exposure_s, info.bands, fov, info.width, info.height);
+  for (double& g : exposure.glare) g *= run.exposure_s;
+  run.model = linear_model(config, run.exposure_s, info.bands, plan.fov, info.width, info.height);
   // The display's matrix and scale were found at unit exposure; the linear layer scales with the time. The
   // display is exposed like the camera's own picture: the time (chosen or automatic) is normalised away, an
   // over-exposure asked for with exposure.scale shows, clipped, as it would in the camera's JPEG.
-  display.scale /= *config.exposure.time_s;
+  exposure.display.scale /= *config.exposure.time_s;
+  return exposure;
+}
 
-  Eigen::Vector3d gains = config.rendering.white_balance;
-  if (config.rendering.white_balance_illuminant)
-    gains =
-        white_balance_gains(run.model.weights, info.bands, cie::illuminant(*config.rendering.white_balance_illuminant));
-  run.intent = rendering_intent(config, gains);
-  run.config = config;
-
-  RunReport report;
-  report.width = run.width();
-  report.height = height;
-  report.exposure_s = run.exposure_s;
-  report.notes = config.notes;
-  report.effective_config = config_json(config);
-  describe_output(info, config, run, report, components, want_display, picture, display_description, display.scale, layout);
-  if (dng) layout.dng = dng_metadata(config, run, info.bands, scene_light, layout);
-  SensorImageWriter writer(output, layout);
-
+// Reads, processes and writes the image block by block: the next block is read while this one is processed and
+// written (one thread at a time uses the reader).
+void write_blocks(SpectralExrReader& reader, const RunPlan& plan, const SensorRun& run, const Exposure& exposure,
+                  SensorImageWriter& writer, Progress& progress) {
+  const SpectralExrInfo& info = reader.info();
+  const SensorConfig& config = run.config;
+  const int k = plan.k, height = run.height(), rows_per_block = plan.rows_per_block;
+  const bool exr = plan.exr, dng = plan.dng, picture = plan.picture;
+  const OutputLayout& layout = plan.layout;
+  const DisplayRendering& display = exposure.display;
   const auto read_block = [&](int y0) {
     BlockInput in;
     in.y0 = y0;
     in.y1 = std::min(height, y0 + rows_per_block);
     in.context = config.cfa.enabled ? demosaic_context(in.y0, in.y1, height) : RowRange{in.y0, in.y1};
-    in.total = read_sensor_rows(reader, *total, k, in.context.first, in.context.last, run.lighting);
+    in.total = read_sensor_rows(reader, *plan.total, k, in.context.first, in.context.last, run.lighting);
     if (exr) {
-      for (const SpectralLayer* layer : component_layers)
+      for (const SpectralLayer* layer : plan.component_layers)
         in.components.push_back(read_sensor_rows(reader, *layer, k, in.y0, in.y1, run.lighting));
       if (layout.object_ids) {
         in.ids.resize(to_size(k * (in.y1 - in.y0)) * to_size(info.width));
@@ -792,7 +526,6 @@ RunReport simulate_sensor(const fs::path& input, const fs::path& output, SensorC
     }
     return in;
   };
-  // The next block is read while this one is processed and written (one thread at a time uses the reader).
   std::future<BlockInput> next = std::async(std::launch::async, read_block, 0);
   const std::size_t row_values = to_size(run.width()) * 3;
   for (;;) {
@@ -801,7 +534,7 @@ RunReport simulate_sensor(const fs::path& input, const fs::path& output, SensorC
     const int y0 = in.y0, y1 = in.y1, e0 = in.context.first, e1 = in.context.last;
     std::vector<float> linear_ext = linear_rows(run, in.total, e0, e1);
     if (config.optics.flare > 0)  // the glare lands on every pixel: it is light, so the linear layer has it too
-      for (std::size_t i = 0; i < linear_ext.size(); ++i) linear_ext[i] += static_cast<float>(glare[i % 3]);
+      for (std::size_t i = 0; i < linear_ext.size(); ++i) linear_ext[i] += static_cast<float>(exposure.glare[i % 3]);
     std::vector<float> image = read_out_rows(run, linear_ext, e0, e1, dng);
     const std::size_t own = to_size(y0 - e0) * row_values, own_size = to_size(y1 - y0) * row_values;
     const std::size_t image_values = dng ? 1 : 3;  // a DNG holds the mosaic: one value per pixel
@@ -837,6 +570,47 @@ RunReport simulate_sensor(const fs::path& input, const fs::path& output, SensorC
     progress.advance();
     if (y1 == height) break;
   }
+}
+
+}  // namespace
+
+void check_output_path(const fs::path& output, const std::vector<fs::path>& inputs) {
+  check_output_file(output, inputs);  // first: "/dev/null: is a character device" says more than its format
+  output_format(output);
+}
+
+RunReport simulate_sensor(const fs::path& input, const fs::path& output, SensorConfig config,
+                          const RunOptions& options) {
+  check_output_path(output, {input});
+  SpectralExrReader reader(input);
+  const SpectralExrInfo& info = reader.info();
+  SensorRun run;
+  RunPlan plan = plan_run(info, output, config, options, run);
+  const std::vector<RowRange> surveyed =
+      plan.auto_time || plan.want_light || config.optics.flare > 0
+          ? survey_rows(plan.auto_time, plan.k, run.height(), plan.rows_per_block)
+          : std::vector<RowRange>{};
+  Progress progress("sensor", plan.blocks + surveyed.size(), options.progress);
+  const Exposure exposure = expose(reader, plan, surveyed, options.illuminant, config, run, progress);
+
+  Eigen::Vector3d gains = config.rendering.white_balance;
+  if (config.rendering.white_balance_illuminant)
+    gains =
+        white_balance_gains(run.model.weights, info.bands, cie::illuminant(*config.rendering.white_balance_illuminant));
+  run.intent = rendering_intent(config, gains);
+  run.config = config;
+
+  RunReport report;
+  report.width = run.width();
+  report.height = run.height();
+  report.exposure_s = run.exposure_s;
+  report.notes = config.notes;
+  report.effective_config = config_json(config);
+  describe_output(info, config, run, report, plan.components, plan.want_display, plan.picture,
+                  exposure.display_description, exposure.display.scale, plan.layout);
+  if (plan.dng) plan.layout.dng = dng_metadata(config, run, info.bands, exposure.scene_light, plan.layout);
+  SensorImageWriter writer(output, plan.layout);
+  write_blocks(reader, plan, run, exposure, writer, progress);
   writer.finish();
   return report;
 }

@@ -11,7 +11,7 @@
 
 #include "analyzer/image_input.h"
 #include "core/file_io.h"
-#include "core/scene.h"
+#include "core/series_format.h"
 #include "series/preview.h"
 
 namespace ct::series {

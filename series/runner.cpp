@@ -1,9 +1,6 @@
 #include "series/runner.h"
 
-#include <fcntl.h>
 #include <sys/resource.h>
-#include <spawn.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -28,6 +25,7 @@
 #include "reference_tracer/render.h"
 #include "sensor_sim/config.h"
 #include "sensor_sim/pipeline.h"
+#include "series/blender_batch.h"
 #include "series/preview.h"
 #include "series/render_cache.h"
 
@@ -75,47 +73,23 @@ void render_with_tracer(Scene scene, const fs::path& out, const RunOptions& opti
   rt::write_render(out, scene, rt::render(scene, render));
 }
 
-// Runs a program and waits; its stderr goes to ours (the batch's progress lines), its stdout to `log`, and
-// its environment is ours with `env` set.
-int run_program(const std::vector<std::string>& argv, const std::vector<std::pair<std::string, std::string>>& env,
-                const fs::path& log) {
-  posix_spawn_file_actions_t actions;
-  posix_spawn_file_actions_init(&actions);
-  posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-  try {
-    const int status = spawn_and_wait(argv, env, &actions);
-    posix_spawn_file_actions_destroy(&actions);
-    return status;
-  } catch (...) {
-    posix_spawn_file_actions_destroy(&actions);
-    throw;
-  }
-}
-
 void render_with_cycles(const Scene& scene, const fs::path& scene_file, const fs::path& out, const fs::path& dir,
                         const RunOptions& options) {
-  std::vector<std::string> argv = {options.blender.string(), "--background", "--factory-startup", "--python",
-                                   options.batch_script.string(), "--",
-                                   "--scene", scene_file.string(), "--out", out.string(),
-                                   "--samples", std::to_string(options.spp.value_or(scene.render.samples)),
-                                   "--seed", std::to_string(options.seed.value_or(scene.render.seed)),
-                                   "--components", options.components,
-                                   "--cache-dir", (dir / "renders" / "cycles-cache").string()};
-  if (options.width || options.height) {
-    argv.push_back("--resolution");
-    argv.push_back(fmt::format("{}x{}", options.width.value_or(scene.camera.width), options.height.value_or(scene.camera.height)));
-  }
-  if (options.max_bounces) {
-    argv.push_back("--max-bounces");
-    argv.push_back(std::to_string(*options.max_bounces));
-  }
-  if (options.bands) {
-    argv.push_back("--bands-file");
-    argv.push_back(options.bands_file.string());
-  }
-  if (!options.progress) argv.push_back("--quiet");
+  BlenderBatchCommand batch(options.blender, options.batch_script);
+  batch.option("--scene", scene_file.string())
+      .option("--out", out.string())
+      .option("--samples", std::to_string(options.spp.value_or(scene.render.samples)))
+      .option("--seed", std::to_string(options.seed.value_or(scene.render.seed)))
+      .option("--components", options.components)
+      .option("--cache-dir", (dir / "renders" / "cycles-cache").string());
+  if (options.width || options.height)
+    batch.option("--resolution", fmt::format("{}x{}", options.width.value_or(scene.camera.width),
+                                             options.height.value_or(scene.camera.height)));
+  batch.option("--max-bounces", options.max_bounces);
+  if (options.bands) batch.option("--bands-file", options.bands_file.string());
+  if (!options.progress) batch.flag("--quiet");
   const fs::path log = dir / "renders" / "blender.log";
-  const int status = run_program(argv, {{"CHROMATRACE_EXE", options.executable.string()}}, log);
+  const int status = run_program(batch.argv(), BlenderBatchCommand::environment(options.executable), log).status;
   if (status != 0 || !fs::exists(out))
     throw std::runtime_error(fmt::format("Blender's batch exited with status {} (its output: {})", status, log.string()));
 }

@@ -25,7 +25,7 @@
 #include <vector>
 
 #include "core/json_input.h"
-#include "core/scene.h"
+#include "core/series_format.h"
 
 namespace ct::series {
 

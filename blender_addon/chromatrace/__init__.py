@@ -5,8 +5,10 @@ light and emission colours) gets its band averages, Cycles renders, and the chan
 wavelengths in a spectral OpenEXR (the layout of docs/spectral-exr.md) by `chromatrace assemble`. Spectra,
 band averages, tessellation and the EXR writer are chromatrace's C++ core, run as the `chromatrace`
 command; this package is properties (properties.py), panels (ui.py), operators (operators.py) and the
-render driver (spectral_render.py), with the pure-Python parts (bands, components, manifest, cache,
-journal, node rules, PLY, batch arguments) free of bpy so plain Python tests them.
+render driver (spectral_render.py) over its steps: where each colour comes from (node_resolution.py), image
+textures (textures.py), the cache key's description (cache_description.py), the scene set up for Cycles
+(render_setup.py) and the pre-flight check (preflight.py). The pure-Python parts (bands, components, manifest,
+cache, journal, node rules, PLY, batch arguments, the scene's parts) are free of bpy so plain Python tests them.
 """
 
 bl_info = {

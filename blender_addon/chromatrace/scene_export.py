@@ -178,7 +178,7 @@ def _camera(scene):
         camera = json.loads(c.scene_json)
         camera["resolution"] = resolution
         return camera
-    from .spectral_render import camera_description
+    from .camera_math import camera_description
     d = camera_description(scene, resolution)
     return {"position": d["position"], "look_at": d["look_at"], "up": d["up"], "fov_deg": d["horizontal_fov_deg"],
             "fov_axis": "horizontal", "resolution": resolution, "sensor_width_mm": d["sensor_width_mm"]}

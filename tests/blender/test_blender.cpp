@@ -20,6 +20,7 @@
 
 #include "core/band_plan.h"
 #include "core/scene.h"
+#include "core/series_format.h"
 #include "core/spectral_exr.h"
 #include "tests/cli/run_command.h"
 #include "tests/cli/text_files.h"

@@ -18,7 +18,7 @@
 
 #include "analyzer/cluster_shape.h"
 #include "core/json_input.h"
-#include "core/scene.h"
+#include "core/series_format.h"
 #include "tests/cli/run_command.h"
 #include "tests/core/spectral_exr_fixtures.h"
 #include "tests/core/bad_scenes.h"

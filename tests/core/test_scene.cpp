@@ -13,6 +13,7 @@
 #include "core/error.h"
 #include "core/rgb_to_spectrum.h"
 #include "core/scene.h"
+#include "core/series_format.h"
 #include "core/structures.h"
 #include "tests/core/bad_scenes.h"
 

@@ -5,7 +5,7 @@
 #include <fstream>
 
 #include "core/error.h"
-#include "core/scene.h"
+#include "core/series_format.h"
 #include "tests/fuzz/fuzz_input.h"
 
 namespace {

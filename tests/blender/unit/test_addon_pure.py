@@ -9,6 +9,8 @@ import unittest
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "..", "..", "blender_addon"))
 
 from chromatrace import bands, batch_args, cache, camera_math, components, defaults, floats, manifest, node_rules, ply, spectra  # noqa: E402
+from chromatrace import scene_parts  # noqa: E402
+from types import SimpleNamespace  # noqa: E402
 from chromatrace.errors import BadInput  # noqa: E402
 from chromatrace.journal import Journal  # noqa: E402
 
@@ -395,6 +397,56 @@ class CameraMath(unittest.TestCase):
         self.assertEqual([round(c, 12) for c in columns[0]], [1, 0, 0])   # right
         self.assertEqual([round(c, 12) for c in columns[1]], [0, 0, 1])   # image up
         self.assertEqual([round(c, 12) for c in columns[2]], [0, -1, 0])  # back
+
+
+    def test_camera_description_of_a_50mm_lens_on_a_full_frame_sensor(self):
+        # 36 mm across and 50 mm focal length: 2·atan(18/50) = 39.598° across, 2·atan(18/50 · 1080/1920) = 22.895°
+        # up (the familiar "normal lens" angles); Blender's identity camera looks down -Z with +Y up.
+        identity = [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]]
+        data = SimpleNamespace(sensor_fit="AUTO", sensor_width=36.0, sensor_height=24.0, lens=50.0)
+        scene = SimpleNamespace(camera=SimpleNamespace(data=data, matrix_world=identity))
+        d = camera_math.camera_description(scene, [1920, 1080])
+        self.assertEqual(d["position"], [0, 0, 0])
+        self.assertEqual(d["look_at"], [0, 0, -1])
+        self.assertEqual(d["up"], [0, 1, 0])
+        self.assertAlmostEqual(d["horizontal_fov_deg"], 39.5978, places=4)
+        self.assertAlmostEqual(d["vertical_fov_deg"], 22.8952, places=4)
+        self.assertEqual(d["sensor_width_mm"], 36.0)
+
+
+class SceneParts(unittest.TestCase):
+    @staticmethod
+    def thing(name, kind="MESH", pass_index=0, materials=(), lightgroup=""):
+        slots = [SimpleNamespace(material=m) for m in materials]
+        return SimpleNamespace(name=name, type=kind, pass_index=pass_index, material_slots=slots, lightgroup=lightgroup)
+
+    def test_used_materials_each_once_in_slot_order(self):
+        a, b = SimpleNamespace(name="a"), SimpleNamespace(name="b")
+        objects = [self.thing("x", materials=(b, None, a)), self.thing("y", materials=(a, b))]
+        self.assertEqual(scene_parts.used_materials(objects), [b, a])
+
+    def test_object_ids_are_distinct_pass_indices_or_else_numbered_by_name(self):
+        lamp = self.thing("lamp", kind="LIGHT", pass_index=9)
+        objects = [self.thing("wall", pass_index=5), self.thing("box", pass_index=2), lamp]
+        self.assertEqual(scene_parts.object_ids(objects, True), {"wall": 5, "box": 2})
+        objects = [self.thing("wall", pass_index=1), self.thing("box", pass_index=1), lamp]
+        self.assertEqual(scene_parts.object_ids(objects, True), {"box": 1, "wall": 2})
+        self.assertEqual(scene_parts.object_ids(objects, False), {})
+
+    def test_light_groups_put_every_emitter_in_one_and_a_lit_world_last(self):
+        glow = SimpleNamespace(name="glow")
+        objects = [self.thing("lamp", kind="LIGHT"), self.thing("panel.1", materials=(glow,)),
+                   self.thing("wall", materials=(SimpleNamespace(name="paint"),)),
+                   self.thing("bulb", kind="LIGHT", lightgroup="panel_1")]
+        scene = SimpleNamespace(world=SimpleNamespace(lightgroup=""))
+        view_layer = SimpleNamespace(lightgroups={})
+        groups, assignments, world = scene_parts.light_groups(scene, {"lights"}, view_layer, objects, {"glow"},
+                                                              {"status": "lit"})
+        self.assertEqual(groups, ["lamp", "panel_1", "world"])
+        self.assertEqual(assignments, {"lamp": "lamp", "panel.1": "panel_1", "bulb": "panel_1"})
+        self.assertEqual(world, "world")
+        self.assertEqual(scene_parts.light_groups(scene, {"paths"}, view_layer, objects, {"glow"}, {"status": "lit"}),
+                         ([], {}, None))
 
 
 if __name__ == "__main__":
