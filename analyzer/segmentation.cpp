@@ -312,16 +312,15 @@ std::vector<std::int32_t> enclosed_parts(const Work& work, const std::vector<std
   return parts;
 }
 
-// `b_pixels`: B with the parts it encloses (`inside_b`), whose pixels count as B's here.
-bool is_highlight(const Work& work, const std::vector<std::int32_t>& part_of, const std::vector<std::int32_t>& inside_b,
-                  const std::vector<std::uint32_t>& b_pixels, const PartStats& a, const PartStats& b) {
+// `b_pixels`: B's pixels, `inside(q)` whether working pixel q is one of them.
+template <typename Inside>
+bool is_highlight(const Work& work, const Inside& inside, const std::vector<std::uint32_t>& b_pixels, const PartStats& a, const PartStats& b) {
   // A highlight is brighter than its object and a small part of it (at most a quarter of the object's size).
   if (!(b.brightness > a.brightness) || 4 * b_pixels.size() > a.n) return false;
   // Distance from B's edge (4-neighbour steps), by breadth-first search inside B.
   const auto w = static_cast<std::size_t>(work.w);
   std::map<std::uint32_t, int> ring;
   std::vector<std::uint32_t> frontier;
-  auto inside = [&](std::size_t q) { return std::find(inside_b.begin(), inside_b.end(), part_of[q]) != inside_b.end(); };
   for (const std::uint32_t q : b_pixels) {
     const std::size_t x = q % w;
     const bool edge = x == 0 || x + 1 == w || q < w || q + w >= work.size() || !inside(q - 1) || !inside(q + 1) || !inside(q - w) || !inside(q + w);
@@ -442,6 +441,380 @@ Adjacency adjacency(const Work& work, const Parts& parts) {
   return adj;
 }
 
+// Step 2: the noise model's encoding — an integer file's codes, the curve of an encoded file as a table — and
+// then its terms, measured on the working image.
+NoiseModel measure_noise(const Work& work, const CodeDecoder& decode, double full_scale, double averaged) {
+  NoiseModel model;
+  model.integer = full_scale > 1;
+  model.codes = decode.table;
+  model.averaged = averaged;
+  if (decode.curve) {
+    // The curve as a table of the linear value of each stored value: an integer file's codes, else 4096 steps
+    // over the full scale.
+    if (!decode.table.empty()) {
+      model.curve = decode.table;
+    } else {
+      constexpr int kSteps = 4096;
+      model.curve_step = decode.full_scale / kSteps;
+      for (int k = 0; k <= kSteps; ++k) model.curve.push_back(static_cast<float>(decode.curve->decode(k * model.curve_step, decode.full_scale)));
+    }
+  }
+  return estimate_noise(work, std::move(model));
+}
+
+// Step 3: each pixel's angular noise; the dark ones are set aside.
+void set_aside_dark(Work& work, const NoiseModel& noise, double dark) {
+  work.angle_sigma.assign(work.size(), 0.0f);
+  for (std::size_t q = 0; q < work.size(); ++q) {
+    if (work.state[q] != kOk) continue;
+    const float* c = &work.rgb[q * 3];
+    double v = 0;
+    for (int k = 0; k < 3; ++k) v += std::pow(noise.sigma(k, c[k]), 2);
+    const double length = std::sqrt(double(c[0]) * c[0] + double(c[1]) * c[1] + double(c[2]) * c[2]);
+    if (!work.clipped[q] && !(length > dark * std::sqrt(v))) {
+      work.state[q] = kDark;
+      continue;
+    }
+    work.angle_sigma[q] = static_cast<float>(std::max(kMinAngle, std::sqrt(v) / length));
+  }
+}
+
+// Step 4: linear colour clusters over the pixel graph. Each part's colour is its mean colour direction — each
+// pixel's unit colour weighted by the inverse variance of its direction — with that mean's own noise. Two parts
+// join when their mean directions differ by less than `tolerance` times the noise of the two means plus `angle`:
+// a part is a linear colour cluster, and a gradual drift cannot chain it into its neighbours.
+class ColourClusters {
+ public:
+  ColourClusters(const Work& work, const NoiseModel& noise, const SegmentationOptions& options)
+      : sets(work.size()), tolerance_(options.tolerance), angle_tolerance_(options.angle_deg * M_PI / 180) {
+    collect_edges(work);
+    const std::size_t n = work.size();
+    // Quantisation does not average out over a smooth part: its mean colour may be off by half a code step per
+    // channel, an angle of up to 3·σ_q/|c| (σ_q = step/√12), which the comparison of means allows for.
+    unit_sum_.assign(n, Vec3::Zero());
+    precision_.assign(n, 0.0);
+    bias_sum_.assign(n, 0.0);
+    for (std::size_t q = 0; q < n; ++q) {
+      if (work.state[q] != kOk) continue;
+      precision_[q] = 1.0 / (double(work.angle_sigma[q]) * work.angle_sigma[q]);
+      const Vec3 c = colour_at(work, q);
+      unit_sum_[q] = c.normalized() * precision_[q];
+      bias_sum_[q] = precision_[q] * 3 * noise.quantisation(c.mean()) * std::sqrt(noise.averaged) / c.norm();
+    }
+  }
+
+  // Graph merging over 8-neighbour edges, lightest first (Felzenszwalb & Huttenlocher).
+  void merge_along_edges() {
+    for (const Edge& e : edges_) try_join(e.a, e.b, 0.0);
+  }
+
+  // Parts of one surface that a slow drift of its colour split (shading by light of two colours, skin) meet
+  // along a boundary without an edge: where the median step across it is at the noise level, they join if
+  // their mean directions differ by less than 3 · angle_deg beyond their noise.
+  void join_across_weak_boundaries() {
+    for (int round = 0; round < 4; ++round) {
+      std::map<std::pair<std::uint32_t, std::uint32_t>, std::vector<float>> across;
+      for (const Edge& e : edges_) {
+        const std::uint32_t a = sets.find(e.a), b = sets.find(e.b);
+        if (a != b) across[{std::min(a, b), std::max(a, b)}].push_back(e.weight);
+      }
+      std::vector<std::tuple<double, std::uint32_t, std::uint32_t>> weak;
+      for (auto& [key, weights] : across) {
+        if (weights.size() < 4) continue;
+        const double median = quantile(std::vector<double>(weights.begin(), weights.end()), 0.5);
+        if (median <= kWeakBoundary) weak.emplace_back(median, key.first, key.second);
+      }
+      std::sort(weak.begin(), weak.end());
+      std::size_t joined = 0;
+      for (const auto& [median, a, b] : weak) joined += try_join(a, b, 2 * angle_tolerance_);
+      if (joined == 0) break;
+    }
+  }
+
+  DisjointSets sets;
+
+ private:
+  struct Edge {
+    float weight;  // the angle between the two colours, in units of its noise σ
+    std::uint32_t a, b;
+  };
+
+  // 8-neighbour edges no steeper than `tolerance`, lightest first (ties by position: deterministic).
+  void collect_edges(const Work& work) {
+    edges_.reserve(work.size() * 4);
+    const int w = work.w, h = work.h;
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x) {
+        const std::size_t p = static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x);
+        if (work.state[p] != kOk) continue;
+        const int offsets[4][2] = {{1, 0}, {0, 1}, {1, 1}, {-1, 1}};
+        for (const auto& o : offsets) {
+          const int nx = x + o[0], ny = y + o[1];
+          if (nx < 0 || nx >= w || ny >= h) continue;
+          const std::size_t q = static_cast<std::size_t>(ny) * static_cast<std::size_t>(w) + static_cast<std::size_t>(nx);
+          if (work.state[q] != kOk) continue;
+          const double sigma = std::hypot(work.angle_sigma[p], work.angle_sigma[q]);
+          const double weight = angle(&work.rgb[p * 3], &work.rgb[q * 3]) / sigma;
+          if (weight <= tolerance_) edges_.push_back({static_cast<float>(weight), static_cast<std::uint32_t>(p), static_cast<std::uint32_t>(q)});
+        }
+      }
+    std::sort(edges_.begin(), edges_.end(), [](const Edge& x, const Edge& y) {
+      return x.weight != y.weight ? x.weight < y.weight : (x.a != y.a ? x.a < y.a : x.b < y.b);
+    });
+  }
+
+  bool try_join(std::uint32_t a, std::uint32_t b, double extra) {
+    a = sets.find(a), b = sets.find(b);
+    if (a == b) return false;
+    const double spread = std::sqrt(1 / precision_[a] + 1 / precision_[b]), bias = bias_sum_[a] / precision_[a] + bias_sum_[b] / precision_[b];
+    if (angle(unit_sum_[a], unit_sum_[b]) > tolerance_ * spread + bias + angle_tolerance_ + extra) return false;
+    const std::uint32_t root = sets.join(a, b), other = root == a ? b : a;
+    unit_sum_[root] += unit_sum_[other];
+    precision_[root] += precision_[other];
+    bias_sum_[root] += bias_sum_[other];
+    return true;
+  }
+
+  std::vector<Edge> edges_;
+  std::vector<Vec3> unit_sum_;
+  std::vector<double> precision_, bias_sum_;
+  double tolerance_, angle_tolerance_;
+};
+
+// Step 5: highlights (and clipped highlights) join their objects — whole parts, a few rounds.
+void extend_over_dichromatic_planes(const Work& work, const NoiseModel& noise, DisjointSets& sets, Segmentation& out) {
+  for (int round = 0; round < 4; ++round) {
+    const Parts parts = parts_of(work, sets);
+    const Adjacency adj = adjacency(work, parts);
+    std::vector<PartStats> stats;
+    for (const auto& pixels : parts.pixels) stats.push_back(part_stats(work, pixels, noise));
+    std::vector<std::int32_t> order(parts.pixels.size());
+    std::iota(order.begin(), order.end(), 0);
+    std::stable_sort(order.begin(), order.end(), [&](std::int32_t x, std::int32_t y) { return stats[static_cast<std::size_t>(x)].n < stats[static_cast<std::size_t>(y)].n; });
+    std::vector<std::uint8_t> touched(parts.pixels.size(), 0);  // 1: grew this round, 2: merged away
+    std::size_t merges = 0;
+    for (const std::int32_t bi : order) {
+      const PartStats& b = stats[static_cast<std::size_t>(bi)];
+      if (touched[static_cast<std::size_t>(bi)] != 0 || b.n < 2) continue;
+      for (const std::int32_t ai : adj.neighbours(bi)) {
+        const PartStats& a = stats[static_cast<std::size_t>(ai)];
+        if (touched[static_cast<std::size_t>(ai)] == 2) continue;
+        const double shared = static_cast<double>(adj.between(ai, bi)), perimeter = static_cast<double>(adj.perimeter[static_cast<std::size_t>(bi)]);
+        if (shared < 0.3 * perimeter) break;  // neighbours are in decreasing order of shared boundary
+        bool join = false;
+        if (b.clipped >= 0.5) {
+          join = shared >= 0.5 * perimeter && b.n <= a.n;
+          if (join) ++out.clipped_merges;
+        } else {
+          std::vector<std::uint32_t> pixels = parts.pixels[static_cast<std::size_t>(bi)];
+          std::vector<std::int32_t> inside = enclosed_parts(work, parts.id, parts.pixels, bi, parts.pixels[static_cast<std::size_t>(bi)], pixels);
+          inside.push_back(bi);
+          const bool free = std::none_of(inside.begin(), inside.end(), [&](std::int32_t k) { return touched[static_cast<std::size_t>(k)] == 2 || k == ai; });
+          const auto in_b = [&](std::size_t q) { return std::find(inside.begin(), inside.end(), parts.id[q]) != inside.end(); };
+          if (free && is_highlight(work, in_b, pixels, a, b)) {
+            join = true;
+            ++out.highlight_merges;
+            for (const std::int32_t k : inside)
+              if (k != bi) {
+                sets.join(parts.pixels[static_cast<std::size_t>(ai)].front(), parts.pixels[static_cast<std::size_t>(k)].front());
+                touched[static_cast<std::size_t>(k)] = 2;
+              }
+          }
+        }
+        if (!join) continue;
+        sets.join(parts.pixels[static_cast<std::size_t>(ai)].front(), parts.pixels[static_cast<std::size_t>(bi)].front());
+        touched[static_cast<std::size_t>(bi)] = 2;
+        touched[static_cast<std::size_t>(ai)] = std::max<std::uint8_t>(touched[static_cast<std::size_t>(ai)], 1);
+        ++merges;
+        break;
+      }
+    }
+    if (merges == 0) break;
+  }
+}
+
+// Step 6: parts smaller than `min_area` join the neighbour whose colours they share; then those one segment
+// encloses join it as details finer than the smallest segment; the rest stay unassigned.
+Parts absorb_small_parts(const Work& work, const NoiseModel& noise, double min_area, DisjointSets& sets) {
+  Parts parts = parts_of(work, sets);
+  {
+    const Adjacency adj = adjacency(work, parts);
+    std::vector<PartStats> stats;
+    for (const auto& pixels : parts.pixels) stats.push_back(part_stats(work, pixels, noise));
+    for (std::size_t bi = 0; bi < parts.pixels.size(); ++bi) {
+      if (static_cast<double>(stats[bi].n) >= min_area) continue;
+      for (const std::int32_t ai : adj.neighbours(static_cast<std::int32_t>(bi))) {
+        const PartStats& a = stats[static_cast<std::size_t>(ai)];
+        if (static_cast<double>(a.n) < min_area) continue;
+        if (angle(stats[bi].direction, a.direction) <= std::max(a.spread, 3 * kMinAngle)) {
+          sets.join(parts.pixels[static_cast<std::size_t>(ai)].front(), parts.pixels[bi].front());
+          break;
+        }
+      }
+    }
+    parts = parts_of(work, sets);
+  }
+  // Small parts that one segment encloses — nine tenths of their boundary with segments is with it, and at least
+  // half their boundary is with segments (the rest with unassigned pixels) — are details of that object finer
+  // than the smallest segment (speckle, embroidery, texture): they join it. A few passes take in clusters of them.
+  for (int pass = 0; pass < 3; ++pass) {
+    const Adjacency adj = adjacency(work, parts);
+    std::size_t joined = 0;
+    for (std::size_t bi = 0; bi < parts.pixels.size(); ++bi) {
+      if (static_cast<double>(parts.pixels[bi].size()) >= min_area) continue;
+      std::size_t best = 0, big = 0;
+      std::int32_t to = -1;
+      for (const std::int32_t ai : adj.neighbours(static_cast<std::int32_t>(bi))) {
+        if (static_cast<double>(parts.pixels[static_cast<std::size_t>(ai)].size()) < min_area) continue;
+        const std::size_t shared = adj.between(ai, static_cast<std::int32_t>(bi));
+        big += shared;
+        if (shared > best) best = shared, to = ai;
+      }
+      if (to >= 0 && double(best) >= kEnclosed * double(big) && 2 * big >= adj.perimeter[bi]) {
+        sets.join(parts.pixels[static_cast<std::size_t>(to)].front(), parts.pixels[bi].front());
+        ++joined;
+      }
+    }
+    parts = parts_of(work, sets);
+    if (joined == 0) break;
+  }
+  return parts;
+}
+
+// The segments of the working image: parts of at least `min_area` numbered by decreasing size (0 for the rest),
+// with each segment's mean colour direction (index 0 unused).
+struct WorkingLabels {
+  std::vector<std::int32_t> label;  // per working pixel
+  std::vector<Vec3> direction;      // per label
+  std::vector<std::uint8_t> mixed;  // per working pixel: another label among its 8 neighbours
+  std::size_t count() const { return direction.size() - 1; }
+};
+
+WorkingLabels number_segments(const Work& work, const Parts& parts, const NoiseModel& noise, double min_area) {
+  std::vector<std::int32_t> order;
+  for (std::size_t k = 0; k < parts.pixels.size(); ++k)
+    if (static_cast<double>(parts.pixels[k].size()) >= min_area) order.push_back(static_cast<std::int32_t>(k));
+  std::stable_sort(order.begin(), order.end(), [&](std::int32_t x, std::int32_t y) { return parts.pixels[static_cast<std::size_t>(x)].size() > parts.pixels[static_cast<std::size_t>(y)].size(); });
+  std::vector<std::int32_t> label_of_part(parts.pixels.size(), 0);
+  for (std::size_t k = 0; k < order.size(); ++k) label_of_part[static_cast<std::size_t>(order[k])] = static_cast<std::int32_t>(k) + 1;
+  WorkingLabels out;
+  out.label.assign(work.size(), 0);
+  for (std::size_t q = 0; q < work.size(); ++q)
+    if (parts.id[q] >= 0) out.label[q] = label_of_part[static_cast<std::size_t>(parts.id[q])];
+  out.direction.assign(order.size() + 1, Vec3::Zero());
+  for (std::size_t k = 0; k < order.size(); ++k) out.direction[k + 1] = part_stats(work, parts.pixels[static_cast<std::size_t>(order[k])], noise).direction;
+  const int w = work.w, h = work.h;
+  out.mixed.assign(work.size(), 0);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const std::size_t q = static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x);
+      for (int j = -1; j <= 1 && !out.mixed[q]; ++j)
+        for (int i = -1; i <= 1; ++i) {
+          const int nx = x + i, ny = y + j;
+          if (nx >= 0 && ny >= 0 && nx < w && ny < h && out.label[static_cast<std::size_t>(ny) * static_cast<std::size_t>(w) + static_cast<std::size_t>(nx)] != out.label[q]) {
+            out.mixed[q] = 1;
+            break;
+          }
+        }
+    }
+  return out;
+}
+
+// Step 7 for one full-size pixel of colour `c` (linear) on working pixel (wx, wy) whose label and a neighbour's
+// differ: the segment among the 3×3 working neighbourhood's labels whose colour direction is nearest; beside
+// unassigned pixels, none if the pixel is too dark for a colour at full size (one full-size pixel has
+// `area_factor` times the noise σ of a working pixel).
+std::int32_t boundary_label(const Work& work, const WorkingLabels& labels, int wx, int wy, const Vec3& c, const NoiseModel& noise,
+                            double area_factor, double dark) {
+  const int w = work.w, h = work.h;
+  std::int32_t label = labels.label[static_cast<std::size_t>(wy) * static_cast<std::size_t>(w) + static_cast<std::size_t>(wx)];
+  std::int32_t candidates[9];
+  int count = 0;
+  bool beside_unassigned = false;
+  for (int j = -1; j <= 1; ++j)
+    for (int i = -1; i <= 1; ++i) {
+      const int nx = wx + i, ny = wy + j;
+      if (nx < 0 || ny < 0 || nx >= w || ny >= h) continue;
+      const std::int32_t l = labels.label[static_cast<std::size_t>(ny) * static_cast<std::size_t>(w) + static_cast<std::size_t>(nx)];
+      if (l == 0) beside_unassigned = true;
+      if (l > 0 && std::find(candidates, candidates + count, l) == candidates + count) candidates[count++] = l;
+    }
+  if (label > 0 && beside_unassigned) {
+    double variance = 0;
+    for (int k = 0; k < 3; ++k) variance += std::pow(noise.sigma(k, c[k]) * area_factor, 2);
+    if (!(c.norm() > dark * std::sqrt(variance))) label = 0;
+  }
+  if (label > 0 && (count > 1 || candidates[0] != label) && c.norm() > 0) {
+    double best = angle(c, labels.direction[static_cast<std::size_t>(label)]);
+    for (int k = 0; k < count; ++k) {
+      const double a = angle(c, labels.direction[static_cast<std::size_t>(candidates[k])]);
+      if (a < best || (a == best && candidates[k] < label)) best = a, label = candidates[k];
+    }
+  }
+  return label;
+}
+
+// Step 7: the labels carried back to full size, and the segments and the unassigned pixels as regions. Bands of
+// rows run side by side, each with its own counts, added afterwards: the same whatever the thread count.
+void labels_at_full_size(const RgbImage& image, const CodeDecoder& decode, const Work& work, const WorkingLabels& labels,
+                         const NoiseModel& noise, double dark, Segmentation& out) {
+  const int W = image.width, H = image.height, w = work.w, h = work.h;
+  out.labels.assign(image.pixel_count(), 0);
+  const bool same = W == w && H == h;
+  const double area_factor = std::sqrt(static_cast<double>(image.pixel_count()) / static_cast<double>(work.size()));
+  struct Counts {
+    std::vector<std::size_t> per_label;
+    std::size_t valid = 0, unassigned = 0, dark = 0, small = 0;
+  };
+  const std::size_t row_bands = std::min<std::size_t>(static_cast<std::size_t>(H), 64);
+  std::vector<Counts> band_counts(row_bands);
+  parallel_for(row_bands, 0, [&](std::size_t band) {
+    Counts& bc = band_counts[band];
+    bc.per_label.assign(labels.count() + 1, 0);
+    for (int y = static_cast<int>(band * static_cast<std::size_t>(H) / row_bands); y < static_cast<int>((band + 1) * static_cast<std::size_t>(H) / row_bands); ++y) {
+      const int wy = same ? y : std::min(h - 1, static_cast<int>((y + 0.5) * h / H));
+      for (int x = 0; x < W; ++x) {
+        const std::size_t p = static_cast<std::size_t>(y) * static_cast<std::size_t>(W) + static_cast<std::size_t>(x);
+        const float* v = &image.rgb[p * 3];
+        if (!std::isfinite(v[0]) || !std::isfinite(v[1]) || !std::isfinite(v[2])) continue;
+        ++bc.valid;
+        const int wx = same ? x : std::min(w - 1, static_cast<int>((x + 0.5) * w / W));
+        const std::size_t q = static_cast<std::size_t>(wy) * static_cast<std::size_t>(w) + static_cast<std::size_t>(wx);
+        std::int32_t label = labels.label[q];
+        if (!same && labels.mixed[q]) label = boundary_label(work, labels, wx, wy, Vec3(decode(v[0]), decode(v[1]), decode(v[2])), noise, area_factor, dark);
+        out.labels[p] = static_cast<std::uint16_t>(label);
+        ++bc.per_label[static_cast<std::size_t>(label)];
+        if (label == 0) {
+          ++bc.unassigned;
+          if (work.state[q] == kDark) ++bc.dark;
+          else ++bc.small;
+        }
+      }
+    }
+  });
+  std::vector<std::size_t> counts(labels.count() + 1, 0);
+  for (const Counts& bc : band_counts) {
+    for (std::size_t k = 0; k < counts.size(); ++k) counts[k] += bc.per_label[k];
+    out.valid_pixels += bc.valid, out.unassigned_pixels += bc.unassigned, out.dark_pixels += bc.dark, out.small_pixels += bc.small;
+  }
+  for (std::size_t k = 1; k < counts.size(); ++k) {
+    Region r{fmt::format("segment {}", k), "segment", static_cast<std::int64_t>(k), {}};
+    r.pixels.reserve(counts[k]);
+    out.regions.push_back(std::move(r));
+  }
+  Region unassigned{"unassigned", "unassigned", 0, {}};
+  unassigned.pixels.reserve(counts[0]);
+  for (std::size_t p = 0; p < out.labels.size(); ++p) {
+    const std::int32_t l = out.labels[p];
+    if (l > 0) out.regions[static_cast<std::size_t>(l - 1)].pixels.push_back(static_cast<std::uint32_t>(p));
+    else if (std::isfinite(image.rgb[p * 3]) && std::isfinite(image.rgb[p * 3 + 1]) && std::isfinite(image.rgb[p * 3 + 2]))
+      unassigned.pixels.push_back(static_cast<std::uint32_t>(p));
+  }
+  // A segment that lost every pixel to its neighbours on the boundaries keeps its number but is left out.
+  std::erase_if(out.regions, [](const Region& r) { return r.pixels.empty(); });
+  if (!unassigned.pixels.empty()) out.regions.push_back(std::move(unassigned));
+}
+
 }  // namespace
 
 double NoiseModel::quantisation(double value) const {
@@ -500,330 +873,15 @@ Segmentation segment_image(const RgbImage& image, const std::optional<ToneCurve>
   Work work = working_image(image, decode, clip_level, options.working_megapixels);
   out.working_width = work.w;
   out.working_height = work.h;
-  NoiseModel model;
-  model.integer = full_scale > 1;
-  model.codes = decode.table;
-  model.averaged = static_cast<double>(image.pixel_count()) / static_cast<double>(work.size());
-  if (decode.curve) {
-    // The curve as a table of the linear value of each stored value: an integer file's codes, else 4096 steps
-    // over the full scale.
-    if (!decode.table.empty()) {
-      model.curve = decode.table;
-    } else {
-      constexpr int kSteps = 4096;
-      model.curve_step = decode.full_scale / kSteps;
-      for (int k = 0; k <= kSteps; ++k) model.curve.push_back(static_cast<float>(decode.curve->decode(k * model.curve_step, decode.full_scale)));
-    }
-  }
-  out.noise = estimate_noise(work, std::move(model));
-  const NoiseModel& noise = out.noise;
-
-  // Each pixel's angular noise; the dark ones are set aside.
-  const std::size_t n = work.size();
-  work.angle_sigma.assign(n, 0.0f);
-  for (std::size_t q = 0; q < n; ++q) {
-    if (work.state[q] != kOk) continue;
-    const float* c = &work.rgb[q * 3];
-    double v = 0;
-    for (int k = 0; k < 3; ++k) v += std::pow(noise.sigma(k, c[k]), 2);
-    const double length = std::sqrt(double(c[0]) * c[0] + double(c[1]) * c[1] + double(c[2]) * c[2]);
-    if (!work.clipped[q] && !(length > options.dark * std::sqrt(v))) {
-      work.state[q] = kDark;
-      continue;
-    }
-    work.angle_sigma[q] = static_cast<float>(std::max(kMinAngle, std::sqrt(v) / length));
-  }
-
-  // Graph merging over 8-neighbour edges, lightest first (ties by position: deterministic).
-  struct Edge {
-    float weight;
-    std::uint32_t a, b;
-  };
-  std::vector<Edge> edges;
-  edges.reserve(n * 4);
-  const int w = work.w, h = work.h;
-  for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x) {
-      const std::size_t p = static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x);
-      if (work.state[p] != kOk) continue;
-      const int offsets[4][2] = {{1, 0}, {0, 1}, {1, 1}, {-1, 1}};
-      for (const auto& o : offsets) {
-        const int nx = x + o[0], ny = y + o[1];
-        if (nx < 0 || nx >= w || ny >= h) continue;
-        const std::size_t q = static_cast<std::size_t>(ny) * static_cast<std::size_t>(w) + static_cast<std::size_t>(nx);
-        if (work.state[q] != kOk) continue;
-        const double sigma = std::hypot(work.angle_sigma[p], work.angle_sigma[q]);
-        const double weight = angle(&work.rgb[p * 3], &work.rgb[q * 3]) / sigma;
-        if (weight <= options.tolerance) edges.push_back({static_cast<float>(weight), static_cast<std::uint32_t>(p), static_cast<std::uint32_t>(q)});
-      }
-    }
-  std::sort(edges.begin(), edges.end(), [](const Edge& x, const Edge& y) {
-    return x.weight != y.weight ? x.weight < y.weight : (x.a != y.a ? x.a < y.a : x.b < y.b);
-  });
+  out.noise = measure_noise(work, decode, full_scale, static_cast<double>(image.pixel_count()) / static_cast<double>(work.size()));
+  set_aside_dark(work, out.noise, options.dark);
+  ColourClusters clusters(work, out.noise, options);
+  clusters.merge_along_edges();
+  clusters.join_across_weak_boundaries();
+  extend_over_dichromatic_planes(work, out.noise, clusters.sets, out);
   const double min_area = std::max(1.0, options.min_area * static_cast<double>(work.valid));
-  // Each part's colour: its mean colour direction, each pixel's unit colour weighted by the inverse variance
-  // of its direction, and that mean's own noise. Two parts join when their mean directions differ by less
-  // than `tolerance` times the noise of the two means plus `angle`: a part is a linear colour cluster, and a
-  // gradual drift cannot chain it into its neighbours.
-  DisjointSets sets(n);
-  // Quantisation does not average out over a smooth part: its mean colour may be off by half a code step per
-  // channel, an angle of up to 3·σ_q/|c| (σ_q = step/√12), which the comparison of means allows for.
-  std::vector<Vec3> unit_sum(n, Vec3::Zero());
-  std::vector<double> precision(n, 0.0), bias_sum(n, 0.0);
-  for (std::size_t q = 0; q < n; ++q) {
-    if (work.state[q] != kOk) continue;
-    precision[q] = 1.0 / (double(work.angle_sigma[q]) * work.angle_sigma[q]);
-    const Vec3 c = colour_at(work, q);
-    unit_sum[q] = c.normalized() * precision[q];
-    bias_sum[q] = precision[q] * 3 * noise.quantisation(c.mean()) * std::sqrt(noise.averaged) / c.norm();
-  }
-  const double angle_tolerance = options.angle_deg * M_PI / 180;
-  auto try_join = [&](std::uint32_t a, std::uint32_t b, double extra) {
-    a = sets.find(a), b = sets.find(b);
-    if (a == b) return false;
-    const double spread = std::sqrt(1 / precision[a] + 1 / precision[b]), bias = bias_sum[a] / precision[a] + bias_sum[b] / precision[b];
-    if (angle(unit_sum[a], unit_sum[b]) > options.tolerance * spread + bias + angle_tolerance + extra) return false;
-    const std::uint32_t root = sets.join(a, b), other = root == a ? b : a;
-    unit_sum[root] += unit_sum[other];
-    precision[root] += precision[other];
-    bias_sum[root] += bias_sum[other];
-    return true;
-  };
-  for (const Edge& e : edges) try_join(e.a, e.b, 0.0);
-
-  // Parts of one surface that a slow drift of its colour split (shading by light of two colours, skin)
-  // meet along a boundary without an edge: where the median step across it is at the noise level, they join.
-  for (int round = 0; round < 4; ++round) {
-    std::map<std::pair<std::uint32_t, std::uint32_t>, std::vector<float>> across;
-    for (const Edge& e : edges) {
-      const std::uint32_t a = sets.find(e.a), b = sets.find(e.b);
-      if (a != b) across[{std::min(a, b), std::max(a, b)}].push_back(e.weight);
-    }
-    std::vector<std::tuple<double, std::uint32_t, std::uint32_t>> weak;
-    for (auto& [key, weights] : across) {
-      if (weights.size() < 4) continue;
-      const double median = quantile(std::vector<double>(weights.begin(), weights.end()), 0.5);
-      if (median <= kWeakBoundary) weak.emplace_back(median, key.first, key.second);
-    }
-    std::sort(weak.begin(), weak.end());
-    std::size_t joined = 0;
-    for (const auto& [median, a, b] : weak) joined += try_join(a, b, 2 * angle_tolerance);
-    if (joined == 0) break;
-  }
-  // Dichromatic extension: highlights (and clipped highlights) join their objects.
-  for (int round = 0; round < 4; ++round) {
-    const Parts parts = parts_of(work, sets);
-    const Adjacency adj = adjacency(work, parts);
-    std::vector<PartStats> stats;
-    for (const auto& pixels : parts.pixels) stats.push_back(part_stats(work, pixels, noise));
-    std::vector<std::int32_t> order(parts.pixels.size());
-    std::iota(order.begin(), order.end(), 0);
-    std::stable_sort(order.begin(), order.end(), [&](std::int32_t x, std::int32_t y) { return stats[static_cast<std::size_t>(x)].n < stats[static_cast<std::size_t>(y)].n; });
-    std::vector<std::uint8_t> touched(parts.pixels.size(), 0);
-    std::size_t merges = 0;
-    for (const std::int32_t bi : order) {
-      const PartStats& b = stats[static_cast<std::size_t>(bi)];
-      if (touched[static_cast<std::size_t>(bi)] != 0 || b.n < 2) continue;
-      for (const std::int32_t ai : adj.neighbours(bi)) {
-        const PartStats& a = stats[static_cast<std::size_t>(ai)];
-        if (touched[static_cast<std::size_t>(ai)] == 2) continue;  // merged away this round
-        const double shared = static_cast<double>(adj.between(ai, bi)), perimeter = static_cast<double>(adj.perimeter[static_cast<std::size_t>(bi)]);
-        if (shared < 0.3 * perimeter) break;  // neighbours are in decreasing order of shared boundary
-        bool join = false;
-        if (b.clipped >= 0.5) {
-          join = shared >= 0.5 * perimeter && b.n <= a.n;
-          if (join) ++out.clipped_merges;
-        } else {
-          std::vector<std::uint32_t> pixels = parts.pixels[static_cast<std::size_t>(bi)];
-          std::vector<std::int32_t> inside = enclosed_parts(work, parts.id, parts.pixels, bi, parts.pixels[static_cast<std::size_t>(bi)], pixels);
-          inside.push_back(bi);
-          const bool free = std::none_of(inside.begin(), inside.end(), [&](std::int32_t k) { return touched[static_cast<std::size_t>(k)] == 2 || k == ai; });
-          if (free && is_highlight(work, parts.id, inside, pixels, a, b)) {
-            join = true;
-            ++out.highlight_merges;
-            for (const std::int32_t k : inside)
-              if (k != bi) {
-                sets.join(parts.pixels[static_cast<std::size_t>(ai)].front(), parts.pixels[static_cast<std::size_t>(k)].front());
-                touched[static_cast<std::size_t>(k)] = 2;
-              }
-          }
-        }
-        if (!join) continue;
-        sets.join(parts.pixels[static_cast<std::size_t>(ai)].front(), parts.pixels[static_cast<std::size_t>(bi)].front());
-        touched[static_cast<std::size_t>(bi)] = 2;
-        touched[static_cast<std::size_t>(ai)] = std::max<std::uint8_t>(touched[static_cast<std::size_t>(ai)], 1);
-        ++merges;
-        break;
-      }
-    }
-    if (merges == 0) break;
-  }
-
-  // Small parts: into the neighbour whose colours they share, else unassigned.
-  Parts parts = parts_of(work, sets);
-  {
-    const Adjacency adj = adjacency(work, parts);
-    std::vector<PartStats> stats;
-    for (const auto& pixels : parts.pixels) stats.push_back(part_stats(work, pixels, noise));
-    for (std::size_t bi = 0; bi < parts.pixels.size(); ++bi) {
-      if (static_cast<double>(stats[bi].n) >= min_area) continue;
-      for (const std::int32_t ai : adj.neighbours(static_cast<std::int32_t>(bi))) {
-        const PartStats& a = stats[static_cast<std::size_t>(ai)];
-        if (static_cast<double>(a.n) < min_area) continue;
-        if (angle(stats[bi].direction, a.direction) <= std::max(a.spread, 3 * kMinAngle)) {
-          sets.join(parts.pixels[static_cast<std::size_t>(ai)].front(), parts.pixels[bi].front());
-          break;
-        }
-      }
-    }
-    parts = parts_of(work, sets);
-  }
-  // Small parts that one segment encloses — nine tenths of their boundary with segments is with it, and at least
-  // half their boundary is with segments (the rest with unassigned pixels) — are details of that object finer
-  // than the smallest segment (speckle, embroidery, texture): they join it. A few passes take in clusters of them.
-  for (int pass = 0; pass < 3; ++pass) {
-    const Adjacency adj = adjacency(work, parts);
-    std::size_t joined = 0;
-    for (std::size_t bi = 0; bi < parts.pixels.size(); ++bi) {
-      if (static_cast<double>(parts.pixels[bi].size()) >= min_area) continue;
-      std::size_t best = 0, big = 0;
-      std::int32_t to = -1;
-      for (const std::int32_t ai : adj.neighbours(static_cast<std::int32_t>(bi))) {
-        if (static_cast<double>(parts.pixels[static_cast<std::size_t>(ai)].size()) < min_area) continue;
-        const std::size_t shared = adj.between(ai, static_cast<std::int32_t>(bi));
-        big += shared;
-        if (shared > best) best = shared, to = ai;
-      }
-      if (to >= 0 && double(best) >= kEnclosed * double(big) && 2 * big >= adj.perimeter[bi]) {
-        sets.join(parts.pixels[static_cast<std::size_t>(to)].front(), parts.pixels[bi].front());
-        ++joined;
-      }
-    }
-    parts = parts_of(work, sets);
-    if (joined == 0) break;
-  }
-
-  // Segments by decreasing size; 0 for the rest, with the reason.
-  std::vector<std::int32_t> order;
-  for (std::size_t k = 0; k < parts.pixels.size(); ++k)
-    if (static_cast<double>(parts.pixels[k].size()) >= min_area) order.push_back(static_cast<std::int32_t>(k));
-  std::stable_sort(order.begin(), order.end(), [&](std::int32_t x, std::int32_t y) { return parts.pixels[static_cast<std::size_t>(x)].size() > parts.pixels[static_cast<std::size_t>(y)].size(); });
-  std::vector<std::int32_t> label_of_part(parts.pixels.size(), 0);
-  for (std::size_t k = 0; k < order.size(); ++k) label_of_part[static_cast<std::size_t>(order[k])] = static_cast<std::int32_t>(k) + 1;
-  std::vector<std::int32_t> work_label(n, 0);
-  for (std::size_t q = 0; q < n; ++q)
-    if (parts.id[q] >= 0) work_label[q] = label_of_part[static_cast<std::size_t>(parts.id[q])];
-  std::vector<Vec3> label_direction(order.size() + 1, Vec3::Zero());
-  for (std::size_t k = 0; k < order.size(); ++k) {
-    const PartStats s = part_stats(work, parts.pixels[static_cast<std::size_t>(order[k])], noise);
-    label_direction[k + 1] = s.direction;
-  }
-
-  // Back to full size; on boundaries, the segment whose colour direction is nearest.
-  const int W = image.width, H = image.height;
-  out.labels.assign(image.pixel_count(), 0);
-  std::vector<std::size_t> counts(order.size() + 1, 0);
-  const bool same = W == w && H == h;
-  const double area_factor = std::sqrt(static_cast<double>(image.pixel_count()) / static_cast<double>(work.size()));
-  // Working pixels with another label among their 8 neighbours: only their full-size pixels need a choice.
-  std::vector<std::uint8_t> work_mixed(n, 0);
-  for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x) {
-      const std::size_t q = static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x);
-      for (int j = -1; j <= 1 && !work_mixed[q]; ++j)
-        for (int i = -1; i <= 1; ++i) {
-          const int nx = x + i, ny = y + j;
-          if (nx >= 0 && ny >= 0 && nx < w && ny < h && work_label[static_cast<std::size_t>(ny) * static_cast<std::size_t>(w) + static_cast<std::size_t>(nx)] != work_label[q]) {
-            work_mixed[q] = 1;
-            break;
-          }
-        }
-    }
-  // Bands of rows side by side, each with its own counts (added afterwards: the same whatever the thread count).
-  struct Counts {
-    std::vector<std::size_t> per_label;
-    std::size_t valid = 0, unassigned = 0, dark = 0, small = 0;
-  };
-  const std::size_t row_bands = std::min<std::size_t>(static_cast<std::size_t>(H), 64);
-  std::vector<Counts> band_counts(row_bands);
-  parallel_for(row_bands, 0, [&](std::size_t band) {
-  Counts& bc = band_counts[band];
-  bc.per_label.assign(order.size() + 1, 0);
-  for (int y = static_cast<int>(band * static_cast<std::size_t>(H) / row_bands); y < static_cast<int>((band + 1) * static_cast<std::size_t>(H) / row_bands); ++y) {
-    const int wy = same ? y : std::min(h - 1, static_cast<int>((y + 0.5) * h / H));
-    for (int x = 0; x < W; ++x) {
-      const std::size_t p = static_cast<std::size_t>(y) * static_cast<std::size_t>(W) + static_cast<std::size_t>(x);
-      const float* v = &image.rgb[p * 3];
-      if (!std::isfinite(v[0]) || !std::isfinite(v[1]) || !std::isfinite(v[2])) continue;
-      ++bc.valid;
-      const int wx = same ? x : std::min(w - 1, static_cast<int>((x + 0.5) * w / W));
-      const std::size_t q = static_cast<std::size_t>(wy) * static_cast<std::size_t>(w) + static_cast<std::size_t>(wx);
-      std::int32_t label = work_label[q];
-      if (!same && work_mixed[q]) {
-        std::int32_t candidates[9];
-        int count = 0;
-        for (int j = -1; j <= 1; ++j)
-          for (int i = -1; i <= 1; ++i) {
-            const int nx = wx + i, ny = wy + j;
-            if (nx < 0 || ny < 0 || nx >= w || ny >= h) continue;
-            const std::int32_t l = work_label[static_cast<std::size_t>(ny) * static_cast<std::size_t>(w) + static_cast<std::size_t>(nx)];
-            if (l > 0 && std::find(candidates, candidates + count, l) == candidates + count) candidates[count++] = l;
-          }
-        bool beside_unassigned = false;
-        for (int j = -1; j <= 1; ++j)
-          for (int i = -1; i <= 1; ++i) {
-            const int nx = wx + i, ny = wy + j;
-            if (nx >= 0 && ny >= 0 && nx < w && ny < h && work_label[static_cast<std::size_t>(ny) * static_cast<std::size_t>(w) + static_cast<std::size_t>(nx)] == 0)
-              beside_unassigned = true;
-          }
-        const Vec3 c(decode(v[0]), decode(v[1]), decode(v[2]));
-        if (label > 0 && beside_unassigned) {
-          // Beside unassigned pixels (dark, mostly): a pixel too dark for a colour at full size is unassigned too;
-          // one full-size pixel has `area_factor` times the noise σ of a working pixel.
-          double variance = 0;
-          for (int k = 0; k < 3; ++k) variance += std::pow(noise.sigma(k, c[k]) * area_factor, 2);
-          if (!(c.norm() > options.dark * std::sqrt(variance))) label = 0;
-        }
-        if (label > 0 && (count > 1 || candidates[0] != label)) {
-          if (c.norm() > 0) {
-            double best = angle(c, label_direction[static_cast<std::size_t>(label)]);
-            for (int k = 0; k < count; ++k) {
-              const double a = angle(c, label_direction[static_cast<std::size_t>(candidates[k])]);
-              if (a < best || (a == best && candidates[k] < label)) best = a, label = candidates[k];
-            }
-          }
-        }
-      }
-      out.labels[p] = static_cast<std::uint16_t>(label);
-      ++bc.per_label[static_cast<std::size_t>(label)];
-      if (label == 0) {
-        ++bc.unassigned;
-        if (work.state[q] == kDark) ++bc.dark;
-        else ++bc.small;
-      }
-    }
-  }
-  });
-  for (const Counts& bc : band_counts) {
-    for (std::size_t k = 0; k < counts.size(); ++k) counts[k] += bc.per_label[k];
-    out.valid_pixels += bc.valid, out.unassigned_pixels += bc.unassigned, out.dark_pixels += bc.dark, out.small_pixels += bc.small;
-  }
-  for (std::size_t k = 1; k < counts.size(); ++k) {
-    Region r{fmt::format("segment {}", k), "segment", static_cast<std::int64_t>(k), {}};
-    r.pixels.reserve(counts[k]);
-    out.regions.push_back(std::move(r));
-  }
-  Region unassigned{"unassigned", "unassigned", 0, {}};
-  unassigned.pixels.reserve(counts[0]);
-  for (std::size_t p = 0; p < out.labels.size(); ++p) {
-    const std::int32_t l = out.labels[p];
-    if (l > 0) out.regions[static_cast<std::size_t>(l - 1)].pixels.push_back(static_cast<std::uint32_t>(p));
-    else if (std::isfinite(image.rgb[p * 3]) && std::isfinite(image.rgb[p * 3 + 1]) && std::isfinite(image.rgb[p * 3 + 2]))
-      unassigned.pixels.push_back(static_cast<std::uint32_t>(p));
-  }
-  // A segment that lost every pixel to its neighbours on the boundaries keeps its number but is left out.
-  std::erase_if(out.regions, [](const Region& r) { return r.pixels.empty(); });
-  if (!unassigned.pixels.empty()) out.regions.push_back(std::move(unassigned));
+  const Parts parts = absorb_small_parts(work, out.noise, min_area, clusters.sets);
+  labels_at_full_size(image, decode, work, number_segments(work, parts, out.noise, min_area), out.noise, options.dark, out);
   out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return out;
 }
