@@ -100,147 +100,166 @@ std::optional<Vec3> intersect_planes(const std::vector<Vec3>& normals) {
   return positive(a.axes.col(2));
 }
 
-IlluminantAnalysis estimate_illuminant(const std::vector<RegionAnalysis>& regions, std::span<const float> rgb,
-                                       const std::optional<Vec3>& known, const std::array<double, 3>& high_levels,
-                                       const std::optional<Vec3>& camera_white, const std::string& assumed_curve) {
-  IlluminantAnalysis out;
-  if (known) out.known = known->normalized();
-  if (camera_white) out.camera_white = camera_white->normalized();
-  IlluminantEstimate highlights, planes;
-  highlights.method = "highlight lines";
-  planes.method = "dichromatic planes";
+namespace {
+
+// What the regions say of the light: the directions of their highlight branches or lines, and the normals of
+// their planes through black, with each one's standard error and the regions that gave them.
+struct Evidence {
   std::vector<Vec3> line_directions, normals;
   std::vector<double> line_weights, line_se, normal_se;
-  // A highlight branch is evidence of the light's colour only when it can be told from the body colour: turned from
-  // the body line by more than 2 of its standard errors.
-  auto told_from_body = [&](const RegionAnalysis& r, const ClusterShape& s) {
-    const double turn = angular_error_deg(s.highlight_branch->direction, s.body_only->line.direction);
-    if (turn > 2 * s.highlight_branch->uncertainty_deg) return true;
-    out.notes.push_back(fmt::format("{}: its highlight branch turns {:.1f}° from its body colour, within 2 × its standard "
-                                    "error ({:.1f}°): it cannot be told from the body colour, so it is left out",
-                                    r.name, turn, s.highlight_branch->uncertainty_deg));
-    return false;
-  };
+  std::vector<std::string> line_regions, plane_regions;
+
+  void add_line(const Vec3& direction, double weight, double se, const std::string& region) {
+    line_directions.push_back(positive(direction));
+    line_weights.push_back(weight);
+    line_se.push_back(se);
+    line_regions.push_back(region);
+  }
+};
+
+// A highlight branch is evidence of the light's colour only when it can be told from the body colour: turned from
+// the body line by more than 2 of its standard errors.
+bool told_from_body(const RegionAnalysis& r, const ClusterShape& s, std::vector<std::string>& notes) {
+  const double turn = angular_error_deg(s.highlight_branch->direction, s.body_only->line.direction);
+  if (turn > 2 * s.highlight_branch->uncertainty_deg) return true;
+  notes.push_back(fmt::format("{}: its highlight branch turns {:.1f}° from its body colour, within 2 × its standard "
+                              "error ({:.1f}°): it cannot be told from the body colour, so it is left out",
+                              r.name, turn, s.highlight_branch->uncertainty_deg));
+  return false;
+}
+
+// An L, skewed T or P: its highlight line (for a P, the line the two-line search found through the broad
+// highlight), unless it ends at a clipping level; the branch's colour by regression when measured
+// (highlight_branch.h), not tilted by the shading across the highlight. False when the region's branch cannot be
+// told from its body colour: then the region is no evidence at all, its plane included.
+bool add_highlight_line(const RegionAnalysis& r, const std::array<double, 3>& high_levels, Evidence& e, std::vector<std::string>& notes) {
+  const ClusterShape& s = r.shape;
+  const Line& h = s.two_lines->highlight;
+  const Vec3 bright = h.at(h.t_max);
+  int clipped = -1;
+  for (int c = 0; c < 3; ++c)
+    if (std::isfinite(high_levels[c]) && bright[c] >= high_levels[c] - 2 * s.line_tolerance) clipped = c;
+  if (clipped >= 0) {
+    notes.push_back(fmt::format("{}: its highlight line ends at the clipping level of {} ({:.4g}), so it is left out of the "
+                                "highlight-line estimate", r.name, "RGB"[clipped], high_levels[clipped]));
+  } else if (const auto& b = s.highlight_branch; b) {
+    if (!told_from_body(r, s, notes)) return false;
+    e.add_line(b->direction, static_cast<double>(b->samples), b->uncertainty_deg / kDeg, r.name);
+  } else {
+    e.add_line(h.direction, static_cast<double>(h.inliers), line_direction_se(h), r.name);
+  }
+  return true;
+}
+
+Evidence gather_evidence(const std::vector<RegionAnalysis>& regions, const std::array<double, 3>& high_levels, std::vector<std::string>& notes) {
+  Evidence e;
   // The whole image mixes objects; it stands in only when it is the one region.
   const bool parts = std::any_of(regions.begin(), regions.end(), [](const RegionAnalysis& r) { return r.source != "image"; });
   for (const RegionAnalysis& r : regions) {
     if (parts && r.source == "image") continue;
     if (r.source == "unassigned") continue;  // the pixels no segment holds: no one surface
     const ClusterShape& s = r.shape;
-    // A P too: its highlight line is the line the two-line search found through the broad highlight.
-    if ((s.shape == ShapeClass::L || s.shape == ShapeClass::SkewedT || s.shape == ShapeClass::P) && s.two_lines) {
-      const Line& h = s.two_lines->highlight;
-      const Vec3 bright = h.at(h.t_max);
-      int clipped = -1;
-      for (int c = 0; c < 3; ++c)
-        if (std::isfinite(high_levels[c]) && bright[c] >= high_levels[c] - 2 * s.line_tolerance) clipped = c;
-      if (clipped >= 0) {
-        out.notes.push_back(fmt::format("{}: its highlight line ends at the clipping level of {} ({:.4g}), so it is "
-                                        "left out of the highlight-line estimate", r.name, "RGB"[clipped],
-                                        high_levels[clipped]));
-      } else if (const auto& b = s.highlight_branch; b) {
-        // The branch's colour by regression (highlight_branch.h): not tilted by the shading across the highlight.
-        if (!told_from_body(r, s)) continue;
-        line_directions.push_back(positive(b->direction));
-        line_weights.push_back(static_cast<double>(b->samples));
-        line_se.push_back(b->uncertainty_deg / kDeg);
-        highlights.regions.push_back(r.name);
-      } else {
-        line_directions.push_back(positive(h.direction));
-        line_weights.push_back(static_cast<double>(h.inliers));
-        line_se.push_back(line_direction_se(h));
-        highlights.regions.push_back(r.name);
-      }
-    }
+    if ((s.shape == ShapeClass::L || s.shape == ShapeClass::SkewedT || s.shape == ShapeClass::P) && s.two_lines &&
+        !add_highlight_line(r, high_levels, e, notes))
+      continue;
     // A planar cluster with a highlight branch (cluster_shape.h): several objects of one body colour with their
     // highlights. Its branch counts when no channel of it reaches a clipping level.
-    if (s.shape == ShapeClass::Planar && s.highlight_branch && told_from_body(r, s)) {
-      if (std::none_of(s.clipping.faces.begin(), s.clipping.faces.end(), [](const ClippedFace& f) { return f.high; })) {
-        line_directions.push_back(positive(s.highlight_branch->direction));
-        line_weights.push_back(static_cast<double>(s.highlight_branch->samples));
-        line_se.push_back(s.highlight_branch->uncertainty_deg / kDeg);
-        highlights.regions.push_back(r.name);
-      } else {
-        out.notes.push_back(fmt::format("{}: its highlight branch reaches a clipping level, so it is left out of the "
-                                        "highlight-line estimate", r.name));
-      }
+    if (s.shape == ShapeClass::Planar && s.highlight_branch && told_from_body(r, s, notes)) {
+      if (std::none_of(s.clipping.faces.begin(), s.clipping.faces.end(), [](const ClippedFace& f) { return f.high; }))
+        e.add_line(s.highlight_branch->direction, static_cast<double>(s.highlight_branch->samples), s.highlight_branch->uncertainty_deg / kDeg, r.name);
+      else
+        notes.push_back(fmt::format("{}: its highlight branch reaches a clipping level, so it is left out of the highlight-line estimate", r.name));
     }
     if (!holds_a_plane(s.shape) || !s.black_plane) continue;
     // A cluster that reaches a face of the cube lost what lay beyond it: its plane through black is partly the
     // face's (a saturated colour clipped at 0 or at the top lies on the face), not the one its light made.
     if (!s.clipping.faces.empty()) {
       const ClippedFace& f = s.clipping.faces.front();
-      out.notes.push_back(fmt::format("{}: {:.1f} % of its pixels lie on clipping faces ({} {} at {:.4g} …), so its plane is "
-                                      "partly the cube's face: left out of the planes' estimate", r.name,
-                                      100 * s.clipping.fraction, "RGB"[f.channel], f.high ? "high" : "low", f.level));
+      notes.push_back(fmt::format("{}: {:.1f} % of its pixels lie on clipping faces ({} {} at {:.4g} …), so its plane is "
+                                  "partly the cube's face: left out of the planes' estimate", r.name,
+                                  100 * s.clipping.fraction, "RGB"[f.channel], f.high ? "high" : "low", f.level));
       continue;
     }
-    normals.push_back(s.black_plane->normal);
-    normal_se.push_back(plane_normal_se(s, kNoiseFactor));
-    planes.regions.push_back(r.name);
+    e.normals.push_back(s.black_plane->normal);
+    e.normal_se.push_back(plane_normal_se(s, kNoiseFactor));
+    e.plane_regions.push_back(r.name);
   }
-  // A light's colour has no negative channel: a direction with one (beyond a few degrees of rounding)
-  // means the regions did not follow the dichromatic model (interreflection, noise, mixed objects).
-  auto finish = [&](IlluminantEstimate& e, const Vec3& v, std::optional<IlluminantEstimate>& slot) {
-    e.rgb = positive(v.normalized());
-    if (e.rgb.minCoeff() < -kNegativeTolerance) {
-      out.notes.push_back(fmt::format("the {} point to ({:.3f}, {:.3f}, {:.3f}), which is no light's colour: no estimate", e.method,
-                                      e.rgb[0], e.rgb[1], e.rgb[2]));
-      return;
-    }
-    if (out.known) e.error_deg = angular_error_deg(e.rgb, *out.known);
-    if (out.camera_white) e.camera_angle_deg = angular_error_deg(e.rgb, *out.camera_white);
-    slot = e;
-  };
-  if (!highlights.regions.empty()) {
-    Vec3 sum = Vec3::Zero();
-    for (std::size_t i = 0; i < line_directions.size(); ++i) sum += line_weights[i] * line_directions[i];
-    highlights.uncertainty_deg = mean_direction_se_deg(line_directions, line_weights, line_se, sum.normalized());
-    finish(highlights, sum, out.highlight_lines);
-  } else if (line_directions.empty()) {
+  return e;
+}
+
+// The estimate in `slot`, with its angles to the known light and the camera's white — unless it has a negative
+// channel (beyond a few degrees of rounding): no light's colour, so the regions did not follow the dichromatic
+// model (interreflection, noise, mixed objects).
+void finish(IlluminantAnalysis& out, IlluminantEstimate e, const Vec3& v, std::optional<IlluminantEstimate>& slot) {
+  e.rgb = positive(v.normalized());
+  if (e.rgb.minCoeff() < -kNegativeTolerance) {
+    out.notes.push_back(fmt::format("the {} point to ({:.3f}, {:.3f}, {:.3f}), which is no light's colour: no estimate", e.method,
+                                    e.rgb[0], e.rgb[1], e.rgb[2]));
+    return;
+  }
+  if (out.known) e.error_deg = angular_error_deg(e.rgb, *out.known);
+  if (out.camera_white) e.camera_angle_deg = angular_error_deg(e.rgb, *out.camera_white);
+  slot = e;
+}
+
+// The highlight lines' weighted mean direction.
+void estimate_from_lines(const Evidence& e, IlluminantAnalysis& out) {
+  if (e.line_regions.empty()) {
     out.notes.push_back("no region is an L, skewed-T or P with a highlight line inside the clipping levels, nor a planar "
                         "cluster with a highlight branch, so no highlight line gives the illuminant");
+    return;
   }
-  if (const auto v = intersect_planes(normals)) {
-    planes.uncertainty_deg = intersection_se_deg(normals, normal_se, *v);
-    // Two planes always meet in a line, whatever made them; only a third plane, or the highlight lines, can show
-    // that they are dichromatic planes of one light.
-    if (normals.size() == 2 && !out.highlight_lines) {
-      planes.reliable = false;
-      planes.unreliable_reason = "two planes meet in a line whatever made them, and no third plane or highlight line "
-                                 "checks that both are dichromatic planes of one light";
-    }
-    finish(planes, *v, out.planes);
-  } else {
+  IlluminantEstimate lines;
+  lines.method = "highlight lines";
+  lines.regions = e.line_regions;
+  Vec3 sum = Vec3::Zero();
+  for (std::size_t i = 0; i < e.line_directions.size(); ++i) sum += e.line_weights[i] * e.line_directions[i];
+  lines.uncertainty_deg = mean_direction_se_deg(e.line_directions, e.line_weights, e.line_se, sum.normalized());
+  finish(out, lines, sum, out.highlight_lines);
+}
+
+// The planes' intersection. Two planes always meet in a line, whatever made them; only a third plane, or the
+// highlight lines, can show that they are dichromatic planes of one light.
+void estimate_from_planes(const Evidence& e, IlluminantAnalysis& out) {
+  const auto v = intersect_planes(e.normals);
+  if (!v) {
     out.notes.push_back(fmt::format("{} region{} with a usable dichromatic plane; the intersection needs two distinct planes",
-                                    normals.size(), normals.size() == 1 ? "" : "s"));
+                                    e.normals.size(), e.normals.size() == 1 ? "" : "s"));
+    return;
   }
-  // Where both exist they must agree within their errors (3 σ combined); when they do not, the planes' estimate
-  // is not trusted (the highlight branch checks its own model on its two halves), and with three or more planes,
-  // which check each other, neither is.
-  if (out.planes && out.highlight_lines) {
-    const double apart = angular_error_deg(out.planes->rgb, out.highlight_lines->rgb);
-    const double sigma = std::hypot(out.planes->uncertainty_deg.value_or(0), out.highlight_lines->uncertainty_deg.value_or(0));
-    // Two planes are checked only as far as the highlight lines reach: no closer than their standard error.
-    if (normals.size() == 2)
-      planes.uncertainty_deg = out.planes->uncertainty_deg =
-          std::max(out.planes->uncertainty_deg.value_or(0), out.highlight_lines->uncertainty_deg.value_or(0));
-    if (apart > 3 * sigma) {
-      const std::string reason = fmt::format("the dichromatic planes and the highlight lines disagree by {:.1f}°, more than "
-                                             "3 × their combined standard error ({:.1f}°)", apart, sigma);
-      out.planes->reliable = false;
-      out.planes->unreliable_reason = reason;
-      if (normals.size() > 2) out.highlight_lines->reliable = false, out.highlight_lines->unreliable_reason = reason;
-    }
+  IlluminantEstimate planes;
+  planes.method = "dichromatic planes";
+  planes.regions = e.plane_regions;
+  planes.uncertainty_deg = intersection_se_deg(e.normals, e.normal_se, *v);
+  if (e.normals.size() == 2 && !out.highlight_lines) {
+    planes.reliable = false;
+    planes.unreliable_reason = "two planes meet in a line whatever made them, and no third plane or highlight line "
+                               "checks that both are dichromatic planes of one light";
   }
-  // A plane through black is one only in the true linear light: a response curve that was guessed, not declared,
-  // tilts every plane alike when it is wrong, which their agreement cannot show.
-  if (out.planes && !assumed_curve.empty() && out.planes->reliable) {
+  finish(out, planes, *v, out.planes);
+}
+
+// Where both exist they must agree within their errors (3 σ combined); when they do not, the planes' estimate
+// is not trusted (the highlight branch checks its own model on its two halves), and with three or more planes,
+// which check each other, neither is.
+void cross_check(std::size_t plane_count, IlluminantAnalysis& out) {
+  if (!out.planes || !out.highlight_lines) return;
+  const double apart = angular_error_deg(out.planes->rgb, out.highlight_lines->rgb);
+  const double sigma = std::hypot(out.planes->uncertainty_deg.value_or(0), out.highlight_lines->uncertainty_deg.value_or(0));
+  // Two planes are checked only as far as the highlight lines reach: no closer than their standard error.
+  if (plane_count == 2)
+    out.planes->uncertainty_deg = std::max(out.planes->uncertainty_deg.value_or(0), out.highlight_lines->uncertainty_deg.value_or(0));
+  if (apart > 3 * sigma) {
+    const std::string reason = fmt::format("the dichromatic planes and the highlight lines disagree by {:.1f}°, more than "
+                                           "3 × their combined standard error ({:.1f}°)", apart, sigma);
     out.planes->reliable = false;
-    out.planes->unreliable_reason = fmt::format("the response curve was assumed ({}), not declared: a dichromatic plane passes "
-                                                "through black only in the true linear light, and a wrong curve tilts every "
-                                                "plane alike, which their agreement cannot show", assumed_curve);
+    out.planes->unreliable_reason = reason;
+    if (plane_count > 2) out.highlight_lines->reliable = false, out.highlight_lines->unreliable_reason = reason;
   }
+}
+
+// The image's mean colour: a guess, always marked so.
+void estimate_grey_world(std::span<const float> rgb, IlluminantAnalysis& out) {
   Vec3 mean = Vec3::Zero();
   std::size_t count = 0;
   for (std::size_t i = 0; i + 2 < rgb.size(); i += 3)
@@ -253,26 +272,53 @@ IlluminantAnalysis estimate_illuminant(const std::vector<RegionAnalysis>& region
     out.grey_world.rgb = positive(mean.normalized());
     if (out.known) out.grey_world.error_deg = angular_error_deg(out.grey_world.rgb, *out.known);
     if (out.camera_white) out.grey_world.camera_angle_deg = angular_error_deg(out.grey_world.rgb, *out.camera_white);
-  } else out.notes.push_back("the image has no finite, non-black pixels: no grey-world estimate");
+  } else {
+    out.notes.push_back("the image has no finite, non-black pixels: no grey-world estimate");
+  }
+}
+
+// Which estimate is used, and why the others are not.
+std::string choice_text(const IlluminantAnalysis& out) {
   const IlluminantEstimate& chosen = out.best();
   std::string why_not;
   for (const auto* e : {out.planes ? &*out.planes : nullptr, out.highlight_lines ? &*out.highlight_lines : nullptr})
     if (e && !e->reliable) why_not += fmt::format("; the {} are not used: {}", e->method, e->unreliable_reason);
-  const bool planes_chosen = out.planes && &chosen == &*out.planes, lines_chosen = out.highlight_lines && &chosen == &*out.highlight_lines;
   auto sigma = [](const std::optional<IlluminantEstimate>& e) { return e && e->uncertainty_deg ? *e->uncertainty_deg : 0.0; };
-  if (planes_chosen)
-    out.choice = fmt::format("dichromatic planes: every dichromatic object's plane holds the light's colour, and {} planes "
-                             "meet in one direction (± {:.2f}°){}{}", out.planes->regions.size(), sigma(out.planes),
-                             out.highlight_lines && out.highlight_lines->reliable
-                                 ? fmt::format(", preferred to the highlight lines (± {:.2f}°), which tilt towards the body colours "
-                                               "where the shading follows the highlight", sigma(out.highlight_lines))
-                                 : "",
-                             why_not);
-  else if (lines_chosen)
-    out.choice = fmt::format("highlight lines: a highlight branch adds the light's colour (± {:.2f}°){}", sigma(out.highlight_lines),
-                             why_not);
-  else
-    out.choice = "grey world, a guess: no reliable dichromatic planes or highlight line" + why_not;
+  if (out.planes && &chosen == &*out.planes)
+    return fmt::format("dichromatic planes: every dichromatic object's plane holds the light's colour, and {} planes "
+                       "meet in one direction (± {:.2f}°){}{}", out.planes->regions.size(), sigma(out.planes),
+                       out.highlight_lines && out.highlight_lines->reliable
+                           ? fmt::format(", preferred to the highlight lines (± {:.2f}°), which tilt towards the body colours "
+                                         "where the shading follows the highlight", sigma(out.highlight_lines))
+                           : "",
+                       why_not);
+  if (out.highlight_lines && &chosen == &*out.highlight_lines)
+    return fmt::format("highlight lines: a highlight branch adds the light's colour (± {:.2f}°){}", sigma(out.highlight_lines), why_not);
+  return "grey world, a guess: no reliable dichromatic planes or highlight line" + why_not;
+}
+
+}  // namespace
+
+IlluminantAnalysis estimate_illuminant(const std::vector<RegionAnalysis>& regions, std::span<const float> rgb,
+                                       const std::optional<Vec3>& known, const std::array<double, 3>& high_levels,
+                                       const std::optional<Vec3>& camera_white, const std::string& assumed_curve) {
+  IlluminantAnalysis out;
+  if (known) out.known = known->normalized();
+  if (camera_white) out.camera_white = camera_white->normalized();
+  const Evidence evidence = gather_evidence(regions, high_levels, out.notes);
+  estimate_from_lines(evidence, out);
+  estimate_from_planes(evidence, out);
+  cross_check(evidence.normals.size(), out);
+  // A plane through black is one only in the true linear light: a response curve that was guessed, not declared,
+  // tilts every plane alike when it is wrong, which their agreement cannot show.
+  if (out.planes && !assumed_curve.empty() && out.planes->reliable) {
+    out.planes->reliable = false;
+    out.planes->unreliable_reason = fmt::format("the response curve was assumed ({}), not declared: a dichromatic plane passes "
+                                                "through black only in the true linear light, and a wrong curve tilts every "
+                                                "plane alike, which their agreement cannot show", assumed_curve);
+  }
+  estimate_grey_world(rgb, out);
+  out.choice = choice_text(out);
   return out;
 }
 

@@ -95,6 +95,80 @@ std::size_t separate_areas(const Region& r, int width) {
 
 std::string rgb3(const Vec3& v) { return fmt::format("({:.3f}, {:.3f}, {:.3f})", v[0], v[1], v[2]); }
 
+// The highlight branch: where it points, how far from the light's colour, where it leaves the body line and how
+// far it reaches.
+void describe_highlight(const ClusterShape& s, const RegionAnalysis& region, const IlluminantEstimate& light, Interpretation& out) {
+  const bool two_lines = s.two_lines && (s.shape == ShapeClass::L || s.shape == ShapeClass::SkewedT || s.shape == ShapeClass::P);
+  if (two_lines || s.highlight_branch) {
+    // The branch's colour by regression when measured (highlight_branch.h), else the highlight line's direction.
+    out.highlight_direction = s.highlight_branch ? unit(s.highlight_branch->direction) : unit(s.two_lines->highlight.direction);
+    if (two_lines) {
+      const Line& h = s.two_lines->highlight;
+      const Line& b = s.two_lines->body;
+      const double body_top = std::max(b.at(b.t_max).norm(), b.at(b.t_min).norm());
+      const double highlight_top = std::max(h.at(h.t_max).norm(), h.at(h.t_min).norm());
+      if (body_top > 0) out.highlight_reach = highlight_top / body_top;
+    }
+    std::string sentence = fmt::format("Its highlight branch points along {}", rgb3(*out.highlight_direction));
+    if (out.light_colour) {
+      out.highlight_light_angle_deg = angular_error_deg(*out.highlight_direction, *out.light_colour);
+      sentence += fmt::format(", {:.1f}° from the light's colour", *out.highlight_light_angle_deg);
+    if (s.highlight_branch) sentence += fmt::format(" (± {:.1f}°, from {} pixels off the body line)", s.highlight_branch->uncertainty_deg, s.highlight_branch->samples);
+    if (light.method == "highlight lines" && std::find(light.regions.begin(), light.regions.end(), region.name) != light.regions.end())
+      sentence += light.regions.size() == 1 ? " — it is the light's estimate itself" : " — one of the branches the light's estimate averages";
+    }
+    if (two_lines) sentence += fmt::format(", leaves the body line {:.0f} % along it", 100 * s.two_lines->junction_on_body);
+    if (out.highlight_reach) sentence += fmt::format(" and reaches {:.2f} × the body line's brightest colour", *out.highlight_reach);
+    out.findings.push_back(sentence + ".");
+  }
+}
+
+// A segment of the light's colour, and a segment of several separate areas.
+void describe_light_coloured(const ClusterShape& s, const RegionAnalysis& region, const Region& pixels, int width,
+                             const IlluminantAnalysis& illuminant, const ShapeCriteria& criteria, Interpretation& out) {
+  if (region.source == "segment") out.separate_areas = separate_areas(pixels, width);
+  bool light_coloured = false;
+  if (out.light_colour && s.moments.mean.norm() > 0) out.mean_light_angle_deg = angular_error_deg(s.moments.mean, *out.light_colour);
+  // Only a light known to within the angle that tells two directions apart can say a colour is the light's: the
+  // most precise reliable measurement, if its standard error is that small.
+  const IlluminantEstimate* sharp = nullptr;
+  for (const auto* e : {illuminant.planes ? &*illuminant.planes : nullptr, illuminant.highlight_lines ? &*illuminant.highlight_lines : nullptr})
+    if (e && e->reliable && e->uncertainty_deg && *e->uncertainty_deg <= criteria.min_line_angle_deg &&
+        (!sharp || *e->uncertainty_deg < *sharp->uncertainty_deg))
+      sharp = e;
+  if (sharp && out.body_colour && region.source != "image") {
+    const double apart = angular_error_deg(*out.body_colour, sharp->rgb);
+    const double near = std::max(criteria.min_line_angle_deg, 2 * *sharp->uncertainty_deg);
+    light_coloured = apart <= near;
+    if (light_coloured)
+      out.findings.push_back(fmt::format("Its body colour lies {:.1f}° from the light's colour as the {} measure it (± {:.1f}°): it "
+                                         "is the light itself, or surfaces that return it unchanged — white and grey cloth, "
+                                         "plates, glass and metal — which all share one colour direction, so a segment of this "
+                                         "colour may hold several of them, touching or not.",
+                                         apart, sharp->method, *sharp->uncertainty_deg));
+  }
+  if (out.separate_areas > 1)
+    out.findings.push_back(fmt::format("This segment is {} separate areas (each at least 1 % of it): the segmentation groups "
+                                       "pixels by colour direction, and {} share this one, so it joins them.", out.separate_areas,
+                                       light_coloured ? "objects of the light's colour — white cloth, glass, plates, the flames — all"
+                                                      : "several objects"));
+}
+
+// What the numbers cannot tell.
+void describe_uncertainty(const RegionAnalysis& region, const IlluminantEstimate& light, const std::optional<Explanation>& explanation,
+                          const ShapeCriteria& criteria, Interpretation& out) {
+  const bool have_light = light.rgb.norm() > 0;
+  if (!have_light) out.uncertain.push_back("no estimate of the light's colour: every angle to it is missing");
+  else if (!light.reliable) out.uncertain.push_back("the light's colour is uncertain: " + light.unreliable_reason);
+  else if (light.uncertainty_deg)
+    out.uncertain.push_back(fmt::format("the light's colour has a standard error of {:.1f}°, so angles to it are uncertain by as much",
+                                        *light.uncertainty_deg));
+  if (!explanation && out.thickness_over_noise && *out.thickness_over_noise > criteria.noise_factor)
+    out.uncertain.push_back("which of interreflection, texture or a second light thickens it: a photograph has no light-path layers to tell");
+  if (region.source == "segment")
+    out.uncertain.push_back("the segment's edges: it is made by colour direction, so it may hold parts of other objects of its colour or miss its own darkest pixels");
+}
+
 }  // namespace
 
 Interpretation interpret_region(const RegionAnalysis& region, const Region& pixels, int width,
@@ -136,30 +210,7 @@ Interpretation interpret_region(const RegionAnalysis& region, const Region& pixe
                                            : fmt::format(": more than the {:g}° two directions need to be told apart, so the plane "
                                                          "is not spanned by this body colour and this light alone", criteria.min_line_angle_deg)));
   }
-  // The highlight branch.
-  const bool two_lines = s.two_lines && (s.shape == ShapeClass::L || s.shape == ShapeClass::SkewedT || s.shape == ShapeClass::P);
-  if (two_lines || s.highlight_branch) {
-    // The branch's colour by regression when measured (highlight_branch.h), else the highlight line's direction.
-    out.highlight_direction = s.highlight_branch ? unit(s.highlight_branch->direction) : unit(s.two_lines->highlight.direction);
-    if (two_lines) {
-      const Line& h = s.two_lines->highlight;
-      const Line& b = s.two_lines->body;
-      const double body_top = std::max(b.at(b.t_max).norm(), b.at(b.t_min).norm());
-      const double highlight_top = std::max(h.at(h.t_max).norm(), h.at(h.t_min).norm());
-      if (body_top > 0) out.highlight_reach = highlight_top / body_top;
-    }
-    std::string sentence = fmt::format("Its highlight branch points along {}", rgb3(*out.highlight_direction));
-    if (out.light_colour) {
-      out.highlight_light_angle_deg = angular_error_deg(*out.highlight_direction, *out.light_colour);
-      sentence += fmt::format(", {:.1f}° from the light's colour", *out.highlight_light_angle_deg);
-    if (s.highlight_branch) sentence += fmt::format(" (± {:.1f}°, from {} pixels off the body line)", s.highlight_branch->uncertainty_deg, s.highlight_branch->samples);
-    if (light.method == "highlight lines" && std::find(light.regions.begin(), light.regions.end(), region.name) != light.regions.end())
-      sentence += light.regions.size() == 1 ? " — it is the light's estimate itself" : " — one of the branches the light's estimate averages";
-    }
-    if (two_lines) sentence += fmt::format(", leaves the body line {:.0f} % along it", 100 * s.two_lines->junction_on_body);
-    if (out.highlight_reach) sentence += fmt::format(" and reaches {:.2f} × the body line's brightest colour", *out.highlight_reach);
-    out.findings.push_back(sentence + ".");
-  }
+  describe_highlight(s, region, light, out);
   // Clipping.
   const ClusterShape& stored = region.shape;  // clipping happens to the values as stored, at the file's levels
   out.clipped_fraction = stored.clipping.fraction;
@@ -192,33 +243,7 @@ Interpretation interpret_region(const RegionAnalysis& region, const Region& pixe
     }
     out.findings.push_back(sentence + ".");
   }
-  // A segment of the light's colour, and a segment of several separate areas.
-  if (region.source == "segment") out.separate_areas = separate_areas(pixels, width);
-  bool light_coloured = false;
-  if (out.light_colour && s.moments.mean.norm() > 0) out.mean_light_angle_deg = angular_error_deg(s.moments.mean, *out.light_colour);
-  // Only a light known to within the angle that tells two directions apart can say a colour is the light's: the
-  // most precise reliable measurement, if its standard error is that small.
-  const IlluminantEstimate* sharp = nullptr;
-  for (const auto* e : {illuminant.planes ? &*illuminant.planes : nullptr, illuminant.highlight_lines ? &*illuminant.highlight_lines : nullptr})
-    if (e && e->reliable && e->uncertainty_deg && *e->uncertainty_deg <= criteria.min_line_angle_deg &&
-        (!sharp || *e->uncertainty_deg < *sharp->uncertainty_deg))
-      sharp = e;
-  if (sharp && out.body_colour && region.source != "image") {
-    const double apart = angular_error_deg(*out.body_colour, sharp->rgb);
-    const double near = std::max(criteria.min_line_angle_deg, 2 * *sharp->uncertainty_deg);
-    light_coloured = apart <= near;
-    if (light_coloured)
-      out.findings.push_back(fmt::format("Its body colour lies {:.1f}° from the light's colour as the {} measure it (± {:.1f}°): it "
-                                         "is the light itself, or surfaces that return it unchanged — white and grey cloth, "
-                                         "plates, glass and metal — which all share one colour direction, so a segment of this "
-                                         "colour may hold several of them, touching or not.",
-                                         apart, sharp->method, *sharp->uncertainty_deg));
-  }
-  if (out.separate_areas > 1)
-    out.findings.push_back(fmt::format("This segment is {} separate areas (each at least 1 % of it): the segmentation groups "
-                                       "pixels by colour direction, and {} share this one, so it joins them.", out.separate_areas,
-                                       light_coloured ? "objects of the light's colour — white cloth, glass, plates, the flames — all"
-                                                      : "several objects"));
+  describe_light_coloured(s, region, pixels, width, illuminant, criteria, out);
   // γ.
   if (region.declared_gamma) {
     out.declared_gamma = region.declared_gamma->declared_gamma;
@@ -244,16 +269,7 @@ Interpretation interpret_region(const RegionAnalysis& region, const Region& pixe
                                                                    : ""));
   }
   if (region.bend) out.findings.push_back("It is " + region.bend->summary + ".");
-  // What is uncertain.
-  if (!have_light) out.uncertain.push_back("no estimate of the light's colour: every angle to it is missing");
-  else if (!light.reliable) out.uncertain.push_back("the light's colour is uncertain: " + light.unreliable_reason);
-  else if (light.uncertainty_deg)
-    out.uncertain.push_back(fmt::format("the light's colour has a standard error of {:.1f}°, so angles to it are uncertain by as much",
-                                        *light.uncertainty_deg));
-  if (!explanation && out.thickness_over_noise && *out.thickness_over_noise > criteria.noise_factor)
-    out.uncertain.push_back("which of interreflection, texture or a second light thickens it: a photograph has no light-path layers to tell");
-  if (region.source == "segment")
-    out.uncertain.push_back("the segment's edges: it is made by colour direction, so it may hold parts of other objects of its colour or miss its own darkest pixels");
+  describe_uncertainty(region, light, explanation, criteria, out);
   return out;
 }
 
