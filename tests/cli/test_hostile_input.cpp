@@ -32,7 +32,7 @@ using test::read_text;
 using test::run_chromatrace;
 using test::write_text;
 
-const fs::path kMinimal = fs::path(CHROMATRACE_TEST_DATA) / "scenes" / "minimal.json";
+const fs::path kMinimal = test::minimal_scene();
 
 // chromatrace with a time limit: a command that waits on a special file is killed after `seconds` (exit 124).
 test::CommandResult run_within(int seconds, const std::vector<std::string>& args) {

@@ -10,26 +10,19 @@
 #include <vector>
 
 #include "tests/cli/run_command.h"
+#include "tests/cli/text_files.h"
 #include "tests/core/spectral_exr_fixtures.h"
 
 namespace ct {
 namespace {
 
 namespace fs = std::filesystem;
+using test::line_count;
 using test::run_chromatrace;
+using test::write_text;
 
-const fs::path kMinimal = fs::path(CHROMATRACE_TEST_DATA) / "scenes" / "minimal.json";
+const fs::path kMinimal = test::minimal_scene();
 
-int line_count(const std::string& s) { return static_cast<int>(std::count(s.begin(), s.end(), '\n')); }
-
-void write_text(const fs::path& path, const std::string& text) { std::ofstream(path, std::ios::binary) << text; }
-
-std::string bytes_of(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
 
 // ---- sizes checked before allocating --------------------------------------------------------------
 
@@ -47,7 +40,7 @@ TEST(Limits, SizesBeyondTheLimitsAreRefusedBeforeAllocating) {
   write_text(dir.file("giant.ply"),
              "ply\nformat ascii 1.0\nelement vertex 4000000000\nproperty float x\nproperty float y\nproperty float z\n"
              "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n");
-  std::string scene = bytes_of(kMinimal);
+  std::string scene = test::read_text(kMinimal);
   const std::size_t objects = scene.find("\"objects\": [") + 12;
   scene.insert(objects, R"({"name": "giant", "material": "wall", "shape": {"type": "mesh", "file": "giant.ply"}},)");
   write_text(dir.file("giant_mesh.json"), scene);

@@ -23,7 +23,7 @@ using test::read_text;
 using test::run_chromatrace;
 using test::write_text;
 
-const fs::path kMinimal = fs::path(CHROMATRACE_TEST_DATA) / "scenes" / "minimal.json";
+const fs::path kMinimal = test::minimal_scene();
 
 // chromatrace with these arguments in a child whose files may grow to `kib` KiB, SIGXFSZ ignored.
 test::CommandResult run_with_file_size_limit(int kib, const std::vector<std::string>& args) {

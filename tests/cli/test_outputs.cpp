@@ -16,6 +16,7 @@
 #include <fmt/core.h>
 
 #include "tests/cli/run_command.h"
+#include "tests/cli/text_files.h"
 #include "tests/core/image_fixtures.h"
 #include "tests/core/spectral_exr_fixtures.h"
 
@@ -23,18 +24,10 @@ namespace ct {
 namespace {
 
 namespace fs = std::filesystem;
+using test::line_count;
 using test::run_chromatrace;
+using test::write_text;
 
-int line_count(const std::string& s) { return static_cast<int>(std::count(s.begin(), s.end(), '\n')); }
-
-void write_text(const fs::path& path, const std::string& text) { std::ofstream(path, std::ios::binary) << text; }
-
-std::string bytes_of(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
 
 // A scene that reads a mesh, a CSV table and a texture beside it.
 constexpr const char* kScene = R"({
@@ -97,7 +90,7 @@ class Outputs : public ::testing::Test {
   // line naming the output as given and the input, and the input's bytes unchanged.
   void expect_input_kept(std::vector<std::string> args, const fs::path& input, const std::string& input_as_named,
                          bool positional = false) const {
-    const std::string before = bytes_of(input);
+    const std::string before = test::read_text(input);
     ASSERT_FALSE(before.empty()) << input;
     for (const fs::path& output : spellings_of(input)) {
       std::vector<std::string> all = args;
@@ -108,7 +101,7 @@ class Outputs : public ::testing::Test {
       EXPECT_EQ(line_count(r.err), 1) << r.err;
       EXPECT_NE(r.err.find(output.string() + ": is the same file as the input " + input_as_named), std::string::npos)
           << r.err;
-      EXPECT_EQ(bytes_of(input), before) << output;
+      EXPECT_EQ(test::read_text(input), before) << output;
     }
   }
 
@@ -159,7 +152,7 @@ TEST_F(Outputs, RenderKeepsTheSceneAndEveryFileItReads) {
   const auto r = run_chromatrace({"render", scene_.string(), "--spp", "1", "--quiet", "-o", dir_.file("latest.exr").string()});
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_TRUE(fs::is_symlink(fs::symlink_status(dir_.file("latest.exr"))));
-  EXPECT_EQ(bytes_of(dir_.file("old.exr")).substr(0, 4), "\x76\x2f\x31\x01");  // now an OpenEXR file
+  EXPECT_EQ(test::read_text(dir_.file("old.exr")).substr(0, 4), "\x76\x2f\x31\x01");  // now an OpenEXR file
 }
 
 TEST_F(Outputs, SensorKeepsItsInputConfigAndCameraCsv) {
@@ -175,7 +168,7 @@ TEST_F(Outputs, AnalyzeKeepsItsImageAndMasks) {
   // An image where analyze writes analysis.json.
   fs::create_directories(dir_.file("out"));
   test::write_test_image(dir_.file("out/analysis.png"), 2, 2, std::vector<float>(12, 0.5f));
-  const std::string before = bytes_of(dir_.file("out/analysis.png"));
+  const std::string before = test::read_text(dir_.file("out/analysis.png"));
   fs::create_symlink("analysis.png", dir_.file("out/analysis.json"));
   const auto r = run_chromatrace({"analyze", png.string(), "--mask", dir_.file("out/analysis.json").string(), "-o",
                                   dir_.file("out").string(), "--quiet"});
@@ -184,7 +177,7 @@ TEST_F(Outputs, AnalyzeKeepsItsImageAndMasks) {
   EXPECT_NE(r.err.find("out/analysis.json: is the same file as the input " + dir_.file("out/analysis.json").string()),
             std::string::npos)
       << r.err;
-  EXPECT_EQ(bytes_of(dir_.file("out/analysis.png")), before);
+  EXPECT_EQ(test::read_text(dir_.file("out/analysis.png")), before);
 }
 
 TEST_F(Outputs, ExportMeshesAndPrepareTextureKeepTheirInputs) {
@@ -199,7 +192,7 @@ TEST_F(Outputs, ExportMeshesAndPrepareTextureKeepTheirInputs) {
   EXPECT_NE(r.err.find("002_tri.ply: is the same file as the input " + dir_.file("002_tri.ply").string()),
             std::string::npos)
       << r.err;
-  EXPECT_EQ(bytes_of(dir_.file("002_tri.ply")), kTriangle);
+  EXPECT_EQ(test::read_text(dir_.file("002_tri.ply")), kTriangle);
   EXPECT_FALSE(fs::exists(dir_.file("001_floor.ply")));  // refused before anything was written
   expect_input_kept({"export-meshes", scene_.string()}, scene_, scene_.string(), true);
 
@@ -216,7 +209,7 @@ TEST_F(Outputs, SeriesKeepsItsFileAndScenes) {
   fs::copy_file(data / "minimal.json", run / "minimal.json");
   fs::copy_file(data / "series_merge.json", run / "a" / "s.json");
   fs::copy_file(data / "minimal.json", run / "a" / "minimal.json");
-  const std::string series = bytes_of(run / "series.json"), scene = bytes_of(run / "minimal.json");
+  const std::string series = test::read_text(run / "series.json"), scene = test::read_text(run / "minimal.json");
   const struct {
     fs::path file;
     std::string says;
@@ -233,10 +226,10 @@ TEST_F(Outputs, SeriesKeepsItsFileAndScenes) {
     EXPECT_EQ(line_count(r.err), 1) << r.err;
     EXPECT_NE(r.err.find(c.says), std::string::npos) << "expected \"" << c.says << "\" in " << r.err;
   }
-  EXPECT_EQ(bytes_of(run / "series.json"), series);
-  EXPECT_EQ(bytes_of(run / "a" / "s.json"), series);
-  EXPECT_EQ(bytes_of(run / "minimal.json"), scene);
-  EXPECT_EQ(bytes_of(run / "a" / "minimal.json"), scene);
+  EXPECT_EQ(test::read_text(run / "series.json"), series);
+  EXPECT_EQ(test::read_text(run / "a" / "s.json"), series);
+  EXPECT_EQ(test::read_text(run / "minimal.json"), scene);
+  EXPECT_EQ(test::read_text(run / "a" / "minimal.json"), scene);
 }
 
 // ---- special files -------------------------------------------------------------------------------

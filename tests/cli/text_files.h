@@ -19,6 +19,9 @@ inline std::string read_text(const std::filesystem::path& path) {
   return bytes.str();
 }
 
+// The smallest valid scene, tests/data/scenes/minimal.json.
+inline std::filesystem::path minimal_scene() { return std::filesystem::path(CHROMATRACE_TEST_DATA) / "scenes" / "minimal.json"; }
+
 inline void write_text(const std::filesystem::path& path, const std::string& text) {
   std::ofstream(path, std::ios::binary) << text;
 }
