@@ -2,7 +2,8 @@
 """Benchmark: a spectral Cycles render planned by `chromatrace plan` against one plain RGB Cycles render.
 
     CHROMATRACE_EXE=build/cli/chromatrace python3 bench/bench_plan_cycles.py [--resolution 96] [--samples 256]
-        [--reference-spp 2048] [--light d65|f11|both] [--blender blender [--blender build/tests/blender/blender-4.5 ...]]
+        [--reference-spp 2048] [--light d65|f11|both] [--no-reconstruction]
+        [--blender blender [--blender build/tests/blender/blender-4.5 ...]]
 
 Each --blender is run in turn (a Blender binary, or a bpy module behind tests/blender/bpy_blender.py, as the
 build's build/tests/blender/blender-4.5 and blender-5.0 are), the scene's GGX masking set to that Cycles' own
@@ -87,7 +88,7 @@ def bench(light, args, work, blender_exe, version):
     res = f"{args.resolution}x{args.resolution}"
     plan_file, report_file = os.path.join(work, f"{light}-plan.json"), os.path.join(work, f"{light}-report.json")
     run([exe, "plan", scene, "--renderer", "cycles", "--edge-step", "5", "--target-de00", "1", "-o", plan_file,
-         "--report", report_file, "-q"])
+         "--report", report_file, "-q"] + (["--no-reconstruction"] if args.no_reconstruction else []))
     with open(report_file) as f:
         report = json.load(f)
     bounces = report["settings"]["max_bounces"]
@@ -145,6 +146,8 @@ def main():
     p.add_argument("--reference-spp", type=int, default=2048)
     p.add_argument("--light", choices=("d65", "f11", "both"), default="both")
     p.add_argument("--blender", action="append", help="a Blender (repeatable; default: blender)")
+    p.add_argument("--no-reconstruction", action="store_true",
+                   help="plan's edges alone, its band values read as a step function (plan --no-reconstruction)")
     args = p.parse_args()
     if not os.environ.get("CHROMATRACE_EXE"):
         sys.exit("set CHROMATRACE_EXE to the chromatrace executable (e.g. build/cli/chromatrace)")
