@@ -73,10 +73,15 @@ void render_with_tracer(Scene scene, const fs::path& out, const RunOptions& opti
   rt::write_render(out, scene, rt::render(scene, render));
 }
 
+// Renders with Cycles through the add-on's batch. A series' scenes are written for the tracer, whose GGX masking
+// defaults to the separable form that Cycles has only up to Blender 3.x: each GGX material is rendered with the
+// masking of the Cycles that runs (--ggx-masking cycles); the batch names each one it changed, and the render's
+// header carries the scene as rendered (masking_notes).
 void render_with_cycles(const Scene& scene, const fs::path& scene_file, const fs::path& out, const fs::path& dir,
                         const RunOptions& options) {
   BlenderBatchCommand batch(options.blender, options.batch_script);
   batch.option("--scene", scene_file.string())
+      .option("--ggx-masking", "cycles")
       .option("--out", out.string())
       .option("--samples", std::to_string(options.spp.value_or(scene.render.samples)))
       .option("--seed", std::to_string(options.seed.value_or(scene.render.seed)))
@@ -92,6 +97,28 @@ void render_with_cycles(const Scene& scene, const fs::path& scene_file, const fs
   const int status = run_program(batch.argv(), BlenderBatchCommand::environment(options.executable), log).status;
   if (status != 0 || !fs::exists(out))
     throw std::runtime_error(fmt::format("Blender's batch exited with status {} (its output: {})", status, log.string()));
+}
+
+// The GGX materials a Cycles render has with another masking than the scene asks: the scene as rendered is in the
+// render's header (chromatrace.scene), fresh or from the cache.
+std::vector<std::string> masking_notes(const Scene& scene, const fs::path& render) {
+  const SpectralExrInfo info = SpectralExrReader(render).info();
+  const auto it = info.metadata.find("chromatrace.scene");
+  if (it == info.metadata.end()) return {};
+  const Json rendered = Json::parse(it->second, nullptr, false);
+  if (!rendered.is_object() || !rendered.contains("materials") || !scene.json.contains("materials")) return {};
+  std::vector<std::string> notes;
+  for (const auto& [name, material] : scene.json["materials"].items()) {
+    if (!material.is_object() || material.value("type", "") != "dichromatic" || material.value("lobe", "ggx") != "ggx") continue;
+    const std::string asked = material.value("masking", "separable");
+    const auto other = rendered["materials"].find(name);
+    if (other == rendered["materials"].end() || !other->is_object()) continue;
+    const std::string used = other->value("masking", "separable");
+    if (used != asked)
+      notes.push_back(fmt::format("materials.{}.masking: \"{}\" rendered with the {} masking of the Cycles that rendered it",
+                                  name, asked, used));
+  }
+  return notes;
 }
 
 // ---- Expectations ---------------------------------------------------------------------------------------
@@ -220,6 +247,8 @@ VariantResult run_variant(const Series& series, const SeriesVariant& variant, co
     result.render_s = seconds_since(start);
     result.render_cpu_s = cpu_seconds() - start_cpu;
   }
+
+  if (options.renderer == Renderer::Cycles) result.render_notes = masking_notes(variant.scene, render);
 
   if (options.renders_only) {
     result.ok = true;
@@ -371,7 +400,7 @@ Json result_json(const SeriesResult& result) {
     } else {
       j["size"] = {v.width, v.height};
       j["render"] = {{"file", "renders/" + v.render_key + ".exr"}, {"key", v.render_key}, {"reused", v.render_reused},
-                     {"seconds", v.render_s}, {"cpu_seconds", v.render_cpu_s}};
+                     {"seconds", v.render_s}, {"cpu_seconds", v.render_cpu_s}, {"notes", v.render_notes}};
       j["scene"] = folder + "/scene.json";
       j["sensor"] = {{"settings", folder + "/sensor.json"}, {"file", folder + "/camera.exr"}, {"seconds", v.sensor_s}};
       j["preview"] = folder + "/camera.png";

@@ -85,6 +85,7 @@ struct VariantResult {
   bool render_reused = false;  // the render was in the cache (from an earlier run or an earlier variant)
   double render_s = 0, sensor_s = 0, analyze_s = 0;
   double render_cpu_s = 0;  // CPU seconds of the render: this process's threads, or Blender's (0 when reused)
+  std::vector<std::string> render_notes;  // what the renderer rendered otherwise than the scene asks (GGX masking)
   std::vector<ExpectationResult> expectations;
   int width = 0, height = 0;
 };

@@ -43,6 +43,11 @@ def _parser():
     p.add_argument("--explain", "--preflight", nargs="?", const="-", metavar="FILE",
                    help="print (or write to FILE) the pre-flight summary as JSON: every material, light and the world "
                         "exact, upsampled or refused, and the renders needed; render nothing")
+    p.add_argument("--ggx-masking", choices=["scene", "cycles"], default="scene",
+                   help="GGX masking-shadowing: the scene's (a material asking for the masking this Cycles does not "
+                        "have is refused; the default), or this Cycles' own (separable up to Blender 3.x, "
+                        "height-correlated from 4.0), each material changed named in a warning and the output's "
+                        "header recording the scene as rendered")
     p.add_argument("--device", choices=["CPU", "CUDA", "OPTIX", "HIP", "ONEAPI", "METAL"], default="CPU",
                    help="Cycles' render device: the CPU (default), or the GPUs of one backend Blender finds; recorded "
                         "in the cache key and the output's header")

@@ -81,7 +81,8 @@ def run(argv):
     chromatrace_tool = tool.Tool(tool.find_executable())
     if args.scene:
         _empty_startup_scene(bpy)
-        scene_import.import_scene(args.scene, bpy.context.scene, chromatrace_tool, log)
+        scene_import.import_scene(args.scene, bpy.context.scene, chromatrace_tool, log, ggx_masking=args.ggx_masking,
+                                  warn=_log)  # also with --quiet
     else:
         bpy.ops.wm.open_mainfile(filepath=os.path.abspath(args.blend))
     scene = bpy.context.scene

@@ -160,11 +160,29 @@ def _ensure_lightgroup(view_layer, group):
         view_layer.lightgroups.add(name=group)
 
 
-def import_scene(path, scene, tool, log=print):
-    """Adds the scene file's objects, lights and camera to `scene` and sets its chromatrace settings."""
+def _use_cycles_masking(document, log):
+    """Gives every GGX material this Cycles' masking, with a warning naming each one changed (--ggx-masking cycles):
+    the document, which the output's header carries, then says what was rendered."""
+    cycles = blender_compat.cycles_ggx_masking()
+    for name, entry in document["materials"].items():
+        if entry["type"] != "dichromatic" or entry.get("lobe", "ggx") != "ggx":
+            continue
+        masking = entry.get("masking", "separable")
+        if masking != cycles:
+            entry["masking"] = cycles
+            log(f"warning: materials.{name}.masking: \"{masking}\" rendered with the {cycles} masking of Cycles in "
+                f"Blender {bpy.app.version_string} (--ggx-masking cycles)")
+
+
+def import_scene(path, scene, tool, log=print, ggx_masking="scene", warn=None):
+    """Adds the scene file's objects, lights and camera to `scene` and sets its chromatrace settings. With
+    `ggx_masking` "cycles", GGX materials take this Cycles' masking instead of being refused for the other, each
+    one changed said through `warn` (`log` when None)."""
     summary = tool.check_scene(path)["scene"]
     with open(path) as f:
         document = json.load(f)
+    if ggx_masking == "cycles":
+        _use_cycles_masking(document, warn or log)
     scene_dir = os.path.dirname(os.path.abspath(path))
     s = scene.chromatrace
     s.scene_name = document.get("name", "")

@@ -225,6 +225,41 @@ TEST_F(Blender, BadInputExitsTwoWithOneErrorLineNamingTheField) {
   }
 }
 
+// A scene written for the tracer's default GGX masking (separable, the paper box) renders on every Cycles with
+// --ggx-masking cycles, as `chromatrace series --renderer cycles` asks: from Blender 4.0 each GGX material is named
+// in one warning and the header's scene has the masking rendered; on 3.x nothing changes.
+TEST_F(Blender, GgxMaskingOfThisCyclesRendersTheOtherMaskingAndSaysSo) {
+  const fs::path out = dir_.file("out.exr");
+  const CommandResult r = batch({"--scene", kBox, "--out", out.string(), "--resolution", "8x8", "--samples", "1",
+                                 "--bands", "400:700:100", "--components", "paths", "--ggx-masking", "cycles", "--quiet"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const bool changes = blender_under_test().major >= 4;
+  const std::vector<std::string> warnings = lines_starting(r.err, "chromatrace: warning: materials.");
+  ASSERT_EQ(warnings.size(), changes ? 2u : 0u) << r.err;
+  for (const std::string& w : warnings) EXPECT_NE(w.find("\"separable\" rendered with the height-correlated masking"), std::string::npos) << w;
+  const json rendered = json::parse(SpectralExrReader(out).info().metadata.at("chromatrace.scene"));
+  for (const char* name : {"sphere", "cylinder"})
+    EXPECT_EQ(rendered["materials"][name].value("masking", "separable"), changes ? "height-correlated" : "separable") << name;
+}
+
+// `chromatrace paper --renderer cycles` runs on every Blender the add-on supports, the paper's scenes written for
+// the tracer's separable masking: series.json's render notes name the GGX materials Cycles rendered otherwise.
+TEST_F(Blender, PaperSeriesWithCyclesRendersAndNotesTheMaskingItUsed) {
+  setenv("CHROMATRACE_BLENDER", blender().c_str(), 1);
+  const fs::path out = dir_.file("paper");
+  const CommandResult r = test::run_chromatrace({"paper", "-o", out.string(), "--renderer", "cycles", "--variant", "3-specular",
+                                                 "--resolution", "8x8", "--spp", "1", "--quiet"});
+  unsetenv("CHROMATRACE_BLENDER");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const json result = json::parse(test::read_text(out / "series.json"));
+  const json& variant = result["variants"].at(0);
+  ASSERT_TRUE(variant["ok"].get<bool>()) << variant.dump();
+  const json& notes = variant["render"]["notes"];
+  ASSERT_EQ(notes.size(), blender_under_test().major >= 4 ? 2u : 0u) << notes.dump();
+  for (const auto& note : notes)
+    EXPECT_NE(note.get<std::string>().find("\"separable\" rendered with the height-correlated masking"), std::string::npos) << note;
+}
+
 // Three bands in R, G and B of one render estimate the same as three renders of one band each: Cycles
 // treats the channels alike and separately. Independent seeds, so the per-pixel differences are pure noise
 // with mean zero; their mean must be within 4 standard errors of 0 in every band and component.
