@@ -38,6 +38,7 @@ json estimate_json(const IlluminantEstimate& e) {
   json j = {{"method", e.method}, {"rgb", vec(e.rgb)}, {"regions", e.regions}};
   j["error_deg"] = e.error_deg ? json(*e.error_deg) : json(nullptr);
   j["uncertainty_deg"] = e.uncertainty_deg ? json(*e.uncertainty_deg) : json(nullptr);
+  j["systematic"] = e.systematic.empty() ? json(nullptr) : json(e.systematic);
   j["reliable"] = e.reliable;
   j["unreliable_reason"] = e.reliable ? json(nullptr) : json(e.unreliable_reason);
   j["camera_angle_deg"] = e.camera_angle_deg ? json(*e.camera_angle_deg) : json(nullptr);

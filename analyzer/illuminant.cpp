@@ -108,6 +108,7 @@ struct Evidence {
   std::vector<Vec3> line_directions, normals;
   std::vector<double> line_weights, line_se, normal_se;
   std::vector<std::string> line_regions, plane_regions;
+  bool line_fitted = false;  // a highlight line fitted across the highlight, not a branch's regression
 
   void add_line(const Vec3& direction, double weight, double se, const std::string& region) {
     line_directions.push_back(positive(direction));
@@ -147,6 +148,7 @@ bool add_highlight_line(const RegionAnalysis& r, const std::array<double, 3>& hi
     e.add_line(b->direction, static_cast<double>(b->samples), b->uncertainty_deg / kDeg, r.name);
   } else {
     e.add_line(h.direction, static_cast<double>(h.inliers), line_direction_se(h), r.name);
+    e.line_fitted = true;
   }
   return true;
 }
@@ -215,6 +217,9 @@ void estimate_from_lines(const Evidence& e, IlluminantAnalysis& out) {
   Vec3 sum = Vec3::Zero();
   for (std::size_t i = 0; i < e.line_directions.size(); ++i) sum += e.line_weights[i] * e.line_directions[i];
   lines.uncertainty_deg = mean_direction_se_deg(e.line_directions, e.line_weights, e.line_se, sum.normalized());
+  if (e.line_fitted)
+    lines.systematic = "a highlight line fitted across the highlight tilts towards its body colour where the shading "
+                       "changes along it, which its standard error leaves out";
   finish(out, lines, sum, out.highlight_lines);
 }
 
@@ -284,16 +289,18 @@ std::string choice_text(const IlluminantAnalysis& out) {
   for (const auto* e : {out.planes ? &*out.planes : nullptr, out.highlight_lines ? &*out.highlight_lines : nullptr})
     if (e && !e->reliable) why_not += fmt::format("; the {} are not used: {}", e->method, e->unreliable_reason);
   auto sigma = [](const std::optional<IlluminantEstimate>& e) { return e && e->uncertainty_deg ? *e->uncertainty_deg : 0.0; };
+  const auto& lines = out.highlight_lines;
   if (out.planes && &chosen == &*out.planes)
     return fmt::format("dichromatic planes: every dichromatic object's plane holds the light's colour, and {} planes "
                        "meet in one direction (± {:.2f}°){}{}", out.planes->regions.size(), sigma(out.planes),
-                       out.highlight_lines && out.highlight_lines->reliable
-                           ? fmt::format(", preferred to the highlight lines (± {:.2f}°), which tilt towards the body colours "
-                                         "where the shading follows the highlight", sigma(out.highlight_lines))
-                           : "",
+                       !lines || !lines->reliable ? ""
+                       : !lines->systematic.empty()
+                           ? fmt::format(", preferred to the highlight lines (± {:.2f}°): {}", sigma(lines), lines->systematic)
+                           : fmt::format(", the first choice when reliable (their standard error is conservative); the "
+                                         "highlight lines (± {:.2f}°) agree with them within their errors", sigma(lines)),
                        why_not);
-  if (out.highlight_lines && &chosen == &*out.highlight_lines)
-    return fmt::format("highlight lines: a highlight branch adds the light's colour (± {:.2f}°){}", sigma(out.highlight_lines), why_not);
+  if (lines && &chosen == &*lines)
+    return fmt::format("highlight lines: a highlight branch adds the light's colour (± {:.2f}°){}", sigma(lines), why_not);
   return "grey world, a guess: no reliable dichromatic planes or highlight line" + why_not;
 }
 

@@ -280,7 +280,9 @@ std::string report_html(const AnalysisImage& input, const ImageAnalysis& a, std:
     illuminant += fmt::format("<tr><th>{}{}</th><td>{}</td><td>{}</td><td>{}{}</td></tr>", escape_html(e->method),
                               e == &il.best() ? " (chosen)" : "", rgb_text(e->rgb),
                               e->uncertainty_deg ? fmt::format("± {:.2f}° (standard error)", *e->uncertainty_deg) : "no uncertainty",
-                              e->reliable ? "reliable. " : "unreliable: " + escape_html(e->unreliable_reason) + ". ", against);
+                              (e->reliable ? "reliable. " : "unreliable: " + escape_html(e->unreliable_reason) + ". ") +
+                                  (e->systematic.empty() ? "" : "Systematic: " + escape_html(e->systematic) + ". "),
+                              against);
   }
   if (il.camera_white)
     illuminant += fmt::format("<tr><th>camera's as-shot white balance</th><td>{}</td><td>a reference</td><td>the light the camera "

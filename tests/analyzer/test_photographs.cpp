@@ -403,6 +403,32 @@ TEST(Photographs, AGlossyObjectsHighlightBranchPointsToTheLightsColour) {
   if (checked == 0) GTEST_SKIP() << "no highlight branch to compare: " << missing;
 }
 
+// With a glossy object's highlight branch among the regions (its segment, or its mask when the segmentation leaves
+// it out) beside the photograph's segments, the chosen estimate lies within 2 of its own standard errors of the white
+// object's colour (a 2-D direction error lies within 2σ with probability 1 − e⁻² ≈ 86 %; within 1σ only 39 %).
+TEST(Photographs, TheChosenEstimateBesideAHighlightBranchIsWithinItsUncertaintyOfTheWhiteObject) {
+  int checked = 0;
+  for (const Photo& photo : photos()) {
+    if (photo.light.empty() || !available(photo)) continue;
+    for (const auto& [glossy, white] : photo.light) {
+      SCOPED_TRACE(photo.file + ": " + glossy);
+      const Read& r = read(photo);
+      std::vector<analyzer::Region> regions = r.segmented.regions;
+      regions.push_back(analyse_object(photo, glossy).region);
+      if (regions.back().source == "segment") regions.pop_back();
+      const analyzer::ImageAnalysis a = analyzer::analyse_image(r.input, "", regions, analyzer::AnalyzeOptions{}, std::nullopt, false);
+      const analyzer::IlluminantEstimate& chosen = a.illuminant.best();
+      if (!chosen.reliable || !chosen.uncertainty_deg) continue;
+      const double angle = analyzer::angular_error_deg(chosen.rgb, measured_light(photo, white));
+      std::cerr << fmt::format("{}: chosen {} ({:.3f}, {:.3f}, {:.3f}) ± {:.2f}°, {:.2f}° from {}\n", photo.file, chosen.method,
+                               chosen.rgb[0], chosen.rgb[1], chosen.rgb[2], *chosen.uncertainty_deg, angle, white);
+      EXPECT_LE(angle, 2 * *chosen.uncertainty_deg) << a.illuminant.choice;
+      ++checked;
+    }
+  }
+  if (checked == 0) GTEST_SKIP() << "no reliable estimate beside a highlight branch";
+}
+
 // An over-exposed object's segment names its clipped faces: the channels and the end (high, low) they are
 // clipped at, exactly those a person sees on the picture.
 TEST(Photographs, ClippedFacesAreNamedWithTheirChannels) {
