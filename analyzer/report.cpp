@@ -13,6 +13,7 @@
 #include "analyzer/viewer_bundle.h"
 #include "core/colour.h"
 #include "core/html_text.h"
+#include "core/statistics.h"
 
 namespace ct::analyzer {
 namespace {
@@ -56,12 +57,7 @@ std::string image_png(const AnalysisImage& input, const RgbImage& layer, const I
       const float m = std::max({layer.rgb[p * 3], layer.rgb[p * 3 + 1], layer.rgb[p * 3 + 2]});
       if (std::isfinite(m)) brightest.push_back(m);
     }
-    white = 0.0;
-    if (!brightest.empty()) {
-      const auto k = static_cast<std::ptrdiff_t>(0.995 * static_cast<double>(brightest.size() - 1));
-      std::nth_element(brightest.begin(), brightest.begin() + k, brightest.end());
-      white = brightest[static_cast<std::size_t>(k)];
-    }
+    white = quantile_in_place(brightest, 0.995);  // 0 for none
   }
   if (!(white > 0)) white = 1;
   const bool encode = !display && !a.encoding.integer;
