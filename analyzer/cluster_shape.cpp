@@ -9,6 +9,7 @@
 #include <fmt/core.h>
 
 #include "analyzer/noise_level.h"
+#include "core/statistics.h"
 
 namespace ct::analyzer {
 namespace {
@@ -40,12 +41,8 @@ std::vector<std::size_t> complement(std::size_t n, const std::vector<std::size_t
 
 // The distance between the lo and hi quantiles of v (which it reorders); v holds at least one value.
 double quantile_range(std::vector<double>& v, double lo, double hi) {
-  const auto at = [&](double q) {
-    const auto k = static_cast<std::ptrdiff_t>(q * static_cast<double>(v.size() - 1));
-    std::nth_element(v.begin(), v.begin() + k, v.end());
-    return v[static_cast<std::size_t>(k)];
-  };
-  return at(hi) - at(lo);
+  const double top = quantile_in_place(v, hi);
+  return top - quantile_in_place(v, lo);
 }
 
 // The two-line model of the dichromatic reflection model: body line, highlight line and their junction.

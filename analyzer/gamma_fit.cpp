@@ -6,6 +6,7 @@
 #include <limits>
 
 #include "core/colour.h"
+#include "core/statistics.h"
 
 namespace ct::analyzer {
 namespace {
@@ -74,13 +75,8 @@ std::optional<GammaFit> fit_gamma(const std::vector<Vec3>& points, GammaFlat fla
   std::vector<double> values;
   for (const Vec3& p : points)
     if (p.minCoeff() > 0) values.insert(values.end(), {p[0], p[1], p[2]});
-  auto percentile = [&](double q) {
-    const auto k = static_cast<std::ptrdiff_t>(q * static_cast<double>(values.size() - 1));
-    std::nth_element(values.begin(), values.begin() + k, values.end());
-    return values[static_cast<std::size_t>(k)];
-  };
-  fit.lo = percentile(0.02);
-  fit.hi = percentile(0.98);
+  fit.lo = quantile_in_place(values, 0.02);
+  fit.hi = quantile_in_place(values, 0.98);
   fit.straightness_as_is = straightness(sample, 1.0, flat);
   fit.straightness_linearised = straightness(sample, 1.0 / fit.gamma, flat);
   return fit;

@@ -6,6 +6,8 @@
 
 #include <Eigen/Eigenvalues>
 
+#include "core/statistics.h"
+
 namespace ct::analyzer {
 namespace {
 
@@ -68,12 +70,11 @@ std::optional<HighlightBranch> highlight_branch(const std::vector<Vec3>& points,
   }
   const Slope all = regress(x, y);
   if (!all.ok) return std::nullopt;
-  // The lower and upper halves of the highlight, by distance from the body line.
-  std::vector<double> sorted = x;
-  std::nth_element(sorted.begin(), sorted.begin() + static_cast<std::ptrdiff_t>(sorted.size() / 2), sorted.end());
-  const double median = sorted[sorted.size() / 2];
+  // The lower and upper halves of the highlight, by distance from the body line: the median (the nearest rank
+  // below, ct::quantile) and what lies below it, and the rest; of an even count of distinct distances, n/2 each.
+  const double median = quantile(x, 0.5);
   std::vector<double> xl, yl, xu, yu;
-  for (std::size_t k = 0; k < x.size(); ++k) (x[k] < median ? xl : xu).push_back(x[k]), (x[k] < median ? yl : yu).push_back(y[k]);
+  for (std::size_t k = 0; k < x.size(); ++k) (x[k] <= median ? xl : xu).push_back(x[k]), (x[k] <= median ? yl : yu).push_back(y[k]);
   const Slope lower = regress(xl, yl), upper = regress(xu, yu);
   HighlightBranch b;
   b.direction = direction_of(all.kappa, body, e);

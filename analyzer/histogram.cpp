@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "core/parallel.h"
+#include "core/statistics.h"
 
 namespace ct::analyzer {
 namespace {
@@ -67,12 +68,10 @@ HistogramSpec histogram_spec(std::span<const float> rgb, int bins, double full_s
   spec.lo.fill(low);
   spec.hi.fill(high > low ? high : low + 1.0);
   if (brightest.size() < 1000) return spec;  // too few pixels for a 99.9th percentile
-  const std::size_t k = static_cast<std::size_t>(kRobustQuantile * static_cast<double>(brightest.size() - 1));
-  std::nth_element(brightest.begin(), brightest.begin() + static_cast<std::ptrdiff_t>(k), brightest.end());
-  const double quantile = brightest[k];
-  if (!(quantile > 0) || high <= kRobustRatio * quantile) return spec;
+  const double top = quantile_in_place(brightest, kRobustQuantile);
+  if (!(top > 0) || high <= kRobustRatio * top) return spec;
   spec.robust = true;
-  spec.hi.fill(kRobustMargin * quantile);
+  spec.hi.fill(kRobustMargin * top);
   for (std::size_t i = 0; i + 2 < rgb.size(); i += 3)
     for (std::size_t c = 0; c < 3; ++c)
       if (std::isfinite(rgb[i + c]) && rgb[i + c] > spec.hi[0]) {

@@ -1,5 +1,4 @@
 #include "analyzer/image_input.h"
-#include "analyzer/raw_input.h"
 
 #include <algorithm>
 #include <array>
@@ -16,7 +15,6 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
-#include "core/colour.h"
 #include "core/error.h"
 #include "core/exr_vocabulary.h"
 #include "core/file_io.h"
@@ -331,37 +329,6 @@ std::optional<ToneCurve> parse_input_transfer(const std::string& text) {
   throw InputError(fmt::format("--input-transfer: \"{}\" is not auto, linear, srgb or gamma=G with G > 0", text));
 }
 
-std::string ToneCurve::describe() const {
-  if (srgb) return "the sRGB curve";
-  if (linear()) return "linear";
-  return fmt::format("I' = {:g}·I^{:g}", k, gamma);
-}
-
-double ToneCurve::decode(double stored, double full_scale) const {
-  const double n = std::abs(stored) / full_scale;
-  const double v = srgb ? srgb_decode(n) : std::pow(n / k, 1.0 / gamma);
-  return std::copysign(v * full_scale, stored);
-}
-
-CodeDecoder::CodeDecoder(const std::optional<ToneCurve>& c, double fs)
-    : curve(c && !c->linear() ? c : std::nullopt), full_scale(fs) {
-  if (curve && fs >= 1 && fs <= 65535 && fs == std::floor(fs)) {
-    table.resize(static_cast<std::size_t>(fs) + 1);
-    for (std::size_t k = 0; k < table.size(); ++k) table[k] = static_cast<float>(curve->decode(static_cast<double>(k), fs));
-  }
-}
-
-RgbImage linear_light(const AnalysisImage& input) {
-  RgbImage out = input.image;
-  const ImageEncoding& e = input.encoding;
-  if (!e.curve || e.curve->linear()) return out;
-  // Codes of integer files are fractions of full scale; a float file stores the normalised signal itself.
-  const CodeDecoder decode(e.curve, e.integer ? e.full_scale : 1.0);
-  for (float& v : out.rgb)
-    if (std::isfinite(v)) v = decode(v);
-  return out;
-}
-
 AnalysisImage read_analysis_image(const std::filesystem::path& file, const std::string& input_transfer,
                                   const RawOptions& raw_options) {
   const std::optional<ToneCurve> declared = parse_input_transfer(input_transfer);
@@ -409,17 +376,6 @@ AnalysisImage read_analysis_image(const std::filesystem::path& file, const std::
     out.object_ids = whole_numbers(name, exr::kObjectIdChannel, raw, id);
   out.object_names = parse_object_names(name, raw.objects_attribute);
   return out;
-}
-
-const RgbImage& select_layer(const AnalysisImage& input, const std::string& layer) {
-  if (layer.empty() || layer == "final") return input.image;
-  if (layer == "linear" && input.linear) return *input.linear;
-  for (const ComponentLayer& c : input.components)
-    if (c.name == layer) return c.image;
-  std::vector<std::string> have{"final"};
-  if (input.linear) have.push_back("linear");
-  for (const ComponentLayer& c : input.components) have.push_back(c.name);
-  throw InputError(fmt::format("{}: --layer: no layer \"{}\" (the file has {})", input.file, layer, fmt::join(have, ", ")));
 }
 
 LabelImage read_label_image(const std::filesystem::path& file) {

@@ -1,10 +1,11 @@
 #include "analyzer/noise_level.h"
 
-#include <limits>
-
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numeric>
+
+#include "core/statistics.h"
 
 namespace ct::analyzer {
 namespace {
@@ -14,12 +15,6 @@ constexpr std::size_t kPerBand = 4096;         // residuals kept per band, at an
 constexpr double kQuartileAbs = 0.3186;        // the 25th percentile of |N(0, 1)|
 constexpr double kClip = 3;                    // the clip, in σ
 constexpr double kTruncatedMedianAbs = 0.6727;  // the median of |N(0, 1)| given |N| < 3
-
-double quantile(std::vector<double>& v, double q) {
-  const auto k = static_cast<std::ptrdiff_t>(q * static_cast<double>(v.size() - 1));
-  std::nth_element(v.begin(), v.begin() + k, v.end());
-  return v[static_cast<std::size_t>(k)];
-}
 
 }  // namespace
 
@@ -36,14 +31,14 @@ double ImageNoise::band_sigma(std::size_t band, const Vec3& u) const {
   std::vector<double> a(r.size() / 3);
   for (std::size_t i = 0; i < a.size(); ++i) a[i] = std::abs(r[i * 3] * u[0] + r[i * 3 + 1] * u[1] + r[i * 3 + 2] * u[2]);
   if (a.empty()) return 0.0;
-  double sigma = quantile(a, 0.25) / kQuartileAbs;
+  double sigma = quantile_in_place(a, 0.25) / kQuartileAbs;
   std::vector<double> inside;
   for (int iteration = 0; iteration < 50 && sigma > 0; ++iteration) {
     inside.clear();
     for (const double x : a)
       if (x <= kClip * sigma) inside.push_back(x);
     if (inside.size() < 8) break;
-    const double next = quantile(inside, 0.5) / kTruncatedMedianAbs;
+    const double next = quantile_in_place(inside, 0.5) / kTruncatedMedianAbs;
     const bool settled = std::abs(next - sigma) <= 1e-4 * sigma;
     sigma = next;
     if (settled) break;

@@ -4,22 +4,18 @@
 #include <numeric>
 
 #include <fmt/core.h>
-#include <opencv2/imgcodecs.hpp>
 
 #include "analyzer/analysis_json.h"
 #include "analyzer/plots.h"
 #include "analyzer/report.h"
 #include "core/error.h"
 #include "core/file_io.h"
+#include "plot/png.h"
 
 namespace ct::analyzer {
 namespace {
 
-void write_png(const std::filesystem::path& file, const cv::Mat& image) {
-  std::vector<std::uint8_t> bytes;
-  if (!cv::imencode(".png", image, bytes)) throw std::runtime_error(fmt::format("{}: PNG encoding failed", file.string()));
-  write_file_atomically(file, std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()));
-}
+void write_png(const std::filesystem::path& file, const cv::Mat& image) { write_file_atomically(file, plot::encode_png(image)); }
 
 }  // namespace
 

@@ -2,12 +2,13 @@
 
 #include <algorithm>
 #include <cmath>
-#include <numbers>
 
 #include <fmt/core.h>
 #include <opencv2/imgproc.hpp>
 
 #include "core/colour.h"
+#include "plot/oblique_cube.h"
+#include "plot/ticks.h"
 
 namespace ct::analyzer {
 namespace {
@@ -42,16 +43,12 @@ void text(cv::Mat& img, const std::string& s, cv::Point at, double scale, const 
   cv::putText(img, s, at, cv::FONT_HERSHEY_SIMPLEX, scale, colour, 1, cv::LINE_AA);
 }
 
-// Where a colour goes in a panel: panels 0–2 are projections (x channel, y channel), panel 3 the 3D view.
-// Values beyond the range (a robust HDR range's outliers) are drawn at its edge, as the histogram counts them.
+// Where a colour goes in a panel: panels 0–2 are projections (x channel, y channel), panel 3 the oblique view of
+// the cube (plot/oblique_cube.h). Values beyond the range (a robust HDR range's outliers) are drawn at its edge,
+// as the histogram counts them.
 class Frame {
  public:
-  explicit Frame(const HistogramSpec& spec) : spec_(spec) {
-    const double az = 35 * std::numbers::pi / 180, el = 25 * std::numbers::pi / 180;
-    // Screen axes of the oblique view: right and up, for the cube centred at the origin.
-    right_ = Vec3(std::cos(az), -std::sin(az), 0);
-    up_ = Vec3(std::sin(az) * std::sin(el), std::cos(az) * std::sin(el), std::cos(el));
-  }
+  explicit Frame(const HistogramSpec& spec) : spec_(spec) {}
   Vec3 unit(const Vec3& x) const {
     Vec3 q;
     for (int c = 0; c < 3; ++c) q[c] = (x[c] - spec_.lo[c]) / (spec_.hi[c] - spec_.lo[c]);
@@ -59,23 +56,26 @@ class Frame {
   }
   // `clamp`: points are held inside the range; fits are not (they are cut at the panel's edge instead).
   cv::Point2f at(const Vec3& x, int panel, bool clamp = false) const {
-    const cv::Point o = panel_origin(panel);
-    const cv::Point2f origin(static_cast<float>(o.x), static_cast<float>(o.y));
     Vec3 q = unit(x);
     if (clamp) q = q.cwiseMax(0.0).cwiseMin(1.0);
+    return at_unit(q, panel);
+  }
+  // A point given in unit-cube coordinates (the range scaled to [0, 1]³).
+  cv::Point2f at_unit(const Vec3& q, int panel) const {
+    const cv::Point o = panel_origin(panel);
+    const cv::Point2f origin(static_cast<float>(o.x), static_cast<float>(o.y));
     if (panel < 3) {
       return origin + cv::Point2f(static_cast<float>(kLeft + q[kProjectionAxes[panel][0]] * kInner),
                                   static_cast<float>(kTop + kInner - q[kProjectionAxes[panel][1]] * kInner));
     }
-    const Vec3 c = q - Vec3::Constant(0.5);
+    const Eigen::Vector2d p = view_.project(q);
     const double scale = kInner / 1.75;  // the cube's projected diagonal fits the panel
-    return origin + cv::Point2f(static_cast<float>(kPanel / 2 + scale * c.dot(right_)),
-                                static_cast<float>(kPanel / 2 + 8 - scale * c.dot(up_)));
+    return origin + cv::Point2f(static_cast<float>(kPanel / 2 + scale * p.x()), static_cast<float>(kPanel / 2 + 8 - scale * p.y()));
   }
 
  private:
   HistogramSpec spec_;
-  Vec3 right_, up_;
+  plot::ObliqueCube view_;
 };
 
 // Tick values and axis names with their unit on every projection, ticks along the three edges from black in the
@@ -87,9 +87,10 @@ void draw_axes(cv::Mat& img, const Frame& frame, const HistogramSpec& spec, cons
     cv::rectangle(img, cv::Point(x0, y0), cv::Point(x1, y1), kFrame, 1);
     for (int axis = 0; axis < 2; ++axis) {
       const int c = kProjectionAxes[p][axis];
-      for (const double t : axis_ticks(spec.lo[c], spec.hi[c])) {
+      const plot::Ticks ticks = plot::linear_ticks(spec.lo[c], spec.hi[c]);
+      for (const double t : ticks.values) {
         const double f = (t - spec.lo[c]) / (spec.hi[c] - spec.lo[c]);
-        const std::string label = tick_label(t, spec.lo[c], spec.hi[c]);
+        const std::string label = ticks.label(t);
         if (axis == 0) {
           const int x = x0 + static_cast<int>(std::lround(f * kInner));
           cv::line(img, cv::Point(x, y1), cv::Point(x, y1 + 4), kDim, 1);
@@ -104,24 +105,20 @@ void draw_axes(cv::Mat& img, const Frame& frame, const HistogramSpec& spec, cons
     text(img, fmt::format("{} ({})", kChannel[kProjectionAxes[p][0]], unit), cv::Point(x0 + kInner / 2, y1 + 36), 0.42, kText, 0);
     text(img, fmt::format("{} ({})", kChannel[kProjectionAxes[p][1]], unit), cv::Point(o.x + 8, y0 - 10), 0.42, kText);
   }
-  const Vec3 lo(spec.lo[0], spec.lo[1], spec.lo[2]), hi(spec.hi[0], spec.hi[1], spec.hi[2]);
-  auto corner = [&](int bits) { return Vec3(bits & 1 ? hi[0] : lo[0], bits & 2 ? hi[1] : lo[1], bits & 4 ? hi[2] : lo[2]); };
-  for (int a = 0; a < 8; ++a)
-    for (int bit = 0; bit < 3; ++bit) {
-      const int b = a | (1 << bit);
-      if (b == a) continue;
-      const cv::Scalar colour = a == 0 ? cv::Scalar(bit == 2 ? 255 : 60, bit == 1 ? 220 : 60, bit == 0 ? 255 : 60) : kFrame;
-      cv::line(img, frame.at(corner(a), 3), frame.at(corner(b), 3), colour, 1, cv::LINE_AA);
-    }
+  // The cube's edges in the 3D view, those from black in their channels' colours.
+  const cv::Scalar from_black[3] = {cv::Scalar(60, 60, 255), cv::Scalar(60, 220, 60), cv::Scalar(255, 60, 60)};
+  plot::draw_cube_edges(
+      img, [&](const Vec3& q) { return cv::Point(frame.at_unit(q, 3)); },
+      [&](const plot::CubeEdge& e) { return e.from == 0 ? from_black[e.channel] : kFrame; });
 }
 
 // The 3D view's tick values and axis names, drawn over the points.
 void draw_3d_labels(cv::Mat& img, const Frame& frame, const HistogramSpec& spec, const std::string& unit) {
   const Vec3 lo(spec.lo[0], spec.lo[1], spec.lo[2]), hi(spec.hi[0], spec.hi[1], spec.hi[2]);
-  auto corner = [&](int bits) { return Vec3(bits & 1 ? hi[0] : lo[0], bits & 2 ? hi[1] : lo[1], bits & 4 ? hi[2] : lo[2]); };
   const cv::Point2f centre = frame.at(0.5 * (lo + hi), 3);
   for (int c = 0; c < 3; ++c) {
-    for (const double t : axis_ticks(lo[c], hi[c], k3dTicks)) {
+    const plot::Ticks ticks = plot::linear_ticks(lo[c], hi[c], k3dTicks);
+    for (const double t : ticks.values) {
       // Black's own value is written once, at the red edge.
       if (c > 0 && t - lo[c] < 0.08 * (hi[c] - lo[c])) continue;
       Vec3 x = lo;
@@ -130,9 +127,9 @@ void draw_3d_labels(cv::Mat& img, const Frame& frame, const HistogramSpec& spec,
       const cv::Point2f out = away * (1.0f / std::max(1.0f, std::hypot(away.x, away.y)));
       cv::line(img, at, at + 4 * out, kDim, 1, cv::LINE_AA);
       const cv::Point2f label = at + 16 * out;
-      text(img, tick_label(t, lo[c], hi[c], k3dTicks), cv::Point(cvRound(label.x), cvRound(label.y) + 4), 0.33, kDim, 0, true);
+      text(img, ticks.label(t), cv::Point(cvRound(label.x), cvRound(label.y) + 4), 0.33, kDim, 0, true);
     }
-    const cv::Point2f end = frame.at(corner(1 << c), 3), away = end - centre;
+    const cv::Point2f end = frame.at_unit(plot::cube_corner(1 << c), 3), away = end - centre;
     const cv::Point2f name = end + away * (34.0f / std::max(1.0f, std::hypot(away.x, away.y)));
     text(img, kChannel[c], cv::Point(cvRound(name.x), cvRound(name.y) + 4), 0.5, kText, 0, true);
   }
@@ -260,25 +257,6 @@ cv::Scalar component_colour(std::size_t k) {
   static const cv::Scalar palette[] = {{75, 25, 230}, {75, 180, 60}, {25, 225, 255}, {200, 130, 0}, {48, 130, 245}, {180, 30, 145},
                                        {240, 240, 70}, {230, 50, 240}, {60, 245, 210}, {212, 190, 250}, {128, 128, 0}, {255, 190, 220}};
   return palette[k % std::size(palette)];
-}
-
-std::vector<double> axis_ticks(double lo, double hi, int target) {
-  std::vector<double> ticks;
-  if (!(hi > lo) || !std::isfinite(lo) || !std::isfinite(hi) || target < 1) return ticks;
-  // The step: (hi − lo) / target rounded to 1, 2, 5 or 10 × a power of ten (Heckbert's nice numbers, Graphics
-  // Gems, 1990: below 1.5 → 1, 3 → 2, 7 → 5, else 10).
-  const double raw = (hi - lo) / target, power = std::pow(10.0, std::floor(std::log10(raw))), f = raw / power;
-  const double step = (f < 1.5 ? 1 : f < 3 ? 2 : f < 7 ? 5 : 10) * power;
-  const double slack = 1e-9 * (hi - lo);
-  for (double k = std::ceil((lo - slack) / step); k * step <= hi + slack; k += 1) ticks.push_back(k * step == 0 ? 0.0 : k * step);
-  return ticks;
-}
-
-std::string tick_label(double value, double lo, double hi, int target) {
-  const std::vector<double> ticks = axis_ticks(lo, hi, target);
-  const double step = ticks.size() >= 2 ? ticks[1] - ticks[0] : std::max(std::abs(hi - lo), 1e-300);
-  const int decimals = std::clamp(static_cast<int>(-std::floor(std::log10(step) + 1e-9)), 0, 12);
-  return fmt::format("{:.{}f}", std::abs(value) < 0.5 * step * 1e-9 ? 0.0 : value, decimals);
 }
 
 ValueUnit value_unit(const ImageAnalysis& a) {

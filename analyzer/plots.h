@@ -30,12 +30,6 @@ struct ComponentMap {
 // set by a bright emitter elsewhere in the image.
 HistogramSpec display_range(const ImageAnalysis& analysis, const RegionSamples& samples);
 
-// Tick values for an axis from lo to hi: the multiples inside [lo, hi] of (hi − lo) / target rounded to 1, 2, 5
-// or 10 × a power of ten (about `target` intervals). Empty for an empty or non-finite range.
-std::vector<double> axis_ticks(double lo, double hi, int target = 5);
-// A tick value written with as many decimals as the step of axis_ticks(lo, hi, target) needs.
-std::string tick_label(double value, double lo, double hi, int target = 5);
-
 // What the plotted values are, short (an axis's unit) and in full (the plot's subtitle, the report): codes or
 // values as stored, linear or encoded by a named curve.
 struct ValueUnit {
@@ -44,7 +38,8 @@ struct ValueUnit {
 };
 ValueUnit value_unit(const ImageAnalysis& analysis);
 
-// An 8-bit BGR image, 2 × 2 panels under a title and a line saying the axes' unit; every axis has tick values.
+// An 8-bit BGR image, 2 × 2 panels under a title and a line saying the axes' unit; every axis has tick values
+// (plot/ticks.h) and the 3D view is the oblique cube (plot/oblique_cube.h).
 cv::Mat plot_region(const RgbImage& layer, const ImageAnalysis& analysis, std::size_t region, PlotColouring colouring,
                     const ComponentMap& components);
 

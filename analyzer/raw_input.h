@@ -8,10 +8,19 @@
 
 #include <filesystem>
 #include <string>
+#include <utility>
+#include <vector>
 
-#include "analyzer/image_input.h"
+#include "analyzer/analysis_image.h"
 
 namespace ct::analyzer {
+
+// How a camera raw file is read: demosaiced by LibRaw's `demosaic` method, or, with `half_size`, not demosaiced
+// (each 2×2 tile's own red, green and blue, as captured).
+struct RawOptions {
+  std::string demosaic = "linear";
+  bool half_size = false;
+};
 
 // Whether the file is read as a camera raw: by its extension (.dng, .cr2, .nef, … any case).
 bool is_camera_raw(const std::filesystem::path& file);

@@ -6,13 +6,15 @@
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "analyzer/plots.h"
 #include "analyzer/viewer_bundle.h"
 #include "core/colour.h"
 #include "core/html_text.h"
+#include "core/statistics.h"
+#include "plot/png.h"
+#include "plot/ticks.h"
 
 namespace ct::analyzer {
 namespace {
@@ -56,12 +58,7 @@ std::string image_png(const AnalysisImage& input, const RgbImage& layer, const I
       const float m = std::max({layer.rgb[p * 3], layer.rgb[p * 3 + 1], layer.rgb[p * 3 + 2]});
       if (std::isfinite(m)) brightest.push_back(m);
     }
-    white = 0.0;
-    if (!brightest.empty()) {
-      const auto k = static_cast<std::ptrdiff_t>(0.995 * static_cast<double>(brightest.size() - 1));
-      std::nth_element(brightest.begin(), brightest.begin() + k, brightest.end());
-      white = brightest[static_cast<std::size_t>(k)];
-    }
+    white = quantile_in_place(brightest, 0.995);  // 0 for none
   }
   if (!(white > 0)) white = 1;
   const bool encode = !display && !a.encoding.integer;
@@ -79,9 +76,7 @@ std::string image_png(const AnalysisImage& input, const RgbImage& layer, const I
   cv::Mat shown;
   if (d.scale < 1) cv::resize(full, shown, cv::Size(d.width, d.height), 0, 0, cv::INTER_AREA);
   else shown = full;
-  std::vector<std::uint8_t> bytes;
-  cv::imencode(".png", shown, bytes);
-  return "data:image/png;base64," + base64(std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()));
+  return "data:image/png;base64," + base64(plot::encode_png(shown));
 }
 
 // Per displayed pixel: the index of the smallest region that holds it (the whole image, 0, if none other).
@@ -194,8 +189,8 @@ json region_json(const RgbImage& layer, const ImageAnalysis& a, std::size_t i, c
   json ticks = json::array();
   for (int c = 0; c < 3; ++c) {
     json channel = json::array();
-    for (const double t : axis_ticks(spec.lo[c], spec.hi[c], 2))
-      channel.push_back({(t - spec.lo[c]) / (spec.hi[c] - spec.lo[c]), tick_label(t, spec.lo[c], spec.hi[c], 2)});
+    const plot::Ticks t = plot::linear_ticks(spec.lo[c], spec.hi[c], 2);
+    for (const double v : t.values) channel.push_back({(v - spec.lo[c]) / (spec.hi[c] - spec.lo[c]), t.label(v)});
     ticks.push_back(std::move(channel));
   }
   return {{"name", r.name},

@@ -9,6 +9,7 @@
 
 #include "core/file_io.h"
 #include "core/html_text.h"
+#include "plot/ticks.h"
 
 namespace ct::calibrate {
 namespace {
@@ -16,25 +17,8 @@ namespace {
 // Channel colours (a colour-blind-safe set: vermillion, bluish green, blue).
 constexpr const char* kChannelColour[3] = {"#d55e00", "#009e73", "#0072b2"};
 
-// A nice step for about `count` ticks over a span.
-double nice_step(double span, int count) {
-  const double raw = span / count, p = std::pow(10.0, std::floor(std::log10(raw)));
-  for (const double m : {1.0, 2.0, 2.5, 5.0, 10.0})
-    if (m * p >= raw) return m * p;
-  return 10 * p;
-}
-
-std::string number(double v) {
-  if (v == 0) return "0";
-  const double a = std::abs(v);
-  if (a >= 1e5 || a < 1e-3) {  // 1e5, 2e-4
-    const int e = static_cast<int>(std::floor(std::log10(a) + 1e-9));
-    return fmt::format("{:g}e{}", v / std::pow(10.0, e), e);
-  }
-  return fmt::format("{:g}", v);
-}
-
-// An x–y plot: linear or logarithmic axes, series of points (markers) and of lines (the model), as SVG.
+// An x–y plot: linear or logarithmic axes with the plotting kit's ticks (plot/ticks.h), series of points (markers)
+// and of lines (the model), as SVG.
 class Plot {
  public:
   Plot(std::string title, std::string x_label, std::string y_label, bool log_x, bool log_y)
@@ -66,11 +50,11 @@ class Plot {
     s += fmt::format(R"svg(<text x="{}" y="18" font-size="14" font-weight="bold">{}</text>)svg", kLeft, escape_html(title_));
     for (const double t : ax.ticks) {
       s += fmt::format(R"svg(<line x1="{0:.1f}" y1="{1}" x2="{0:.1f}" y2="{2}" stroke="#e4e4e4"/>)svg", X(t), kTop, kHeight - kBottom);
-      s += fmt::format(R"svg(<text x="{:.1f}" y="{}" text-anchor="middle">{}</text>)svg", X(t), kHeight - kBottom + 16, number(t));
+      s += fmt::format(R"svg(<text x="{:.1f}" y="{}" text-anchor="middle">{}</text>)svg", X(t), kHeight - kBottom + 16, ax.label(t));
     }
     for (const double t : ay.ticks) {
       s += fmt::format(R"svg(<line x1="{0}" y1="{1:.1f}" x2="{2}" y2="{1:.1f}" stroke="#e4e4e4"/>)svg", kLeft, Y(t), kWidth - kRight);
-      s += fmt::format(R"svg(<text x="{}" y="{:.1f}" text-anchor="end">{}</text>)svg", kLeft - 6, Y(t) + 4, number(t));
+      s += fmt::format(R"svg(<text x="{}" y="{:.1f}" text-anchor="end">{}</text>)svg", kLeft - 6, Y(t) + 4, ay.label(t));
     }
     s += fmt::format(R"svg(<rect x="{}" y="{}" width="{}" height="{}" fill="none" stroke="#555"/>)svg", kLeft, kTop, kWidth - kLeft - kRight,
                      kHeight - kTop - kBottom);
@@ -112,21 +96,23 @@ class Plot {
   struct Axis {
     double lo, hi;
     bool log;
+    double step = 1;  // of a linear axis
     std::vector<double> ticks;
     double map(double v) const { return log ? (std::log10(v) - std::log10(lo)) / (std::log10(hi) - std::log10(lo)) : (v - lo) / (hi - lo); }
+    std::string label(double t) const { return log ? plot::superscript_exponent(plot::log_tick_label(t)) : plot::tick_label(t, step); }
   };
   static bool usable(double v, bool log) { return std::isfinite(v) && (!log || v > 0); }
+  // A logarithmic axis spans whole decades, a linear one whole steps.
   static Axis axis(double lo, double hi, bool log) {
-    Axis a{lo, hi, log, {}};
+    Axis a{lo, hi, log, 1, {}};
     if (log) {
       a.lo = std::pow(10.0, std::floor(std::log10(lo)));
       a.hi = std::pow(10.0, std::ceil(std::log10(hi)));
-      for (double t = a.lo; t <= a.hi * 1.0001; t *= 10) a.ticks.push_back(t);
+      a.ticks = plot::log_ticks(a.lo, a.hi);
     } else {
-      const double step = nice_step(hi - lo, 5);
-      a.lo = std::floor(lo / step) * step;
-      a.hi = std::ceil(hi / step) * step;
-      for (double t = a.lo; t <= a.hi + step * 1e-6; t += step) a.ticks.push_back(t);
+      const plot::NiceRange r = plot::nice_range(lo, hi, 5);
+      a.lo = r.lo, a.hi = r.hi, a.step = r.step;
+      a.ticks = plot::multiples_in(r.lo, r.hi, r.step);
     }
     return a;
   }

@@ -11,6 +11,8 @@
 
 #include "core/file_io.h"
 #include "core/html_text.h"
+#include "plot/png.h"
+#include "plot/ticks.h"
 #include "series/figure_data.h"
 #include "series/figure_raster.h"
 
@@ -112,8 +114,10 @@ std::string findings_table(const VariantView& v) {
 
 std::string plot_note(const VariantView& v) {
   const HistogramPoints& p = v.points;
-  std::string note = fmt::format("Cube shown: 0 to {} in each channel [{}]. ", tick_label(p.hi, p.step), escape_html(p.units));
-  if (p.lo != 0) note = fmt::format("Cube shown: {} to {} in each channel [{}]. ", tick_label(p.lo, p.step), tick_label(p.hi, p.step), escape_html(p.units));
+  std::string note = fmt::format("Cube shown: 0 to {} in each channel [{}]. ", plot::tick_label(p.hi, p.step), escape_html(p.units));
+  if (p.lo != 0)
+    note = fmt::format("Cube shown: {} to {} in each channel [{}]. ", plot::tick_label(p.lo, p.step), plot::tick_label(p.hi, p.step),
+                       escape_html(p.units));
   if (p.beyond > 0)
     note += p.lamps_beyond == p.beyond ? fmt::format("{} px of lamps seen directly lie beyond it and are not drawn. ", p.beyond)
                                        : fmt::format("{} px lie beyond it and are not drawn ({} of them lamps seen directly). ", p.beyond,
@@ -212,7 +216,7 @@ std::string variants_table(const fs::path& dir, const std::vector<VariantView>& 
   return html + "</table>";
 }
 
-void write_png(const fs::path& file, const cv::Mat& image) { write_file_atomically(file, encode_png(image)); }
+void write_png(const fs::path& file, const cv::Mat& image) { write_file_atomically(file, plot::encode_png(image)); }
 
 }  // namespace
 

@@ -12,6 +12,7 @@
 #include "analyzer/image_input.h"
 #include "core/file_io.h"
 #include "core/series_format.h"
+#include "plot/png.h"
 #include "series/preview.h"
 
 namespace ct::series {
@@ -38,12 +39,6 @@ double number_at(const Json& j, const char* key) {
 constexpr int kMaxEmbeddedSide = 512;
 
 }  // namespace
-
-std::string encode_png(const cv::Mat& image) {
-  std::vector<unsigned char> bytes;
-  if (!cv::imencode(".png", image, bytes)) throw std::runtime_error("PNG encoding failed");
-  return std::string(bytes.begin(), bytes.end());
-}
 
 std::vector<VariantView> read_variants(const Json& result) {
   std::vector<VariantView> variants;
@@ -123,16 +118,16 @@ void load_images(VariantView& variant, const fs::path& dir, std::size_t max_poin
       cv::Mat shown = camera;
       if (std::max(width, height) > kMaxEmbeddedSide)
         cv::resize(camera, shown, display_size(camera, kMaxEmbeddedSide), 0, 0, cv::INTER_AREA);
-      camera_png = encode_png(shown);
+      camera_png = plot::encode_png(shown);
     }
     variant.camera_png = std::move(camera_png);
 
     variant.points = gather_points(input, camera, channel_units(exr, input), max_points);
-    variant.plane = principal_plane(variant.points);
+    variant.plane = plot::principal_plane(variant.points.rgb);
     variant.oblique = oblique_plot(variant.points);
     variant.projection = projection_plot(variant.points, variant.plane);
-    variant.oblique_png = encode_png(variant.oblique);
-    variant.projection_png = encode_png(variant.projection);
+    variant.oblique_png = plot::encode_png(variant.oblique);
+    variant.projection_png = plot::encode_png(variant.projection);
     variant.points.rgb.clear();
     variant.points.rgb.shrink_to_fit();
     variant.points.bgr.clear();
@@ -157,7 +152,7 @@ std::string thumbnail_png(const fs::path& dir, const VariantView& variant, int s
   if (f >= 1) small = camera;
   else cv::resize(camera, small, cv::Size(std::max(1, static_cast<int>(camera.cols * f)), std::max(1, static_cast<int>(camera.rows * f))), 0, 0,
                   cv::INTER_AREA);
-  return encode_png(small);
+  return plot::encode_png(small);
 }
 
 std::string expected_text(const FindingView& f) {

@@ -45,7 +45,7 @@ struct VariantView {
   cv::Mat oblique, projection;        // the histogram plots (8-bit BGR)
   std::string oblique_png, projection_png;
   HistogramPoints points;             // what the plots hold (points.rgb cleared after drawing)
-  PrincipalPlane plane;
+  plot::PrincipalPlane plane;
 };
 
 // The variants of series.json in its order; malformed entries become failed variants naming what is wrong.
@@ -74,7 +74,5 @@ const std::vector<std::string>& extra_panels(int figure);
 
 // The camera image shown scaled by a whole factor (or reduced) so that its long side is near `box`.
 cv::Size display_size(const cv::Mat& camera, int box);
-
-std::string encode_png(const cv::Mat& image);
 
 }  // namespace ct::series

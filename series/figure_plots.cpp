@@ -1,23 +1,27 @@
 #include "series/figure_plots.h"
 
 #include <algorithm>
-#include <cctype>
 #include <cmath>
-#include <numbers>
 #include <numeric>
 
-#include <Eigen/Eigenvalues>
 #include <OpenImageIO/imageio.h>
 #include <fmt/core.h>
 #include <opencv2/imgproc.hpp>
 
 #include "core/json_input.h"
+#include "plot/oblique_cube.h"
+#include "plot/text.h"
+#include "plot/ticks.h"
 #include "series/preview.h"
 
 namespace ct::series {
 namespace {
 
 using Vec3 = Eigen::Vector3d;
+using plot::Align;
+using plot::put_text;
+using plot::text_width;
+using plot::tick_label;
 
 const cv::Scalar kWhite(255, 255, 255), kInk(40, 40, 40), kSoftInk(95, 95, 95), kEdge(190, 190, 190),
     kGrid(232, 232, 232), kOutline(175, 175, 175);
@@ -57,7 +61,7 @@ void put_centred(cv::Mat& img, std::string_view text, cv::Point2d centre, double
 // Text turned 90° counter-clockwise (read bottom to top), centred on `centre`.
 void put_vertical(cv::Mat& img, std::string_view text, cv::Point centre, double scale, const cv::Scalar& colour) {
   int baseline = 0;
-  const std::string s = ascii(text);
+  const std::string s = plot::ascii(text);
   const cv::Size size = cv::getTextSize(s, kFont, scale, 1, &baseline);
   cv::Mat strip(size.height + baseline + 4, size.width + 4, CV_8UC3, kWhite);
   cv::putText(strip, s, cv::Point(2, size.height + 2), kFont, scale, colour, 1, cv::LINE_AA);
@@ -108,140 +112,6 @@ std::size_t points_in(const std::vector<cv::Point2d>& at, const cv::Rect& box) {
 }
 
 }  // namespace
-
-// ---- Text ---------------------------------------------------------------------------------------------------
-
-std::string ascii(std::string_view text) {
-  static const std::pair<std::string_view, std::string_view> replacements[] = {
-      {"\u2014", "-"}, {"\u2013", "-"}, {"\u2212", "-"}, {"\u00d7", "x"},  {"\u2192", "->"}, {"\u2018", "'"},
-      {"\u2019", "'"}, {"\u201c", "\""}, {"\u201d", "\""}, {"\u2026", "..."}, {"\u2714", "ok"}, {"\u2717", "x"},
-      {"\u00b3", "^3"}, {"\u00b2", "^2"}, {"\u00b0", " deg"}, {"\u03b3", "gamma"}, {"\u2265", ">="}, {"\u2264", "<="},
-      {"\u00e9", "e"}, {"\u00a0", " "}, {"\u2009", " "}, {"\u202f", " "}};
-  std::string out;
-  for (std::size_t i = 0; i < text.size();) {
-    const unsigned char c = static_cast<unsigned char>(text[i]);
-    if (c < 0x80) {
-      out += static_cast<char>(c);
-      ++i;
-      continue;
-    }
-    bool replaced = false;
-    for (const auto& [from, to] : replacements)
-      if (text.substr(i, from.size()) == from) {
-        out += to;
-        i += from.size();
-        replaced = true;
-        break;
-      }
-    if (replaced) continue;
-    // Any other character: one '?' for its whole UTF-8 sequence.
-    out += '?';
-    ++i;
-    while (i < text.size() && (static_cast<unsigned char>(text[i]) & 0xC0) == 0x80) ++i;
-  }
-  return out;
-}
-
-namespace {
-
-// Text split into runs; an exponent ("^0.45", "^-2") is a raised run, as the font has no usable caret.
-struct Run {
-  std::string text;
-  bool raised = false;
-};
-
-std::vector<Run> runs_of(std::string_view text) {
-  const std::string s = ascii(text);
-  std::vector<Run> runs(1);
-  for (std::size_t i = 0; i < s.size(); ++i) {
-    if (s[i] == '^' && i + 1 < s.size() && (std::isdigit(static_cast<unsigned char>(s[i + 1])) || s[i + 1] == '-' || s[i + 1] == '.')) {
-      Run exponent{"", true};
-      std::size_t j = i + 1;
-      while (j < s.size() && (std::isdigit(static_cast<unsigned char>(s[j])) || s[j] == '.' || (j == i + 1 && s[j] == '-'))) exponent.text += s[j++];
-      runs.push_back(std::move(exponent));
-      runs.push_back({});
-      i = j - 1;
-      continue;
-    }
-    runs.back().text += s[i];
-  }
-  return runs;
-}
-
-constexpr double kRaisedScale = 0.72;
-
-}  // namespace
-
-int text_width(std::string_view text, double scale, int thickness) {
-  int width = 0, baseline = 0;
-  for (const Run& run : runs_of(text))
-    if (!run.text.empty())
-      width += cv::getTextSize(run.text, kFont, run.raised ? scale * kRaisedScale : scale, thickness, &baseline).width + (run.raised ? 1 : 0);
-  return width;
-}
-
-int put_text(cv::Mat& img, std::string_view text, cv::Point at, double scale, const cv::Scalar& colour, Align align,
-             int thickness) {
-  const int width = text_width(text, scale, thickness);
-  if (align == Align::Centre) at.x -= width / 2;
-  if (align == Align::Right) at.x -= width;
-  int baseline = 0;
-  const int raise = static_cast<int>(std::lround(cv::getTextSize("0", kFont, scale, thickness, &baseline).height * 0.45));
-  for (const Run& run : runs_of(text)) {
-    if (run.text.empty()) continue;
-    const double s = run.raised ? scale * kRaisedScale : scale;
-    cv::putText(img, run.text, at - cv::Point(0, run.raised ? raise : 0), kFont, s, colour, thickness, cv::LINE_AA);
-    at.x += cv::getTextSize(run.text, kFont, s, thickness, &baseline).width + (run.raised ? 1 : 0);
-  }
-  return width;
-}
-
-std::vector<std::string> wrap_text(std::string_view text, int width, double scale, int thickness) {
-  std::vector<std::string> lines;
-  std::string line;
-  std::size_t i = 0;
-  while (i < text.size()) {
-    const std::size_t space = std::min(text.find(' ', i), text.size());
-    const std::string word(text.substr(i, space - i));
-    i = space + 1;
-    if (word.empty()) continue;
-    const std::string candidate = line.empty() ? word : line + " " + word;
-    if (!line.empty() && text_width(candidate, scale, thickness) > width) {
-      lines.push_back(line);
-      line = word;
-    } else {
-      line = candidate;
-    }
-  }
-  if (!line.empty()) lines.push_back(line);
-  return lines;
-}
-
-void draw_mark(cv::Mat& img, cv::Point at, int size, bool ok) {
-  if (ok) {
-    const cv::Scalar green(40, 140, 30);
-    cv::line(img, at + cv::Point(1, -size / 2), at + cv::Point(size / 3, -1), green, 2, cv::LINE_AA);
-    cv::line(img, at + cv::Point(size / 3, -1), at + cv::Point(size, -size), green, 2, cv::LINE_AA);
-  } else {
-    const cv::Scalar red(30, 30, 200);
-    cv::line(img, at + cv::Point(1, -size + 1), at + cv::Point(size - 1, -1), red, 2, cv::LINE_AA);
-    cv::line(img, at + cv::Point(1, -1), at + cv::Point(size - 1, -size + 1), red, 2, cv::LINE_AA);
-  }
-}
-
-double nice_step(double span, int intervals) {
-  if (!(span > 0) || !std::isfinite(span)) return 1;
-  const double raw = span / std::max(1, intervals);
-  const double magnitude = std::pow(10.0, std::floor(std::log10(raw)));
-  const double norm = raw / magnitude;
-  return magnitude * (norm < 1.5 ? 1 : norm < 3 ? 2 : norm < 7 ? 5 : 10);
-}
-
-std::string tick_label(double value, double step) {
-  const int decimals = std::max(0, -static_cast<int>(std::floor(std::log10(step) + 1e-9)));
-  if (std::abs(value) < step * 1e-6) value = 0;
-  return fmt::format("{:.{}f}", value, decimals);
-}
 
 // ---- Units and points -----------------------------------------------------------------------------------------
 
@@ -304,10 +174,10 @@ HistogramPoints gather_points(const analyzer::AnalysisImage& input, const cv::Ma
   }
   if (top.empty()) top = top_all;  // nothing but lamps
   const double data_hi = quantile(top, 0.9995), data_lo = std::min(0.0, quantile(bottom, 0.0005));
-  const double span = data_hi > data_lo ? data_hi - data_lo : 1.0;
-  out.step = nice_step(span, 4);
-  out.lo = std::floor(data_lo / out.step + 1e-6) * out.step;
-  out.hi = std::max(out.lo + out.step, std::ceil((data_lo + span) / out.step - 1e-6) * out.step);
+  const plot::NiceRange cube = plot::nice_range(data_lo, data_hi, 4);
+  out.lo = cube.lo;
+  out.hi = cube.hi;
+  out.step = cube.step;
 
   std::vector<std::size_t> inside;
   for (std::size_t p = 0; p < n; ++p) {
@@ -352,64 +222,20 @@ HistogramPoints gather_points(const analyzer::AnalysisImage& input, const cv::Ma
   return out;
 }
 
-PrincipalPlane principal_plane(const HistogramPoints& points) {
-  PrincipalPlane plane;
-  plane.axis = {Vec3(1, 1, 1).normalized(), Vec3(1, 0, -1).normalized()};
-  if (points.rgb.size() < 3) return plane;
-  Vec3 mean = Vec3::Zero();
-  for (const Vec3& x : points.rgb) mean += x;
-  mean /= static_cast<double>(points.rgb.size());
-  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
-  for (const Vec3& x : points.rgb) covariance += (x - mean) * (x - mean).transpose();
-  covariance /= static_cast<double>(points.rgb.size());
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(covariance);
-  const Vec3 values = solver.eigenvalues();  // ascending
-  const double total = values.sum();
-  if (!(total > 0)) return plane;
-  Vec3 first = solver.eigenvectors().col(2), second = solver.eigenvectors().col(1);
-  if (first.sum() < 0) first = -first;
-  Eigen::Index largest = 0;
-  second.cwiseAbs().maxCoeff(&largest);
-  if (second[largest] < 0) second = -second;
-  plane.axis = {first, second};
-  plane.share = {values[2] / total, values[1] / total};
-  return plane;
-}
-
 // ---- The oblique view -------------------------------------------------------------------------------------
 
 namespace {
 
-// The unit cube [0, 1]³ (the shown range scaled) seen from azimuth 35°, elevation 25°, as the analyzer's plots:
-// black is the lowest corner, the achromatic axis upright, R to the right, G to the left, B up.
+// The unit cube [0, 1]³ (the shown range scaled) seen obliquely (plot/oblique_cube.h) and placed on the plot.
 class Oblique {
  public:
-  Oblique(const cv::Rect& area) {
-    const double az = 35 * std::numbers::pi / 180, el = 25 * std::numbers::pi / 180;
-    right_ = Vec3(std::cos(az), -std::sin(az), 0);
-    up_ = Vec3(std::sin(az) * std::sin(el), std::cos(az) * std::sin(el), std::cos(el));
-    towards_viewer_ = right_.cross(up_);
-    if (towards_viewer_.dot(Vec3(-0.5, -0.5, 0)) < 0) towards_viewer_ = -towards_viewer_;  // black is nearest
-    double x0 = 1e9, x1 = -1e9, y0 = 1e9, y1 = -1e9;
-    for (int bits = 0; bits < 8; ++bits) {
-      const Vec3 c = corner(bits) - Vec3::Constant(0.5);
-      x0 = std::min(x0, c.dot(right_)), x1 = std::max(x1, c.dot(right_));
-      y0 = std::min(y0, c.dot(up_)), y1 = std::max(y1, c.dot(up_));
-    }
-    scale_ = std::min(area.width / (x1 - x0), area.height / (y1 - y0));
-    origin_ = cv::Point2d(area.x + area.width / 2.0 - scale_ * (x0 + x1) / 2, area.y + area.height / 2.0 + scale_ * (y0 + y1) / 2);
-  }
-  static Vec3 corner(int bits) { return Vec3(bits & 1 ? 1 : 0, bits & 2 ? 1 : 0, bits & 4 ? 1 : 0); }
-  cv::Point2d at(const Vec3& q) const {
-    const Vec3 c = q - Vec3::Constant(0.5);
-    return origin_ + cv::Point2d(scale_ * c.dot(right_), -scale_ * c.dot(up_));
-  }
-  double nearness(const Vec3& q) const { return (q - Vec3::Constant(0.5)).dot(towards_viewer_); }
+  explicit Oblique(const cv::Rect& area) : placement_(plot::fit_cube(view_, area)) {}
+  cv::Point2d at(const Vec3& q) const { return placement_.at(view_, q); }
+  double nearness(const Vec3& q) const { return view_.nearness(q); }
 
  private:
-  Vec3 right_, up_, towards_viewer_;
-  double scale_ = 1;
-  cv::Point2d origin_;
+  plot::ObliqueCube view_;
+  plot::CubePlacement placement_;
 };
 
 // Ticks along the cube edge from corner a to corner b (unit coordinates), for the channel values lo…hi,
@@ -423,9 +249,9 @@ void edge_ticks(cv::Mat& img, const Oblique& view, const Vec3& a, const Vec3& b,
   const cv::Point2d middle = (pa + pb) * 0.5;
   if (normal.dot(middle - centre) < 0) normal = -normal;
   const double range = points.hi - points.lo;
-  for (int k = 0;; ++k) {
-    const double value = points.lo + k * points.step;
-    if (value > points.hi + 1e-9 * range) break;
+  const std::vector<double> values = plot::multiples_in(points.lo, points.hi, points.step);
+  for (std::size_t k = 0; k < values.size(); ++k) {
+    const double value = values[k];
     const double t = (value - points.lo) / range;
     const cv::Point2d p = pa + (pb - pa) * t;
     cv::line(img, rounded(p), rounded(p + normal * 5), kInk, 1, cv::LINE_AA);
@@ -446,11 +272,7 @@ cv::Mat oblique_plot(const HistogramPoints& points) {
   const double range = points.hi - points.lo;
   auto unit = [&](const Vec3& x) { return ((x.array() - points.lo) / range).matrix().eval(); };
 
-  for (int a = 0; a < 8; ++a)
-    for (int bit = 0; bit < 3; ++bit) {
-      const int b = a | (1 << bit);
-      if (b != a) cv::line(img, rounded(view.at(Oblique::corner(a))), rounded(view.at(Oblique::corner(b))), kEdge, 1, cv::LINE_AA);
-    }
+  plot::draw_cube_edges(img, [&](const Vec3& q) { return rounded(view.at(q)); }, [](const plot::CubeEdge&) { return kEdge; });
   draw_dashed(img, view.at(Vec3::Zero()), view.at(Vec3::Ones()), kEdge);
   // The axes from black in their channels' colours, under the points.
   for (int c = 0; c < 3; ++c)
@@ -492,7 +314,7 @@ cv::Mat oblique_plot(const HistogramPoints& points) {
 
 // ---- The projection ---------------------------------------------------------------------------------------
 
-cv::Mat projection_plot(const HistogramPoints& points, const PrincipalPlane& plane) {
+cv::Mat projection_plot(const HistogramPoints& points, const plot::PrincipalPlane& plane) {
   cv::Mat img(kPlotHeight, kPlotWidth, CV_8UC3, kWhite);
   put_text(img, fmt::format("Projection on PC1, PC2 ({:.0f} % of the variance)", 100 * (plane.share[0] + plane.share[1])),
            {10, 20}, kTitle, kInk);
@@ -518,14 +340,14 @@ cv::Mat projection_plot(const HistogramPoints& points, const PrincipalPlane& pla
   };
 
   // Grid and ticks: one step for both axes (the scales are equal).
-  const double step = nice_step(std::max(va1 - va0, vb1 - vb0), 5);
-  for (double v = std::ceil(va0 / step) * step; v <= va1 + 1e-9 * step; v += step) {
+  const double step = plot::nice_step(std::max(va1 - va0, vb1 - vb0), 5);
+  for (const double v : plot::multiples_in(va0, va1, step)) {
     const int x = static_cast<int>(std::lround(to_pixel({v, 0}).x));
     cv::line(img, {x, area.y}, {x, area.y + area.height}, kGrid, 1);
     cv::line(img, {x, area.y + area.height}, {x, area.y + area.height + 5}, kInk, 1);
     put_text(img, tick_label(v, step), {x, area.y + area.height + 20}, kTick, kInk, Align::Centre);
   }
-  for (double v = std::ceil(vb0 / step) * step; v <= vb1 + 1e-9 * step; v += step) {
+  for (const double v : plot::multiples_in(vb0, vb1, step)) {
     const int y = static_cast<int>(std::lround(to_pixel({0, v}).y));
     cv::line(img, {area.x, y}, {area.x + area.width, y}, kGrid, 1);
     cv::line(img, {area.x - 5, y}, {area.x, y}, kInk, 1);

@@ -6,8 +6,15 @@
 #include <fmt/format.h>
 #include <opencv2/imgproc.hpp>
 
+#include "plot/text.h"
+
 namespace ct::series {
 namespace {
+
+using plot::Align;
+using plot::draw_mark;
+using plot::put_text;
+using plot::wrap_text;
 
 const cv::Scalar kWhite(255, 255, 255), kInk(30, 30, 30), kSoftInk(100, 100, 100), kRule(200, 200, 200),
     kError(30, 30, 180);

@@ -2,14 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
-#include <stdexcept>
 #include <vector>
-
-#include <fmt/core.h>
-#include <opencv2/imgcodecs.hpp>
 
 #include "core/colour.h"
 #include "core/file_io.h"
+#include "plot/png.h"
 
 namespace ct::series {
 namespace {
@@ -70,10 +67,7 @@ cv::Mat preview_image(const analyzer::AnalysisImage& input) {
 }
 
 void write_preview_png(const std::filesystem::path& file, const analyzer::AnalysisImage& input) {
-  std::vector<unsigned char> bytes;
-  if (!cv::imencode(".png", preview_image(input), bytes))
-    throw std::runtime_error(fmt::format("{}: PNG encoding failed", file.string()));
-  write_file_atomically(file, std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()));
+  write_file_atomically(file, plot::encode_png(preview_image(input)));
 }
 
 }  // namespace ct::series

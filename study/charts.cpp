@@ -11,14 +11,18 @@
 #include <opencv2/imgproc.hpp>
 
 #include "core/file_io.h"
-#include "series/figure_data.h"
-#include "series/figure_plots.h"
+#include "plot/png.h"
+#include "plot/text.h"
+#include "plot/ticks.h"
 
 namespace ct::study {
 namespace {
 namespace fs = std::filesystem;
-using series::Align;
-using series::put_text;
+using plot::Align;
+using plot::log_tick_label;
+using plot::log_ticks;
+using plot::put_text;
+using plot::text_width;
 
 const cv::Scalar kWhite(255, 255, 255), kInk(40, 40, 40), kSoft(120, 120, 120), kGrid(228, 228, 228);
 
@@ -46,14 +50,6 @@ std::string short_label(const Setting& s) {
   if (s.knob == "bounces") return fmt::format("{} bounce{}", s.max_bounces, s.max_bounces == 1 ? "" : "s");
   if (s.knob == "planned") return "planned";
   return s.value;
-}
-
-std::string tick_text(double v) {
-  const double e = std::floor(std::log10(v) + 1e-9);
-  const double m = v / std::pow(10.0, e);
-  if (e >= -2 && e <= 3) return fmt::format("{:g}", v);
-  if (std::abs(m - 1) < 1e-6) return fmt::format("10^{}", static_cast<int>(e));
-  return fmt::format("{:g}x10^{}", std::round(m), static_cast<int>(e));
 }
 
 struct LogAxis {
@@ -97,23 +93,6 @@ void draw_marker(cv::Mat& img, cv::Point p, const cv::Scalar& colour, bool squar
 
 }  // namespace
 
-std::vector<double> log_ticks(double lo, double hi) {
-  std::vector<double> ticks;
-  const bool fine = std::log10(hi) - std::log10(lo) < 3;
-  for (int e = static_cast<int>(std::floor(std::log10(lo))); e <= static_cast<int>(std::ceil(std::log10(hi))); ++e)
-    for (double m : fine ? std::vector<double>{1, 2, 5} : std::vector<double>{1}) {
-      const double v = m * std::pow(10.0, e);
-      if (v >= lo * (1 - 1e-9) && v <= hi * (1 + 1e-9)) ticks.push_back(v);
-    }
-  if (ticks.size() < 2) {
-    ticks.clear();
-    ticks.push_back(std::pow(10.0, std::floor(std::log10(lo))));
-    ticks.push_back(std::pow(10.0, std::ceil(std::log10(hi))));
-    if (ticks[0] == ticks[1]) ticks[1] *= 10;
-  }
-  return ticks;
-}
-
 cv::Mat chart(const StudyResult& result, ChartValue value) {
   const int W = 980, H = 640, left = 96, right = 236, top = 64, bottom = 78;
   cv::Mat img(H, W, CV_8UC3, kWhite);
@@ -146,13 +125,13 @@ cv::Mat chart(const StudyResult& result, ChartValue value) {
     const int px = static_cast<int>(std::lround(x.at(t)));
     cv::line(img, {px, top}, {px, H - bottom}, kGrid, 1);
     cv::line(img, {px, H - bottom}, {px, H - bottom + 5}, kInk, 1);
-    put_text(img, tick_text(t), {px, H - bottom + 22}, 0.45, kInk, Align::Centre);
+    put_text(img, log_tick_label(t), {px, H - bottom + 22}, 0.45, kInk, Align::Centre);
   }
   for (double t : log_ticks(ylo, yhi)) {
     const int py = static_cast<int>(std::lround(y.at(t)));
     cv::line(img, {left, py}, {W - right, py}, kGrid, 1);
     cv::line(img, {left - 5, py}, {left, py}, kInk, 1);
-    put_text(img, tick_text(t), {left - 9, py + 5}, 0.45, kInk, Align::Right);
+    put_text(img, log_tick_label(t), {left - 9, py + 5}, 0.45, kInk, Align::Right);
   }
   cv::rectangle(img, {left, top}, {W - right, H - bottom}, kInk, 1);
   put_text(img, "render CPU time (seconds, log scale)", {(left + W - right) / 2, H - 24}, 0.5, kInk, Align::Centre);
@@ -175,7 +154,7 @@ cv::Mat chart(const StudyResult& result, ChartValue value) {
     const int py = static_cast<int>(std::lround(y.at(1.0)));
     for (int px = left; px < W - right; px += 8) cv::line(img, {px, py}, {std::min(px + 3, W - right), py}, kSoft, 1);
     put_text(img, "dE00 = 1", {W - right - 6, py - 6}, 0.42, kSoft, Align::Right);
-    const int w = series::text_width("dE00 = 1", 0.42);
+    const int w = text_width("dE00 = 1", 0.42);
     taken.emplace_back(cv::Point(W - right - 6 - w, py - 18) - origin, cv::Size(w, 14));
   }
   // The Pareto front (of mean ΔE00 against CPU seconds) as a staircase, on every chart.
@@ -207,7 +186,7 @@ cv::Mat chart(const StudyResult& result, ChartValue value) {
     // The label in the first free place of: right, left, above right, below right, above left, below left; in
     // none, the first of them inside the plot (else right of the marker anyway).
     const std::string text = short_label(r->setting);
-    const int w = series::text_width(text, 0.4), h = 12;
+    const int w = text_width(text, 0.4), h = 12;
     const cv::Point offsets[] = {{10, 4}, {-10 - w, 4}, {8, -10}, {8, 18}, {-8 - w, -10}, {-8 - w, 18}};
     std::optional<cv::Rect> place, first_inside;
     for (const cv::Point& o : offsets) {
@@ -261,7 +240,7 @@ void write_charts(const fs::path& dir, const StudyResult& result) {
                                                        {"p95_vs_cost.png", ChartValue::P95De00},
                                                        {"systematic_vs_cost.png", ChartValue::SystematicRms},
                                                        {"structure_vs_cost.png", ChartValue::DirectionDeg}};
-  for (const auto& [name, value] : charts) write_file_atomically(dir / name, series::encode_png(chart(result, value)));
+  for (const auto& [name, value] : charts) write_file_atomically(dir / name, plot::encode_png(chart(result, value)));
 }
 
 }  // namespace ct::study

@@ -1,7 +1,8 @@
 #pragma once
-// The study's charts (docs/study.md), PNG drawn with OpenCV: error against render cost on logarithmic axes, one
-// marker per setting coloured by the knob it changes (a circle for the tracer, a square for Cycles), the Pareto
-// front as a staircase through the settings no other beats on both, and a dotted line at ΔE00 = 1.
+// The study's charts (docs/study.md), PNG drawn with OpenCV and the plotting kit (plot/): error against render
+// cost on logarithmic axes, one marker per setting coloured by the knob it changes (a circle for the tracer, a
+// square for Cycles), the Pareto front as a staircase through the settings no other beats on both, and a dotted
+// line at ΔE00 = 1.
 //
 //   error_vs_cost.png      mean ΔE00 against CPU seconds
 //   p95_vs_cost.png        95th-percentile ΔE00 against CPU seconds
@@ -24,9 +25,5 @@ enum class ChartValue { MeanDe00, P95De00, SystematicRms, DirectionDeg };
 cv::Mat chart(const StudyResult& result, ChartValue value);
 
 void write_charts(const std::filesystem::path& dir, const StudyResult& result);
-
-// Ticks of a logarithmic axis over [lo, hi] (lo > 0): the powers of ten inside, and 2 and 5 times them when
-// the range spans fewer than three decades; at least the two ends' nearest powers of ten.
-std::vector<double> log_ticks(double lo, double hi);
 
 }  // namespace ct::study

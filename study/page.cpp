@@ -8,8 +8,8 @@
 
 #include "core/file_io.h"
 #include "core/html_text.h"
+#include "plot/png.h"
 #include "study/charts.h"
-#include "series/figure_data.h"
 
 namespace ct::study {
 namespace {
@@ -19,7 +19,7 @@ std::string optional_deg(const std::optional<double>& v) { return v ? fmt::forma
 
 std::string image_tag(const StudyResult& result, ChartValue value, const char* alt) {
   return fmt::format("<img alt=\"{}\" src=\"data:image/png;base64,{}\">", alt,
-                     base64(series::encode_png(chart(result, value))));
+                     base64(plot::encode_png(chart(result, value))));
 }
 
 }  // namespace

@@ -1,5 +1,5 @@
-// Plots and the report a person can read: tick values at round numbers on every axis, the unit of the values
-// said, and the regions listed by size with their pixel counts.
+// Plots and the report a person can read: the unit of the values said, and the regions listed by size with their
+// pixel counts (the tick values on every axis: tests/plot/test_ticks.cpp).
 #include <algorithm>
 #include <regex>
 #include <string>
@@ -18,29 +18,6 @@ namespace ct::test {
 namespace {
 
 using namespace ct::analyzer;
-
-void expect_ticks(double lo, double hi, const std::vector<double>& expected) {
-  const std::vector<double> ticks = axis_ticks(lo, hi);
-  ASSERT_EQ(ticks.size(), expected.size()) << lo << " to " << hi;
-  for (std::size_t k = 0; k < ticks.size(); ++k) EXPECT_NEAR(ticks[k], expected[k], 1e-12 * (hi - lo)) << lo << " to " << hi;
-}
-
-// The step is (hi − lo) / 5 rounded to 1, 2, 5 or 10 × 10^n (below 1.5 → 1, 3 → 2, 7 → 5); the ticks are its
-// multiples in range.
-TEST(Plots, AxisTicksAreRoundNumbersInsideTheRange) {
-  expect_ticks(0, 255, {0, 50, 100, 150, 200, 250});                             // 51 = 5.1 × 10 → 50
-  expect_ticks(0, 1, {0, 0.2, 0.4, 0.6, 0.8, 1});                                // 0.2
-  expect_ticks(0, 65535, {0, 10000, 20000, 30000, 40000, 50000, 60000});         // 13107 = 1.31 × 10^4 → 10000
-  expect_ticks(0.013, 0.087, {0.02, 0.03, 0.04, 0.05, 0.06, 0.07, 0.08});        // 0.0148 → 0.01
-  expect_ticks(-1, 1, {-1, -0.5, 0, 0.5, 1});                                    // 0.4 → 0.5
-  EXPECT_TRUE(axis_ticks(1, 1).empty());
-  EXPECT_TRUE(axis_ticks(0, std::numeric_limits<double>::infinity()).empty());
-  EXPECT_EQ(tick_label(100, 0, 255), "100");
-  EXPECT_EQ(tick_label(0.4, 0, 1), "0.4");
-  EXPECT_EQ(tick_label(0.06, 0.013, 0.087), "0.06");
-  EXPECT_EQ(tick_label(0, -1, 1), "0.0");
-  EXPECT_EQ(tick_label(40000, 0, 65535), "40000");
-}
 
 // An 8-bit PNG without a colour space is sRGB-encoded codes: the plots and the report say so; the report lists
 // the regions by size with their pixel counts, and analysis.json gives that order.

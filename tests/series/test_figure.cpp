@@ -165,13 +165,5 @@ TEST(FigurePoints, TheRangeIgnoresARareOutlierAndTheSubsampleIsDeterministic) {
   EXPECT_GT(hi, 0.047);
 }
 
-TEST(FigureText, AsciiReplacesWhatTheFontCannotDraw) {
-  EXPECT_EQ(ascii("a — b × c → d"), "a - b x c -> d");
-  EXPECT_EQ(ascii("λ"), "?");
-  EXPECT_EQ(tick_label(0.30000000000000004, 0.1), "0.3");
-  EXPECT_EQ(tick_label(250, 50), "250");
-  EXPECT_DOUBLE_EQ(nice_step(1.0, 4), 0.2);
-}
-
 }  // namespace
 }  // namespace ct::series

@@ -154,12 +154,6 @@ TEST(StudyPareto, MarksExactlyTheUndominated) {
   EXPECT_FALSE(s[4].pareto);  // (4, 1) is beaten by (3, 1)
 }
 
-TEST(StudyCharts, LogTicks) {
-  EXPECT_EQ(study::log_ticks(0.1, 10), (std::vector<double>{0.1, 0.2, 0.5, 1, 2, 5, 10}));
-  EXPECT_EQ(study::log_ticks(0.01, 1000), (std::vector<double>{0.01, 0.1, 1, 10, 100, 1000}));
-  EXPECT_EQ(study::log_ticks(3, 4), (std::vector<double>{1, 10}));
-}
-
 TEST(StudyCommand, BadInputIsOneLineAndExit2) {
   const fs::path dir = fresh_dir("bad");
   const std::vector<std::vector<std::string>> cases = {
