@@ -11,6 +11,7 @@
 #include <fmt/core.h>
 
 #include "core/error.h"
+#include "core/statistics.h"
 #include "core/parallel.h"
 
 namespace ct::analyzer {
@@ -108,13 +109,6 @@ Work working_image(const RgbImage& image, const CodeDecoder& decode, double clip
     for (std::size_t k = 0; k < 3; ++k) work.rgb[q * 3 + k] = static_cast<float>(colour[q * 3 + k] / valid[q]);
   }
   return work;
-}
-
-double quantile(std::vector<double> v, double q) {
-  if (v.empty()) return 0.0;
-  const auto k = static_cast<std::ptrdiff_t>(q * static_cast<double>(v.size() - 1));
-  std::nth_element(v.begin(), v.begin() + k, v.end());
-  return v[static_cast<std::size_t>(k)];
 }
 
 // Immerkær's 3×3 mask [1 −2 1; −2 4 −2; 1 −2 1] cancels any locally planar signal and leaves 6σ of white

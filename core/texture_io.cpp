@@ -12,6 +12,7 @@
 
 #include "core/colour.h"
 #include "core/error.h"
+#include "core/statistics.h"
 #include "core/file_io.h"
 #include "core/library_output.h"
 #include "core/limits.h"
@@ -66,9 +67,7 @@ NegativeTexels zero_capture_noise(std::vector<float>& values, int width, const s
   }
   if (n.count == 0) return n;
   if (!positive.empty()) {
-    auto tenth = positive.begin() + static_cast<std::ptrdiff_t>(positive.size() / 10);
-    std::nth_element(positive.begin(), tenth, positive.end());
-    n.threshold = *tenth;
+    n.threshold = static_cast<float>(quantile_in_place(std::span<float>(positive), 0.1));
   }
   if (n.largest > n.threshold || negative_sum > 1e-4 * positive_sum)
     throw InputError(fmt::format(
