@@ -8,7 +8,6 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 #include <opencv2/core.hpp>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "compare/compare.h"
@@ -16,6 +15,7 @@
 #include "core/error.h"
 #include "core/file_io.h"
 #include "core/html_text.h"
+#include "plot/png.h"
 
 namespace ct::cmp {
 namespace {
@@ -156,9 +156,7 @@ std::string png(const Comparison& c) {
   for (int panel = 0; panel < 4; ++panel)
     cv::putText(img, labels[panel], cv::Point(panel * (pw + gap) + 2, 16), cv::FONT_HERSHEY_SIMPLEX, 0.45,
                 cv::Scalar(230, 230, 230), 1, cv::LINE_AA);
-  std::vector<uchar> bytes;
-  if (!cv::imencode(".png", img, bytes)) throw std::runtime_error("PNG encoding failed");
-  return std::string(bytes.begin(), bytes.end());
+  return plot::encode_png(img);
 }
 
 std::string html(const Comparison& c, const std::string& png_bytes) {
