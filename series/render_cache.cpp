@@ -1,6 +1,7 @@
 #include "series/render_cache.h"
 
 #include <cstdint>
+#include <filesystem>
 #include <string_view>
 
 #include <fmt/core.h>
@@ -28,6 +29,19 @@ void hash_named_files(Json& document) {
   });
 }
 
+// A program by its path, size and modification time (nothing when it cannot be read: the key still holds the path).
+Json executable_identity(const std::filesystem::path& program) {
+  Json identity = {{"path", program.string()}};
+  std::error_code error;
+  const auto resolved = std::filesystem::canonical(program, error);
+  if (error) return identity;
+  const auto size = std::filesystem::file_size(resolved, error);
+  if (!error) identity["size"] = size;
+  const auto time = std::filesystem::last_write_time(resolved, error);
+  if (!error) identity["modified"] = static_cast<std::int64_t>(time.time_since_epoch().count());
+  return identity;
+}
+
 }  // namespace
 
 Json render_inputs(const Scene& scene, const RunOptions& options) {
@@ -47,6 +61,9 @@ Json render_inputs(const Scene& scene, const RunOptions& options) {
           {"components", options.components}};
   // The reconstruction changes no pixel's band values, but the file carries it and every colour made of them.
   if (const BandReconstruction* r = bands.reconstruction()) inputs["reconstruction"] = reconstruction_json(*r);
+  // Another Blender is another Cycles (its GGX masking, its sampling): the executable, and its size and time, so
+  // that one upgraded in place renders again too.
+  if (options.renderer == Renderer::Cycles) inputs["blender"] = executable_identity(options.blender);
   return inputs;
 }
 

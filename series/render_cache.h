@@ -11,7 +11,8 @@
 
 namespace ct::series {
 
-// What a render depends on: the scene with its named files hashed, the renderer and the run's render settings.
+// What a render depends on: the scene with its named files hashed, the renderer (for Cycles, the Blender: its path,
+// size and modification time) and the run's render settings.
 Json render_inputs(const Scene& scene, const RunOptions& options);
 
 // The cache key of those inputs: 16 hex digits of FNV-1a (64 bits; a cache key, not a cryptographic hash).
