@@ -150,7 +150,7 @@ int run_render(RenderOptions& o) {
 
 struct CyclesOptions {
   Common common;
-  std::string source, bands, bands_file, components, resolution, on_mixing_nodes, on_world;
+  std::string source, bands, bands_file, components, resolution, on_mixing_nodes, on_world, ggx_masking;
   std::optional<int> samples, max_bounces, bands_per_render;
   std::optional<std::uint64_t> seed;
 };
@@ -170,6 +170,7 @@ CLI::App* add_cycles(CLI::App* farm, CyclesOptions& o) {
   cmd->add_option("--bands-per-render", o.bands_per_render, "Bands multiplexed into one Cycles render: 1, 2 or 3");
   cmd->add_option("--on-mixing-nodes", o.on_mixing_nodes, "refuse or one-band (as the batch)");
   cmd->add_option("--on-world", o.on_world, "refuse or omit (as the batch)");
+  cmd->add_option("--ggx-masking", o.ggx_masking, "scene or cycles: GGX with the scene's masking or this Cycles' own (as the batch)");
   add_common(cmd, o.common);
   return cmd;
 }
@@ -201,7 +202,8 @@ int run_cycles(CyclesOptions& o) {
       .option("--seed", o.seed)
       .option("--bands-per-render", o.bands_per_render)
       .option("--on-mixing-nodes", o.on_mixing_nodes)
-      .option("--on-world", o.on_world);
+      .option("--on-world", o.on_world)
+      .option("--ggx-masking", o.ggx_masking);
 
   // How many band groups: the batch's pre-flight check, here and now, which also refuses bad input before
   // anything is submitted. Its summary lands in DIR/slurm/preflight.json only when something is submitted.

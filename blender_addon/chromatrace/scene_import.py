@@ -40,7 +40,8 @@ def _material(name, entry, scene_dir):
             masking, cycles = entry.get("masking", "separable"), blender_compat.cycles_ggx_masking()
             if masking != cycles:
                 raise BadInput(f"materials.{name}.masking: \"{masking}\", but the GGX of Cycles in Blender "
-                               f"{bpy.app.version_string} has {cycles} masking: Cycles would render another material")
+                               f"{bpy.app.version_string} has {cycles} masking: Cycles would render another material "
+                               f"(--ggx-masking cycles renders it with Cycles' masking, and says so)")
         else:
             s.exponent = entry["exponent"]
     else:

@@ -233,6 +233,12 @@ TEST(FarmInput, CyclesWithBouncesIsOneTaskPerBandGroupAndBounceLimit) {
   EXPECT_EQ(refused.exit_code, 2) << refused.err;
   EXPECT_EQ(refused.err, "chromatrace farm: error: --samples: must be at least 1, got 0\n");
   EXPECT_FALSE(fs::exists(bad));
+
+  // The batch's --ggx-masking reaches every task.
+  const fs::path masked = dir.file("masked");
+  const CommandResult m = test::run_chromatrace({"farm", "cycles", kBox, "-o", masked.string(), "--dry-run", "--ggx-masking", "cycles"});
+  ASSERT_EQ(m.exit_code, 0) << m.err;
+  EXPECT_NE(read_file(masked / "slurm" / "tasks.sh").find("--ggx-masking cycles"), std::string::npos);
 }
 
 // Bad input needs no cluster: one line naming the option (or the missing command), exit 2, nothing submitted.
