@@ -47,8 +47,9 @@ struct IlluminantAnalysis {
 
   // The estimate to trust most: the planes' intersection when reliable, else the highlight lines when reliable,
   // else grey world (a guess, never reliable). The planes come first although their standard error is often the
-  // larger: it is conservative — on the synthetic scenes and on StillLife with the bagel their error is a tenth to
-  // a half of it, where the highlight branches' errors are about one of theirs — and the lines may carry a
+  // larger: it looks conservative — on the analyzer's synthetic component render and on StillLife with the bagel
+  // (two images, not a sweep) their error is a tenth and a half of it, where the highlight branches' errors are
+  // about one of theirs — and the lines may carry a
   // systematic tilt (`systematic`). Choosing by standard error instead puts a synthetic render's light 8.4° off
   // rather than 2.0° (tests/analyzer/test_analyze_command.cpp).
   const IlluminantEstimate& best() const {

@@ -26,6 +26,14 @@ def _spectrum(settings, source, scene_dir):
     settings.set_from_json(source, scene_dir)
 
 
+def _ggx_masking(entry):
+    """The GGX masking a material asks for (the format's default, separable, when it names none); None when it has
+    no GGX lobe."""
+    if entry["type"] != "dichromatic" or entry.get("lobe", "ggx") != "ggx":
+        return None
+    return entry.get("masking", "separable")
+
+
 def _material(name, entry, scene_dir):
     material = bpy.data.materials.new(name)
     s = material.chromatrace
@@ -37,7 +45,7 @@ def _material(name, entry, scene_dir):
         s.lobe = entry.get("lobe", "ggx")
         if s.lobe == "ggx":
             s.roughness = entry["roughness"]
-            masking, cycles = entry.get("masking", "separable"), blender_compat.cycles_ggx_masking()
+            masking, cycles = _ggx_masking(entry), blender_compat.cycles_ggx_masking()
             if masking != cycles:
                 raise BadInput(f"materials.{name}.masking: \"{masking}\", but the GGX of Cycles in Blender "
                                f"{bpy.app.version_string} has {cycles} masking: Cycles would render another material "
@@ -166,10 +174,8 @@ def _use_cycles_masking(document, log):
     the document, which the output's header carries, then says what was rendered."""
     cycles = blender_compat.cycles_ggx_masking()
     for name, entry in document["materials"].items():
-        if entry["type"] != "dichromatic" or entry.get("lobe", "ggx") != "ggx":
-            continue
-        masking = entry.get("masking", "separable")
-        if masking != cycles:
+        masking = _ggx_masking(entry)
+        if masking is not None and masking != cycles:
             entry["masking"] = cycles
             log(f"warning: materials.{name}.masking: \"{masking}\" rendered with the {cycles} masking of Cycles in "
                 f"Blender {bpy.app.version_string} (--ggx-masking cycles)")
