@@ -296,8 +296,8 @@ std::string choice_text(const IlluminantAnalysis& out) {
                        !lines || !lines->reliable ? ""
                        : !lines->systematic.empty()
                            ? fmt::format(", preferred to the highlight lines (± {:.2f}°): {}", sigma(lines), lines->systematic)
-                           : fmt::format(", the first choice when reliable (their standard error is conservative); the "
-                                         "highlight lines (± {:.2f}°) agree with them within their errors", sigma(lines)),
+                           : fmt::format(", the first choice when reliable; the highlight lines (± {:.2f}°) agree with "
+                                         "them within their errors", sigma(lines)),
                        why_not);
   if (lines && &chosen == &*lines)
     return fmt::format("highlight lines: a highlight branch adds the light's colour (± {:.2f}°){}", sigma(lines), why_not);
