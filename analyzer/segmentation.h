@@ -11,10 +11,11 @@
 //     `working_megapixels` (never enlarged), so that the same objects give the same segments at any size.
 //  2. The noise of the working image is estimated once for the whole image (Immerkær 1996, "Fast noise
 //     variance estimation", with a low quantile of |3×3 Laplacian difference| per brightness band so that
-//     flat areas decide it), as σ² = a + b·v per channel in the values as the file stores them (read plus
-//     shot noise for a linear file; what the encoding's steps and compression did, for an sRGB or gamma
-//     file), carried into linear light by the curve's slope, plus the quantisation noise of integer files
-//     (step/√12 of the stored code, in linear light).
+//     flat areas decide it, and values clipped at black or at the top left out), as σ² = a + b·v + c·v² per
+//     channel in the values as the file stores them (read, shot and signal-proportional noise for a linear
+//     file, fitted in relative terms so that the dark bands count as much as the bright; what the encoding's
+//     steps and compression did, for an sRGB or gamma file), carried into linear light by the curve's
+//     slope, plus the quantisation noise of integer files (step/√12 of the stored code, in linear light).
 //  3. Pixels darker than `dark` noise σ have no reliable colour direction and are left unassigned ("dark").
 //  4. Linear colour clusters grow over the pixel graph (8-neighbours, the edges taken in increasing order of
 //     the angle between the two colours in units of its noise σ, as in Felzenszwalb & Huttenlocher's graph
@@ -58,12 +59,13 @@ struct SegmentationOptions {
   double dark = 3;                   // pixels with brightness below dark · σ are left unassigned
 };
 
-// The noise of the working image: σ_c² = a_c + b_c · v for channel c at stored value v — in linear light
+// The noise of the working image: σ_c² = a_c + b_c · v + c_c · v² for channel c at stored value v — in linear light
 // for a linear file; for an encoded one (sRGB, gamma) in the values as stored, carried into linear light by
 // the curve's slope (`curve`) — never below `floor`.
 struct NoiseModel {
-  Vec3 a = Vec3::Zero();
-  Vec3 b = Vec3::Zero();
+  Vec3 a = Vec3::Zero();  // read (dark) noise
+  Vec3 b = Vec3::Zero();  // shot noise
+  Vec3 c = Vec3::Zero();  // the part proportional to the signal (gain differences, film grain, an HDR merge)
   double floor = 0;
   std::size_t samples = 0;  // pixels the estimate used
   // Integer files: the linear value of each stored code (empty for float files, and for linear integer files
