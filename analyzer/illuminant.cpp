@@ -79,7 +79,12 @@ double intersection_se_deg(const std::vector<Vec3>& normals, const std::vector<d
   principal_axes(m, values, axes);  // descending: the third is the intersection's
   const double lambda2 = std::max(values[1], 1e-12);
   const double from_fits = std::sqrt(tilt / k) / std::sqrt(lambda2);
-  const double from_misfit = k > 2 ? std::sqrt(miss / (k - 2)) / std::sqrt(lambda2 / k) : 0.0;
+  // The misfit's standard error rests on ν = k − 2 degrees of freedom: |error|² / (2 s²) follows F(2, ν), whose
+  // distribution function is 1 − (1 + 2f/ν)^(−ν/2). Widened by √(ν (e^(4/ν) − 1)) / 2, the stated σ keeps what it
+  // means when known: 2σ holds the error with probability 1 − e⁻² ≈ 86 % (×3.7 at three planes, ×1.45 at five, ×1.14 at ten).
+  const double nu = k - 2;
+  const double from_misfit =
+      k > 2 ? std::sqrt(miss / nu) / std::sqrt(lambda2 / k) * std::sqrt(nu * std::expm1(4 / nu)) / 2 : 0.0;
   return std::max(from_fits, from_misfit) * kDeg;
 }
 

@@ -3,11 +3,12 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <numeric>
 #include <tuple>
 
-#include <Eigen/Eigenvalues>
+#include <Eigen/Dense>
 #include <fmt/core.h>
 
 #include "core/error.h"
@@ -19,6 +20,7 @@ namespace {
 
 constexpr double kMinAngle = 0.002;  // radians: the angular noise never counts as less (noise-free renders)
 constexpr double kWeakBoundary = 1.5;  // the median step (noise σ) across a boundary that is no edge
+constexpr double kTextureSteps = 2.5;  // or, where both parts are textured, at most this many times the median step within the smoother one
 constexpr double kEnclosed = 0.9;      // the share of a small part's boundary with segments that one segment must hold
 constexpr std::uint8_t kInvalid = 0, kOk = 1, kDark = 2;
 
@@ -111,10 +113,49 @@ Work working_image(const RgbImage& image, const CodeDecoder& decode, double clip
   return work;
 }
 
+// σ² = a + b·v + c·v² over the bands (levels v, variances), a, b, c ≥ 0: the camera's three terms (read or
+// dark noise; shot noise; a part proportional to the signal — pixel gain differences, film grain, an HDR merge's
+// exposure steps), as EMVA 1288 writes them. Least squares in relative terms (each residual over its band's
+// variance): a band's σ is measured to about the same relative precision at every level, so the dark bands count
+// as much as the bright ones, where an absolute fit would let the brightest band set the whole line. The
+// non-negative solution is the best of the subsets of terms whose unconstrained fit is non-negative.
+struct NoiseTerms {
+  double a = 0, b = 0, c = 0;
+};
+
+NoiseTerms fit_noise_terms(const std::vector<double>& level, const std::vector<double>& variance) {
+  NoiseTerms best;
+  double best_cost = std::numeric_limits<double>::infinity();
+  const std::size_t n = level.size();
+  if (n == 0) return best;
+  for (int subset = 1; subset < 8; ++subset) {
+    std::vector<int> terms;
+    for (int t = 0; t < 3; ++t)
+      if (subset & (1 << t)) terms.push_back(t);
+    if (terms.size() > n) continue;
+    Eigen::MatrixXd A(static_cast<Eigen::Index>(n), static_cast<Eigen::Index>(terms.size()));
+    Eigen::VectorXd y(static_cast<Eigen::Index>(n));
+    for (std::size_t k = 0; k < n; ++k) {
+      const double w = 1 / variance[k];
+      for (std::size_t t = 0; t < terms.size(); ++t) A(static_cast<Eigen::Index>(k), static_cast<Eigen::Index>(t)) = w * std::pow(level[k], terms[t]);
+      y(static_cast<Eigen::Index>(k)) = 1;  // variance[k] · w
+    }
+    const Eigen::VectorXd x = A.colPivHouseholderQr().solve(y);
+    if ((x.array() < 0).any() || !x.allFinite()) continue;
+    const double cost = (A * x - y).squaredNorm();
+    if (cost < best_cost) {
+      best_cost = cost;
+      best = {};
+      for (std::size_t t = 0; t < terms.size(); ++t) (terms[t] == 0 ? best.a : terms[t] == 1 ? best.b : best.c) = x(static_cast<Eigen::Index>(t));
+    }
+  }
+  return best;
+}
+
 // Immerkær's 3×3 mask [1 −2 1; −2 4 −2; 1 −2 1] cancels any locally planar signal and leaves 6σ of white
 // noise; where the image is flat it holds noise only. Per channel and per band of 16 equal-count brightness
 // bands, the 25th percentile of its magnitude (0.3186 × 6σ for Gaussian noise) weights the flat pixels of the
-// band; σ² = a + b·I is fitted over the bands.
+// band; σ² = a + b·I + c·I² is fitted over the bands (fit_noise_terms).
 // The noise is estimated where it lives: in the values as the file stores them. A linear camera file's are
 // read and shot noise, σ² = a + b·v; an encoded file's (sRGB, a gamma) are what the encoding's steps and the
 // compression did to the stored values, which the same straight line describes there and no straight line
@@ -140,7 +181,9 @@ NoiseModel estimate_noise(const Work& work, NoiseModel model) {
         for (int j = -1; j <= 1 && usable; ++j)
           for (int i = -1; i <= 1; ++i) {
             const std::size_t q = static_cast<std::size_t>(y + j) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x + i);
-            if (work.state[q] == kInvalid || work.clipped[q]) {
+            // Clipped values hold no noise: at the top, and a channel at black (0: a camera's offset or a
+            // gamut's edge clamped it there).
+            if (work.state[q] == kInvalid || work.clipped[q] || !(stored[q * 3 + static_cast<std::size_t>(c)] > 0)) {
               usable = false;
               break;
             }
@@ -159,24 +202,14 @@ NoiseModel estimate_noise(const Work& work, NoiseModel model) {
       std::vector<double> m;
       for (std::size_t k = lo; k < hi; ++k) m.push_back(samples[k].second);
       const double sigma = quantile(m, 0.25) / (6 * 0.3186);
+      if (!(sigma > 0)) continue;  // a band of one constant value: no noise to measure there
       level.push_back(samples[(lo + hi) / 2].first);
       variance.push_back(sigma * sigma);
     }
-    // Least squares σ² = a + b·I with a, b >= 0.
-    const double n = kBands;
-    const double sx = std::accumulate(level.begin(), level.end(), 0.0), sy = std::accumulate(variance.begin(), variance.end(), 0.0);
-    double sxx = 0, sxy = 0;
-    for (std::size_t k = 0; k < level.size(); ++k) sxx += level[k] * level[k], sxy += level[k] * variance[k];
-    const double det = n * sxx - sx * sx;
-    double a = sy / n, b = 0;
-    if (det > 0) {
-      b = (n * sxy - sx * sy) / det;
-      a = (sy - b * sx) / n;
-    }
-    if (b < 0) b = 0, a = sy / n;
-    if (a < 0) a = 0, b = sxx > 0 ? sxy / sxx : 0;
-    model.a[c] = a;
-    model.b[c] = b;
+    const NoiseTerms terms = fit_noise_terms(level, variance);
+    model.a[c] = terms.a;
+    model.b[c] = terms.b;
+    model.c[c] = terms.c;
   }
   return model;
 }
@@ -503,24 +536,58 @@ class ColourClusters {
   }
 
   // Parts of one surface that a slow drift of its colour split (shading by light of two colours, skin) meet
-  // along a boundary without an edge: where the median step across it is at the noise level, they join if
-  // their mean directions differ by less than 3 · angle_deg beyond their noise.
+  // along a boundary without an edge: where the median step across it is at the noise level, or no larger than
+  // 2.5 times the median step within the smoother of the two (their texture: a boundary no sharper than the
+  // surface's own grain is no edge; Felzenszwalb & Huttenlocher compare a boundary with the parts' insides so),
+  // they join if their mean directions differ by less than 3 · angle_deg beyond their noise.
   void join_across_weak_boundaries() {
+    const double extra = 2 * angle_tolerance_;
+    // The parts as they stand before these joins whose mean colour is known well enough to tell the difference
+    // this forgives (anchors): a join must keep every two of them within it, so that a run of joins, each small,
+    // cannot carry one surface's colour into another's (a dark background into a bread roll through its shade).
+    std::map<std::uint32_t, std::vector<Anchor>> anchors;
+    for (std::uint32_t q = 0; q < sets.parent.size(); ++q)
+      if (sets.find(q) == q && precision_[q] > 0 && tolerance_ / std::sqrt(precision_[q]) <= extra)
+        anchors[q].push_back({unit_sum_[q].normalized(), 1 / precision_[q], bias_sum_[q] / precision_[q]});
     for (int round = 0; round < 4; ++round) {
       std::map<std::pair<std::uint32_t, std::uint32_t>, std::vector<float>> across;
       for (const Edge& e : edges_) {
         const std::uint32_t a = sets.find(e.a), b = sets.find(e.b);
         if (a != b) across[{std::min(a, b), std::max(a, b)}].push_back(e.weight);
       }
+      std::map<std::uint32_t, std::vector<float>> within;
+      for (const Edge& e : edges_) {
+        const std::uint32_t a = sets.find(e.a), b = sets.find(e.b);
+        if (a == b) within[a].push_back(e.weight);
+      }
+      // A part's texture: the median step between its own neighbours (0 when too few to say).
+      const auto texture = [&](std::uint32_t part) {
+        const std::vector<float>& steps = within[part];
+        return steps.size() < 8 ? 0.0 : quantile(std::vector<double>(steps.begin(), steps.end()), 0.5);
+      };
       std::vector<std::tuple<double, std::uint32_t, std::uint32_t>> weak;
       for (auto& [key, weights] : across) {
         if (weights.size() < 4) continue;
         const double median = quantile(std::vector<double>(weights.begin(), weights.end()), 0.5);
-        if (median <= kWeakBoundary) weak.emplace_back(median, key.first, key.second);
+        if (median <= std::max(kWeakBoundary, kTextureSteps * std::min(texture(key.first), texture(key.second))))
+          weak.emplace_back(median, key.first, key.second);
       }
       std::sort(weak.begin(), weak.end());
       std::size_t joined = 0;
-      for (const auto& [median, a, b] : weak) joined += try_join(a, b, 2 * angle_tolerance_);
+      for (const auto& [median, a, b] : weak) {
+        const std::uint32_t ra = sets.find(a), rb = sets.find(b);
+        if (ra == rb) continue;
+        auto& xa = anchors[ra];
+        auto& xb = anchors[rb];
+        if (!compatible(xa, xb, extra)) continue;
+        if (!try_join(ra, rb, extra)) continue;
+        ++joined;
+        const std::uint32_t root = sets.find(ra), other = root == ra ? rb : ra;
+        auto& into = anchors[root];
+        auto& from = anchors[other];
+        into.insert(into.end(), from.begin(), from.end());
+        anchors.erase(other);
+      }
       if (joined == 0) break;
     }
   }
@@ -528,6 +595,20 @@ class ColourClusters {
   DisjointSets sets;
 
  private:
+  struct Anchor {
+    Vec3 direction;
+    double variance, bias;  // of the direction, radians²; the quantisation's allowance, radians
+  };
+
+  // Every anchor of one part within `extra` (beyond the noise of the two means) of every anchor of the other.
+  bool compatible(const std::vector<Anchor>& a, const std::vector<Anchor>& b, double extra) const {
+    for (const Anchor& x : a)
+      for (const Anchor& y : b)
+        if (angle(x.direction, y.direction) > tolerance_ * std::sqrt(x.variance + y.variance) + x.bias + y.bias + angle_tolerance_ + extra)
+          return false;
+    return true;
+  }
+
   struct Edge {
     float weight;  // the angle between the two colours, in units of its noise σ
     std::uint32_t a, b;
@@ -841,7 +922,7 @@ double NoiseModel::slope(double value) const {
 double NoiseModel::sigma(int channel, double value) const {
   const double q = quantisation(value);
   const double v = std::max(0.0, encode(value));
-  const double measured = std::sqrt(std::max(0.0, a[channel] + b[channel] * v)) * slope(value);
+  const double measured = std::sqrt(std::max(0.0, a[channel] + b[channel] * v + c[channel] * v * v)) * slope(value);
   return std::max(floor, std::sqrt(measured * measured + q * q));
 }
 

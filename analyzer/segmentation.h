@@ -11,10 +11,11 @@
 //     `working_megapixels` (never enlarged), so that the same objects give the same segments at any size.
 //  2. The noise of the working image is estimated once for the whole image (Immerkær 1996, "Fast noise
 //     variance estimation", with a low quantile of |3×3 Laplacian difference| per brightness band so that
-//     flat areas decide it), as σ² = a + b·v per channel in the values as the file stores them (read plus
-//     shot noise for a linear file; what the encoding's steps and compression did, for an sRGB or gamma
-//     file), carried into linear light by the curve's slope, plus the quantisation noise of integer files
-//     (step/√12 of the stored code, in linear light).
+//     flat areas decide it, and values clipped at black or at the top left out), as σ² = a + b·v + c·v² per
+//     channel in the values as the file stores them (read, shot and signal-proportional noise for a linear
+//     file, fitted in relative terms so that the dark bands count as much as the bright; what the encoding's
+//     steps and compression did, for an sRGB or gamma file), carried into linear light by the curve's
+//     slope, plus the quantisation noise of integer files (step/√12 of the stored code, in linear light).
 //  3. Pixels darker than `dark` noise σ have no reliable colour direction and are left unassigned ("dark").
 //  4. Linear colour clusters grow over the pixel graph (8-neighbours, the edges taken in increasing order of
 //     the angle between the two colours in units of its noise σ, as in Felzenszwalb & Huttenlocher's graph
@@ -22,8 +23,10 @@
 //     taken, and two parts join only while their mean colour directions differ by less than `tolerance`
 //     times the noise of those means plus `angle_deg`, so that a gradual drift cannot chain objects together.
 //     Parts that a slow drift of one surface's colour split meet along a boundary with no edge (a median step
-//     across it of at most 1.5 σ) and join if their mean directions differ by less than 3 · angle_deg beyond
-//     their noise.
+//     across it of at most 1.5 σ, or of at most 2.5 times the median step within the smoother part: no sharper
+//     than the surface's own texture) and join if their mean directions differ by less than 3 · angle_deg beyond
+//     their noise, and if every part that was well measured before these joins stays within that of every other
+//     one in the joined part, so that a run of small joins cannot carry one surface's colour into another's.
 //  5. Dichromatic extension: a brighter neighbour B of a region A, at most a quarter of A's size and bordered
 //     by A on at least 30 % of its boundary, joins A when B's colours are A's body colour plus one other
 //     colour (the mean colours of B's rings, pixels at the same distance from B's edge, lie in a plane with
@@ -58,12 +61,13 @@ struct SegmentationOptions {
   double dark = 3;                   // pixels with brightness below dark · σ are left unassigned
 };
 
-// The noise of the working image: σ_c² = a_c + b_c · v for channel c at stored value v — in linear light
+// The noise of the working image: σ_c² = a_c + b_c · v + c_c · v² for channel c at stored value v — in linear light
 // for a linear file; for an encoded one (sRGB, gamma) in the values as stored, carried into linear light by
 // the curve's slope (`curve`) — never below `floor`.
 struct NoiseModel {
-  Vec3 a = Vec3::Zero();
-  Vec3 b = Vec3::Zero();
+  Vec3 a = Vec3::Zero();  // read (dark) noise
+  Vec3 b = Vec3::Zero();  // shot noise
+  Vec3 c = Vec3::Zero();  // the part proportional to the signal (gain differences, film grain, an HDR merge)
   double floor = 0;
   std::size_t samples = 0;  // pixels the estimate used
   // Integer files: the linear value of each stored code (empty for float files, and for linear integer files
