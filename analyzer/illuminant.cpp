@@ -269,6 +269,16 @@ void cross_check(std::size_t plane_count, IlluminantAnalysis& out) {
 }
 
 // The image's mean colour: a guess, always marked so.
+// Every light's colour lies within 54.7° of grey (arccos(1/√3), grey to a primary): an estimate whose 2σ reaches
+// that far could be any light's colour, so it says nothing of this one.
+void refuse_if_uninformative(std::optional<IlluminantEstimate>& e) {
+  const double octant_deg = std::acos(1 / std::sqrt(3.0)) * kDeg;
+  if (!e || !e->reliable || !e->uncertainty_deg || 2 * *e->uncertainty_deg < octant_deg) return;
+  e->reliable = false;
+  e->unreliable_reason = fmt::format("its 2σ ({:.0f}°) reaches past {:.1f}°, the angle from grey to a primary: it could be any "
+                                     "light's colour", 2 * *e->uncertainty_deg, octant_deg);
+}
+
 void estimate_grey_world(std::span<const float> rgb, IlluminantAnalysis& out) {
   Vec3 mean = Vec3::Zero();
   std::size_t count = 0;
@@ -321,6 +331,7 @@ IlluminantAnalysis estimate_illuminant(const std::vector<RegionAnalysis>& region
   estimate_from_lines(evidence, out);
   estimate_from_planes(evidence, out);
   cross_check(evidence.normals.size(), out);
+  for (auto* e : {&out.planes, &out.highlight_lines}) refuse_if_uninformative(*e);
   // A plane through black is one only in the true linear light: a response curve that was guessed, not declared,
   // tilts every plane alike when it is wrong, which their agreement cannot show.
   if (out.planes && !assumed_curve.empty() && out.planes->reliable) {

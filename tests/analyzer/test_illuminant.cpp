@@ -4,7 +4,10 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <numbers>
 #include <random>
+
+#include <Eigen/Geometry>
 
 #include "analyzer/highlight_branch.h"
 #include "analyzer/illuminant.h"
@@ -155,6 +158,39 @@ TEST(Illuminant, TwoPlanesAloneAreUnreliable) {
   EXPECT_FALSE(a.best().reliable);
   EXPECT_EQ(a.best().method, "grey world");
   EXPECT_NE(a.choice.find("the dichromatic planes are not used"), std::string::npos) << a.choice;
+}
+
+// Every light's colour lies within 54.7° of grey (grey to a primary). Three planes that miss a common direction,
+// with one degree of freedom to say by how much, have a 2σ beyond that: they could be any light's colour, and grey
+// world is the guess. The same three planes, meeting, are an estimate.
+TEST(Illuminant, AnEstimateThatCouldBeAnyLightIsUnreliable) {
+  const Scene scene = dichromatic_scene(kWarm);
+  const LayerContext context = layer_context(scene.image, {}, 64);
+  std::vector<RegionAnalysis> regions;
+  for (const Region& r : label_regions(scene.ids, "object", scene.names, {0})) {
+    regions.push_back(analyse_region(scene.image, context, r, AnalyzeOptions{}));
+    ClusterShape& s = regions.back().shape;
+    s.shape = ShapeClass::Planar;  // the planes without their highlight lines
+    s.two_lines.reset();
+    s.highlight_branch.reset();
+    ASSERT_TRUE(s.black_plane);
+    if (regions.size() == 3) break;
+  }
+  const IlluminantAnalysis meeting = estimate_illuminant(regions, scene.image.rgb, kWarm);
+  ASSERT_TRUE(meeting.planes);
+  EXPECT_TRUE(meeting.planes->reliable) << meeting.planes->unreliable_reason;
+  // Tilt the third plane by 10° about the axis in it that is perpendicular to the light: it no longer holds the light.
+  Vec3& n = regions[2].shape.black_plane->normal;
+  const Vec3 axis = n.cross(kWarm.normalized()).normalized();
+  n = Eigen::AngleAxisd(10 * std::numbers::pi / 180, axis) * n;
+  const IlluminantAnalysis missing = estimate_illuminant(regions, scene.image.rgb, kWarm);
+  ASSERT_TRUE(missing.planes);
+  ASSERT_TRUE(missing.planes->uncertainty_deg);
+  EXPECT_GT(2 * *missing.planes->uncertainty_deg, std::acos(1 / std::sqrt(3.0)) * 180 / std::numbers::pi);
+  EXPECT_FALSE(missing.planes->reliable);
+  EXPECT_NE(missing.planes->unreliable_reason.find("could be any light's colour"), std::string::npos)
+      << missing.planes->unreliable_reason;
+  EXPECT_EQ(missing.best().method, "grey world");
 }
 
 TEST(Illuminant, OnePlaneIsNotEnough) {
