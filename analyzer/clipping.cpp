@@ -39,7 +39,10 @@ Clipping find_clipping(std::span<const float> rgb, const std::array<double, 3>& 
       if (count[c][s] < 3 || fraction < kFaceFraction) continue;
       if (!(s == 1 && rules.known_high)) {
         const double spread = std::max(hi[c][s][0] - lo[c][s][0], hi[c][s][1] - lo[c][s][1]);
-        const double scale = std::max({std::abs(high_levels[c]) < 1e300 ? std::abs(high_levels[c] - low[c]) : 0.0,
+        // A lower face's spread is measured against the other channels' own values on it: the image's levels, set
+        // by its brightest parts (a lamp's flame in an HDR photograph), would call every dim region's lower face flat.
+        const double range = s == 1 && std::abs(high_levels[c]) < 1e300 ? std::abs(high_levels[c] - low[c]) : 0.0;
+        const double scale = std::max({range,
                                        static_cast<double>(std::abs(hi[c][s][0] - low[(c + 1) % 3])),
                                        static_cast<double>(std::abs(hi[c][s][1] - low[(c + 2) % 3]))});
         if (spread <= kFaceSpread * scale) continue;

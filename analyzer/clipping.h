@@ -28,9 +28,10 @@ struct Clipping {
 // A face counts when at least this share of the samples lies on it: a few pixels exactly at a channel's
 // maximum happen without clipping.
 constexpr double kFaceFraction = 0.005;
-// … and, when the upper levels are only estimated (each channel's largest value in a float image), only when
-// the other channels keep changing on it (their range above this share of the level): a flat patch that
-// happens to hold a channel's largest value is not clipped.
+// … and, when the upper levels are only estimated (each channel's largest value in a float image), and on every
+// lower face, only when the other channels keep changing on it (their range above this share of the level; on a
+// lower face, of the other channels' largest value on it): a flat patch that happens to hold a channel's largest or
+// smallest value is not clipped.
 constexpr double kFaceSpread = 0.01;
 
 // Where the faces are. `known_high`: the upper levels are limits the camera or the file format clipped at
