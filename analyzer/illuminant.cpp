@@ -138,8 +138,8 @@ bool told_from_body(const RegionAnalysis& r, const ClusterShape& s, std::vector<
 // highlight), unless it ends at a clipping level; the branch's colour by regression when measured
 // (highlight_branch.h), not tilted by the shading across the highlight. False when the region's branch cannot be
 // told from its body colour: then the region is no evidence at all, its plane included.
-bool add_highlight_line(const RegionAnalysis& r, const std::array<double, 3>& high_levels, Evidence& e, std::vector<std::string>& notes) {
-  const ClusterShape& s = r.shape;
+bool add_highlight_line(const RegionAnalysis& r, const ClusterShape& s, const std::array<double, 3>& high_levels, Evidence& e,
+                        std::vector<std::string>& notes) {
   const Line& h = s.two_lines->highlight;
   const Vec3 bright = h.at(h.t_max);
   int clipped = -1;
@@ -165,9 +165,13 @@ Evidence gather_evidence(const std::vector<RegionAnalysis>& regions, const std::
   for (const RegionAnalysis& r : regions) {
     if (parts && r.source == "image") continue;
     if (r.source == "unassigned") continue;  // the pixels no segment holds: no one surface
-    const ClusterShape& s = r.shape;
+    // A cluster clipped only at black (its darkest pixels at the file's lowest value) keeps its highlight whole:
+    // its highlight line is read on the samples off the faces. Its plane is not (see below).
+    const bool black_only = r.shape.shape == ShapeClass::Clipped && !r.shape.unclipped.empty() &&
+                            std::none_of(r.shape.clipping.faces.begin(), r.shape.clipping.faces.end(), [](const ClippedFace& f) { return f.high; });
+    const ClusterShape& s = black_only ? r.shape.unclipped.front() : r.shape;
     if ((s.shape == ShapeClass::L || s.shape == ShapeClass::SkewedT || s.shape == ShapeClass::P) && s.two_lines &&
-        !add_highlight_line(r, high_levels, e, notes))
+        !add_highlight_line(r, s, high_levels, e, notes))
       continue;
     // A planar cluster with a highlight branch (cluster_shape.h): several objects of one body colour with their
     // highlights. Its branch counts when no channel of it reaches a clipping level.
@@ -180,11 +184,11 @@ Evidence gather_evidence(const std::vector<RegionAnalysis>& regions, const std::
     if (!holds_a_plane(s.shape) || !s.black_plane) continue;
     // A cluster that reaches a face of the cube lost what lay beyond it: its plane through black is partly the
     // face's (a saturated colour clipped at 0 or at the top lies on the face), not the one its light made.
-    if (!s.clipping.faces.empty()) {
-      const ClippedFace& f = s.clipping.faces.front();
+    if (!r.shape.clipping.faces.empty()) {
+      const ClippedFace& f = r.shape.clipping.faces.front();
       notes.push_back(fmt::format("{}: {:.1f} % of its pixels lie on clipping faces ({} {} at {:.4g} …), so its plane is "
                                   "partly the cube's face: left out of the planes' estimate", r.name,
-                                  100 * s.clipping.fraction, "RGB"[f.channel], f.high ? "high" : "low", f.level));
+                                  100 * r.shape.clipping.fraction, "RGB"[f.channel], f.high ? "high" : "low", f.level));
       continue;
     }
     e.normals.push_back(s.black_plane->normal);

@@ -55,6 +55,16 @@ std::string process_of(ShapeClass c) {
   return "";
 }
 
+// "a P", "an L", "a linear cluster": the class as a noun.
+std::string class_article(ShapeClass c) {
+  const std::string name(class_name(c));
+  switch (c) {
+    case ShapeClass::L: return "an L";
+    case ShapeClass::P: case ShapeClass::SkewedT: return "a " + name;
+    default: return "a " + name + " cluster";
+  }
+}
+
 Vec3 unit(const Vec3& v) { return v.sum() < 0 ? Vec3(-v.normalized()) : v.normalized(); }
 
 // The body reflection's direction: the body line of a two-line fit, else the robust body line, else the line.
@@ -175,10 +185,19 @@ Interpretation interpret_region(const RegionAnalysis& region, const Region& pixe
                                 const IlluminantAnalysis& illuminant, const ImageEncoding& encoding,
                                 const std::optional<Explanation>& explanation, const ShapeCriteria& criteria) {
   Interpretation out;
-  const ClusterShape& s = region.linear_light ? *region.linear_light : region.shape;
-  out.light_class = std::string(class_name(s.shape));
+  const ClusterShape& whole = region.linear_light ? *region.linear_light : region.shape;
+  out.light_class = std::string(class_name(whole.shape));
   out.stored_class = std::string(class_name(region.shape.shape));
-  out.process = process_of(s.shape);
+  out.process = process_of(whole.shape);
+  // A clipped cluster is read on the samples off its faces: what the light made there is whole.
+  const bool clipped = whole.shape == ShapeClass::Clipped && !whole.unclipped.empty() && whole.unclipped.front().samples > 0;
+  const ClusterShape& s = clipped ? whole.unclipped.front() : whole;
+  const auto& faces = region.shape.clipping.faces;
+  if (whole.shape == ShapeClass::Clipped && !faces.empty() && std::none_of(faces.begin(), faces.end(), [](const ClippedFace& f) { return f.high; }))
+    out.process = "the file holds channels at its lowest value (black), below which the colour was cut off: the "
+                  "cluster's dark end lies flattened on faces of the RGB cube";
+  if (clipped)
+    out.process += fmt::format("; off the faces, its {} pixels are {}: {}", s.samples, class_article(s.shape), process_of(s.shape));
   out.curve = encoding.curve ? encoding.curve->describe() : "not known";
   if (s.samples == 0) {
     out.uncertain.push_back(s.reason);

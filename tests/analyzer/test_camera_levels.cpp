@@ -164,6 +164,22 @@ TEST(CameraLevels, KnownLevelsCountEverySampleOnThem) {
   EXPECT_EQ(find_clipping(dark, {1e4, 1e4, 1e4}, ClippingRules{true, {-2048, -2048, -2048}}).fraction, 0.0);
 }
 
+// A lower face is judged against the other channels' own values on it, not the image's levels: in an HDR image
+// whose flame sets the levels at 500, a dim region whose green is 0 in 30 % of its pixels while red runs from 0.001
+// to 0.05 lies on green's lower face; a uniform patch whose green is 0 is a colour, not a face.
+TEST(CameraLevels, ALowerFaceIsJudgedOnItsOwnValues) {
+  std::vector<float> dim;
+  for (int i = 0; i < 100; ++i) dim.insert(dim.end(), {0.001f + 0.0005f * float(i), i % 10 < 3 ? 0.0f : 0.0002f * float(i), 0.0f + 0.0001f * float(i)});
+  const Clipping c = find_clipping(dim, {500, 500, 500}, ClippingRules{false, {0, 0, 0}});
+  ASSERT_EQ(c.faces.size(), 1u);
+  EXPECT_EQ(c.faces.front().channel, 1);
+  EXPECT_FALSE(c.faces.front().high);
+  EXPECT_NEAR(c.fraction, 0.3, 1e-12);
+  std::vector<float> uniform;
+  for (int i = 0; i < 100; ++i) uniform.insert(uniform.end(), {0.03f, 0.0f, 0.01f});
+  EXPECT_EQ(find_clipping(uniform, {500, 500, 500}, ClippingRules{false, {0, 0, 0}}).fraction, 0.0);
+}
+
 // An integer file's full scale is a known limit too: a 16-bit patch at 65535 is wholly clipped.
 TEST(CameraLevels, AnIntegerFilesFullScaleIsKnown) {
   TempDir dir;
