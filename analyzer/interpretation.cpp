@@ -194,8 +194,9 @@ Interpretation interpret_region(const RegionAnalysis& region, const Region& pixe
   const ClusterShape& s = clipped ? whole.unclipped.front() : whole;
   const auto& faces = region.shape.clipping.faces;
   if (whole.shape == ShapeClass::Clipped && !faces.empty() && std::none_of(faces.begin(), faces.end(), [](const ClippedFace& f) { return f.high; }))
-    out.process = "the file holds channels at its lowest value (black), below which the colour was cut off: the "
-                  "cluster's dark end lies flattened on faces of the RGB cube";
+    out.process = "the file holds channels at their lowest value, below which the colour was cut off — a saturated "
+                  "colour outside the file's gamut, or dim pixels under its black — and the cluster lies flattened on faces "
+                  "of the RGB cube";
   if (clipped)
     out.process += fmt::format("; off the faces, its {} pixels are {}: {}", s.samples, class_article(s.shape), process_of(s.shape));
   out.curve = encoding.curve ? encoding.curve->describe() : "not known";

@@ -130,8 +130,16 @@ json summary(const RegionAnalysis& r, const std::optional<Explanation>& e) {
   if (s.samples > 0) {
     row("mean", rgb_text(s.moments.mean));
     row("σ along axes", rgb_text(s.sigma));
-    row("noise σ along axes", rgb_text(s.noise_sigma));
-    row("linearity / planarity / scattering", fmt::format("{:.3f} / {:.3f} / {:.3f}", s.linearity, s.planarity, s.scattering));
+    // A clipped cluster's shape is measured on its samples off the faces (analysis.json: `unclipped`).
+    if (s.shape != ShapeClass::Clipped) {
+      row("noise σ along axes", rgb_text(s.noise_sigma));
+      row("linearity / planarity / scattering", fmt::format("{:.3f} / {:.3f} / {:.3f}", s.linearity, s.planarity, s.scattering));
+    } else if (!s.unclipped.empty() && s.unclipped.front().samples > 0) {
+      const ClusterShape& u = s.unclipped.front();
+      row("off the faces", fmt::format("{} ({} samples)", class_name(u.shape), u.samples));
+      row("noise σ along axes, off the faces", rgb_text(u.noise_sigma));
+      row("linearity / planarity / scattering, off the faces", fmt::format("{:.3f} / {:.3f} / {:.3f}", u.linearity, u.planarity, u.scattering));
+    }
   }
   if (s.line) row("line direction", rgb_text(s.line->direction));
   if (s.two_lines && (s.shape == ShapeClass::L || s.shape == ShapeClass::SkewedT)) {

@@ -157,9 +157,9 @@ NoiseTerms fit_noise_terms(const std::vector<double>& level, const std::vector<d
 // bands, the 25th percentile of its magnitude (0.3186 × 6σ for Gaussian noise) weights the flat pixels of the
 // band; σ² = a + b·I + c·I² is fitted over the bands (fit_noise_terms).
 // The noise is estimated where it lives: in the values as the file stores them. A linear camera file's are
-// read and shot noise, σ² = a + b·v; an encoded file's (sRGB, a gamma) are what the encoding's steps and the
-// compression did to the stored values, which the same straight line describes there and no straight line
-// does in linear light (at the dark end the curve's slope shrinks them many times). `model` brings the curve.
+// read and shot noise and a part proportional to the signal; an encoded file's (sRGB, a gamma) are what the
+// encoding's steps and the compression did to the stored values, which the same curve describes there and no
+// such curve does in linear light (at the dark end the curve's slope shrinks them many times). `model` brings the curve.
 NoiseModel estimate_noise(const Work& work, NoiseModel model) {
   std::vector<double> brightest;
   for (std::size_t q = 0; q < work.size(); ++q)

@@ -52,5 +52,27 @@ TEST(Plots, ReportListsRegionsBySizeAndSaysTheUnit) {
   EXPECT_EQ(in->spec().height, 828);
 }
 
+// A clipped cluster's shape is measured on its samples off the faces: the report gives those, named so, not the
+// unmeasured statistics of the whole as zeros.
+TEST(Plots, AClippedRegionsSummaryIsOfItsSamplesOffTheFaces) {
+  TempDir dir;
+  const int w = 64, h = 32;
+  std::vector<std::uint8_t> pixels;
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x)  // red reaches 255 at x = 32 and stays there: half the image on R's upper face
+      pixels.insert(pixels.end(), {static_cast<std::uint8_t>(std::min(255, 8 * x)), static_cast<std::uint8_t>(4 * x + 2 * (y % 3)), static_cast<std::uint8_t>(2 * x + (y % 2))});
+  OIIO::ImageSpec spec(w, h, 3, OIIO::TypeDesc::UINT8);
+  auto out = OIIO::ImageOutput::create(dir.file("clipped.png").string());
+  ASSERT_TRUE(out && out->open(dir.file("clipped.png").string(), spec) && out->write_image(OIIO::TypeDesc::UINT8, pixels.data()) && out->close());
+  const CommandResult r = run_chromatrace({"analyze", dir.file("clipped.png").string(), "-o", dir.file("o").string(), "-q"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const nlohmann::json a = nlohmann::json::parse(read_file(dir.file("o") / "analysis.json"));
+  ASSERT_EQ(a["regions"][0]["shape"]["class"], "clipped");
+  const std::string html = read_file(dir.file("o") / "report.html");
+  EXPECT_NE(html.find("off the faces"), std::string::npos);
+  EXPECT_EQ(html.find("\"linearity / planarity / scattering\""), std::string::npos);
+  EXPECT_EQ(html.find("\"noise σ along axes\""), std::string::npos);
+}
+
 }  // namespace
 }  // namespace ct::test
