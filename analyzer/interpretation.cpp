@@ -129,6 +129,11 @@ void describe_highlight(const ClusterShape& s, const RegionAnalysis& region, con
     }
     if (two_lines) sentence += fmt::format(", leaves the body line {:.0f} % along it", 100 * s.two_lines->junction_on_body);
     if (out.highlight_reach) sentence += fmt::format(" and reaches {:.2f} × the body line's brightest colour", *out.highlight_reach);
+    // Read on the samples below a clipping level: what lay beyond it is cut off, so the branch is of its dimmer part.
+    const auto& faces = region.shape.clipping.faces;
+    if (std::any_of(faces.begin(), faces.end(), [](const ClippedFace& f) { return f.high; }))
+      sentence += "; its brightest part is clipped, so this is the branch below the clipping level, and where the cut "
+                  "was the highlight's colour is not known";
     out.findings.push_back(sentence + ".");
   }
 }

@@ -588,6 +588,12 @@ TEST_P(EachPhotograph, EachRegionsInterpretationCarriesItsOwnNumbers) {
       EXPECT_LT(analyzer::angular_error_deg(vec(in["highlight_direction"]), expected), 1e-5);  // acos near 1: ~1e-7°
       EXPECT_NEAR(in["highlight_light_angle_deg"].get<double>(), analyzer::angular_error_deg(expected, chosen), 1e-5);
     }
+    // A highlight branch read below a clipping level says its brightest part is cut.
+    const auto& all_faces = region["shape"]["clipping"]["faces"];
+    const bool cut = std::any_of(all_faces.begin(), all_faces.end(), [](const nlohmann::json& f) { return f["side"] == "high"; });
+    if (!in["highlight_direction"].is_null()) {
+      EXPECT_EQ(text.find("its brightest part is clipped") != std::string::npos, cut) << text;
+    }
     for (const auto& face : region["shape"]["clipping"]["faces"]) {
       EXPECT_NE(text.find(fmt::format("{} {} at {:.4g}", face["channel"].get<std::string>(), face["side"].get<std::string>(),
                                       face["level"].get<double>())), std::string::npos) << text;
