@@ -551,19 +551,19 @@ class ColourClusters {
         anchors[q].push_back({unit_sum_[q].normalized(), 1 / precision_[q], bias_sum_[q] / precision_[q]});
     for (int round = 0; round < 4; ++round) {
       std::map<std::pair<std::uint32_t, std::uint32_t>, std::vector<float>> across;
-      for (const Edge& e : edges_) {
-        const std::uint32_t a = sets.find(e.a), b = sets.find(e.b);
-        if (a != b) across[{std::min(a, b), std::max(a, b)}].push_back(e.weight);
-      }
       std::map<std::uint32_t, std::vector<float>> within;
       for (const Edge& e : edges_) {
         const std::uint32_t a = sets.find(e.a), b = sets.find(e.b);
-        if (a == b) within[a].push_back(e.weight);
+        if (a != b) across[{std::min(a, b), std::max(a, b)}].push_back(e.weight);
+        else within[a].push_back(e.weight);
       }
-      // A part's texture: the median step between its own neighbours (0 when too few to say).
+      // Each part's texture, once: the median step between its own neighbours (0 when too few to say).
+      std::map<std::uint32_t, double> texture_of;
+      for (const auto& [part, steps] : within)
+        if (steps.size() >= 8) texture_of[part] = quantile(std::vector<double>(steps.begin(), steps.end()), 0.5);
       const auto texture = [&](std::uint32_t part) {
-        const std::vector<float>& steps = within[part];
-        return steps.size() < 8 ? 0.0 : quantile(std::vector<double>(steps.begin(), steps.end()), 0.5);
+        const auto it = texture_of.find(part);
+        return it == texture_of.end() ? 0.0 : it->second;
       };
       std::vector<std::tuple<double, std::uint32_t, std::uint32_t>> weak;
       for (auto& [key, weights] : across) {

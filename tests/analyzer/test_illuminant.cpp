@@ -137,20 +137,26 @@ TEST(Illuminant, APlaneOnAClippingFaceIsLeftOut) {
   EXPECT_EQ(said, faced);
 }
 
-// Two planes meet in a line whatever made them: without a highlight line to check them, the planes' estimate is
-// marked unreliable (and grey world, a guess, is never reliable), so the chosen estimate says it is not trusted.
-TEST(Illuminant, TwoPlanesAloneAreUnreliable) {
-  const Scene scene = dichromatic_scene(kWarm);
+// The first `count` objects of the scene as planes without their highlight lines.
+std::vector<RegionAnalysis> planes_only(const Scene& scene, std::size_t count) {
   const LayerContext context = layer_context(scene.image, {}, 64);
   std::vector<RegionAnalysis> regions;
   for (const Region& r : label_regions(scene.ids, "object", scene.names, {0})) {
     regions.push_back(analyse_region(scene.image, context, r, AnalyzeOptions{}));
     ClusterShape& s = regions.back().shape;
-    s.shape = ShapeClass::Planar;  // the planes without their highlight lines
+    s.shape = ShapeClass::Planar;
     s.two_lines.reset();
     s.highlight_branch.reset();
-    if (regions.size() == 2) break;
+    if (regions.size() == count) break;
   }
+  return regions;
+}
+
+// Two planes meet in a line whatever made them: without a highlight line to check them, the planes' estimate is
+// marked unreliable (and grey world, a guess, is never reliable), so the chosen estimate says it is not trusted.
+TEST(Illuminant, TwoPlanesAloneAreUnreliable) {
+  const Scene scene = dichromatic_scene(kWarm);
+  const std::vector<RegionAnalysis> regions = planes_only(scene, 2);
   const IlluminantAnalysis a = estimate_illuminant(regions, scene.image.rgb, kWarm);
   ASSERT_TRUE(a.planes);
   EXPECT_FALSE(a.planes->reliable);
@@ -165,17 +171,9 @@ TEST(Illuminant, TwoPlanesAloneAreUnreliable) {
 // world is the guess. The same three planes, meeting, are an estimate.
 TEST(Illuminant, AnEstimateThatCouldBeAnyLightIsUnreliable) {
   const Scene scene = dichromatic_scene(kWarm);
-  const LayerContext context = layer_context(scene.image, {}, 64);
-  std::vector<RegionAnalysis> regions;
-  for (const Region& r : label_regions(scene.ids, "object", scene.names, {0})) {
-    regions.push_back(analyse_region(scene.image, context, r, AnalyzeOptions{}));
-    ClusterShape& s = regions.back().shape;
-    s.shape = ShapeClass::Planar;  // the planes without their highlight lines
-    s.two_lines.reset();
-    s.highlight_branch.reset();
-    ASSERT_TRUE(s.black_plane);
-    if (regions.size() == 3) break;
-  }
+  std::vector<RegionAnalysis> regions = planes_only(scene, 3);
+  ASSERT_EQ(regions.size(), 3u);
+  for (const RegionAnalysis& r : regions) ASSERT_TRUE(r.shape.black_plane);
   const IlluminantAnalysis meeting = estimate_illuminant(regions, scene.image.rgb, kWarm);
   ASSERT_TRUE(meeting.planes);
   EXPECT_TRUE(meeting.planes->reliable) << meeting.planes->unreliable_reason;
