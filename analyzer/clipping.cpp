@@ -59,4 +59,10 @@ Clipping find_clipping(std::span<const float> rgb, const std::array<double, 3>& 
   return result;
 }
 
+bool reaches_the_top(const Clipping& c) {
+  return std::any_of(c.faces.begin(), c.faces.end(), [](const ClippedFace& f) { return f.high; });
+}
+
+bool only_at_black(const Clipping& c) { return !c.faces.empty() && !reaches_the_top(c); }
+
 }  // namespace ct::analyzer

@@ -49,5 +49,11 @@ struct ClippingRules {
 // clipped).
 Clipping find_clipping(std::span<const float> rgb, const std::array<double, 3>& high_levels, const ClippingRules& rules);
 
+// A face at a channel's upper limit: a highlight or a bright colour cut off, where what lay beyond is lost.
+bool reaches_the_top(const Clipping& c);
+// Faces, all at the lower limits: channels at the file's black (a colour outside its gamut, dim pixels under its
+// black); the brightest samples, a highlight among them, are whole.
+bool only_at_black(const Clipping& c);
+
 
 }  // namespace ct::analyzer

@@ -126,6 +126,12 @@ struct ClusterShape {
   std::vector<ClusterShape> unclipped;  // for clipped clusters: the shape of the samples off the faces
 };
 
+// The shape the light made, as far as it can be read: a clipped cluster's samples off its faces (`unclipped`)
+// when there are any; any other cluster itself.
+inline const ClusterShape& off_the_faces(const ClusterShape& s) {
+  return s.shape == ShapeClass::Clipped && !s.unclipped.empty() && s.unclipped.front().samples > 0 ? s.unclipped.front() : s;
+}
+
 inline constexpr double kNoLevel = std::numeric_limits<double>::infinity();
 
 // What the cluster is judged against.

@@ -167,16 +167,14 @@ Evidence gather_evidence(const std::vector<RegionAnalysis>& regions, const std::
     if (r.source == "unassigned") continue;  // the pixels no segment holds: no one surface
     // A cluster clipped only at black (its darkest pixels at the file's lowest value) keeps its highlight whole:
     // its highlight line is read on the samples off the faces. Its plane is not (see below).
-    const bool black_only = r.shape.shape == ShapeClass::Clipped && !r.shape.unclipped.empty() &&
-                            std::none_of(r.shape.clipping.faces.begin(), r.shape.clipping.faces.end(), [](const ClippedFace& f) { return f.high; });
-    const ClusterShape& s = black_only ? r.shape.unclipped.front() : r.shape;
+    const ClusterShape& s = only_at_black(r.shape.clipping) ? off_the_faces(r.shape) : r.shape;
     if ((s.shape == ShapeClass::L || s.shape == ShapeClass::SkewedT || s.shape == ShapeClass::P) && s.two_lines &&
         !add_highlight_line(r, s, high_levels, e, notes))
       continue;
     // A planar cluster with a highlight branch (cluster_shape.h): several objects of one body colour with their
     // highlights. Its branch counts when no channel of it reaches a clipping level.
     if (s.shape == ShapeClass::Planar && s.highlight_branch && told_from_body(r, s, notes)) {
-      if (std::none_of(s.clipping.faces.begin(), s.clipping.faces.end(), [](const ClippedFace& f) { return f.high; }))
+      if (!reaches_the_top(s.clipping))
         e.add_line(s.highlight_branch->direction, static_cast<double>(s.highlight_branch->samples), s.highlight_branch->uncertainty_deg / kDeg, r.name);
       else
         notes.push_back(fmt::format("{}: its highlight branch reaches a clipping level, so it is left out of the highlight-line estimate", r.name));

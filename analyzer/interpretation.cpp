@@ -130,8 +130,7 @@ void describe_highlight(const ClusterShape& s, const RegionAnalysis& region, con
     if (two_lines) sentence += fmt::format(", leaves the body line {:.0f} % along it", 100 * s.two_lines->junction_on_body);
     if (out.highlight_reach) sentence += fmt::format(" and reaches {:.2f} × the body line's brightest colour", *out.highlight_reach);
     // Read on the samples below a clipping level: what lay beyond it is cut off, so the branch is of its dimmer part.
-    const auto& faces = region.shape.clipping.faces;
-    if (std::any_of(faces.begin(), faces.end(), [](const ClippedFace& f) { return f.high; }))
+    if (reaches_the_top(region.shape.clipping))
       sentence += "; its brightest part is clipped, so this is the branch below the clipping level, and where the cut "
                   "was the highlight's colour is not known";
     out.findings.push_back(sentence + ".");
@@ -195,10 +194,9 @@ Interpretation interpret_region(const RegionAnalysis& region, const Region& pixe
   out.stored_class = std::string(class_name(region.shape.shape));
   out.process = process_of(whole.shape);
   // A clipped cluster is read on the samples off its faces: what the light made there is whole.
-  const bool clipped = whole.shape == ShapeClass::Clipped && !whole.unclipped.empty() && whole.unclipped.front().samples > 0;
-  const ClusterShape& s = clipped ? whole.unclipped.front() : whole;
-  const auto& faces = region.shape.clipping.faces;
-  if (whole.shape == ShapeClass::Clipped && !faces.empty() && std::none_of(faces.begin(), faces.end(), [](const ClippedFace& f) { return f.high; }))
+  const ClusterShape& s = off_the_faces(whole);
+  const bool clipped = &s != &whole;
+  if (whole.shape == ShapeClass::Clipped && only_at_black(region.shape.clipping))
     out.process = "the file holds channels at their lowest value, below which the colour was cut off — a saturated "
                   "colour outside the file's gamut, or dim pixels under its black — and the cluster lies flattened on faces "
                   "of the RGB cube";

@@ -12,7 +12,6 @@ namespace {
 
 constexpr int kBands = 16;
 constexpr std::size_t kPerBand = 4096;         // residuals kept per band, at an even stride
-constexpr double kQuartileAbs = 0.3186;        // the 25th percentile of |N(0, 1)|
 constexpr double kClip = 3;                    // the clip, in σ
 constexpr double kTruncatedMedianAbs = 0.6727;  // the median of |N(0, 1)| given |N| < 3
 
@@ -63,7 +62,6 @@ ImageNoise estimate_image_noise(const RgbImage& image, const std::array<double, 
   }
   const std::size_t interior = (w - 2 * s) * (h - 2 * s);
   const std::size_t stride = std::max<std::size_t>(1, interior / std::max<std::size_t>(1, max_pixels));
-  const int mask[3][3] = {{1, -2, 1}, {-2, 4, -2}, {1, -2, 1}};
   std::vector<std::pair<double, std::array<float, 3>>> found;  // (brightness, residual / 6)
   std::vector<double> brightness;  // of every finite pixel visited: the bands are its quantiles
   for (std::size_t i = 0; i < interior; i += stride) {
@@ -72,16 +70,14 @@ ImageNoise estimate_image_noise(const RgbImage& image, const std::array<double, 
     const double level = (double(centre[0]) + centre[1] + centre[2]) / 3.0;
     if (!std::isfinite(level)) continue;
     brightness.push_back(level);
-    std::array<double, 3> r{};
+    std::array<float, 3> r{};
     bool ok = true;
-    for (int j = -1; j <= 1 && ok; ++j)
-      for (int k = -1; k <= 1 && ok; ++k) {
-        const std::size_t q = static_cast<std::size_t>(static_cast<std::ptrdiff_t>((y * w + x)) +
-                                                       static_cast<std::ptrdiff_t>(s) * (j * static_cast<std::ptrdiff_t>(w) + k));
-        ok = usable[q] != 0;
-        for (std::size_t c = 0; c < 3 && ok; ++c) r[c] += mask[j + 1][k + 1] * static_cast<double>(image.rgb[q * 3 + c]);
-      }
-    if (ok) found.push_back({level, {static_cast<float>(r[0] / 6), static_cast<float>(r[1] / 6), static_cast<float>(r[2] / 6)}});
+    for (std::size_t c = 0; c < 3 && ok; ++c) {
+      const auto m = immerkaer_response(y * w + x, w, s, [&](std::size_t q) { return image.rgb[q * 3 + c]; }, [&](std::size_t q) { return usable[q] != 0; });
+      ok = m.has_value();
+      if (ok) r[c] = static_cast<float>(*m / kImmerkaerGain);
+    }
+    if (ok) found.push_back({level, r});
   }
   noise.pixels = found.size();
   if (found.size() < static_cast<std::size_t>(kBands) * 16) return noise;

@@ -31,6 +31,25 @@
 
 namespace ct::analyzer {
 
+// Immerkær's mask at pixel p of an image `width` pixels wide, its taps `spacing` pixels apart: Σ mask · value(q)
+// over the taps q, 6σ of white noise and nothing of a locally planar signal; none when a tap is not usable(q)
+// (clamped and clipped values carry no noise). p must lie `spacing` pixels inside the image's edges.
+inline constexpr double kImmerkaerGain = 6;      // the mask's response to white noise of σ 1: √(Σ mask²)
+inline constexpr double kQuartileAbs = 0.3186;   // the 25th percentile of |N(0, 1)|
+template <class Value, class Usable>
+std::optional<double> immerkaer_response(std::size_t p, std::size_t width, std::size_t spacing, Value value, Usable usable) {
+  static constexpr int kMask[3][3] = {{1, -2, 1}, {-2, 4, -2}, {1, -2, 1}};
+  double r = 0;
+  for (int j = -1; j <= 1; ++j)
+    for (int k = -1; k <= 1; ++k) {
+      const std::size_t q = static_cast<std::size_t>(static_cast<std::ptrdiff_t>(p) +
+                                                     static_cast<std::ptrdiff_t>(spacing) * (j * static_cast<std::ptrdiff_t>(width) + k));
+      if (!usable(q)) return std::nullopt;
+      r += kMask[j + 1][k + 1] * static_cast<double>(value(q));
+    }
+  return r;
+}
+
 // A camera's own noise, from its calibration (chromatrace calibrate: a chromatrace-sensor/1 file), in digital numbers
 // above black: a value of mean signal μ varies by K²(σ_read² + DSNU²) + 1/12 + K·μ + (PRNU·μ)² — read noise, fixed
 // offsets, quantisation, shot noise and fixed gains, all of which spread one image's cluster (DSNU and PRNU with

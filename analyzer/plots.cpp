@@ -159,7 +159,7 @@ void draw_circle(cv::Mat& img, const Frame& frame, const Vec3& x, const cv::Scal
 
 void draw_fits(cv::Mat& img, const Frame& frame, const ClusterShape& s) {
   // A clipped cluster shows the fits of its pixels off the faces.
-  if (!s.unclipped.empty()) return draw_fits(img, frame, s.unclipped.front());
+  if (&off_the_faces(s) != &s) return draw_fits(img, frame, off_the_faces(s));
   auto segment = [&](const Line& l, const cv::Scalar& colour) { draw_polyline(img, frame, {l.at(l.t_min), l.at(l.t_max)}, colour, 2); };
   if (s.plane && s.significant_axes >= 2) {
     // The principal plane's patch: ±2σ along the first two axes about the mean.

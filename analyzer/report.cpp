@@ -103,7 +103,7 @@ json unit(const Vec3& x, const HistogramSpec& s) {
 }
 
 json fits_json(const ClusterShape& s, const HistogramSpec& spec) {
-  if (!s.unclipped.empty()) return fits_json(s.unclipped.front(), spec);  // the fits of the pixels off the faces
+  if (&off_the_faces(s) != &s) return fits_json(off_the_faces(s), spec);  // the fits of the pixels off the faces
   json lines = json::array(), curve = json::array(), plane = json::array();
   auto add = [&](const Line& l, const char* kind) { lines.push_back({{"from", unit(l.at(l.t_min), spec)}, {"to", unit(l.at(l.t_max), spec)}, {"kind", kind}}); };
   if (s.line) add(*s.line, "line");
@@ -134,8 +134,7 @@ json summary(const RegionAnalysis& r, const std::optional<Explanation>& e) {
     if (s.shape != ShapeClass::Clipped) {
       row("noise σ along axes", rgb_text(s.noise_sigma));
       row("linearity / planarity / scattering", fmt::format("{:.3f} / {:.3f} / {:.3f}", s.linearity, s.planarity, s.scattering));
-    } else if (!s.unclipped.empty() && s.unclipped.front().samples > 0) {
-      const ClusterShape& u = s.unclipped.front();
+    } else if (const ClusterShape& u = off_the_faces(s); &u != &s) {
       row("off the faces", fmt::format("{} ({} samples)", class_name(u.shape), u.samples));
       row("noise σ along axes, off the faces", rgb_text(u.noise_sigma));
       row("linearity / planarity / scattering, off the faces", fmt::format("{:.3f} / {:.3f} / {:.3f}", u.linearity, u.planarity, u.scattering));

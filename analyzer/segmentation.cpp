@@ -11,6 +11,7 @@
 #include <Eigen/Dense>
 #include <fmt/core.h>
 
+#include "analyzer/noise_level.h"
 #include "core/error.h"
 #include "core/statistics.h"
 #include "core/parallel.h"
@@ -152,8 +153,10 @@ NoiseTerms fit_noise_terms(const std::vector<double>& level, const std::vector<d
   return best;
 }
 
-// Immerkær's 3×3 mask [1 −2 1; −2 4 −2; 1 −2 1] cancels any locally planar signal and leaves 6σ of white
-// noise; where the image is flat it holds noise only. Per channel and per band of 16 equal-count brightness
+// Immerkær's 3×3 mask (immerkaer_response, analyzer/noise_level.h) cancels any locally planar signal and leaves
+// 6σ of white noise; where the image is flat it holds noise only. Unlike the image's noise for the clusters'
+// extents (estimate_image_noise), the segmentation's is measured per channel, on the working image, in the stored
+// values, and fitted by a curve over the brightness. Per channel and per band of 16 equal-count brightness
 // bands, the 25th percentile of its magnitude (0.3186 × 6σ for Gaussian noise) weights the flat pixels of the
 // band; σ² = a + b·I + c·I² is fitted over the bands (fit_noise_terms).
 // The noise is estimated where it lives: in the values as the file stores them. A linear camera file's are
@@ -171,26 +174,16 @@ NoiseModel estimate_noise(const Work& work, NoiseModel model) {
   std::vector<double> stored(work.rgb.size());
   for (std::size_t k = 0; k < stored.size(); ++k) stored[k] = model.encode(work.rgb[k]);
   const int w = work.w;
-  const int mask[3][3] = {{1, -2, 1}, {-2, 4, -2}, {1, -2, 1}};
   for (int c = 0; c < 3; ++c) {
     std::vector<std::pair<double, double>> samples;  // (value, |mask response|)
+    // Clipped values hold no noise: at the top, and a channel at black (0: a camera's offset or a gamut's edge
+    // clamped it there).
+    const auto value = [&](std::size_t q) { return stored[q * 3 + static_cast<std::size_t>(c)]; };
+    const auto usable = [&](std::size_t q) { return work.state[q] != kInvalid && !work.clipped[q] && value(q) > 0; };
     for (int y = 1; y + 1 < work.h; ++y)
       for (int x = 1; x + 1 < w; ++x) {
-        double m = 0;
-        bool usable = true;
-        for (int j = -1; j <= 1 && usable; ++j)
-          for (int i = -1; i <= 1; ++i) {
-            const std::size_t q = static_cast<std::size_t>(y + j) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x + i);
-            // Clipped values hold no noise: at the top, and a channel at black (0: a camera's offset or a
-            // gamut's edge clamped it there).
-            if (work.state[q] == kInvalid || work.clipped[q] || !(stored[q * 3 + static_cast<std::size_t>(c)] > 0)) {
-              usable = false;
-              break;
-            }
-            m += mask[j + 1][i + 1] * stored[q * 3 + static_cast<std::size_t>(c)];
-          }
-        if (usable)
-          samples.emplace_back(stored[(static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x)) * 3 + static_cast<std::size_t>(c)], std::abs(m));
+        const std::size_t p = static_cast<std::size_t>(y) * static_cast<std::size_t>(w) + static_cast<std::size_t>(x);
+        if (const auto m = immerkaer_response(p, static_cast<std::size_t>(w), 1, value, usable)) samples.emplace_back(value(p), std::abs(*m));
       }
     model.samples = std::max(model.samples, samples.size());
     if (samples.size() < 64) continue;
@@ -201,7 +194,7 @@ NoiseModel estimate_noise(const Work& work, NoiseModel model) {
       const std::size_t lo = samples.size() * static_cast<std::size_t>(band) / kBands, hi = samples.size() * static_cast<std::size_t>(band + 1) / kBands;
       std::vector<double> m;
       for (std::size_t k = lo; k < hi; ++k) m.push_back(samples[k].second);
-      const double sigma = quantile(m, 0.25) / (6 * 0.3186);
+      const double sigma = quantile(m, 0.25) / (kImmerkaerGain * kQuartileAbs);
       if (!(sigma > 0)) continue;  // a band of one constant value: no noise to measure there
       level.push_back(samples[(lo + hi) / 2].first);
       variance.push_back(sigma * sigma);
