@@ -319,6 +319,7 @@ json analysis_to_json(const ImageAnalysis& a, const std::vector<bool>& plotted) 
             {"noise_factor", k.noise_factor},
             {"relative_floor", k.relative_floor},
             {"clipped_fraction", k.clipped_fraction},
+            {"black_faces_fraction", k.black_faces_fraction},
             {"body_only_fraction", k.body_only_fraction},
             {"two_line_residual", k.two_line_residual},
             {"min_highlight_samples", k.min_highlight_samples},

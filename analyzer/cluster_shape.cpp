@@ -157,7 +157,25 @@ class ShapeDecision {
         rest.insert(rest.end(), rgb_.begin() + static_cast<std::ptrdiff_t>(i * 3), rgb_.begin() + static_cast<std::ptrdiff_t>(i * 3 + 3));
     ShapeContext inner = context_;
     inner.criteria.clipped_fraction = 2.0;  // the unclipped part is judged on its shape alone
-    s_.unclipped.push_back(analyse_shape(rest, inner));
+    ClusterShape off = analyse_shape(rest, inner);
+    if (only_at_black(s_.clipping) &&
+        test("faces only at black: clipped fraction < black_faces_fraction", s_.clipping.fraction, k_.black_faces_fraction,
+             s_.clipping.fraction < k_.black_faces_fraction) &&
+        off.samples > 0) {
+      // The cluster is its samples off the faces, with its clipping and all the decisions taken.
+      std::vector<Decision> decisions = std::move(s_.decisions);
+      decisions.insert(decisions.end(), off.decisions.begin(), off.decisions.end());
+      Clipping clipping = std::move(s_.clipping);
+      const std::size_t samples = s_.samples;
+      s_ = std::move(off);
+      s_.reason += fmt::format(" (read on its {} samples off the faces; {:.1f} % lie at black, on {} face{})", s_.samples,
+                               100 * clipping.fraction, clipping.faces.size(), clipping.faces.size() == 1 ? "" : "s");
+      s_.decisions = std::move(decisions);
+      s_.clipping = std::move(clipping);
+      s_.samples = samples;
+      return true;
+    }
+    s_.unclipped.push_back(std::move(off));
     return settle(ShapeClass::Clipped, fmt::format("{:.1f} % of the pixels lie on {} face{} of the RGB cube", 100 * s_.clipping.fraction,
                                                    s_.clipping.faces.size(), s_.clipping.faces.size() == 1 ? "" : "s"));
   }

@@ -6,7 +6,8 @@
 // Each class is decided by numbered tests on those numbers, in this order (docs/analyze.md, "Classes",
 // states the same with the thresholds of ShapeCriteria):
 //   none      fewer than min_samples valid samples, or all black
-//   clipped   at least clipped_fraction of the samples on faces of the RGB cube
+//   clipped   at least clipped_fraction of the samples on faces of the RGB cube — unless every face is at black
+//             and they hold less than black_faces_fraction: then the class of the samples off the faces
 //   point     σ1 not significant
 //   linear    σ2 not significant, or the body line holds body_only_fraction of the samples
 //   L         body + highlight lines leave a small residual (two_line_residual), meet at an angle, the highlight leaving the body
@@ -51,6 +52,10 @@ struct ShapeCriteria {
   double noise_factor = 3;
   double relative_floor = 0.01;
   double clipped_fraction = 0.02;
+  // Faces at black (channels at the file's lowest value) cut off the darkest end of the body line, not the highlight
+  // the classes are read from: while they hold less than this share, the cluster is what its samples off the faces
+  // are, and its clipping a finding. (Any face at the top cuts the highlight: clipped from clipped_fraction on.)
+  double black_faces_fraction = 0.5;
   double body_only_fraction = 0.98;
   double two_line_residual = 0.3;  // the points' rms distance from the nearer line, as a share of σ2
   std::size_t min_highlight_samples = 5;  // a line: two samples fix it, three more confirm it …

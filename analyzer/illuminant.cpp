@@ -184,6 +184,14 @@ Evidence gather_evidence(const std::vector<RegionAnalysis>& regions, const std::
     // face's (a saturated colour clipped at 0 or at the top lies on the face), not the one its light made.
     if (!r.shape.clipping.faces.empty()) {
       const ClippedFace& f = r.shape.clipping.faces.front();
+      if (only_at_black(r.shape.clipping)) {
+        // The samples left near a face at black are those whose noise happened to lie above it: biased off the face,
+        // they tilt the plane of the rest.
+        notes.push_back(fmt::format("{}: {:.1f} % of its pixels lie at black ({} low at {:.4g} …); the rest near them kept only "
+                                    "the noise above that level, which tilts its plane: left out of the planes' estimate",
+                                    r.name, 100 * r.shape.clipping.fraction, "RGB"[f.channel], f.level));
+        continue;
+      }
       notes.push_back(fmt::format("{}: {:.1f} % of its pixels lie on clipping faces ({} {} at {:.4g} …), so its plane is "
                                   "partly the cube's face: left out of the planes' estimate", r.name,
                                   100 * r.shape.clipping.fraction, "RGB"[f.channel], f.high ? "high" : "low", f.level));

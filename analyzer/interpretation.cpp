@@ -243,7 +243,10 @@ Interpretation interpret_region(const RegionAnalysis& region, const Region& pixe
       out.clipped_faces.push_back(fmt::format("{} {} at {:.4g}", "RGB"[f.channel], f.high ? "high" : "low", f.level));
       faces.push_back(fmt::format("{} ({:.1f} %)", out.clipped_faces.back(), 100 * f.fraction));
     }
-    out.findings.push_back(fmt::format("{:.1f} % of its pixels are clipped: {}.", 100 * stored.clipping.fraction, fmt::join(faces, ", ")));
+    std::string sentence = fmt::format("{:.1f} % of its pixels are clipped: {}", 100 * stored.clipping.fraction, fmt::join(faces, ", "));
+    if (only_at_black(stored.clipping) && whole.shape != ShapeClass::Clipped && stored.shape != ShapeClass::Clipped)
+      sentence +=  " — at black: its darkest pixels, fewer than half, so its class is that of the pixels off the faces";
+    out.findings.push_back(sentence + ".");
   } else {
     out.findings.push_back("No pixel of it lies on a clipping level.");
   }

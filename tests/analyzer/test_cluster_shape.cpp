@@ -141,6 +141,34 @@ TEST(ClusterShape, OverExposedLineIsClippedOnTheRedFace) {
   EXPECT_LT(line_angle_degrees(s.unclipped[0].line->direction, kBody), kDegrees);
 }
 
+// Faces at black cut off the darkest end of the body line, not the highlight: an L whose blue is 0 along its darkest
+// quarter (a colour under the file's black there) is an L, read on its samples off the face, with the face kept;
+// with blue 0 along more than half of it, it is clipped, and an L off the face. (A face at the top makes a cluster
+// clipped from clipped_fraction on: OverExposedLineIsClippedOnTheRedFace.)
+TEST(ClusterShape, AnLWithItsDarkestPixelsAtBlackIsAnL) {
+  for (const double cut : {0.25, 0.6}) {
+    SCOPED_TRACE(::testing::Message() << "blue at 0 below u = " << cut);
+    const RgbImage image = make_image(128, 128, [cut](double u, double) -> Vec3 {
+      Vec3 c = u < 0.85 ? Vec3(u / 0.85 * kBody) : Vec3(kBody + 0.5 * (u - 0.85) / 0.15 * kIlluminant);
+      if (u < cut) c[2] = 0;
+      return c;
+    });
+    int columns = 0;  // x ≥ 1 (x = 0 is black in every channel: dark, not clipped) with u = x / 127 < cut
+    for (int x = 1; x < 128; ++x) columns += x / 127.0 < cut;
+    const ClusterShape s = shape_of(image);
+    ASSERT_EQ(s.clipping.faces.size(), 1u) << describe(s);
+    EXPECT_EQ(s.clipping.faces[0].channel, 2);
+    EXPECT_FALSE(s.clipping.faces[0].high);
+    EXPECT_DOUBLE_EQ(s.clipping.fraction, columns / 128.0);
+    EXPECT_EQ(s.samples, 128u * 128u);
+    EXPECT_EQ(s.shape, cut < 0.5 ? ShapeClass::L : ShapeClass::Clipped) << describe(s);
+    const ClusterShape& l = off_the_faces(s);
+    ASSERT_EQ(l.shape, ShapeClass::L) << describe(l);
+    EXPECT_LT(line_angle_degrees(l.two_lines->body.direction, kBody), kDegrees);
+    EXPECT_LT(line_angle_degrees(l.two_lines->highlight.direction, kIlluminant), kDegrees);
+  }
+}
+
 TEST(ClusterShape, PowerCurveBendsALineAndTheFitFindsGamma) {
   const ClusterShape s = shape_of(gamma_line());
   ASSERT_EQ(s.shape, ShapeClass::Gamma) << describe(s);

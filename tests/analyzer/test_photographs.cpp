@@ -594,6 +594,10 @@ TEST_P(EachPhotograph, EachRegionsInterpretationCarriesItsOwnNumbers) {
     if (!in["highlight_direction"].is_null()) {
       EXPECT_EQ(text.find("its brightest part is clipped") != std::string::npos, cut) << text;
     }
+    // Faces only at black, under half of the cluster: its class is that of the pixels off them, and it says so.
+    const bool at_black_only = !all_faces.empty() && !cut;
+    EXPECT_EQ(text.find("its class is that of the pixels off the faces") != std::string::npos,
+              at_black_only && region["shape"]["class"] != "clipped" && shape["class"] != "clipped") << text;
     for (const auto& face : region["shape"]["clipping"]["faces"]) {
       EXPECT_NE(text.find(fmt::format("{} {} at {:.4g}", face["channel"].get<std::string>(), face["side"].get<std::string>(),
                                       face["level"].get<double>())), std::string::npos) << text;
