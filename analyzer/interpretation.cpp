@@ -137,8 +137,9 @@ void describe_highlight(const ClusterShape& s, const RegionAnalysis& region, con
   }
 }
 
-// A segment of the light's colour, and a segment of several separate areas.
-void describe_light_coloured(const ClusterShape& s, const RegionAnalysis& region, const Region& pixels, int width,
+// A segment whose colour one direction stands for several objects — the light's colour, or a dim colour whose
+// weaker channels lie at black — and a segment of several separate areas.
+void describe_shared_colour(const ClusterShape& s, const RegionAnalysis& region, const Region& pixels, int width,
                              const IlluminantAnalysis& illuminant, const ShapeCriteria& criteria, Interpretation& out) {
   if (region.source == "segment") out.separate_areas = separate_areas(pixels, width);
   bool light_coloured = false;
@@ -161,11 +162,25 @@ void describe_light_coloured(const ClusterShape& s, const RegionAnalysis& region
                                          "colour may hold several of them, touching or not.",
                                          apart, sharp->method, *sharp->uncertainty_deg));
   }
+  // Most of its pixels at black in some channels (as many as make it clipped): there only the channels above black
+  // measure the colour, and dim surfaces that differ in the others look alike.
+  const Clipping& clipping = region.shape.clipping;
+  std::string at_black;
+  if (region.source == "segment" && only_at_black(clipping) && clipping.fraction >= criteria.black_faces_fraction) {
+    std::vector<std::string> channels;
+    for (const ClippedFace& f : clipping.faces) channels.push_back(std::string(1, "RGB"[f.channel]));
+    at_black = fmt::format("{}", fmt::join(channels, " or "));
+    out.findings.push_back(fmt::format("{:.0f} % of its pixels have {} at black: there only the channels above black measure "
+                                       "their colour, so dim surfaces whose colours differ in {} look alike, and a segment of "
+                                       "such pixels may hold several dark objects, touching or not.",
+                                       100 * clipping.fraction, at_black, at_black));
+  }
   if (out.separate_areas > 1)
     out.findings.push_back(fmt::format("This segment is {} separate areas (each at least 1 % of it): the segmentation groups "
                                        "pixels by colour direction, and {} share this one, so it joins them.", out.separate_areas,
-                                       light_coloured ? "objects of the light's colour — white cloth, glass, plates, the flames — all"
-                                                      : "several objects"));
+                                       light_coloured      ? "objects of the light's colour — white cloth, glass, plates, the flames — all"
+                                       : !at_black.empty() ? "dim objects that differ only in " + at_black
+                                                           : "several objects"));
 }
 
 // What the numbers cannot tell.
@@ -269,7 +284,7 @@ Interpretation interpret_region(const RegionAnalysis& region, const Region& pixe
     }
     out.findings.push_back(sentence + ".");
   }
-  describe_light_coloured(s, region, pixels, width, illuminant, criteria, out);
+  describe_shared_colour(s, region, pixels, width, illuminant, criteria, out);
   // γ.
   if (region.declared_gamma) {
     out.declared_gamma = region.declared_gamma->declared_gamma;

@@ -594,10 +594,14 @@ TEST_P(EachPhotograph, EachRegionsInterpretationCarriesItsOwnNumbers) {
     if (!in["highlight_direction"].is_null()) {
       EXPECT_EQ(text.find("its brightest part is clipped") != std::string::npos, cut) << text;
     }
-    // Faces only at black, under half of the cluster: its class is that of the pixels off them, and it says so.
+    // Faces only at black, under half of the cluster: its class is that of the pixels off them, and it says so; a
+    // segment with at least half of it there may hold several dark objects, and says why.
     const bool at_black_only = !all_faces.empty() && !cut;
     EXPECT_EQ(text.find("its class is that of the pixels off the faces") != std::string::npos,
               at_black_only && region["shape"]["class"] != "clipped" && shape["class"] != "clipped") << text;
+    EXPECT_EQ(text.find("may hold several dark objects") != std::string::npos,
+              at_black_only && region["source"] == "segment" &&
+                  region["shape"]["clipping"]["fraction"].get<double>() >= j["criteria"]["black_faces_fraction"].get<double>()) << text;
     for (const auto& face : region["shape"]["clipping"]["faces"]) {
       EXPECT_NE(text.find(fmt::format("{} {} at {:.4g}", face["channel"].get<std::string>(), face["side"].get<std::string>(),
                                       face["level"].get<double>())), std::string::npos) << text;
