@@ -140,7 +140,7 @@ void describe_highlight(const ClusterShape& s, const RegionAnalysis& region, con
 // A segment whose colour one direction stands for several objects — the light's colour, or a dim colour whose
 // weaker channels lie at black — and a segment of several separate areas.
 void describe_shared_colour(const ClusterShape& s, const RegionAnalysis& region, const Region& pixels, int width,
-                             const IlluminantAnalysis& illuminant, const ShapeCriteria& criteria, Interpretation& out) {
+                            const IlluminantAnalysis& illuminant, const ShapeCriteria& criteria, Interpretation& out) {
   if (region.source == "segment") out.separate_areas = separate_areas(pixels, width);
   bool light_coloured = false;
   if (out.light_colour && s.moments.mean.norm() > 0) out.mean_light_angle_deg = angular_error_deg(s.moments.mean, *out.light_colour);
@@ -260,7 +260,7 @@ Interpretation interpret_region(const RegionAnalysis& region, const Region& pixe
     }
     std::string sentence = fmt::format("{:.1f} % of its pixels are clipped: {}", 100 * stored.clipping.fraction, fmt::join(faces, ", "));
     if (only_at_black(stored.clipping) && whole.shape != ShapeClass::Clipped && stored.shape != ShapeClass::Clipped)
-      sentence +=  " — at black: its darkest pixels, fewer than half, so its class is that of the pixels off the faces";
+      sentence += " — at black: its darkest pixels, fewer than half, so its class is that of the pixels off the faces";
     out.findings.push_back(sentence + ".");
   } else {
     out.findings.push_back("No pixel of it lies on a clipping level.");
