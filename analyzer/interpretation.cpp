@@ -259,8 +259,10 @@ Interpretation interpret_region(const RegionAnalysis& region, const Region& pixe
       faces.push_back(fmt::format("{} ({:.1f} %)", out.clipped_faces.back(), 100 * f.fraction));
     }
     std::string sentence = fmt::format("{:.1f} % of its pixels are clipped: {}", 100 * stored.clipping.fraction, fmt::join(faces, ", "));
-    if (only_at_black(stored.clipping) && whole.shape != ShapeClass::Clipped && stored.shape != ShapeClass::Clipped)
-      sentence += " — at black: its darkest pixels, fewer than half, so its class is that of the pixels off the faces";
+    // Enough of it at black to be clipped, yet under black_faces_fraction: the class was read off the faces.
+    if (only_at_black(stored.clipping) && stored.clipping.fraction >= criteria.clipped_fraction &&
+        whole.shape != ShapeClass::Clipped && stored.shape != ShapeClass::Clipped)
+      sentence += " — only at black, in fewer than half of them, so its class is that of the pixels off the faces";
     out.findings.push_back(sentence + ".");
   } else {
     out.findings.push_back("No pixel of it lies on a clipping level.");
