@@ -52,7 +52,7 @@ struct ShapeCriteria {
   double noise_factor = 3;
   double relative_floor = 0.01;
   double clipped_fraction = 0.02;
-  // Faces at black (channels at the file's lowest value) cut off the darkest end of the body line, not the highlight
+  // Faces at black (channels at the file's lowest value) cut off the dim, saturated end of the body line, not the highlight
   // the classes are read from: while they hold less than this share, the cluster is what its samples off the faces
   // are, and its clipping a finding. (Any face at the top cuts the highlight: clipped from clipped_fraction on.)
   double black_faces_fraction = 0.5;
