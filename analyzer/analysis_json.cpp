@@ -48,6 +48,11 @@ json estimate_json(const IlluminantEstimate& e) {
 json interpretation_json(const Interpretation& i) {
   auto opt = [](const std::optional<double>& v) { return v ? json(*v) : json(nullptr); };
   auto opt_vec = [](const std::optional<Vec3>& v) { return v ? vec(*v) : json(nullptr); };
+  json findings = json::array(), statements = json::array();
+  for (const Statement& f : i.findings) {
+    findings.push_back(f.text);
+    statements.push_back({{"kind", f.kind}, {"text", f.text}, {"claims", f.claims}});
+  }
   return {{"text", interpretation_text(i)},
           {"class_in_linear_light", i.light_class},
           {"class_as_stored", i.stored_class},
@@ -69,7 +74,15 @@ json interpretation_json(const Interpretation& i) {
           {"declared_gamma", opt(i.declared_gamma)},
           {"fitted_gamma", opt(i.fitted_gamma)},
           {"fitted_gamma_se", opt(i.fitted_gamma_se)},
-          {"findings", i.findings},
+          {"findings", findings},
+          {"statements", statements},
+          {"process_kind", i.process_kind},
+          {"process_claims", i.process_claims},
+          {"mean_colour", opt_vec(i.mean_colour)},
+          {"body_reach", i.body_reach ? json{{"miss", i.body_reach->miss}, {"angle_deg", i.body_reach->angle_deg},
+                                             {"uncertainty_deg", i.body_reach->uncertainty_deg}, {"allowed_deg", i.body_reach->allowed_deg},
+                                             {"reaches", i.body_reach->reaches}}
+                                      : json(nullptr)},
           {"uncertain", i.uncertain}};
 }
 
@@ -151,7 +164,9 @@ json shape_to_json(const ClusterShape& s) {
       {"decisions", decisions},
       {"samples", s.samples},
       {"fit_points", s.fit_points},
-      {"clipping", {{"fraction", s.clipping.fraction}, {"pixels", s.clipping.clipped}, {"faces", faces}}},
+      {"clipping", {{"fraction", s.clipping.fraction}, {"pixels", s.clipping.clipped}, {"faces", faces},
+                    {"at_top", s.clipping.at_top}, {"at_black", s.clipping.at_black},
+                    {"black_brightest_median", s.clipping.black_brightest_median}, {"top", s.clipping.top}}},
   };
   if (s.samples == 0) return j;
   j["mean"] = vec(s.moments.mean);
@@ -280,6 +295,7 @@ json analysis_to_json(const ImageAnalysis& a, const std::vector<bool>& plotted) 
               {"gamma_against_declared", optional_json(r.declared_gamma, [](const GammaComparison& c) {
                  return json{{"declared_curve", c.declared}, {"declared_gamma", c.declared_gamma}, {"fitted_gamma", c.fitted},
                              {"gamma_se", c.se}, {"difference_in_se", c.difference_in_se}, {"agree", c.agree},
+                             {"measured", c.measured}, {"not_measured", c.measured ? json(nullptr) : json(c.not_measured)},
                              {"rule", fmt::format("agree when |fitted - declared| <= {} gamma_se", kGammaAgreement)}};
                })},
               {"files", {{"histogram", "histograms/" + stem + ".json"},
@@ -311,6 +327,7 @@ json analysis_to_json(const ImageAnalysis& a, const std::vector<bool>& plotted) 
                          {"full_max", spec.full_max}}},
           {"clipping_levels", a.context.high_levels},
           {"clipping_levels_source", a.context.high_levels_source},
+          {"clipping_low_levels", a.context.clipping.low},
           {"quantisation_sigma", a.context.quantisation_sigma},
           {"image_noise", image_noise_json(a.context.noise)},
           {"criteria",

@@ -3,6 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <vector>
+
+#include "core/statistics.h"
 
 namespace ct::analyzer {
 Clipping find_clipping(std::span<const float> rgb, const std::array<double, 3>& high_levels, const ClippingRules& rules) {
@@ -50,6 +53,21 @@ Clipping find_clipping(std::span<const float> rgb, const std::array<double, 3>& 
       kept[c][s] = true;
       result.faces.push_back({c, s == 1, s == 1 ? high_levels[c] : low[c], count[c][s], fraction});
     }
+  for (int c = 0; c < 3; ++c) result.at_black[c] = count[c][0], result.at_top[c] = count[c][1];
+  result.known_high = rules.known_high;
+  for (const double level : high_levels)
+    if (std::isfinite(level)) result.top = std::max(result.top, level);
+  if (!(result.top > 0))
+    for (std::size_t i = 0; i < n * 3; ++i)
+      if (std::isfinite(rgb[i])) result.top = std::max(result.top, static_cast<double>(rgb[i]));
+  for (int c = 0; c < 3; ++c) {
+    if (count[c][0] == 0) continue;
+    std::vector<double> brightest;
+    brightest.reserve(count[c][0]);
+    for (std::size_t i = 0; i < n; ++i)
+      if (side(i, c) == 0) brightest.push_back(std::max({rgb[i * 3], rgb[i * 3 + 1], rgb[i * 3 + 2]}));
+    result.black_brightest_median[c] = quantile_in_place(brightest, 0.5);
+  }
   result.on_face.assign(n, 0);
   for (std::size_t i = 0; i < n; ++i)
     for (int c = 0; c < 3; ++c)

@@ -23,7 +23,21 @@ struct Clipping {
   std::size_t clipped = 0;         // samples on any of those faces
   double fraction = 0;
   std::vector<std::uint8_t> on_face;  // per sample: 1 if on one of the faces
+  // Every sample at a channel's limit, whether or not enough of them make a face: a sheen's few pixels at the top
+  // are clipped too (a highlight cut off), though too few to flatten the cluster.
+  std::array<std::size_t, 3> at_top{};    // samples at or above the channel's upper limit
+  std::array<std::size_t, 3> at_black{};  // at or below its lower limit, with another channel above its own
+  // Of the samples at black in channel c: the median of their brightest channel, as stored. Dim pixels under the
+  // file's black, or a bright colour outside its gamut, have the same face; this tells them apart.
+  std::array<double, 3> black_brightest_median{};
+  // What "dim" is measured against: the top of the file's range — the largest finite upper limit, else (no limit
+  // known) the brightest channel of the brightest sample. Dim: under kDimShare of it.
+  double top = 0;
+  // Whether the upper limits are ones the camera or the file clipped at (ClippingRules::known_high); otherwise they
+  // are each channel's largest value, and a few samples there are no clipping unless they make a face.
+  bool known_high = false;
 };
+inline constexpr double kDimShare = 0.25;
 
 // A face counts when at least this share of the samples lies on it: a few pixels exactly at a channel's
 // maximum happen without clipping.

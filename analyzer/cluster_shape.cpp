@@ -206,11 +206,16 @@ class ShapeDecision {
                 threshold, s_.sigma[a] > threshold);
   }
 
-  // point: σ1 within the noise (judged against the noise alone: a uniform patch has no relative floor).
+  // point: every principal axis within the noise along it (judged against the noise alone: a uniform patch has no
+  // relative floor). The axes' noise differs (brightness noise against colour noise), so a cluster whose first axis
+  // is within its noise may still have a second that is not.
   bool point() {
-    if (test("sigma1 > noise_factor * noise1", s1_, k_.noise_factor * s_.noise_sigma[0], s1_ > k_.noise_factor * s_.noise_sigma[0]))
-      return false;
-    return settle(ShapeClass::Point, "the cluster is no larger than the noise: a single colour");
+    bool beyond = false;
+    for (int a = 0; a < 3; ++a)
+      beyond = test(fmt::format("sigma{} > noise_factor * noise{}", a + 1, a + 1), s_.sigma[a], k_.noise_factor * s_.noise_sigma[a],
+                    s_.sigma[a] > k_.noise_factor * s_.noise_sigma[a]) || beyond;
+    if (beyond) return false;
+    return settle(ShapeClass::Point, "every principal axis is within the noise along it: a single colour");
   }
 
   // linear: only the first principal axis stands above the noise.

@@ -8,7 +8,7 @@
 //   none      fewer than min_samples valid samples, or all black
 //   clipped   at least clipped_fraction of the samples on faces of the RGB cube — unless every face is at black
 //             and they hold less than black_faces_fraction: then the class of the samples off the faces
-//   point     σ1 not significant
+//   point     no σk above noise_factor × the noise along its axis
 //   linear    σ2 not significant, or the body line holds body_only_fraction of the samples
 //   L         body + highlight lines leave a small residual (two_line_residual), meet at an angle, the highlight leaving the body
 //   skewed-T  line at its bright end (L) or part-way along it (skewed-T) …

@@ -5,6 +5,8 @@
 #include <cstdint>
 #include <limits>
 
+#include <fmt/format.h>
+
 #include "core/colour.h"
 #include "core/statistics.h"
 
@@ -30,7 +32,7 @@ namespace {
 // The γ whose inverse makes `sample` straightest: a coarse grid over log γ, then golden-section search in the
 // bracket around the best grid point.
 double best_gamma(const std::vector<Vec3>& sample, GammaFlat flat) {
-  const double lo = std::log(0.2), hi = std::log(5.0);
+  const double lo = std::log(kGammaMin), hi = std::log(kGammaMax);
   constexpr int kGrid = 48;
   auto cost = [&](double log_gamma) { return straightness(sample, std::exp(-log_gamma), flat); };
   int best = 0;
@@ -130,7 +132,14 @@ std::optional<GammaComparison> compare_gamma(const GammaFit& fit, const ToneCurv
   c.fitted = fit.gamma;
   c.se = *fit.gamma_se;
   c.difference_in_se = std::abs(c.fitted - c.declared_gamma) / c.se;
-  c.agree = c.difference_in_se <= kGammaAgreement;
+  if (gamma_at_bound(c.fitted))
+    c.not_measured = fmt::format("the best fit lies at the edge of the searched range ({:g} to {:g}): no power curve straightens the "
+                                 "cluster better than another, as for a line through black, which stays a line under any γ",
+                                 kGammaMin, kGammaMax);
+  else if (c.fitted - 2 * c.se <= kGammaMin || c.fitted + 2 * c.se >= kGammaMax)
+    c.not_measured = fmt::format("its uncertainty (± {:.3g}) reaches past the searched range ({:g} to {:g})", c.se, kGammaMin, kGammaMax);
+  c.measured = c.not_measured.empty();
+  c.agree = c.measured && c.difference_in_se <= kGammaAgreement;
   return c;
 }
 

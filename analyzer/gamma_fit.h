@@ -31,7 +31,12 @@ struct GammaFit {
   double lo = 0, hi = 0;             // the 2nd and 98th percentiles of the used samples' values, as stored
 };
 
-// Searches γ in [0.2, 5]; nullopt with fewer than 10 positive samples.
+// The range fit_gamma searches. A fit within 1 % of either end found no minimum inside it: a cluster no power curve
+// bends or straightens (a line through black stays a line under any γ) carries no information on γ.
+inline constexpr double kGammaMin = 0.2, kGammaMax = 5.0;
+inline bool gamma_at_bound(double gamma) { return gamma <= kGammaMin * 1.01 || gamma >= kGammaMax / 1.01; }
+
+// Searches γ in [kGammaMin, kGammaMax]; nullopt with fewer than 10 positive samples.
 std::optional<GammaFit> fit_gamma(const std::vector<Vec3>& points, GammaFlat flat = GammaFlat::Line);
 
 // The standard error of fit_gamma's γ on these points, by the bootstrap: γ refitted on 16 resamples (with
@@ -46,6 +51,10 @@ struct GammaComparison {
   double declared_gamma = 1;   // its encoding exponent; the sRGB curve's effective one over the fit's values
   double fitted = 1, se = 0;
   double difference_in_se = 0;  // |fitted − declared_gamma| / se
+  // The fit is a measurement: inside the searched range by more than 2 standard errors, with a standard error
+  // above 0. Otherwise `not_measured` says why, and `agree` is false: nothing was measured to agree.
+  bool measured = false;
+  std::string not_measured;
   bool agree = false;
 };
 inline constexpr double kGammaAgreement = 3;  // standard errors

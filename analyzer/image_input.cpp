@@ -37,6 +37,7 @@ struct RawImage {
   std::string colour_space;  // oiio:ColorSpace
   float display_gamma = 0;   // oiio:Gamma (0: not given)
   std::string conversion;    // what OpenImageIO did to give R, G, B from other stored values ("" for nothing)
+  std::string first_of_many;  // a file of several images (an animated GIF, a multi-page TIFF): which one was read
 };
 
 constexpr const char* kCameraKeys[] = {"chromatrace.black_level", "chromatrace.white_level", "chromatrace.dark_signal",
@@ -137,6 +138,18 @@ RawImage read_raw(const std::filesystem::path& file) {
   raw.colour_space = spec.get_string_attribute("oiio:ColorSpace");
   raw.display_gamma = spec.get_float_attribute("oiio:Gamma", 0.0f);
   raw.conversion = conversion_note(spec, in->format_name(), file);
+  // An animated GIF's frames, a multi-page TIFF's pages, a multi-part EXR's parts: the first is read. Counted up to
+  // a bound, so that a file of thousands of frames is not decoded just to count them.
+  constexpr int kCountedImages = 1000;
+  int images = 1;
+  {
+    const LibraryStderrSilenced quiet;
+    while (images < kCountedImages && in->seek_subimage(images, 0)) ++images;
+    if (images > 1 && !in->seek_subimage(0, 0)) throw InputError(fmt::format("{}: cannot return to its first image", name));
+  }
+  if (images > 1)
+    raw.first_of_many = fmt::format("the file holds {}{} images ({}); the first, {} × {}, was analysed", images >= kCountedImages ? "at least " : "",
+                                    images, in->format_name(), spec.width, spec.height);
   if (raw.width < 1 || raw.height < 1) throw InputError(fmt::format("{}: image has no pixels", name));
   check_image_size(name, raw.width, raw.height, raw.channels, bytes, static_cast<int>(type.size()));
   raw.values.resize(static_cast<std::size_t>(raw.width) * static_cast<std::size_t>(raw.height) *
@@ -361,6 +374,7 @@ AnalysisImage read_analysis_image(const std::filesystem::path& file, const std::
   out.display = extract_rgb(raw, "display");
   apply_camera_metadata(raw, out);
   if (!raw.conversion.empty()) out.notes.push_back(raw.conversion);
+  if (!raw.first_of_many.empty()) out.notes.push_back(raw.first_of_many);
   set_aside_invalid_pixels(raw, out);
   if (declared) {
     out.encoding.curve = declared;

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "analyzer/cluster_shape.h"
 #include "analyzer/explain.h"
 #include "analyzer/illuminant.h"
 #include "analyzer/region_analysis.h"
@@ -17,11 +18,40 @@
 
 namespace ct::analyzer {
 
+// One sentence of an interpretation and the kind of claim it makes. Each kind has a premise, checked before the
+// sentence is written (docs/analyze.md, "Statements and their premises"); where a premise fails, a sentence of
+// another kind says what is true instead. The kinds are stable names: tests recompute each premise from
+// analysis.json and the image.
+struct Statement {
+  std::string kind;
+  std::string text;
+  // The premises the sentence rests on, by name (docs/analyze.md lists them and how each is measured):
+  // reaches_black, misses_black, light_highlight, not_light_highlight, within_noise, no_top_clipping,
+  // top_clipped, at_black_dim, at_black_bright, on_model_plane, off_model_plane, gamma_measured, gamma_not_measured,
+  // thick, flat, light_coloured, nothing_clipped.
+  std::vector<std::string> claims;
+};
+
+// Where a straight line of colours passes black: its closest distance to black, and that distance seen from the
+// line's brightest end as an angle — 0 for a line through black, along which its direction is a colour.
+struct BlackReach {
+  double miss = 0;           // closest distance to black, in the cluster's units
+  double angle_deg = 0;      // atan(miss / (the brightest end's distance along the line))
+  double uncertainty_deg = 0;  // the standard error of that angle (the line's rms over √inliers, its tilt included)
+  double allowed_deg = 0;    // max(min_line_angle_deg, 2 × uncertainty): within it, the line reaches black
+  bool reaches = false;
+};
+BlackReach black_reach(const Line& line, double min_line_angle_deg);
+
 struct Interpretation {
   std::string light_class;   // the class in linear light (the stored values' when they are linear)
   std::string stored_class;  // the class of the values as stored
   std::string process;       // the physical process the class stands for
-  std::optional<Vec3> body_colour;   // unit direction of the body (matte) reflection
+  std::string process_kind;  // its statement kind (process.*)
+  std::vector<std::string> process_claims;  // the premises it rests on (Statement::claims)
+  std::optional<Vec3> body_colour;   // unit direction of the body (matte) reflection: only of a line that reaches black
+  std::optional<BlackReach> body_reach;  // where the body line passes black (none: no line, a single colour)
+  std::optional<Vec3> mean_colour;   // the mean colour, unit (stands for the colour where no body colour is quoted)
   std::optional<Vec3> light_colour;  // the chosen illuminant estimate, unit
   std::string light_method;          // which estimate, and whether it is reliable
   std::optional<double> body_light_angle_deg;  // between the body colour and the light's colour
@@ -36,7 +66,7 @@ struct Interpretation {
   std::size_t separate_areas = 0;              // 4-connected parts of at least 1 % of the region (segments)
   std::optional<double> declared_gamma, fitted_gamma, fitted_gamma_se;
   std::string curve;                           // the declared curve, described ("linear" when none)
-  std::vector<std::string> findings;           // sentences with the numbers above
+  std::vector<Statement> findings;             // sentences with the numbers above, each of a kind
   std::vector<std::string> uncertain;          // what the numbers cannot tell
 };
 

@@ -121,44 +121,54 @@ json fits_json(const ClusterShape& s, const HistogramSpec& spec) {
 std::string rgb_text(const Vec3& v) { return fmt::format("({:.4g}, {:.4g}, {:.4g})", v[0], v[1], v[2]); }
 std::string percent(double v) { return fmt::format("{:.1f} %", 100 * v); }
 
-// The numbers a person reads first; analysis.json has them all.
+// The numbers a person reads first; analysis.json has them all. They are of the cluster the heading names: in
+// linear light when a curve encoded the file (its class leads), with the mean as stored beside it and the clipping
+// measured on the stored values, where it happened.
 json summary(const RegionAnalysis& r, const std::optional<Explanation>& e) {
-  const ClusterShape& s = r.shape;
+  const ClusterShape& s = r.linear_light ? *r.linear_light : r.shape;
+  const std::string light = r.linear_light ? " (linear light)" : "";
   json rows = json::array();
   auto row = [&](std::string key, std::string value) { rows.push_back({std::move(key), std::move(value)}); };
   row("pixels", fmt::format("{} ({} valid)", r.pixels, s.samples));
   if (s.samples > 0) {
-    row("mean", rgb_text(s.moments.mean));
-    row("σ along axes", rgb_text(s.sigma));
+    row("mean" + light, rgb_text(s.moments.mean));
+    if (r.linear_light) row("mean (as stored)", rgb_text(r.shape.moments.mean));
+    row("σ along axes" + light, rgb_text(s.sigma));
     // A clipped cluster's shape is measured on its samples off the faces (analysis.json: `unclipped`).
     if (s.shape != ShapeClass::Clipped) {
-      row("noise σ along axes", rgb_text(s.noise_sigma));
-      row("linearity / planarity / scattering", fmt::format("{:.3f} / {:.3f} / {:.3f}", s.linearity, s.planarity, s.scattering));
+      row("noise σ along axes" + light, rgb_text(s.noise_sigma));
+      row("linearity / planarity / scattering" + light, fmt::format("{:.3f} / {:.3f} / {:.3f}", s.linearity, s.planarity, s.scattering));
     } else if (const ClusterShape& u = off_the_faces(s); &u != &s) {
       row("off the faces", fmt::format("{} ({} samples)", class_name(u.shape), u.samples));
-      row("noise σ along axes, off the faces", rgb_text(u.noise_sigma));
-      row("linearity / planarity / scattering, off the faces", fmt::format("{:.3f} / {:.3f} / {:.3f}", u.linearity, u.planarity, u.scattering));
+      row("noise σ along axes, off the faces" + light, rgb_text(u.noise_sigma));
+      row("linearity / planarity / scattering, off the faces" + light, fmt::format("{:.3f} / {:.3f} / {:.3f}", u.linearity, u.planarity, u.scattering));
     }
   }
-  if (s.line) row("line direction", rgb_text(s.line->direction));
+  // Directions are unit colours; a line's is a colour only inside the positive octant (its components are in
+  // analysis.json either way).
+  auto direction = [](const Vec3& v) { return v.minCoeff() >= 0 ? rgb_text(v) : std::string("outside the positive octant: no colour"); };
+  if (s.line) row("line direction" + light, direction(s.line->direction));
   if (s.two_lines && (s.shape == ShapeClass::L || s.shape == ShapeClass::SkewedT)) {
-    row("body line", rgb_text(s.two_lines->body.direction));
-    row("highlight line", rgb_text(s.two_lines->highlight.direction));
+    row("body line" + light, direction(s.two_lines->body.direction));
+    row("highlight line" + light, direction(s.two_lines->highlight.direction));
     row("highlight leaves body line at", percent(s.two_lines->junction_on_body));
     row("angle between lines", fmt::format("{:.1f}°", s.two_lines->angle_deg));
   }
-  if (s.black_plane && s.significant_axes >= 2) row("dichromatic plane normal", rgb_text(s.black_plane->normal));
-  if (s.plane && s.significant_axes >= 2) row("thickness off plane / noise", fmt::format("{:.2f}", s.sigma[2] / std::max(1e-300, s.noise_sigma[2])));
-  if (s.curve && (s.shape == ShapeClass::Curved || s.shape == ShapeClass::Gamma)) row("bend (sagitta / chord)", fmt::format("{:.3f}", s.curve->bend));
-  if (s.gamma && s.shape == ShapeClass::Gamma)
-    row("γ", s.gamma->gamma_se ? fmt::format("{:.3f} ± {:.3f}", s.gamma->gamma, *s.gamma->gamma_se)
-                               : fmt::format("{:.3f}", s.gamma->gamma));
+  if (s.plane && s.significant_axes >= 2) row("thickness off plane / noise" + light, fmt::format("{:.2f}", s.sigma[2] / std::max(1e-300, s.noise_sigma[2])));
+  if (s.curve && (s.shape == ShapeClass::Curved || s.shape == ShapeClass::Gamma)) row("bend (sagitta / chord)" + light, fmt::format("{:.3f}", s.curve->bend));
+  if (r.shape.gamma && r.shape.shape == ShapeClass::Gamma) {
+    const GammaFit& g = *r.shape.gamma;
+    row("γ (as stored)", gamma_at_bound(g.gamma)               ? fmt::format("not measured: the fit lies at the edge of the searched range ({:g} to {:g})", kGammaMin, kGammaMax)
+                         : g.gamma_se ? fmt::format("{:.3f} ± {:.3f}", g.gamma, *g.gamma_se)
+                                      : fmt::format("{:.3f}", g.gamma));
+  }
   if (const auto& c = r.declared_gamma)
-    row("γ against the declared curve", fmt::format("{}: fitted {:.3f}, declared {} ≈ {:.3f}, {:.1f} standard errors apart (agreement: at most {:g})",
-                                                    c->agree ? "agree" : "disagree", c->fitted, c->declared, c->declared_gamma,
-                                                    c->difference_in_se, kGammaAgreement));
+    row("γ against the declared curve", c->measured ? fmt::format("{}: fitted {:.3f}, declared {} ≈ {:.3f}, {:.1f} standard errors apart (agreement: at most {:g})",
+                                                                  c->agree ? "agree" : "disagree", c->fitted, c->declared, c->declared_gamma,
+                                                                  c->difference_in_se, kGammaAgreement)
+                                                    : fmt::format("not measured: {} (declared {} ≈ {:.3f})", c->not_measured, c->declared, c->declared_gamma));
   if (r.bend) row("what bends it", r.bend->summary);
-  if (!s.clipping.faces.empty()) row("clipped", percent(s.clipping.fraction));
+  if (!r.shape.clipping.faces.empty()) row("clipped (as stored)", percent(r.shape.clipping.fraction));
   if (r.linear_light) row("class of the values as stored", std::string(class_name(r.shape.shape)));
   if (e) {
     if (e->direct_share) row("direct / indirect", percent(*e->direct_share) + " / " + percent(e->indirect_share.value_or(0)));

@@ -6,7 +6,7 @@
 #include <memory>
 #include <optional>
 
-#include <fmt/core.h>
+#include <fmt/format.h>
 #include <OpenImageIO/imageio.h>
 
 #include "analyzer/analysis.h"
@@ -193,7 +193,11 @@ Action add_analyze(CLI::App& app) {
                  best.uncertainty_deg ? fmt::format(" ± {:.2f}°", *best.uncertainty_deg) : "",
                  best.reliable ? "" : ", unreliable: " + best.unreliable_reason,
                  best.error_deg ? fmt::format(", {:.2f}° from the known one", *best.error_deg) : "");
-      fmt::print(stderr, "{}: analysis.json, report.html\n", o->output);
+      std::vector<std::string> written = {"analysis.json", "histograms/"};
+      if (!o->no_plots) written.push_back("plots/");
+      if (analysis.segmentation) written.push_back("labels.png");
+      if (!o->no_report) written.push_back("report.html");
+      fmt::print(stderr, "{}: {}\n", o->output, fmt::join(written, ", "));
     }
     return 0;
   };

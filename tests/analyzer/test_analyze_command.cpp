@@ -258,6 +258,58 @@ TEST(AnalyzeCommand, TransparentNegativeAndNonFinitePixelsAreLeftOutAndCounted) 
   EXPECT_FALSE(std::filesystem::exists(dir.file("x")));
 }
 
+// The last line lists what was written, and only that: no report.html under --no-report, no plots/ under
+// --no-plots.
+TEST(AnalyzeCommand, TheLastLineNamesTheFilesWritten) {
+  TempDir dir;
+  write_sensor_exr(dir.file("line.exr"), {matte_line(), matte_line(), {}, {}, {}});
+  const auto last_line = [](const std::string& err) {
+    const std::size_t end = err.find_last_not_of('\n'), start = err.rfind('\n', end);
+    return err.substr(start == std::string::npos ? 0 : start + 1, end - (start == std::string::npos ? 0 : start + 1) + 1);
+  };
+  const std::string all = dir.file("all").string(), bare = dir.file("bare").string();
+  const CommandResult r = run_chromatrace({"analyze", dir.file("line.exr").string(), "-o", all});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(last_line(r.err), all + ": analysis.json, histograms/, plots/, report.html");
+  const CommandResult b = run_chromatrace({"analyze", dir.file("line.exr").string(), "-o", bare, "--no-report", "--no-plots"});
+  ASSERT_EQ(b.exit_code, 0) << b.err;
+  EXPECT_EQ(last_line(b.err), bare + ": analysis.json, histograms/");
+  EXPECT_FALSE(std::filesystem::exists(dir.file("bare") / "report.html"));
+  EXPECT_FALSE(std::filesystem::exists(dir.file("bare") / "plots"));
+}
+
+// A file of several images (a multi-page TIFF here; an animated GIF's frames alike) is analysed on its first, and
+// says so: on the terminal and in analysis.json's notes.
+TEST(AnalyzeCommand, AFileOfSeveralImagesSaysWhichWasAnalysed) {
+  TempDir dir;
+  const std::string file = dir.file("pages.tif").string();
+  OIIO::ImageSpec first(32, 16, 3, OIIO::TypeDesc::UINT8), second(8, 8, 3, OIIO::TypeDesc::UINT8);
+  const OIIO::ImageSpec specs[] = {first, second};
+  std::vector<std::uint8_t> a(32 * 16 * 3), b(8 * 8 * 3, 200);
+  for (std::size_t i = 0; i < a.size(); ++i) a[i] = static_cast<std::uint8_t>(40 + (i * 7) % 150);
+  auto out = OIIO::ImageOutput::create(file);
+  ASSERT_TRUE(out && out->supports("multiimage"));
+  ASSERT_TRUE(out->open(file, 2, specs));
+  ASSERT_TRUE(out->write_image(OIIO::TypeDesc::UINT8, a.data()));
+  ASSERT_TRUE(out->open(file, second, OIIO::ImageOutput::AppendSubimage));
+  ASSERT_TRUE(out->write_image(OIIO::TypeDesc::UINT8, b.data()));
+  ASSERT_TRUE(out->close());
+  const CommandResult r = run_chromatrace({"analyze", file, "-o", dir.file("o").string(), "--no-plots", "--no-report"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const std::string note = "the file holds 2 images (tiff); the first, 32 × 16, was analysed";
+  EXPECT_NE(r.err.find(file + ": note: " + note), std::string::npos) << r.err;
+  const nlohmann::json j = analysis(dir.file("o"));
+  EXPECT_EQ(j["image"]["width"], 32);
+  EXPECT_NE(std::find(j["notes"].begin(), j["notes"].end(), note), j["notes"].end()) << j["notes"].dump();
+  // One image: no such note.
+  OIIO::ImageSpec single(32, 16, 3, OIIO::TypeDesc::UINT8);
+  auto one = OIIO::ImageOutput::create(dir.file("one.tif").string());
+  ASSERT_TRUE(one && one->open(dir.file("one.tif").string(), single) && one->write_image(OIIO::TypeDesc::UINT8, a.data()) && one->close());
+  const CommandResult s = run_chromatrace({"analyze", dir.file("one.tif").string(), "-o", dir.file("p").string(), "--no-plots", "--no-report"});
+  ASSERT_EQ(s.exit_code, 0) << s.err;
+  EXPECT_EQ(s.err.find("images ("), std::string::npos) << s.err;
+}
+
 TEST(AnalyzeCommand, BadInputIsOneLineAndExitTwo) {
   TempDir dir;
   std::ofstream(dir.file("junk.png")) << "not an image";
