@@ -249,8 +249,32 @@ static json segmentation_json(const Segmentation& s) {
           {"clipped_highlight_merges", s.clipped_merges}};
 }
 
+// Why the mask's taps are as far apart as they are.
+static std::string spacing_reason(const ImageNoise& noise) {
+  const auto& c = noise.spacing_choice;
+  if (!c) return "the file says each pixel's three values were measured at it (chromatrace.cfa 0, or raw half size): taps adjacent";
+  std::string reason;
+  if (c->confirmed)
+    reason = fmt::format("the noise's measured correlation shows it independent at {} pixel{} (residuals correlated with their "
+                         "neighbours' {} pixel{} on within {} of -2/3, white noise's, beyond 2 standard errors)",
+                         c->spacing, c->spacing == 1 ? "" : "s", c->spacing, c->spacing == 1 ? "" : "s", kSpacingTolerance);
+  else
+    reason = fmt::format("the noise's measured correlation does not show it independent at 1, 2 or 3 pixels (shared by neighbouring "
+                         "pixels: demosaicing, compression, resampling, or too little noise to tell): taps {} pixels apart, the "
+                         "farthest tried", c->spacing);
+  if (c->correlated_beyond)
+    reason += "; the noise is still shared at 3 pixels, so its sigma is a lower bound and clusters may look thicker than their noise";
+  return reason;
+}
+
 // The noise every region's shape is judged against: per brightness band, σ along R, G and B.
 static json image_noise_json(const ImageNoise& noise) {
+  json spacing_tests = json::array();
+  if (noise.spacing_choice)
+    for (const SpacingTest& t : noise.spacing_choice->tests)
+      spacing_tests.push_back({{"spacing", t.spacing}, {"measurable", t.measurable},
+                               {"departure", t.measurable ? json(t.departure) : json(nullptr)},
+                               {"standard_error", t.measurable ? json(t.standard_error) : json(nullptr)}});
   json bands = json::array();
   for (std::size_t k = 0; k < noise.bands.size(); ++k)
     bands.push_back({{"brightness", {noise.bands[k].lo, noise.bands[k].hi}},
@@ -269,8 +293,8 @@ static json image_noise_json(const ImageNoise& noise) {
   return {{"estimator", "Immerkaer 1996 over the whole image: 3x3 residuals of R, G, B, per brightness band the 3-sigma clipped "
                         "median of their projection (flat areas decide, not texture)"},
           {"spacing", noise.spacing},
-          {"spacing_reason", noise.spacing == 1 ? "the file says each pixel's three values were measured at it (chromatrace.cfa 0, or raw half size)"
-                                                : "the pixels may be demosaiced (interpolated from neighbouring photosites, so sharing their noise): the mask's taps are 3 pixels apart"},
+          {"spacing_reason", spacing_reason(noise)},
+          {"spacing_tests", spacing_tests},
           {"brightness", "(R + G + B) / 3 in the analysed layer's units"},
           {"pixels_used", noise.pixels},
           {"floor", noise.floor},

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numbers>
 #include <numeric>
 
 #include "core/statistics.h"
@@ -24,11 +25,11 @@ std::size_t ImageNoise::band_of(double brightness) const {
   return static_cast<std::size_t>(k - bands.begin());
 }
 
-double ImageNoise::band_sigma(std::size_t band, const Vec3& u) const {
-  if (const auto& v = bands[band].model_variance) return std::sqrt(u.cwiseAbs2().dot(*v));
-  const std::vector<float>& r = bands[band].residuals;
-  std::vector<double> a(r.size() / 3);
-  for (std::size_t i = 0; i < a.size(); ++i) a[i] = std::abs(r[i * 3] * u[0] + r[i * 3 + 1] * u[1] + r[i * 3 + 2] * u[2]);
+namespace {
+
+// The noise σ of values |x| of which the flat areas' are Gaussian: from the lower quartile, then the median within
+// kClip σ iterated to its fixed point (noise_level.h).
+double clipped_sigma(std::vector<double>& a) {
   if (a.empty()) return 0.0;
   double sigma = quantile_in_place(a, 0.25) / kQuartileAbs;
   std::vector<double> inside;
@@ -43,6 +44,165 @@ double ImageNoise::band_sigma(std::size_t band, const Vec3& u) const {
     if (settled) break;
   }
   return sigma;
+}
+
+}  // namespace
+
+double ImageNoise::band_sigma(std::size_t band, const Vec3& u) const {
+  if (const auto& v = bands[band].model_variance) return std::sqrt(u.cwiseAbs2().dot(*v));
+  const std::vector<float>& r = bands[band].residuals;
+  std::vector<double> a(r.size() / 3);
+  for (std::size_t i = 0; i < a.size(); ++i) a[i] = std::abs(r[i * 3] * u[0] + r[i * 3 + 1] * u[1] + r[i * 3 + 2] * u[2]);
+  return clipped_sigma(a);
+}
+
+namespace {
+
+// A deterministic dither in [−½, ½) for value `index` (SplitMix64 of it).
+double dither(std::uint64_t index) {
+  std::uint64_t z = index + 0x9e3779b97f4a7c15ULL;
+  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+  z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+  z ^= z >> 31;
+  return static_cast<double>(z >> 11) / 9007199254740992.0 - 0.5;
+}
+
+// Residual pairs at one spacing: each sampled pixel's residual over its band's σ with its neighbour's s pixels to the
+// right and s pixels down, per channel, and the 4 × 4 tile each pair lies in.
+struct Pairs {
+  std::array<std::vector<double>, 3> u, v;
+  std::vector<std::uint8_t> tile;
+};
+
+// Gnanadesikan–Kettenring: the correlation of u and v from the robust σ of their sum and difference.
+double robust_correlation(const std::vector<double>& u, const std::vector<double>& v, const std::vector<std::uint8_t>& tile, int left_out) {
+  std::vector<double> plus, minus;
+  plus.reserve(u.size()), minus.reserve(u.size());
+  for (std::size_t i = 0; i < u.size(); ++i) {
+    if (tile[i] == left_out) continue;
+    plus.push_back(std::abs(u[i] + v[i]) / std::numbers::sqrt2);
+    minus.push_back(std::abs(u[i] - v[i]) / std::numbers::sqrt2);
+  }
+  const double p = clipped_sigma(plus), m = clipped_sigma(minus);
+  return p * p + m * m > 0 ? (p * p - m * m) / (p * p + m * m) : 0.0;
+}
+
+SpacingTest test_spacing(const RgbImage& image, const std::array<double, 3>& low, const std::array<double, 3>& high, double step, int spacing) {
+  constexpr double kWhite = -2.0 / 3.0;
+  constexpr int kTiles = 4;
+  constexpr std::size_t kMaxSamples = std::size_t{1} << 15;
+  SpacingTest t;
+  t.spacing = spacing;
+  const std::size_t w = static_cast<std::size_t>(std::max(0, image.width)), h = static_cast<std::size_t>(std::max(0, image.height));
+  const std::size_t s = static_cast<std::size_t>(spacing);
+  if (w < 4 * s + 1 || h < 4 * s + 1) return t;
+  const auto value = [&](std::size_t q, std::size_t c) {
+    const double v = image.rgb[q * 3 + c];
+    return step > 0 ? v + step * dither(q * 3 + c) : v;
+  };
+  const auto usable = [&](std::size_t q) {
+    for (std::size_t c = 0; c < 3; ++c) {
+      const double v = image.rgb[q * 3 + c];
+      if (!std::isfinite(v) || !(v > low[c]) || !(v < high[c])) return false;
+    }
+    return true;
+  };
+  // Pixels whose own and both neighbours' masks lie inside the image: [s, w − 2s) × [s, h − 2s).
+  const std::size_t iw = w - 3 * s, ih = h - 3 * s, interior = iw * ih;
+  const std::size_t stride = std::max<std::size_t>(1, interior / kMaxSamples);
+  struct Sample {
+    double brightness;
+    std::array<double, 9> r;  // own, right, down × R, G, B
+    std::uint8_t tile;
+  };
+  std::vector<Sample> samples;
+  for (std::size_t i = 0; i < interior; i += stride) {
+    const std::size_t x = s + i % iw, y = s + i / iw, p = y * w + x;
+    Sample a{};
+    bool ok = true;
+    const std::size_t at[3] = {p, p + s, p + s * w};
+    for (std::size_t k = 0; k < 3 && ok; ++k)
+      for (std::size_t c = 0; c < 3 && ok; ++c) {
+        const auto m = immerkaer_response(at[k], w, s, [&](std::size_t q) { return value(q, c); }, usable);
+        ok = m.has_value();
+        if (ok) a.r[k * 3 + c] = *m / kImmerkaerGain;
+      }
+    if (!ok) continue;
+    a.brightness = (double(image.rgb[p * 3]) + image.rgb[p * 3 + 1] + image.rgb[p * 3 + 2]) / 3;
+    a.tile = static_cast<std::uint8_t>((y * kTiles / h) * kTiles + x * kTiles / w);
+    samples.push_back(a);
+  }
+  if (samples.size() < static_cast<std::size_t>(kBands) * 64) return t;
+  // Bands of brightness, each its own σ per channel.
+  std::sort(samples.begin(), samples.end(), [](const Sample& a, const Sample& b) { return a.brightness < b.brightness; });
+  std::array<std::vector<double>, 3> band_sigma;
+  std::vector<std::size_t> band_of(samples.size());
+  for (int band = 0; band < kBands; ++band) {
+    const std::size_t from = samples.size() * static_cast<std::size_t>(band) / kBands, to = samples.size() * static_cast<std::size_t>(band + 1) / kBands;
+    for (std::size_t i = from; i < to; ++i) band_of[i] = static_cast<std::size_t>(band);
+    for (std::size_t c = 0; c < 3; ++c) {
+      std::vector<double> a;
+      for (std::size_t i = from; i < to; ++i) a.push_back(std::abs(samples[i].r[c]));
+      band_sigma[c].push_back(clipped_sigma(a));
+    }
+  }
+  // The rounding and the dither are white and add 2 · step²/12 to each pixel's variance: they pull the correlation
+  // towards −2/3 by their share of it, undone here; a channel where they are most of it (or whose residuals are
+  // exactly 0 in most bands: compressed away) tells nothing.
+  std::array<double, 3> scale{1, 1, 1};
+  for (std::size_t c = 0; c < 3; ++c) {
+    std::vector<double> squares;
+    std::size_t zero = 0;
+    for (const double b : band_sigma[c]) squares.push_back(b * b), zero += b == 0;
+    const double variance = quantile(squares, 0.5), rounding = step > 0 ? 2 * step * step / 12 : 0.0;
+    if (2 * zero > band_sigma[c].size() || !(variance > 1.5 * rounding) || !(variance > 0)) return t;
+    scale[c] = variance / (variance - rounding);
+  }
+  Pairs pairs;
+  for (std::size_t i = 0; i < samples.size(); ++i)
+    for (std::size_t c = 0; c < 3; ++c) {
+      const double sigma = band_sigma[c][band_of[i]];
+      if (!(sigma > 0)) continue;
+      for (const std::size_t k : {std::size_t{1}, std::size_t{2}}) {  // right, down
+        pairs.u[c].push_back(samples[i].r[c] / sigma);
+        pairs.v[c].push_back(samples[i].r[k * 3 + c] / sigma);
+        if (c == 0) pairs.tile.push_back(samples[i].tile);
+      }
+    }
+  for (std::size_t c = 1; c < 3; ++c)
+    if (pairs.u[c].size() != pairs.u[0].size()) return t;  // a band σ of 0 in one channel only: tiles would not line up
+  const auto departure = [&](int left_out) {
+    double d = 0;
+    for (std::size_t c = 0; c < 3; ++c) d = std::max(d, std::abs(robust_correlation(pairs.u[c], pairs.v[c], pairs.tile, left_out) - kWhite) * scale[c]);
+    return d;
+  };
+  t.departure = departure(-1);
+  std::vector<double> jack;
+  for (int k = 0; k < kTiles * kTiles; ++k) jack.push_back(departure(k));
+  const double mean = std::accumulate(jack.begin(), jack.end(), 0.0) / static_cast<double>(jack.size());
+  double ss = 0;
+  for (const double d : jack) ss += (d - mean) * (d - mean);
+  t.standard_error = std::sqrt(static_cast<double>(jack.size() - 1) / static_cast<double>(jack.size()) * ss);
+  t.measurable = true;
+  return t;
+}
+
+}  // namespace
+
+SpacingChoice choose_noise_spacing(const RgbImage& image, const std::array<double, 3>& low_levels,
+                                   const std::array<double, 3>& high_levels, double step) {
+  SpacingChoice choice;
+  for (int s = 1; s <= kInterpolatedNoiseSpacing; ++s) choice.tests.push_back(test_spacing(image, low_levels, high_levels, step, s));
+  choice.spacing = kInterpolatedNoiseSpacing;
+  for (const SpacingTest& t : choice.tests)
+    if (t.measurable && t.departure + 2 * t.standard_error <= kSpacingTolerance) {
+      choice.spacing = t.spacing;
+      choice.confirmed = true;
+      break;
+    }
+  const SpacingTest& last = choice.tests.back();
+  choice.correlated_beyond = last.measurable && last.departure > kCorrelatedBeyond + 3 * last.standard_error;
+  return choice;
 }
 
 ImageNoise estimate_image_noise(const RgbImage& image, const std::array<double, 3>& low_levels, const std::array<double, 3>& high_levels,

@@ -63,6 +63,38 @@ struct CameraNoiseModel {
   }
 };
 
+// The mask's spacing chosen by the noise's measured correlation (choose_noise_spacing). At spacing s the residuals
+// of noise independent from pixel to pixel at that distance correlate with their neighbours' s pixels on by exactly
+// −2/3 (the mask's own autocorrelation: [1 −2 1] against itself shifted by one tap, −4/6); noise shared between
+// pixels s apart (demosaicing, compression, resampling) moves that correlation and makes the mask under-read σ by
+// about 4.8 times the departure. The correlation is Gnanadesikan and Kettenring's robust one, (S+² − S−²)/(S+² + S−²)
+// with S± the clipped-median σ (as the bands') of (z(p) ± z(q))/√2, z the residual over its band's σ, so that
+// texture beyond 3σ does not count; its standard error by the jackknife over 4 × 4 tiles of the image.
+struct SpacingTest {
+  int spacing = 0;
+  double departure = 0;        // |ρ + 2/3| of the worst channel, corrected for the rounding's white share (integer files)
+  double standard_error = 0;   // of the departure
+  bool measurable = false;     // residuals enough, and the noise above the rounding in every channel
+};
+struct SpacingChoice {
+  int spacing = 3;
+  bool confirmed = false;          // independence shown at the chosen spacing: departure + 2 SE ≤ kSpacingTolerance
+  bool correlated_beyond = false;  // at the largest spacing the noise is still shared: σ is a lower bound
+  std::vector<SpacingTest> tests;  // spacings 1, 2, 3
+};
+// Independent within this departure: about a 10 % bias of σ (4.8 × 0.02), the sampling error of a 50-pixel cluster's
+// own σ (1/√(2n)), which moves noise_factor 3 to 2.7–3.3.
+inline constexpr double kSpacingTolerance = 0.02;
+// Still correlated at the largest spacing when the departure exceeds this by 3 SE: two standard errors of a band's σ
+// from 4096 residuals (2 × 1.8 %) over 4.8.
+inline constexpr double kCorrelatedBeyond = 0.0076;
+
+// The smallest spacing of 1, 2 and 3 at which the noise is shown independent, else 3. `step`: the file's code step
+// (1 for an integer file's stored codes, 0 for a float file): integer values get a deterministic dither of ± step/2
+// so that rounding neither fakes independence nor quantises the estimator. Limits as for estimate_image_noise.
+SpacingChoice choose_noise_spacing(const RgbImage& image, const std::array<double, 3>& low_levels,
+                                   const std::array<double, 3>& high_levels, double step);
+
 struct ImageNoise {
   struct Band {
     double lo = 0, hi = 0;         // the brightness (mean of R, G, B) of its pixels
@@ -76,6 +108,7 @@ struct ImageNoise {
   std::size_t pixels = 0;   // pixels with a residual: finite, unclipped 3×3 neighbourhoods (at an even stride)
   double floor = 0;         // never below: the quantisation noise of integer images (step/√12), else 0
   int spacing = 1;          // pixels between the mask's taps
+  std::optional<SpacingChoice> spacing_choice;  // how it was chosen, when it was measured
 
   // The band a brightness falls into (the nearest at the ends).
   std::size_t band_of(double brightness) const;

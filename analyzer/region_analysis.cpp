@@ -41,8 +41,12 @@ LayerContext layer_context(const RgbImage& layer, const ImageEncoding& encoding,
     for (double& level : c.high_levels)
       if (!(level > 0)) level = std::numeric_limits<double>::infinity();
   }
-  c.noise = estimate_image_noise(layer, c.clipping.low, c.high_levels, c.quantisation_sigma,
-                                 encoding.independent_pixel_noise() ? 1 : kInterpolatedNoiseSpacing);
+  // The mask's taps adjacent when the file says each pixel's noise is its own; else as far apart as the measured
+  // correlation of the noise calls for.
+  std::optional<SpacingChoice> choice;
+  if (!encoding.independent_pixel_noise()) choice = choose_noise_spacing(layer, c.clipping.low, c.high_levels, encoding.integer ? 1.0 : 0.0);
+  c.noise = estimate_image_noise(layer, c.clipping.low, c.high_levels, c.quantisation_sigma, choice ? choice->spacing : 1);
+  c.noise.spacing_choice = choice;
   return c;
 }
 
@@ -57,6 +61,7 @@ LayerContext linear_light_context(const LayerContext& stored, const RgbImage& li
   c.clipping.low.fill(curve.decode(stored.clipping.low[0], full_scale));
   c.quantisation_sigma = 0;
   c.noise = estimate_image_noise(linear, c.clipping.low, c.high_levels, 0.0, stored.noise.spacing);
+  c.noise.spacing_choice = stored.noise.spacing_choice;
   return c;
 }
 
