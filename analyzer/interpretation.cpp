@@ -423,12 +423,13 @@ Interpretation interpret_region(const RegionAnalysis& region, const Region& pixe
                                              : std::string();
     if (!premises.body->reaches)
       out.findings.push_back({"no_body_colour",
-                              fmt::format("Its {} does not reach black: it passes {:.3g} from black, {:.1f}° seen from its brightest "
-                                          "end, beyond the {:.1f}° within which it would, so its direction is no body colour — a colour "
-                                          "added to every pixel (a black level or flare, light of another colour over all of it) or a "
-                                          "second light shifts it. {}",
+                              fmt::format("Its {} does not reach black: it passes {:.3g} from black ({:.2f} × the length of its mean "
+                                          "colour), {:.1f}° seen from its brightest end, beyond the {:.1f}° within which it would, so its "
+                                          "direction is no body colour — a colour added to every pixel (a black level or flare, light of "
+                                          "another colour over all of it) or a second light shifts it. {}",
                                           s.two_lines && body_line == &s.two_lines->body ? "body line" : "line", premises.body->miss,
-                                          premises.body->angle_deg, premises.body->allowed_deg, mean),
+                                          premises.body->miss / std::max(1e-300, s.moments.mean.norm()), premises.body->angle_deg,
+                                          premises.body->allowed_deg, mean),
                               {"misses_black"}});
     else
       out.findings.push_back({"no_body_colour",

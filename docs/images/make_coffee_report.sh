@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Makes docs/images/analyze_coffee.png, the report of docs/analyze.md on skimage's coffee.png (Debian's
 # python3-skimage; Rachel Michetti, CC0): analysed on its segments, the white cup's segment picked (the segment that
-# holds the cup's body, pixel (330, 250)), in headless Chromium.
+# holds the cup's body, pixel (300, 200)), in headless Chromium.
 # Usage: docs/images/make_coffee_report.sh [build-dir]   (needs chromium and the npm packages of ./setup.sh)
 set -euo pipefail
 root=$(cd "$(dirname "$0")/../.." && pwd)
@@ -10,8 +10,8 @@ photo=/usr/lib/python3/dist-packages/skimage/data/coffee.png
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 "$build/cli/chromatrace" analyze "$photo" -o "$tmp/coffee" --segment --quiet
-# The cup's segment: the label at (330, 250) in labels.png, read by oiiotool.
-label=$(oiiotool "$tmp/coffee/labels.png" --cut 1x1+330+250 -d uint16 --printstats 2>/dev/null |
+# The cup's segment: the label at (300, 200) in labels.png, read by oiiotool.
+label=$(oiiotool "$tmp/coffee/labels.png" --cut 1x1+300+200 -d uint16 --printstats 2>/dev/null |
         sed -n 's/.*Max: *\([0-9.]*\).*/\1/p' | head -1)
 label=$(python3 -c "print(round(float('$label') * 65535))")
 cat > "$tmp/shot.mjs" <<JS
