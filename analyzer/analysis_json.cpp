@@ -78,6 +78,7 @@ json interpretation_json(const Interpretation& i) {
           {"statements", statements},
           {"process_kind", i.process_kind},
           {"process_claims", i.process_claims},
+          {"process_rest_kind", i.process_rest_kind.empty() ? json(nullptr) : json(i.process_rest_kind)},
           {"mean_colour", opt_vec(i.mean_colour)},
           {"body_reach", i.body_reach ? json{{"miss", i.body_reach->miss}, {"angle_deg", i.body_reach->angle_deg},
                                              {"uncertainty_deg", i.body_reach->uncertainty_deg}, {"allowed_deg", i.body_reach->allowed_deg},

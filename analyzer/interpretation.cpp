@@ -20,8 +20,9 @@ struct Premises {
   bool body_is_colour = false;     // its direction lies in the positive octant
   std::optional<bool> light_highlight;  // the highlight branch is the light's colour (none: no branch, or no light to say)
   std::size_t top_pixels = 0;      // samples at a channel's top level (a sheen's, though too few for a face)
+  bool cut_at_top = false;         // the cluster described is the part below faces at the top: its bright end was cut
   bool body_reaches() const { return body && body->reaches && body_is_colour; }
-  bool body_misses() const { return body && !body->reaches; }
+  bool body_misses() const { return body && body->measured && !body->reaches; }
 };
 
 // What the class stands for physically, in the dichromatic reflection model and the camera — of this cluster:
@@ -57,6 +58,10 @@ Statement process_of(ShapeClass c, const Premises& p) {
                          "(matte) reflection with a colour added to every pixel (below)", {"misses_black"});
       if (!p.body_reaches())
         return statement("process.line", "one colour whose brightness changes with the shading: a straight line (below)");
+      if (p.cut_at_top)
+        return statement("process.matte_below_clipping", "body (matte) reflection: one colour whose brightness changes with the "
+                                                         "shading, a line from black along the body colour, cut where it reached the "
+                                                         "clipping level", {"reaches_black", "top_clipped"});
       if (p.top_pixels > 0)
         return statement("process.matte", "body (matte) reflection: one colour whose brightness changes with the shading, a line from "
                                           "black along the body colour, with a sheen cut off at the top too small to shape the cluster "
@@ -159,7 +164,8 @@ std::size_t separate_areas(const Region& r, int width) {
   return static_cast<std::size_t>(std::count_if(size.begin(), size.end(), [&](std::size_t n) { return n > 0 && static_cast<double>(n) >= least; }));
 }
 
-std::string rgb3(const Vec3& v) { return fmt::format("({:.3f}, {:.3f}, {:.3f})", v[0], v[1], v[2]); }
+// (+ 0.0 turns a −0 into 0: a direction in the positive octant is never printed with a minus sign.)
+std::string rgb3(const Vec3& v) { return fmt::format("({:.3f}, {:.3f}, {:.3f})", v[0] + 0.0, v[1] + 0.0, v[2] + 0.0); }
 
 // A direction's words: its components where it is a colour, else which channels are negative — never a negative
 // number called a colour.
@@ -183,7 +189,16 @@ std::optional<Branch> measure_branch(const ClusterShape& s, const IlluminantEsti
   if (light.rgb.norm() > 0 && b.colour) {
     b.light_angle_deg = angular_error_deg(b.direction, light.rgb);
     // Twice the two directions' combined standard error, never below the angle that tells two directions apart.
-    const double branch_se = s.highlight_branch ? s.highlight_branch->uncertainty_deg : 0.0;
+    // The regression's standard error, else the highlight line's own: its direction is known to rms / (√n · the
+    // spread along it), the spread of points evenly along its length being length / √12.
+    double branch_se = 0;
+    if (s.highlight_branch) {
+      branch_se = s.highlight_branch->uncertainty_deg;
+    } else {
+      const Line& h = s.two_lines->highlight;
+      const double spread = (h.t_max - h.t_min) / std::sqrt(12.0);
+      branch_se = spread > 0 ? std::atan2(h.rms, std::sqrt(std::max<double>(1, static_cast<double>(h.inliers))) * spread) * kDeg : 90.0;
+    }
     b.allowed_deg = std::max(criteria.min_line_angle_deg, 2 * std::hypot(branch_se, light.uncertainty_deg.value_or(0.0)));
     if (light.reliable) b.light = *b.light_angle_deg <= *b.allowed_deg;
   } else if (!b.colour) {
@@ -281,13 +296,11 @@ void describe_shared_colour(const RegionAnalysis& region, const Region& pixels, 
   std::string at_black;
   if (region.source == "segment" && only_at_black(clipping) && clipping.fraction >= criteria.black_faces_fraction) {
     std::vector<std::string> channels;
-    const ClippedFace* largest = &clipping.faces.front();
-    for (const ClippedFace& f : clipping.faces) {
-      channels.push_back(std::string(1, "RGB"[f.channel]));
-      if (f.count > largest->count) largest = &f;
-    }
+    for (const ClippedFace& f : clipping.faces) channels.push_back(std::string(1, "RGB"[f.channel]));
+    // The channel with most pixels at black, face or not.
+    const auto most = static_cast<std::size_t>(std::max_element(clipping.at_black.begin(), clipping.at_black.end()) - clipping.at_black.begin());
     at_black = fmt::format("{}", fmt::join(channels, " or "));
-    const double median = clipping.black_brightest_median[static_cast<std::size_t>(largest->channel)];
+    const double median = clipping.black_brightest_median[most];
     if (median < kDimShare * clipping.top)
       out.findings.push_back({"at_black.dim",
                               fmt::format("{:.0f} % of its pixels have {} at black, and they are dim (the median of their brightest "
@@ -309,7 +322,7 @@ void describe_shared_colour(const RegionAnalysis& region, const Region& pixels, 
     out.findings.push_back({"separate_areas",
                             fmt::format("This segment is {} separate areas (each at least 1 % of it): the segmentation groups pixels by "
                                         "colour direction, and {} share this one, so it joins them.", out.separate_areas,
-                                        light_coloured      ? "objects of the light's colour — white cloth, glass, plates, the flames — all"
+                                        light_coloured      ? "objects of the light's colour — white cloth, glass, plates, metal, lamps — all"
                                         : !at_black.empty() ? "objects that differ only in " + at_black
                                                             : "several objects"),
                             {}});
@@ -347,7 +360,9 @@ BlackReach black_reach(const Line& line, double min_line_angle_deg) {
                                : std::numeric_limits<double>::infinity();
   r.uncertainty_deg = std::atan2(se, std::hypot(r.miss, top)) * kDeg;
   r.allowed_deg = std::max(min_line_angle_deg, 2 * r.uncertainty_deg);
-  r.reaches = r.angle_deg <= r.allowed_deg;
+  // A line known no better than the angle that tells two directions apart cannot say where it passes black.
+  r.measured = std::isfinite(se) && r.uncertainty_deg <= min_line_angle_deg;
+  r.reaches = r.measured && r.angle_deg <= r.allowed_deg;
   return r;
 }
 
@@ -392,8 +407,11 @@ Interpretation interpret_region(const RegionAnalysis& region, const Region& pixe
                   "colour outside the file's gamut, or dim pixels under its black — and the cluster lies flattened on faces "
                   "of the RGB cube";
   if (clipped) {
-    const Statement rest = process_of(s.shape, premises);
+    Premises below = premises;
+    below.cut_at_top = reaches_the_top(stored.clipping);
+    const Statement rest = process_of(s.shape, below);
     out.process += fmt::format("; off the faces, its {} pixels are {}: {}", s.samples, class_article(s.shape), rest.text);
+    out.process_rest_kind = rest.kind;
     out.process_claims = rest.claims;
   }
   if (s.samples == 0) {
@@ -421,39 +439,52 @@ Interpretation interpret_region(const RegionAnalysis& region, const Region& pixe
   } else if (premises.body) {
     const std::string mean = out.mean_colour ? fmt::format("Its mean colour is {} (unit RGB, linear){}.", colour_words(*out.mean_colour), to_light)
                                              : std::string();
-    if (!premises.body->reaches)
+    const char* what = s.two_lines && body_line == &s.two_lines->body ? "body line" : "line";
+    if (!premises.body->measured)
+      out.findings.push_back({"body_reach_unknown",
+                              fmt::format("Its {} is too short or too scattered to tell where it passes black (its angle from black is "
+                                          "known to ± {:.1f}°, more than the {:g}° that tell two directions apart), so its direction is not "
+                                          "quoted as a body colour. {}", what, premises.body->uncertainty_deg, criteria.min_line_angle_deg, mean),
+                              {}});
+    else if (!premises.body->reaches)
       out.findings.push_back({"no_body_colour",
                               fmt::format("Its {} does not reach black: it passes {:.3g} from black ({:.2f} × the length of its mean "
                                           "colour), {:.1f}° seen from its brightest end, beyond the {:.1f}° within which it would, so its "
                                           "direction is no body colour — a colour added to every pixel (a black level or flare, light of "
                                           "another colour over all of it) or a second light shifts it. {}",
-                                          s.two_lines && body_line == &s.two_lines->body ? "body line" : "line", premises.body->miss,
-                                          premises.body->miss / std::max(1e-300, s.moments.mean.norm()), premises.body->angle_deg,
-                                          premises.body->allowed_deg, mean),
+                                          what, premises.body->miss, premises.body->miss / std::max(1e-300, s.moments.mean.norm()),
+                                          premises.body->angle_deg, premises.body->allowed_deg, mean),
                               {"misses_black"}});
     else
-      out.findings.push_back({"no_body_colour",
-                              fmt::format("Its line reaches black but points along a direction with negative {}, which is no colour. {}",
-                                          negative_channels(unit(body_line->direction)), mean),
-                              {}});
+      out.findings.push_back({"no_body_colour.not_a_colour",
+                              fmt::format("Its {} reaches black but points along a direction with negative {}, which is no colour. {}",
+                                          what, negative_channels(unit(body_line->direction)), mean),
+                              {"reaches_black_not_a_colour"}});
   } else if (out.mean_colour) {
     out.findings.push_back({"mean_colour", fmt::format("Its colour is {} (unit RGB, linear){}.", colour_words(*out.mean_colour), to_light), {}});
   }
   // The dichromatic plane: spanned by the body colour and the light's — unless the cluster is thicker than its noise
   // off it, which no single plane of the model is.
   const bool planar = s.significant_axes >= 2 && s.black_plane;
-  const std::optional<double> thickness =
-      s.plane && s.significant_axes >= 2 ? std::optional<double>(s.sigma[2] / std::max(1e-300, s.noise_sigma[2])) : std::nullopt;
+  // (None for a noise-free image: there is no noise to be thick against.)
+  const std::optional<double> thickness = s.plane && s.significant_axes >= 2 && s.noise_sigma[2] > 0
+                                              ? std::optional<double>(s.sigma[2] / s.noise_sigma[2]) : std::nullopt;
   const bool thick = thickness && *thickness > criteria.noise_factor;
-  if (planar && out.light_colour) {
+  if (planar && out.light_colour && !light.reliable) {
+    out.light_off_plane_deg = std::asin(std::min(1.0, std::abs(s.black_plane->normal.normalized().dot(*out.light_colour)))) * kDeg;
+    out.findings.push_back({"plane.light_unknown",
+                            fmt::format("Its plane through black lies {:.1f}° from the light's colour, which is too uncertain to say "
+                                        "whether the plane holds it.", *out.light_off_plane_deg),
+                            {}});
+  } else if (planar && out.light_colour && thickness) {
     out.light_off_plane_deg = std::asin(std::min(1.0, std::abs(s.black_plane->normal.normalized().dot(*out.light_colour)))) * kDeg;
     const double allowed = std::max(criteria.min_line_angle_deg, 2 * light.uncertainty_deg.value_or(0.0));
     const bool holds = *out.light_off_plane_deg <= allowed;
     // How far the cluster lies off that plane, in units of its noise across it: the model's plane passes black.
-    const double off_black_plane = s.black_plane->rms / std::max(1e-300, s.noise_sigma[2]);
+    const double off_black_plane = s.black_plane->rms / s.noise_sigma[2];
     std::string sentence = fmt::format("Its plane through black holds the light's colour within {:.1f}°", *out.light_off_plane_deg);
     std::string kind = "plane.off_model";
-    std::vector<std::string> claims = {"off_model_plane"};
+    std::vector<std::string> claims = {"off_model_plane", thick ? "thick" : "flat"};
     if (holds && !thick && off_black_plane <= criteria.noise_factor) {
       kind = "plane.model", claims = {"on_model_plane"};
       sentence += fmt::format(" (at most {:.1f}°), and the cluster lies within {:.1f} × its noise of that plane: a plane spanned by this "
@@ -486,7 +517,8 @@ Interpretation interpret_region(const RegionAnalysis& region, const Region& pixe
     // Enough of it at black to be clipped, yet under black_faces_fraction: the class was read off the faces.
     if (only_at_black(stored.clipping) && stored.clipping.fraction >= criteria.clipped_fraction &&
         whole.shape != ShapeClass::Clipped && stored.shape != ShapeClass::Clipped)
-      sentence += " — only at black, in fewer than half of them, so its class is that of the pixels off the faces";
+      sentence += fmt::format(" — only at black, in fewer than {:g} % of them, so its class is that of the pixels off the faces",
+                              100 * criteria.black_faces_fraction);
     out.findings.push_back({"clipping.faces", sentence + ".", {}});
   }
   std::vector<std::string> few;
@@ -500,12 +532,13 @@ Interpretation interpret_region(const RegionAnalysis& region, const Region& pixe
                                 100.0 * static_cast<double>(stored.clipping.at_black[k]) / static_cast<double>(stored.samples), "RGB"[c]));
   }
   if (!few.empty()) {
-    const bool top = premises.top_pixels > 0 && std::any_of(std::begin(high_face), std::end(high_face), [](bool f) { return !f; });
+    bool top = false;
+    for (int c = 0; c < 3; ++c) top = top || (stored.clipping.known_high && stored.clipping.at_top[static_cast<std::size_t>(c)] > 0 && !high_face[c]);
     out.findings.push_back({"clipping.few",
                             fmt::format("Clipped, though too few to flatten a face (under {:.1f} %, or spread too little): {}{}.",
                                         100 * kFaceFraction, fmt::join(few, ", "),
                                         top ? " — at the top, a sheen or the peak of a highlight cut off" : ""),
-                            {}});
+                            top ? std::vector<std::string>{"top_clipped"} : std::vector<std::string>{}});
   }
   if (stored.clipping.faces.empty() && few.empty()) out.findings.push_back({"clipping.none", "No pixel of it lies on a clipping level.", {"nothing_clipped"}});
   // Thickness beyond the noise.

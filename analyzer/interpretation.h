@@ -39,7 +39,8 @@ struct BlackReach {
   double angle_deg = 0;      // atan(miss / (the brightest end's distance along the line))
   double uncertainty_deg = 0;  // the standard error of that angle (the line's rms over √inliers, its tilt included)
   double allowed_deg = 0;    // max(min_line_angle_deg, 2 × uncertainty): within it, the line reaches black
-  bool reaches = false;
+  bool measured = false;     // the uncertainty is within min_line_angle_deg: the line can tell where it passes
+  bool reaches = false;      // measured, and within allowed_deg
 };
 BlackReach black_reach(const Line& line, double min_line_angle_deg);
 
@@ -49,6 +50,7 @@ struct Interpretation {
   std::string process;       // the physical process the class stands for
   std::string process_kind;  // its statement kind (process.*)
   std::vector<std::string> process_claims;  // the premises it rests on (Statement::claims)
+  std::string process_rest_kind;  // a clipped cluster's: the kind of what its pixels off the faces are
   std::optional<Vec3> body_colour;   // unit direction of the body (matte) reflection: only of a line that reaches black
   std::optional<BlackReach> body_reach;  // where the body line passes black (none: no line, a single colour)
   std::optional<Vec3> mean_colour;   // the mean colour, unit (stands for the colour where no body colour is quoted)

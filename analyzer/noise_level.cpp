@@ -134,7 +134,7 @@ SpacingTest test_spacing(const RgbImage& image, const std::array<double, 3>& low
   }
   if (samples.size() < static_cast<std::size_t>(kBands) * 64) return t;
   // Bands of brightness, each its own σ per channel.
-  std::sort(samples.begin(), samples.end(), [](const Sample& a, const Sample& b) { return a.brightness < b.brightness; });
+  std::stable_sort(samples.begin(), samples.end(), [](const Sample& a, const Sample& b) { return a.brightness < b.brightness; });
   std::array<std::vector<double>, 3> band_sigma;
   std::vector<std::size_t> band_of(samples.size());
   for (int band = 0; band < kBands; ++band) {
@@ -158,19 +158,19 @@ SpacingTest test_spacing(const RgbImage& image, const std::array<double, 3>& low
     if (2 * zero > band_sigma[c].size() || !(variance > 1.5 * rounding) || !(variance > 0)) return t;
     scale[c] = variance / (variance - rounding);
   }
+  // Pairs of samples whose band has a σ in every channel, so that the channels' pairs share their tiles.
   Pairs pairs;
-  for (std::size_t i = 0; i < samples.size(); ++i)
-    for (std::size_t c = 0; c < 3; ++c) {
-      const double sigma = band_sigma[c][band_of[i]];
-      if (!(sigma > 0)) continue;
-      for (const std::size_t k : {std::size_t{1}, std::size_t{2}}) {  // right, down
-        pairs.u[c].push_back(samples[i].r[c] / sigma);
-        pairs.v[c].push_back(samples[i].r[k * 3 + c] / sigma);
-        if (c == 0) pairs.tile.push_back(samples[i].tile);
+  for (std::size_t i = 0; i < samples.size(); ++i) {
+    const std::size_t band = band_of[i];
+    if (!(band_sigma[0][band] > 0 && band_sigma[1][band] > 0 && band_sigma[2][band] > 0)) continue;
+    for (const std::size_t k : {std::size_t{1}, std::size_t{2}}) {  // right, down
+      for (std::size_t c = 0; c < 3; ++c) {
+        pairs.u[c].push_back(samples[i].r[c] / band_sigma[c][band]);
+        pairs.v[c].push_back(samples[i].r[k * 3 + c] / band_sigma[c][band]);
       }
+      pairs.tile.push_back(samples[i].tile);
     }
-  for (std::size_t c = 1; c < 3; ++c)
-    if (pairs.u[c].size() != pairs.u[0].size()) return t;  // a band σ of 0 in one channel only: tiles would not line up
+  }
   const auto departure = [&](int left_out) {
     double d = 0;
     for (std::size_t c = 0; c < 3; ++c) d = std::max(d, std::abs(robust_correlation(pairs.u[c], pairs.v[c], pairs.tile, left_out) - kWhite) * scale[c]);
@@ -200,8 +200,9 @@ SpacingChoice choose_noise_spacing(const RgbImage& image, const std::array<doubl
       choice.confirmed = true;
       break;
     }
+  // Still shared at the farthest spacing (only asked when no spacing was shown independent).
   const SpacingTest& last = choice.tests.back();
-  choice.correlated_beyond = last.measurable && last.departure > kCorrelatedBeyond + 3 * last.standard_error;
+  choice.correlated_beyond = !choice.confirmed && last.measurable && last.departure > kCorrelatedBeyond + 3 * last.standard_error;
   return choice;
 }
 

@@ -11,12 +11,12 @@
 // noise. A region's noise along u is the root of the bands' variances averaged over its samples' brightness:
 // the noise of a textured surface is the image's noise at its brightness, not the spread of its texture.
 //
-// The mask assumes noise independent from pixel to pixel. Demosaicing (and a camera's further processing)
-// interpolates each channel from neighbouring photosites, so neighbouring pixels share their noise and the
-// mask on adjacent pixels sees almost none of it: on bilinear-demosaiced white noise, red and blue residuals
-// vanish at three pixels of four and the estimate falls to 0, green's to a third. With its taps `spacing`
-// pixels apart (3: beyond the reach of a 3×3 interpolation, so the taps' noise is independent again) the mask
-// still cancels a planar signal, and gives each pixel's own noise σ for white and for interpolated noise alike.
+// The mask assumes noise independent from pixel to pixel. Demosaicing (and a camera's further processing, JPEG
+// compression, resampling) makes neighbouring pixels share their noise, and the mask on adjacent pixels sees
+// little of it: on bilinear-demosaiced white noise, red and blue residuals vanish at three pixels of four and the
+// estimate falls to 0, green's to a third. With its taps `spacing` pixels apart the mask still cancels a planar
+// signal; the spacing is the smallest at which the noise's measured correlation shows it independent
+// (choose_noise_spacing), at most 3 (beyond the reach of a 3×3 interpolation).
 
 #include <algorithm>
 #include <array>
@@ -119,8 +119,8 @@ struct ImageNoise {
 // Pixels whose 3×3 neighbourhood holds a non-finite value, a value at or below a channel's lower limit
 // (`low_levels`: the lowest code, where a converter clamps) or at or above its clipping level (`high_levels`,
 // +∞ for none) have no residual: clamped values carry no noise. At most `max_pixels` pixels are used, at an
-// even stride; deterministic. `spacing`: 1 when the image says each pixel's noise is its own, else
-// kInterpolatedNoiseSpacing.
+// even stride; deterministic. `spacing`: 1 when the image says each pixel's noise is its own, else the one
+// choose_noise_spacing chose.
 inline constexpr int kInterpolatedNoiseSpacing = 3;
 ImageNoise estimate_image_noise(const RgbImage& image, const std::array<double, 3>& low_levels, const std::array<double, 3>& high_levels,
                                 double floor, int spacing = 1, std::size_t max_pixels = std::size_t{1} << 18);

@@ -28,10 +28,39 @@ bool positive_octant(const V3& v) { return v.minCoeff() >= 0; }
 // Directions are quoted with their components summing to at least 0 (towards brighter).
 V3 brighter(const V3& v) { return v.sum() < 0 ? V3(-v) : v; }
 
-// What each kind of statement claims by its words: the claims it must carry.
+// Every kind of statement there is, with the claims its words make: the claims it must carry. A kind not listed
+// is itself a failure, so that no new kind of sentence goes unaudited.
 const std::map<std::string, std::set<std::string>>& required_claims() {
   static const std::map<std::string, std::set<std::string>> required = {
       {"body_colour", {"reaches_black"}},
+      {"no_body_colour", {"misses_black"}},
+      {"no_body_colour.not_a_colour", {"reaches_black_not_a_colour"}},
+      {"body_reach_unknown", {}},
+      {"mean_colour", {}},
+      {"highlight.no_light", {}},
+      {"highlight.light_unknown", {}},
+      {"plane.light_unknown", {}},
+      {"clipping.faces", {}},
+      {"clipping.few", {}},
+      {"separate_areas", {}},
+      {"curve", {}},
+      {"stored_class", {}},
+      {"light_paths", {}},
+      {"bend", {}},
+      {"process.none", {}},
+      {"process.clipped", {}},
+      {"process.mixed", {}},
+      {"process.line", {}},
+      {"process.thickened_line", {}},
+      {"process.fork", {}},
+      {"process.gamma", {}},
+      {"process.curved", {}},
+      {"process.thickened", {}},
+      {"process.volume", {}},
+      {"process.superposed", {}},
+      {"process.planar", {}},
+      {"process.highlight_unknown", {}},
+      {"process.matte_below_clipping", {"reaches_black", "top_clipped"}},
       {"highlight.light", {"light_highlight"}},
       {"highlight.not_light", {"not_light_highlight"}},
       {"highlight.not_a_colour", {"not_light_highlight"}},
@@ -78,6 +107,10 @@ class RegionAudit {
   std::optional<bool> holds(const std::string& claim) const {
     if (claim == "reaches_black") return body_reaches();
     if (claim == "misses_black") return body_misses();
+    if (claim == "reaches_black_not_a_colour") {
+      const auto r = reach();
+      return r && r->measured && r->angle <= r->allowed && !body_direction_is_colour();
+    }
     if (claim == "light_highlight") return branch_is_light();
     if (claim == "not_light_highlight") return branch_is_not_light();
     if (claim == "within_noise") return within_noise();
@@ -109,6 +142,7 @@ class RegionAudit {
   // the larger of min_line_angle_deg and twice the standard error of its closest point to black.
   struct Reach {
     double angle = 0, allowed = 0;
+    bool measured = false;  // its uncertainty within min_line_angle_deg
   };
   std::optional<Reach> reach() const {
     const json* line = body_line();
@@ -125,7 +159,9 @@ class RegionAudit {
     // it) carried over the distance p·d from the centroid to the closest point.
     const double spread = (t1 - t0) / std::sqrt(12.0);
     const double se = spread > 0 ? rms / std::sqrt(n) * std::hypot(1.0, p.dot(d) / spread) : std::numeric_limits<double>::infinity();
-    r.allowed = std::max(min_angle_, 2 * std::atan2(se, brightest.norm()) * kDegrees);
+    const double uncertainty = std::atan2(se, brightest.norm()) * kDegrees;
+    r.allowed = std::max(min_angle_, 2 * uncertainty);
+    r.measured = std::isfinite(se) && uncertainty <= min_angle_;
     return r;
   }
   bool body_direction_is_colour() const {
@@ -134,11 +170,11 @@ class RegionAudit {
   }
   bool body_reaches() const {
     const auto r = reach();
-    return r && r->angle <= r->allowed && body_direction_is_colour();
+    return r && r->measured && r->angle <= r->allowed && body_direction_is_colour();
   }
   bool body_misses() const {
     const auto r = reach();
-    return r && r->angle > r->allowed;
+    return r && r->measured && r->angle > r->allowed;
   }
 
   std::optional<V3> branch() const {
@@ -148,8 +184,17 @@ class RegionAudit {
       return brighter(v3((*read_)["two_lines"]["highlight"]["direction"]));
     return std::nullopt;
   }
+  // Twice the branch's and the light's standard errors combined, at least min_line_angle_deg. A highlight line without
+  // a regression is known to rms / (√n · σ_t) radians, σ_t² = (t_max − t_min)²/12.
   double branch_allowed() const {
-    const double se = read_->value("highlight_branch", json()).is_object() ? (*read_)["highlight_branch"]["uncertainty_deg"].get<double>() : 0.0;
+    double se = 90;
+    if (read_->value("highlight_branch", json()).is_object()) {
+      se = (*read_)["highlight_branch"]["uncertainty_deg"].get<double>();
+    } else {
+      const json& h = (*read_)["two_lines"]["highlight"];
+      const double spread = (h["t_max"].get<double>() - h["t_min"].get<double>()) / std::sqrt(12.0);
+      if (spread > 0) se = std::atan(h["rms"].get<double>() / (std::sqrt(std::max(1.0, h["inliers"].get<double>())) * spread)) * kDegrees;
+    }
     return std::max(min_angle_, 2 * std::hypot(se, light_se_));
   }
   bool branch_is_light() const {
@@ -173,17 +218,21 @@ class RegionAudit {
 
   std::optional<double> thickness() const {
     if (!read_->value("plane", json()).is_object() || read_->value("significant_axes", 0) < 2) return std::nullopt;
-    return v3((*read_)["sigma"])[2] / std::max(1e-300, v3((*read_)["noise_sigma"])[2]);
+    const double noise = v3((*read_)["noise_sigma"])[2];
+    if (!(noise > 0)) return std::nullopt;  // a noise-free image: nothing to be thick against
+    return v3((*read_)["sigma"])[2] / noise;
   }
 
   std::optional<bool> on_model_plane() const {
-    if (!read_->value("dichromatic_plane", json()).is_object() || light_.norm() == 0) return std::nullopt;
+    // Only a reliable light can say whether the plane holds it.
+    if (!read_->value("dichromatic_plane", json()).is_object() || !light_reliable_) return std::nullopt;
     const V3 normal = v3((*read_)["dichromatic_plane"]["normal"]).normalized();
     const double off = std::asin(std::min(1.0, std::abs(normal.dot(light_.normalized())))) * kDegrees;
     const auto t = thickness();
     // … and the cluster lies within its noise of the plane through black (rms distance over the noise across it).
-    const double off_black = (*read_)["dichromatic_plane"]["rms"].get<double>() / std::max(1e-300, v3((*read_)["noise_sigma"])[2]);
-    return off <= std::max(min_angle_, 2 * light_se_) && t && *t <= noise_factor_ && off_black <= noise_factor_;
+    if (!t) return std::nullopt;
+    const double off_black = (*read_)["dichromatic_plane"]["rms"].get<double>() / v3((*read_)["noise_sigma"])[2];
+    return off <= std::max(min_angle_, 2 * light_se_) && *t <= noise_factor_ && off_black <= noise_factor_;
   }
 
   std::optional<bool> gamma_measured() const {
@@ -307,11 +356,17 @@ std::vector<std::string> audit_statements(const json& analysis, const RegionPixe
         else if (!*ok) fail(fmt::format("premise '{}' is false for \"{}\"", c.get<std::string>(), sentence));
       }
       const auto& required = required_claims();
-      if (const auto it = required.find(kind); it != required.end())
-        for (const std::string& c : it->second)
-          if (!made.contains(c)) fail(fmt::format("a {} statement without its premise '{}': \"{}\"", kind, c, sentence));
+      const auto it = required.find(kind);
+      if (it == required.end()) {
+        fail(fmt::format("a statement of a kind the audit does not know, '{}': \"{}\"", kind, sentence));
+        return;
+      }
+      for (const std::string& c : it->second)
+        if (!made.contains(c)) fail(fmt::format("a {} statement without its premise '{}': \"{}\"", kind, c, sentence));
     };
-    check_claims(in["process_kind"], in["process"], in["process_claims"]);
+    // A clipped cluster's process describes its pixels off the faces too: their kind's claims are required.
+    const bool rest = in.value("process_rest_kind", json()).is_string();
+    check_claims(rest ? in["process_rest_kind"].get<std::string>() : in["process_kind"].get<std::string>(), in["process"], in["process_claims"]);
     for (const json& s : in["statements"]) {
       check_claims(s["kind"], s["text"], s["claims"]);
       if (text.find(s["text"].get<std::string>()) == std::string::npos) fail("a statement missing from the paragraph: " + s["text"].get<std::string>());
@@ -325,6 +380,7 @@ std::vector<std::string> audit_statements(const json& analysis, const RegionPixe
     if (read["samples"].get<std::size_t>() == 0) continue;
     if (audit.body_reaches() && !has_statement(statements, "body_colour")) fail("its line reaches black, but no body colour is quoted");
     if (!audit.body_reaches() && has_statement(statements, "body_colour")) fail("a body colour is quoted of a line that does not reach black");
+    if (audit.body_misses() && !has_statement(statements, "no_body_colour")) fail("its line misses black, and no sentence says so");
     for (int c = 0; c < 3; ++c) {
       const char channel = "RGB"[c];
       const auto k = static_cast<std::size_t>(c);

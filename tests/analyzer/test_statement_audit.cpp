@@ -31,7 +31,7 @@ using nlohmann::json;
 struct Case {
   json shape = {{"class", "linear"}, {"samples", 1000}};
   json statements = json::array();
-  std::string process_kind = "process.other";
+  std::string process_kind = "process.thickened";
   json process_claims = json::array();
   json gamma = nullptr;
   json interpretation_extra = json::object();
@@ -177,8 +177,11 @@ TEST(StatementAudit, ClippingSentencesAreAboutThePixelsThatExist) {
   Case bowl;
   for (int i = 0; i < 100; ++i) bowl.pixels.insert(bowl.pixels.end(), {179.0f, 60.0f, 0.0f});
   bowl.pixels.insert(bowl.pixels.end(), {255.0f, 120.0f, 20.0f});  // the sheen
-  bowl.say("at_black.dim", "100 % of its pixels have B at black, and they are dim.", {"at_black_dim"});
-  EXPECT_FALSE(bowl.audit().empty()) << "bright pixels at black called dim passed";
+  bowl.say("clipping.faces", "98 % of its pixels are clipped: B low at 0 (98 %).");
+  bowl.say("clipping.few", "Clipped, though too few to flatten a face: 1 pixel (0.98 %) with R at its top.");
+  bowl.say("at_black.dim", "98 % of its pixels have B at black, and they are dim.", {"at_black_dim"});
+  ASSERT_EQ(bowl.audit().size(), 1u) << joined(bowl.audit());
+  EXPECT_NE(bowl.audit()[0].find("premise 'at_black_dim' is false"), std::string::npos) << "bright pixels at black called dim passed";
   Case bright = bowl;
   bright.statements = json::array();
   bright.say("clipping.faces", "98 % of its pixels are clipped: B low at 0 (98 %).");
@@ -212,8 +215,13 @@ TEST(StatementAudit, AsTheModelHasItNeverOfAPlaneFarOffIt) {
   EXPECT_TRUE(flat.audit().empty()) << joined(flat.audit());
   Case thick = flat;
   thick.shape["sigma"] = {0.2, 0.05, 0.004935};
-  thick.shape["noise_sigma"] = {1e-6, 1e-6, 1e-6};  // 4935 × as thick as its noise off the plane
-  EXPECT_FALSE(thick.audit().empty()) << "'as the model has it' of a plane 4935 × as thick as its noise passed";
+  thick.shape["noise_sigma"] = {1e-6, 1e-6, 1e-6};  // 4935 × as thick as its noise off the plane …
+  thick.shape["dichromatic_plane"]["rms"] = 2e-6;   // … and within it of the plane through black
+  thick.statements = json::array();
+  thick.say("plane.model", "A plane as the dichromatic model has it.", {"on_model_plane"});
+  ASSERT_EQ(thick.audit().size(), 1u) << joined(thick.audit());
+  EXPECT_NE(thick.audit()[0].find("premise 'on_model_plane' is false"), std::string::npos)
+      << "'as the model has it' of a plane 4935 × as thick as its noise passed";
   Case shifted = flat;  // flat, but its plane misses black: the white cup's
   shifted.shape["dichromatic_plane"]["rms"] = 0.02;
   shifted.statements = json::array();
@@ -295,8 +303,11 @@ TEST(StatementAudit, PaperStatementsAreTrue) {
       const json& region = a["regions"][k];
       const bool whole = region["source"] == "image";
       const std::int64_t label = region["label"].is_number() ? region["label"].get<std::int64_t>() : -1;
-      if (!whole && (label < 0 || image.object_ids.empty())) ADD_FAILURE() << "region " << region["name"] << ": no pixels to audit";
       std::vector<float> rgb;
+      if (!whole && (label < 0 || image.object_ids.empty())) {
+        ADD_FAILURE() << "region " << region["name"] << ": no pixels to audit";
+        return rgb;
+      }
       for (std::size_t p = 0; p < layer.pixel_count(); ++p) {
         if (!whole && image.object_ids[p] != label) continue;
         const float* c = &layer.rgb[p * 3];
