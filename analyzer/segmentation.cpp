@@ -6,7 +6,9 @@
 #include <limits>
 #include <map>
 #include <numeric>
+#include <optional>
 #include <tuple>
+#include <unordered_map>
 
 #include <Eigen/Dense>
 #include <fmt/core.h>
@@ -405,61 +407,137 @@ bool is_highlight(const Work& work, const Inside& inside, const std::vector<std:
 }
 
 struct Parts {
-  std::vector<std::int32_t> id;                   // per working pixel, -1 for none
-  std::vector<std::vector<std::uint32_t>> pixels;  // per part
+  std::vector<std::int32_t> id;                    // per working pixel, -1 for none
+  std::vector<std::vector<std::uint32_t>> pixels;  // per part, in increasing order; empty once folded into another part
+  bool alive(std::size_t k) const { return !pixels[k].empty(); }
 };
 
+// The parts of the disjoint sets' pixels, numbered in the order of their first pixel.
 Parts parts_of(const Work& work, DisjointSets& sets) {
   Parts parts;
   parts.id.assign(work.size(), -1);
-  std::map<std::uint32_t, std::int32_t> index;
+  std::vector<std::int32_t> index(work.size(), -1);  // per root
   for (std::size_t q = 0; q < work.size(); ++q) {
     if (work.state[q] != kOk) continue;
-    const std::uint32_t root = sets.find(static_cast<std::uint32_t>(q));
-    auto [it, added] = index.try_emplace(root, static_cast<std::int32_t>(parts.pixels.size()));
-    if (added) parts.pixels.emplace_back();
-    parts.id[q] = it->second;
-    parts.pixels[static_cast<std::size_t>(it->second)].push_back(static_cast<std::uint32_t>(q));
+    std::int32_t& k = index[sets.find(static_cast<std::uint32_t>(q))];
+    if (k < 0) k = static_cast<std::int32_t>(parts.pixels.size()), parts.pixels.emplace_back();
+    parts.id[q] = k;
+    parts.pixels[static_cast<std::size_t>(k)].push_back(static_cast<std::uint32_t>(q));
   }
   return parts;
 }
 
-// Shared 4-neighbour boundary lengths between parts, and each part's whole boundary (to anything else).
-struct Adjacency {
-  std::map<std::pair<std::int32_t, std::int32_t>, std::size_t> shared;
-  std::vector<std::size_t> perimeter;
-  std::size_t between(std::int32_t a, std::int32_t b) const {
-    const auto it = shared.find({std::min(a, b), std::max(a, b)});
-    return it == shared.end() ? 0 : it->second;
+// Shared 4-neighbour boundary lengths between parts, and each part's whole boundary (to anything else): per part,
+// the parts it meets and the length of boundary it shares with each, counted in one pass over the pixels.
+// merge() folds one part into another and updates only their neighbours' entries, so that the adjacency of the
+// merged parts costs the two parts' degrees, not a pass over the image.
+class Adjacency {
+ public:
+  Adjacency(const Work& work, const Parts& parts) : perimeter(parts.pixels.size(), 0), shared_(parts.pixels.size()) {
+    auto pair = [&](std::size_t p, std::size_t q) {
+      const std::int32_t a = parts.id[p], b = parts.id[q];
+      if (a == b) return;
+      if (a >= 0) ++perimeter[static_cast<std::size_t>(a)];
+      if (b >= 0) ++perimeter[static_cast<std::size_t>(b)];
+      if (a >= 0 && b >= 0) ++shared_[static_cast<std::size_t>(a)][b], ++shared_[static_cast<std::size_t>(b)][a];
+    };
+    const auto w = static_cast<std::size_t>(work.w);
+    for (std::size_t q = 0; q < work.size(); ++q) {
+      if (q % w + 1 < w) pair(q, q + 1);
+      if (q + w < work.size()) pair(q, q + w);
+    }
   }
+
+  std::vector<std::size_t> perimeter;
+
+  std::size_t between(std::int32_t a, std::int32_t b) const {
+    const auto& m = shared_[static_cast<std::size_t>(a)];
+    const auto it = m.find(b);
+    return it == m.end() ? 0 : it->second;
+  }
+
+  // a's neighbours by decreasing shared boundary, then increasing id.
   std::vector<std::int32_t> neighbours(std::int32_t a) const {
     std::vector<std::pair<std::size_t, std::int32_t>> list;
-    for (const auto& [key, count] : shared)
-      if (key.first == a || key.second == a) list.emplace_back(count, key.first == a ? key.second : key.first);
+    list.reserve(shared_[static_cast<std::size_t>(a)].size());
+    for (const auto& [b, count] : shared_[static_cast<std::size_t>(a)]) list.emplace_back(count, b);
     std::sort(list.begin(), list.end(), [](const auto& x, const auto& y) { return x.first != y.first ? x.first > y.first : x.second < y.second; });
     std::vector<std::int32_t> out;
+    out.reserve(list.size());
     for (const auto& [count, b] : list) out.push_back(b);
     return out;
   }
+
+  // `from` becomes part of `into`: the boundary between them is inside now, and what each shared with a third
+  // part, the union shares with it.
+  void merge(std::int32_t into, std::int32_t from) {
+    auto& to = shared_[static_cast<std::size_t>(into)];
+    auto& gone = shared_[static_cast<std::size_t>(from)];
+    perimeter[static_cast<std::size_t>(into)] = perimeter[static_cast<std::size_t>(into)] + perimeter[static_cast<std::size_t>(from)] - 2 * between(into, from);
+    perimeter[static_cast<std::size_t>(from)] = 0;
+    to.erase(from);
+    for (const auto& [n, count] : gone) {
+      if (n == into) continue;
+      to[n] += count;
+      auto& other = shared_[static_cast<std::size_t>(n)];
+      other.erase(from);
+      other[into] += count;
+    }
+    std::unordered_map<std::int32_t, std::size_t>().swap(gone);
+  }
+
+ private:
+  std::vector<std::unordered_map<std::int32_t, std::size_t>> shared_;  // per part: neighbour → shared boundary
 };
 
-Adjacency adjacency(const Work& work, const Parts& parts) {
+// The parts of the working image with their adjacency and (while kept) statistics, from the start of step 5 to the
+// end of step 6. A round or pass joins parts in the disjoint sets while it reads the parts as they stood at its
+// start; fold() then brings them up to date: each group of joined parts becomes the one of them with the lowest id
+// (the one with the first pixel, which parts_of would number first), its pixels in increasing order, its statistics
+// measured afresh, its adjacency merged from the group's. The other parts keep their ids, in the order parts_of
+// would give them, and their statistics: parts, adjacency and statistics are those a rebuild from the sets would
+// give, at the cost of the joined parts' pixels and neighbours only.
+struct PartGraph {
+  Parts parts;
   Adjacency adj;
-  adj.perimeter.assign(parts.pixels.size(), 0);
-  auto pair = [&](std::size_t p, std::size_t q) {
-    const std::int32_t a = parts.id[p], b = parts.id[q];
-    if (a == b) return;
-    if (a >= 0) ++adj.perimeter[static_cast<std::size_t>(a)];
-    if (b >= 0) ++adj.perimeter[static_cast<std::size_t>(b)];
-    if (a >= 0 && b >= 0) ++adj.shared[{std::min(a, b), std::max(a, b)}];
-  };
-  const auto w = static_cast<std::size_t>(work.w);
-  for (std::size_t q = 0; q < work.size(); ++q) {
-    if (q % w + 1 < w) pair(q, q + 1);
-    if (q + w < work.size()) pair(q, q + w);
+  std::vector<PartStats> stats;  // per part, while `keep_stats`
+  bool keep_stats = true;
+
+  PartGraph(const Work& work, DisjointSets& sets, const NoiseModel& noise) : parts(parts_of(work, sets)), adj(work, parts) {
+    stats.reserve(parts.pixels.size());
+    for (const auto& pixels : parts.pixels) stats.push_back(part_stats(work, pixels, noise));
   }
-  return adj;
-}
+
+  // `joined`: every part that took part in a join since the last fold (either side).
+  void fold(const Work& work, const NoiseModel& noise, DisjointSets& sets, std::vector<std::int32_t> joined) {
+    std::sort(joined.begin(), joined.end());
+    joined.erase(std::unique(joined.begin(), joined.end()), joined.end());
+    std::vector<std::pair<std::uint32_t, std::int32_t>> groups;  // (root, part), parts in increasing id per root
+    groups.reserve(joined.size());
+    for (const std::int32_t k : joined) groups.emplace_back(sets.find(parts.pixels[static_cast<std::size_t>(k)].front()), k);
+    std::sort(groups.begin(), groups.end());
+    for (std::size_t i = 0; i < groups.size();) {
+      std::size_t j = i + 1;
+      while (j < groups.size() && groups[j].first == groups[i].first) ++j;
+      if (j - i > 1) {
+        const std::int32_t into = groups[i].second;
+        auto& pixels = parts.pixels[static_cast<std::size_t>(into)];
+        for (std::size_t k = i + 1; k < j; ++k) {
+          const std::int32_t from = groups[k].second;
+          adj.merge(into, from);
+          auto& moved = parts.pixels[static_cast<std::size_t>(from)];
+          for (const std::uint32_t q : moved) parts.id[q] = into;
+          pixels.insert(pixels.end(), moved.begin(), moved.end());
+          std::vector<std::uint32_t>().swap(moved);
+          if (keep_stats) stats[static_cast<std::size_t>(from)] = PartStats{};
+        }
+        std::sort(pixels.begin(), pixels.end());
+        if (keep_stats) stats[static_cast<std::size_t>(into)] = part_stats(work, pixels, noise);
+      }
+      i = j;
+    }
+  }
+};
 
 // Step 2: the noise model's encoding — an integer file's codes, the curve of an encoded file as a table — and
 // then its terms, measured on the working image.
@@ -542,28 +620,44 @@ class ColourClusters {
     for (std::uint32_t q = 0; q < sets.parent.size(); ++q)
       if (sets.find(q) == q && precision_[q] > 0 && tolerance_ / std::sqrt(precision_[q]) <= extra)
         anchors[q].push_back({unit_sum_[q].normalized(), 1 / precision_[q], bias_sum_[q] / precision_[q]});
+    constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
+    std::vector<std::uint32_t> edge_part(edges_.size());          // per edge: the part holding both ends, else kNone
+    std::vector<std::uint32_t> within_start(sets.parent.size() + 1);  // per part: where its steps start in within_steps
+    std::vector<float> within_steps(edges_.size());
+    std::vector<double> texture_of(sets.parent.size());
     for (int round = 0; round < 4; ++round) {
-      std::map<std::pair<std::uint32_t, std::uint32_t>, std::vector<float>> across;
-      std::map<std::uint32_t, std::vector<float>> within;
-      for (const Edge& e : edges_) {
+      // The steps across each boundary between two parts, grouped by sorting, and within each part, grouped by
+      // counting (a group's median is its step of rank ⌊(n − 1)/2⌋ in increasing order, core/statistics.h's rule).
+      std::vector<std::pair<std::uint64_t, float>> across;
+      std::fill(within_start.begin(), within_start.end(), 0u);
+      for (std::size_t k = 0; k < edges_.size(); ++k) {
+        const Edge& e = edges_[k];
         const std::uint32_t a = sets.find(e.a), b = sets.find(e.b);
-        if (a != b) across[{std::min(a, b), std::max(a, b)}].push_back(e.weight);
-        else within[a].push_back(e.weight);
+        edge_part[k] = a == b ? a : kNone;
+        if (a != b) across.emplace_back(std::uint64_t{std::min(a, b)} << 32 | std::max(a, b), e.weight);
+        else ++within_start[a + 1];
       }
+      std::partial_sum(within_start.begin(), within_start.end(), within_start.begin());
+      std::vector<std::uint32_t> fill(within_start.begin(), within_start.end() - 1);
+      for (std::size_t k = 0; k < edges_.size(); ++k)
+        if (edge_part[k] != kNone) within_steps[fill[edge_part[k]]++] = edges_[k].weight;
+      std::sort(across.begin(), across.end());
       // Each part's texture, once: the median step between its own neighbours (0 when too few to say).
-      std::map<std::uint32_t, double> texture_of;
-      for (const auto& [part, steps] : within)
-        if (steps.size() >= 8) texture_of[part] = quantile(std::vector<double>(steps.begin(), steps.end()), 0.5);
-      const auto texture = [&](std::uint32_t part) {
-        const auto it = texture_of.find(part);
-        return it == texture_of.end() ? 0.0 : it->second;
-      };
+      std::fill(texture_of.begin(), texture_of.end(), 0.0);
+      for (std::size_t part = 0; part < texture_of.size(); ++part) {
+        const auto lo = within_steps.begin() + within_start[part], hi = within_steps.begin() + within_start[part + 1];
+        if (hi - lo < 8) continue;
+        const auto middle = lo + (hi - lo - 1) / 2;
+        std::nth_element(lo, middle, hi);
+        texture_of[part] = *middle;
+      }
       std::vector<std::tuple<double, std::uint32_t, std::uint32_t>> weak;
-      for (auto& [key, weights] : across) {
-        if (weights.size() < 4) continue;
-        const double median = quantile(std::vector<double>(weights.begin(), weights.end()), 0.5);
-        if (median <= std::max(kWeakBoundary, kTextureSteps * std::min(texture(key.first), texture(key.second))))
-          weak.emplace_back(median, key.first, key.second);
+      for (std::size_t i = 0, j = 0; i < across.size(); i = j) {
+        while (j < across.size() && across[j].first == across[i].first) ++j;
+        if (j - i < 4) continue;
+        const double median = across[i + (j - i - 1) / 2].second;
+        const auto a = static_cast<std::uint32_t>(across[i].first >> 32), b = static_cast<std::uint32_t>(across[i].first & 0xffffffffu);
+        if (median <= std::max(kWeakBoundary, kTextureSteps * std::min(texture_of[a], texture_of[b]))) weak.emplace_back(median, a, b);
       }
       std::sort(weak.begin(), weak.end());
       std::size_t joined = 0;
@@ -649,21 +743,26 @@ class ColourClusters {
   double tolerance_, angle_tolerance_;
 };
 
-// Step 5: highlights (and clipped highlights) join their objects — whole parts, a few rounds.
-void extend_over_dichromatic_planes(const Work& work, const NoiseModel& noise, DisjointSets& sets, Segmentation& out) {
+// Step 5: highlights (and clipped highlights) join their objects — whole parts, a few rounds. Each round reads the
+// parts, their adjacency and statistics as they stood at its start; its joins are folded in at its end.
+void extend_over_dichromatic_planes(const Work& work, const NoiseModel& noise, DisjointSets& sets, PartGraph& graph, Segmentation& out) {
+  const Parts& parts = graph.parts;
+  const Adjacency& adj = graph.adj;
+  const std::vector<PartStats>& stats = graph.stats;
+  std::vector<std::uint8_t> in_inside(parts.pixels.size(), 0);  // the parts of B and those it encloses, while B is tried
   for (int round = 0; round < 4; ++round) {
-    const Parts parts = parts_of(work, sets);
-    const Adjacency adj = adjacency(work, parts);
-    std::vector<PartStats> stats;
-    for (const auto& pixels : parts.pixels) stats.push_back(part_stats(work, pixels, noise));
-    std::vector<std::int32_t> order(parts.pixels.size());
-    std::iota(order.begin(), order.end(), 0);
+    std::vector<std::int32_t> order;
+    for (std::size_t k = 0; k < parts.pixels.size(); ++k)
+      if (parts.alive(k)) order.push_back(static_cast<std::int32_t>(k));
     std::stable_sort(order.begin(), order.end(), [&](std::int32_t x, std::int32_t y) { return stats[static_cast<std::size_t>(x)].n < stats[static_cast<std::size_t>(y)].n; });
     std::vector<std::uint8_t> touched(parts.pixels.size(), 0);  // 1: grew this round, 2: merged away
+    std::vector<std::int32_t> joined;
     std::size_t merges = 0;
     for (const std::int32_t bi : order) {
       const PartStats& b = stats[static_cast<std::size_t>(bi)];
       if (touched[static_cast<std::size_t>(bi)] != 0 || b.n < 2) continue;
+      // B with the parts it encloses, found once for B (they do not depend on the neighbour A), when first needed.
+      std::optional<std::pair<std::vector<std::uint32_t>, std::vector<std::int32_t>>> enclosing;
       for (const std::int32_t ai : adj.neighbours(bi)) {
         const PartStats& a = stats[static_cast<std::size_t>(ai)];
         if (touched[static_cast<std::size_t>(ai)] == 2) continue;
@@ -673,19 +772,27 @@ void extend_over_dichromatic_planes(const Work& work, const NoiseModel& noise, D
         if (b.clipped >= 0.5) {
           join = shared >= 0.5 * perimeter && b.n <= a.n;
           if (join) ++out.clipped_merges;
-        } else {
-          std::vector<std::uint32_t> pixels = parts.pixels[static_cast<std::size_t>(bi)];
-          std::vector<std::int32_t> inside = enclosed_parts(work, parts.id, parts.pixels, bi, parts.pixels[static_cast<std::size_t>(bi)], pixels);
-          inside.push_back(bi);
+        } else if (b.brightness > a.brightness && 4 * b.n <= a.n) {  // else no highlight, whatever B encloses (is_highlight)
+          if (!enclosing) {
+            enclosing.emplace(parts.pixels[static_cast<std::size_t>(bi)], std::vector<std::int32_t>{});
+            auto& [pixels, inside] = *enclosing;
+            inside = enclosed_parts(work, parts.id, parts.pixels, bi, parts.pixels[static_cast<std::size_t>(bi)], pixels);
+            inside.push_back(bi);
+          }
+          const auto& [pixels, inside] = *enclosing;
           const bool free = std::none_of(inside.begin(), inside.end(), [&](std::int32_t k) { return touched[static_cast<std::size_t>(k)] == 2 || k == ai; });
-          const auto in_b = [&](std::size_t q) { return std::find(inside.begin(), inside.end(), parts.id[q]) != inside.end(); };
-          if (free && is_highlight(work, in_b, pixels, a, b)) {
+          for (const std::int32_t k : inside) in_inside[static_cast<std::size_t>(k)] = 1;
+          const auto in_b = [&](std::size_t q) { return parts.id[q] >= 0 && in_inside[static_cast<std::size_t>(parts.id[q])] != 0; };
+          const bool highlight = free && is_highlight(work, in_b, pixels, a, b);
+          for (const std::int32_t k : inside) in_inside[static_cast<std::size_t>(k)] = 0;
+          if (highlight) {
             join = true;
             ++out.highlight_merges;
             for (const std::int32_t k : inside)
               if (k != bi) {
                 sets.join(parts.pixels[static_cast<std::size_t>(ai)].front(), parts.pixels[static_cast<std::size_t>(k)].front());
                 touched[static_cast<std::size_t>(k)] = 2;
+                joined.push_back(k);
               }
           }
         }
@@ -693,43 +800,46 @@ void extend_over_dichromatic_planes(const Work& work, const NoiseModel& noise, D
         sets.join(parts.pixels[static_cast<std::size_t>(ai)].front(), parts.pixels[static_cast<std::size_t>(bi)].front());
         touched[static_cast<std::size_t>(bi)] = 2;
         touched[static_cast<std::size_t>(ai)] = std::max<std::uint8_t>(touched[static_cast<std::size_t>(ai)], 1);
+        joined.push_back(ai), joined.push_back(bi);
         ++merges;
         break;
       }
     }
+    graph.fold(work, noise, sets, std::move(joined));
     if (merges == 0) break;
   }
 }
 
 // Step 6: parts smaller than `min_area` join the neighbour whose colours they share; then those one segment
 // encloses join it as details finer than the smallest segment; the rest stay unassigned.
-Parts absorb_small_parts(const Work& work, const NoiseModel& noise, double min_area, DisjointSets& sets) {
-  Parts parts = parts_of(work, sets);
+void absorb_small_parts(const Work& work, const NoiseModel& noise, double min_area, DisjointSets& sets, PartGraph& graph) {
+  const Parts& parts = graph.parts;
+  const Adjacency& adj = graph.adj;
   {
-    const Adjacency adj = adjacency(work, parts);
-    std::vector<PartStats> stats;
-    for (const auto& pixels : parts.pixels) stats.push_back(part_stats(work, pixels, noise));
+    const std::vector<PartStats>& stats = graph.stats;
+    std::vector<std::int32_t> joined;
     for (std::size_t bi = 0; bi < parts.pixels.size(); ++bi) {
-      if (static_cast<double>(stats[bi].n) >= min_area) continue;
+      if (!parts.alive(bi) || static_cast<double>(stats[bi].n) >= min_area) continue;
       for (const std::int32_t ai : adj.neighbours(static_cast<std::int32_t>(bi))) {
         const PartStats& a = stats[static_cast<std::size_t>(ai)];
         if (static_cast<double>(a.n) < min_area) continue;
         if (angle(stats[bi].direction, a.direction) <= std::max(a.spread, 3 * kMinAngle)) {
           sets.join(parts.pixels[static_cast<std::size_t>(ai)].front(), parts.pixels[bi].front());
+          joined.push_back(ai), joined.push_back(static_cast<std::int32_t>(bi));
           break;
         }
       }
     }
-    parts = parts_of(work, sets);
+    graph.keep_stats = false;  // not read again
+    graph.fold(work, noise, sets, std::move(joined));
   }
   // Small parts that one segment encloses — nine tenths of their boundary with segments is with it, and at least
   // half their boundary is with segments (the rest with unassigned pixels) — are details of that object finer
   // than the smallest segment (speckle, embroidery, texture): they join it. A few passes take in clusters of them.
   for (int pass = 0; pass < 3; ++pass) {
-    const Adjacency adj = adjacency(work, parts);
-    std::size_t joined = 0;
+    std::vector<std::int32_t> joined;
     for (std::size_t bi = 0; bi < parts.pixels.size(); ++bi) {
-      if (static_cast<double>(parts.pixels[bi].size()) >= min_area) continue;
+      if (!parts.alive(bi) || static_cast<double>(parts.pixels[bi].size()) >= min_area) continue;
       std::size_t best = 0, big = 0;
       std::int32_t to = -1;
       for (const std::int32_t ai : adj.neighbours(static_cast<std::int32_t>(bi))) {
@@ -740,13 +850,13 @@ Parts absorb_small_parts(const Work& work, const NoiseModel& noise, double min_a
       }
       if (to >= 0 && double(best) >= kEnclosed * double(big) && 2 * big >= adj.perimeter[bi]) {
         sets.join(parts.pixels[static_cast<std::size_t>(to)].front(), parts.pixels[bi].front());
-        ++joined;
+        joined.push_back(to), joined.push_back(static_cast<std::int32_t>(bi));
       }
     }
-    parts = parts_of(work, sets);
-    if (joined == 0) break;
+    const bool any = !joined.empty();
+    graph.fold(work, noise, sets, std::move(joined));
+    if (!any) break;
   }
-  return parts;
 }
 
 // The segments of the working image: parts of at least `min_area` numbered by decreasing size (0 for the rest),
@@ -946,10 +1056,11 @@ Segmentation segment_image(const RgbImage& image, const std::optional<ToneCurve>
   ColourClusters clusters(work, out.noise, options);
   clusters.merge_along_edges();
   clusters.join_across_weak_boundaries();
-  extend_over_dichromatic_planes(work, out.noise, clusters.sets, out);
+  PartGraph graph(work, clusters.sets, out.noise);
+  extend_over_dichromatic_planes(work, out.noise, clusters.sets, graph, out);
   const double min_area = std::max(1.0, options.min_area * static_cast<double>(work.valid));
-  const Parts parts = absorb_small_parts(work, out.noise, min_area, clusters.sets);
-  labels_at_full_size(image, decode, work, number_segments(work, parts, out.noise, min_area), out.noise, options.dark, out);
+  absorb_small_parts(work, out.noise, min_area, clusters.sets, graph);
+  labels_at_full_size(image, decode, work, number_segments(work, graph.parts, out.noise, min_area), out.noise, options.dark, out);
   out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return out;
 }
