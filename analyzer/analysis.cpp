@@ -58,7 +58,7 @@ void confirm_declared_gamma(RegionAnalysis& r, const RgbImage& stored, const Reg
 }  // namespace
 
 std::vector<Region> select_regions(const AnalysisImage& input, const RgbImage& layer, const RegionOptions& options,
-                                   Segmentation* segmentation) {
+                                   Segmentation* segmentation, bool progress) {
   std::vector<Region> regions{whole_image_region(layer.width, layer.height)};
   auto append = [&](std::vector<Region> more) { std::move(more.begin(), more.end(), std::back_inserter(regions)); };
   // Id 0 is "no object" by convention, unless the file gives it a name.
@@ -84,7 +84,7 @@ std::vector<Region> select_regions(const AnalysisImage& input, const RgbImage& l
     const ImageEncoding& e = input.encoding;
     const std::optional<ToneCurve> curve = final_layer ? e.curve : std::nullopt;
     const double clip = final_layer && e.integer ? e.clipping_level().value_or(e.full_scale) : 0.0;
-    Segmentation s = segment_image(layer, curve, e.integer ? e.full_scale : 1.0, clip, options.segmentation);
+    Segmentation s = segment_image(layer, curve, e.integer ? e.full_scale : 1.0, clip, options.segmentation, progress);
     append(std::move(s.regions));
     s.regions.clear();
     if (segmentation) *segmentation = std::move(s);

@@ -27,9 +27,9 @@ struct RegionOptions {
 // rectangles and segments (by decreasing size, then the unassigned pixels as a region of their own), in that
 // order. Label and mask images must match the image's size (InputError naming the file otherwise).
 // With options.segment and `segmentation`, the segmentation's label map and numbers are kept there (its
-// regions are moved into the result).
+// regions are moved into the result); with `progress`, the segmentation shows a progress bar on stderr.
 std::vector<Region> select_regions(const AnalysisImage& input, const RgbImage& layer, const RegionOptions& options,
-                                   Segmentation* segmentation = nullptr);
+                                   Segmentation* segmentation = nullptr, bool progress = false);
 
 struct ImageAnalysis {
   std::string file;

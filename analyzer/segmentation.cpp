@@ -1,6 +1,7 @@
 #include "analyzer/segmentation.h"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -17,6 +18,7 @@
 #include "core/error.h"
 #include "core/statistics.h"
 #include "core/parallel.h"
+#include "core/progress.h"
 
 namespace ct::analyzer {
 namespace {
@@ -26,6 +28,34 @@ constexpr double kWeakBoundary = 1.5;  // the median step (noise σ) across a bo
 constexpr double kTextureSteps = 2.5;  // or, where both parts are textured, at most this many times the median step within the smoother one
 constexpr double kEnclosed = 0.9;      // the share of a small part's boundary with segments that one segment must hold
 constexpr std::uint8_t kInvalid = 0, kOk = 1, kDark = 2;
+
+// One step's share of the segmentation's progress bar, given out in `parts` instalments as the step goes (from any
+// thread), the rest when it ends.
+class StepShare {
+ public:
+  StepShare(Progress& bar, double units, std::size_t parts)
+      : bar_(bar), units_(static_cast<std::size_t>(std::max(1.0, std::round(units)))), parts_(std::max<std::size_t>(1, parts)) {}
+  StepShare(const StepShare&) = delete;
+  StepShare& operator=(const StepShare&) = delete;
+  ~StepShare() { bar_.advance(units_ - std::min(units_, given(done_.load()))); }
+  void advance() {
+    const std::size_t k = done_.fetch_add(1) + 1;
+    if (k <= parts_) bar_.advance(given(k) - given(k - 1));
+  }
+
+ private:
+  std::size_t given(std::size_t k) const { return units_ * std::min(k, parts_) / parts_; }
+  Progress& bar_;
+  std::size_t units_, parts_;
+  std::atomic<std::size_t> done_{0};
+};
+
+// The working size for an image of width × height: about `megapixels`, never enlarged.
+std::pair<int, int> working_size(int width, int height, double megapixels) {
+  const double f = std::sqrt(static_cast<double>(width) * static_cast<double>(height) / (megapixels * 1e6));
+  if (!(f > 1)) return {width, height};
+  return {std::max(1, static_cast<int>(std::lround(width / f))), std::max(1, static_cast<int>(std::lround(height / f)))};
+}
 
 // The image area-averaged to the working size, in linear light.
 struct Work {
@@ -57,12 +87,10 @@ Spans spans(int from, int to) {
   return s;
 }
 
-Work working_image(const RgbImage& image, const CodeDecoder& decode, double clip_level, double megapixels) {
+Work working_image(const RgbImage& image, const CodeDecoder& decode, double clip_level, double megapixels, StepShare& progress) {
   const int W = image.width, H = image.height;
-  const double f = std::sqrt(static_cast<double>(image.pixel_count()) / (megapixels * 1e6));
   Work work;
-  work.w = f > 1 ? std::max(1, static_cast<int>(std::lround(W / f))) : W;
-  work.h = f > 1 ? std::max(1, static_cast<int>(std::lround(H / f))) : H;
+  std::tie(work.w, work.h) = working_size(W, H, megapixels);
   const Spans sx = spans(W, work.w), sy = spans(H, work.h);
   const std::size_t n = work.size();
   // Per working pixel: weighted sums of valid colour, valid weight, clipped weight, total weight.
@@ -102,6 +130,7 @@ Work working_image(const RgbImage& image, const CodeDecoder& decode, double clip
       }
     }
   }
+  progress.advance();
   });
   work.rgb.assign(n * 3, 0.0f);
   work.state.assign(n, kInvalid);
@@ -165,7 +194,7 @@ NoiseTerms fit_noise_terms(const std::vector<double>& level, const std::vector<d
 // read and shot noise and a part proportional to the signal; an encoded file's (sRGB, a gamma) are what the
 // encoding's steps and the compression did to the stored values, which the same curve describes there and no
 // such curve does in linear light (at the dark end the curve's slope shrinks them many times). `model` brings the curve.
-NoiseModel estimate_noise(const Work& work, NoiseModel model) {
+NoiseModel estimate_noise(const Work& work, NoiseModel model, StepShare& progress) {
   std::vector<double> brightest;
   for (std::size_t q = 0; q < work.size(); ++q)
     if (work.state[q] == kOk && !work.clipped[q]) {
@@ -205,6 +234,7 @@ NoiseModel estimate_noise(const Work& work, NoiseModel model) {
     model.a[c] = terms.a;
     model.b[c] = terms.b;
     model.c[c] = terms.c;
+    progress.advance();
   }
   return model;
 }
@@ -541,7 +571,7 @@ struct PartGraph {
 
 // Step 2: the noise model's encoding — an integer file's codes, the curve of an encoded file as a table — and
 // then its terms, measured on the working image.
-NoiseModel measure_noise(const Work& work, const CodeDecoder& decode, double full_scale, double averaged) {
+NoiseModel measure_noise(const Work& work, const CodeDecoder& decode, double full_scale, double averaged, StepShare& progress) {
   NoiseModel model;
   model.integer = full_scale > 1;
   model.codes = decode.table;
@@ -557,7 +587,7 @@ NoiseModel measure_noise(const Work& work, const CodeDecoder& decode, double ful
       for (int k = 0; k <= kSteps; ++k) model.curve.push_back(static_cast<float>(decode.curve->decode(k * model.curve_step, decode.full_scale)));
     }
   }
-  return estimate_noise(work, std::move(model));
+  return estimate_noise(work, std::move(model), progress);
 }
 
 // Step 3: each pixel's angular noise; the dark ones are set aside.
@@ -602,8 +632,13 @@ class ColourClusters {
   }
 
   // Graph merging over 8-neighbour edges, lightest first (Felzenszwalb & Huttenlocher).
-  void merge_along_edges() {
-    for (const Edge& e : edges_) try_join(e.a, e.b, 0.0);
+  void merge_along_edges(StepShare& progress) {
+    const std::size_t chunk = edges_.size() / 16 + 1;
+    for (std::size_t k = 0; k < edges_.size(); ++k) {
+      const Edge& e = edges_[k];
+      try_join(e.a, e.b, 0.0);
+      if ((k + 1) % chunk == 0) progress.advance();
+    }
   }
 
   // Parts of one surface that a slow drift of its colour split (shading by light of two colours, skin) meet
@@ -611,7 +646,7 @@ class ColourClusters {
   // 2.5 times the median step within the smoother of the two (their texture: a boundary no sharper than the
   // surface's own grain is no edge; Felzenszwalb & Huttenlocher compare a boundary with the parts' insides so),
   // they join if their mean directions differ by less than 3 · angle_deg beyond their noise.
-  void join_across_weak_boundaries() {
+  void join_across_weak_boundaries(StepShare& progress) {
     const double extra = 2 * angle_tolerance_;
     // The parts as they stand before these joins whose mean colour is known well enough to tell the difference
     // this forgives (anchors): a join must keep every two of them within it, so that a run of joins, each small,
@@ -675,6 +710,7 @@ class ColourClusters {
         into.insert(into.end(), from.begin(), from.end());
         anchors.erase(other);
       }
+      progress.advance();
       if (joined == 0) break;
     }
   }
@@ -745,7 +781,8 @@ class ColourClusters {
 
 // Step 5: highlights (and clipped highlights) join their objects — whole parts, a few rounds. Each round reads the
 // parts, their adjacency and statistics as they stood at its start; its joins are folded in at its end.
-void extend_over_dichromatic_planes(const Work& work, const NoiseModel& noise, DisjointSets& sets, PartGraph& graph, Segmentation& out) {
+void extend_over_dichromatic_planes(const Work& work, const NoiseModel& noise, DisjointSets& sets, PartGraph& graph, Segmentation& out,
+                                    StepShare& progress) {
   const Parts& parts = graph.parts;
   const Adjacency& adj = graph.adj;
   const std::vector<PartStats>& stats = graph.stats;
@@ -806,13 +843,14 @@ void extend_over_dichromatic_planes(const Work& work, const NoiseModel& noise, D
       }
     }
     graph.fold(work, noise, sets, std::move(joined));
+    progress.advance();
     if (merges == 0) break;
   }
 }
 
 // Step 6: parts smaller than `min_area` join the neighbour whose colours they share; then those one segment
 // encloses join it as details finer than the smallest segment; the rest stay unassigned.
-void absorb_small_parts(const Work& work, const NoiseModel& noise, double min_area, DisjointSets& sets, PartGraph& graph) {
+void absorb_small_parts(const Work& work, const NoiseModel& noise, double min_area, DisjointSets& sets, PartGraph& graph, StepShare& progress) {
   const Parts& parts = graph.parts;
   const Adjacency& adj = graph.adj;
   {
@@ -832,6 +870,7 @@ void absorb_small_parts(const Work& work, const NoiseModel& noise, double min_ar
     }
     graph.keep_stats = false;  // not read again
     graph.fold(work, noise, sets, std::move(joined));
+    progress.advance();
   }
   // Small parts that one segment encloses — nine tenths of their boundary with segments is with it, and at least
   // half their boundary is with segments (the rest with unassigned pixels) — are details of that object finer
@@ -855,6 +894,7 @@ void absorb_small_parts(const Work& work, const NoiseModel& noise, double min_ar
     }
     const bool any = !joined.empty();
     graph.fold(work, noise, sets, std::move(joined));
+    progress.advance();
     if (!any) break;
   }
 }
@@ -935,7 +975,7 @@ std::int32_t boundary_label(const Work& work, const WorkingLabels& labels, int w
 // Step 7: the labels carried back to full size, and the segments and the unassigned pixels as regions. Bands of
 // rows run side by side, each with its own counts, added afterwards: the same whatever the thread count.
 void labels_at_full_size(const RgbImage& image, const CodeDecoder& decode, const Work& work, const WorkingLabels& labels,
-                         const NoiseModel& noise, double dark, Segmentation& out) {
+                         const NoiseModel& noise, double dark, Segmentation& out, StepShare& progress) {
   const int W = image.width, H = image.height, w = work.w, h = work.h;
   out.labels.assign(image.pixel_count(), 0);
   const bool same = W == w && H == h;
@@ -969,6 +1009,7 @@ void labels_at_full_size(const RgbImage& image, const CodeDecoder& decode, const
         }
       }
     }
+    progress.advance();
   });
   std::vector<std::size_t> counts(labels.count() + 1, 0);
   for (const Counts& bc : band_counts) {
@@ -1040,27 +1081,53 @@ void check_segmentation_options(const SegmentationOptions& o) {
   check(o.dark >= 0 && std::isfinite(o.dark), "--segment-dark", o.dark, ">= 0");
 }
 
+// The progress bar's shares of the steps, about their wall time in microseconds on a 2-core machine: steps 1 and 7
+// (on every core) per pixel of the image, the others per working pixel, as measured on photographs from 0.06 to 24
+// megapixels and synthetic mosaics (bench/README.md), so that the bar moves about evenly in time.
+constexpr double kWorkingImageCost = 0.025, kFullSizeCost = 0.03;  // per pixel of the image
+constexpr double kNoiseCost = 0.5, kDarkCost = 0.15, kEdgesCost = 0.7, kMergeCost = 0.5, kWeakCost = 0.6, kPartsCost = 0.2,
+                 kExtendCost = 0.5, kSmallCost = 0.3;  // per working pixel
+
 Segmentation segment_image(const RgbImage& image, const std::optional<ToneCurve>& curve, double full_scale, double clip_level,
-                           const SegmentationOptions& options) {
+                           const SegmentationOptions& options, bool progress) {
   const auto start = std::chrono::steady_clock::now();
   Segmentation out;
   out.options = options;
   out.width = image.width;
   out.height = image.height;
+  const auto [ww, wh] = working_size(image.width, image.height, options.working_megapixels);
+  const double pixels = static_cast<double>(image.pixel_count()), working = static_cast<double>(ww) * static_cast<double>(wh);
+  Progress bar("segment",
+               static_cast<std::size_t>(std::round(std::max(1.0, (kWorkingImageCost + kFullSizeCost) * pixels +
+                                                              (kNoiseCost + kDarkCost + kEdgesCost + kMergeCost + kWeakCost + kPartsCost + kExtendCost + kSmallCost) * working))),
+               progress);
   const CodeDecoder decode(curve, full_scale);
-  Work work = working_image(image, decode, clip_level, options.working_megapixels);
+  std::optional<StepShare> step;  // the step under way (emplacing the next gives the bar the rest of its share)
+  step.emplace(bar, kWorkingImageCost * pixels, 64);
+  Work work = working_image(image, decode, clip_level, options.working_megapixels, *step);
   out.working_width = work.w;
   out.working_height = work.h;
-  out.noise = measure_noise(work, decode, full_scale, static_cast<double>(image.pixel_count()) / static_cast<double>(work.size()));
+  step.emplace(bar, kNoiseCost * working, 3);
+  out.noise = measure_noise(work, decode, full_scale, pixels / static_cast<double>(work.size()), *step);
+  step.emplace(bar, kDarkCost * working, 1);
   set_aside_dark(work, out.noise, options.dark);
+  step.emplace(bar, kEdgesCost * working, 1);
   ColourClusters clusters(work, out.noise, options);
-  clusters.merge_along_edges();
-  clusters.join_across_weak_boundaries();
+  step.emplace(bar, kMergeCost * working, 16);
+  clusters.merge_along_edges(*step);
+  step.emplace(bar, kWeakCost * working, 4);
+  clusters.join_across_weak_boundaries(*step);
+  step.emplace(bar, kPartsCost * working, 1);
   PartGraph graph(work, clusters.sets, out.noise);
-  extend_over_dichromatic_planes(work, out.noise, clusters.sets, graph, out);
+  step.emplace(bar, kExtendCost * working, 4);
+  extend_over_dichromatic_planes(work, out.noise, clusters.sets, graph, out, *step);
   const double min_area = std::max(1.0, options.min_area * static_cast<double>(work.valid));
-  absorb_small_parts(work, out.noise, min_area, clusters.sets, graph);
-  labels_at_full_size(image, decode, work, number_segments(work, graph.parts, out.noise, min_area), out.noise, options.dark, out);
+  step.emplace(bar, kSmallCost * working, 4);
+  absorb_small_parts(work, out.noise, min_area, clusters.sets, graph, *step);
+  step.emplace(bar, kFullSizeCost * pixels, 64);
+  labels_at_full_size(image, decode, work, number_segments(work, graph.parts, out.noise, min_area), out.noise, options.dark, out, *step);
+  step.reset();
+  bar.finish();
   out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return out;
 }

@@ -105,9 +105,10 @@ struct Segmentation {
 // `image`: the analysed layer as stored; `curve` (if not linear) is undone first, with `full_scale` the
 // value of a full-scale code (1 for float files). `clip_level`: stored values at or above it are clipped
 // (none if <= 0). NaN pixels (unreadable, transparent, negative) are in no segment and not counted as valid.
-// Deterministic: the same image and options give the same labels whatever the thread count.
+// Deterministic: the same image and options give the same labels whatever the thread count. With `progress`, a
+// progress bar ("segment", core/progress.h) on stderr runs through the steps.
 Segmentation segment_image(const RgbImage& image, const std::optional<ToneCurve>& curve, double full_scale,
-                           double clip_level, const SegmentationOptions& options);
+                           double clip_level, const SegmentationOptions& options, bool progress = false);
 
 // InputError naming the option when a parameter is out of range.
 void check_segmentation_options(const SegmentationOptions& options);

@@ -156,8 +156,6 @@ Action add_analyze(CLI::App& app) {
 
     const analyzer::AnalysisImage input = analyzer::read_analysis_image(o->image, o->input_transfer, o->raw);
     const analyzer::RgbImage& layer = analyzer::select_layer(input, o->layer);
-    analyzer::Segmentation segmentation;
-    std::vector<analyzer::Region> regions = analyzer::select_regions(input, layer, o->regions, &segmentation);
     if (!o->quiet && input.encoding.curve)
       fmt::print(stderr, "{}: R, G, B {} ({})\n", o->image,
                  input.encoding.curve->linear() ? "taken as linear light" : "encoded by " + input.encoding.curve->describe() +
@@ -165,6 +163,8 @@ Action add_analyze(CLI::App& app) {
                  input.encoding.curve_source);
     if (!o->quiet)
       for (const std::string& note : input.notes) fmt::print(stderr, "{}: note: {}\n", o->image, note);
+    analyzer::Segmentation segmentation;
+    std::vector<analyzer::Region> regions = analyzer::select_regions(input, layer, o->regions, &segmentation, !o->quiet);
     analyzer::AnalyzeOptions options;
     if (!o->camera_config.empty()) options.camera_noise = camera_noise(o->camera_config, o->image, o->layer);
     options.bins = o->bins;
