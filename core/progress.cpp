@@ -59,7 +59,9 @@ void Progress::draw(std::size_t done, bool final_line) {
   const double fraction = total_ ? std::min(1.0, static_cast<double>(done) / static_cast<double>(total_)) : 1.0;
   const double elapsed = elapsed_seconds();
   std::string eta;
-  if (!final_line && fraction > 0.0) eta = ", ETA " + format_duration(elapsed * (1.0 - fraction) / fraction);
+  // An estimate from the first few per cent (one tile, one step of several) says more of that step than of the rest.
+  constexpr double kEtaFrom = 0.05;
+  if (!final_line && fraction >= kEtaFrom) eta = ", ETA " + format_duration(elapsed * (1.0 - fraction) / fraction);
   constexpr int kWidth = 30;
   const int filled = static_cast<int>(fraction * kWidth);
   const std::string bar = std::string(filled, '#') + std::string(kWidth - filled, '.');
