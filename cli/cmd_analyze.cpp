@@ -156,6 +156,10 @@ Action add_analyze(CLI::App& app) {
 
     const analyzer::AnalysisImage input = analyzer::read_analysis_image(o->image, o->input_transfer, o->raw);
     const analyzer::RgbImage& layer = analyzer::select_layer(input, o->layer);
+    // Regions first: a bad --labels or --mask is one line, with nothing printed before it. The segmentation's
+    // progress bar starts with it.
+    analyzer::Segmentation segmentation;
+    std::vector<analyzer::Region> regions = analyzer::select_regions(input, layer, o->regions, &segmentation, !o->quiet);
     if (!o->quiet && input.encoding.curve)
       fmt::print(stderr, "{}: R, G, B {} ({})\n", o->image,
                  input.encoding.curve->linear() ? "taken as linear light" : "encoded by " + input.encoding.curve->describe() +
@@ -163,8 +167,6 @@ Action add_analyze(CLI::App& app) {
                  input.encoding.curve_source);
     if (!o->quiet)
       for (const std::string& note : input.notes) fmt::print(stderr, "{}: note: {}\n", o->image, note);
-    analyzer::Segmentation segmentation;
-    std::vector<analyzer::Region> regions = analyzer::select_regions(input, layer, o->regions, &segmentation, !o->quiet);
     analyzer::AnalyzeOptions options;
     if (!o->camera_config.empty()) options.camera_noise = camera_noise(o->camera_config, o->image, o->layer);
     options.bins = o->bins;
