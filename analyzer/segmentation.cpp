@@ -1119,6 +1119,7 @@ Segmentation segment_image(const RgbImage& image, const std::optional<ToneCurve>
   clusters.join_across_weak_boundaries(*step);
   step.emplace(bar, kPartsCost * working, 1);
   PartGraph graph(work, clusters.sets, out.noise);
+  out.parts = graph.parts.pixels.size();
   step.emplace(bar, kExtendCost * working, 4);
   extend_over_dichromatic_planes(work, out.noise, clusters.sets, graph, out, *step);
   const double min_area = std::max(1.0, options.min_area * static_cast<double>(work.valid));

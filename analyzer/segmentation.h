@@ -42,6 +42,8 @@
 //     colour direction is nearest theirs (unassigned working pixels stay unassigned).
 // Steps 1 and 7 run on every core, in bands of rows whose sums and counts add in a fixed order: the labels do
 // not depend on the thread count.
+// Steps 5 and 6 keep each part's neighbours, with the boundary shared with each, and update them as parts join
+// (only the joined parts' neighbours): the cost is near-linear in the working pixels and the parts.
 
 #include <cstdint>
 #include <string>
@@ -95,6 +97,7 @@ struct Segmentation {
   std::size_t unassigned_pixels = 0;          // valid pixels in no segment
   std::size_t dark_pixels = 0, small_pixels = 0;  // … of which too dark, or in parts under min_area
   std::size_t highlight_merges = 0, clipped_merges = 0;  // dichromatic extensions made
+  std::size_t parts = 0;                      // linear colour clusters after step 4 (what steps 5 and 6 work on)
   NoiseModel noise;
   SegmentationOptions options;
   double seconds = 0;  // wall time of the segmentation
