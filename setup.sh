@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # Installs chromatrace's dependencies from Debian 12 packages and builds it into build/.
 # Usage: ./setup.sh            (as root, or with sudo available)
 set -euo pipefail

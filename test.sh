@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # Runs every test of the build ./setup.sh made (build/): CTest (unit, end-to-end, Blender, Slurm and browser
 # tests), then the sanitised parsers (.ci/sanitize-parsers): the readers of bad input and their unit tests built
 # with AddressSanitizer and UndefinedBehaviorSanitizer into build-asan/, and each fuzz harness for 30 s. CI

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // A whole analysis: which regions, each region's histogram, shape and light-path explanation, and the
 // illuminant estimated from all of them. analysis_json.h, plots.h and report.h present the result.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The image an analysis reads, as its readers (analyzer/image_input.h, analyzer/raw_input.h) give it: the final
 // R, G, B and, from the sensor simulator's EXR output, also the noise-free linear signal, the light-path components

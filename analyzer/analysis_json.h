@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // analysis.json: every number of an analysis (docs/analyze.md, "analysis.json", lists each field), and
 // the per-region histogram files it points to.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // What bends a cluster (docs/analyze.md, "What bends a cluster"). A cluster is bent when its principal curve
 // departs from its chord by more than max_bend_for_straight (the curve model's own test of straightness). Four

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Clipping: samples pressed onto a face of the RGB cube, where one channel stopped at the sensor's or
 // the encoding's limit while the others went on changing (the paper's over-exposure artefact), or at

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The shape of a colour cluster: its moments judged against the noise level, robust line and plane fits
 // in the dichromatic model (body line, highlight line, where the highlight leaves the body line), the

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Pixel area integration at object edges (the paper's interpolated structures, Figure 4b): a pixel that
 // straddles the edge between two objects records a mix of their colours, which lies between their clusters.

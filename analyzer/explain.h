@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Which light paths built a cluster, from the component layers of a simulated image (the sensor
 // simulator's <component>.R/G/B, in the units of linear.R/G/B).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Gamma diagnosis: which power curve I' = k·I^γ (per channel) bent a straight cluster.
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The colour a highlight adds: the direction of a dichromatic cluster's highlight branch. Each colour of a
 // glossy object is c = m_b·body + m_s·light (body reflection plus surface reflection of the light's colour).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // 3D colour histograms of a region's samples, their three 2D projections and the rg-chromaticity
 // histogram.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The illuminant's colour, inferred from the clusters as the dichromatic reflection model allows:
 //  - highlight lines: the specular part of a dichromatic surface has the illuminant's colour, so the

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Reading the image an analysis reads (analyzer/analysis_image.h): any file OpenImageIO opens (8/16-bit PNG/TIFF,
 // float EXR, …), with the sensor simulator's extra layers, object ids and camera numbers when present, or a

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // What a region's cluster says about how its light was made, in words carrying the region's own numbers: the
 // physical process its class stands for (the class in linear light when a curve encoded the values), its body

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Straight lines in colour space: the total-least-squares line through points, and a robust search
 // (RANSAC) for the line that most points lie near, which finds a body (matte) line among highlight pixels

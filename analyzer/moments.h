@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Mean, covariance and principal axes of a cluster of colours (the principal axes of any set of colours:
 // core/principal_axes.h).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The noise level a cluster's extent is judged against, estimated once for the whole image.
 //

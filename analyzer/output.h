@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The analysis directory: analysis.json, histograms/region-NN.json, plots/region-NN[-density|-components].png,
 // report.html and, with segmentation, labels.png (16-bit grey: 0 unassigned, k segment k; --labels reads it

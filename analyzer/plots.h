@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // PNG plots of a region's colour histogram, drawn with OpenCV: the RG, RB and GB projections and an
 // oblique 3D view of the RGB cube, with the fitted lines, curve and plane drawn over the points.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The principal curve of a bent cluster: a cubic in the position along the principal axis. Its bend
 // (sagitta over chord) measures how much a "banana" or a gamma-bent line departs from a straight line.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Camera raw files (DNG and the raw formats LibRaw knows: CR2, CR3, NEF, ARW, RAF, ORF, RW2, PEF, …) read as
 // linear camera RGB for the analysis (docs/analyze.md, "Camera raw"): the file's black level subtracted, no

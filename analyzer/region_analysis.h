@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // One region of one RGB layer, analysed: its histogram and its cluster shape, judged in the context of
 // the whole layer (histogram range, clipping levels, quantisation).

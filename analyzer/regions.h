@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Image regions whose colours are analysed together: the whole image, the parts of a label image or
 // channel (object_id), masks, rectangles, and automatic segments (analyzer/segmentation.h).

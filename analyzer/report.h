@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // report.html: one self-contained page (it opens offline, from file://) with the image beside a rotatable
 // 3D histogram of the selected region. It inlines the viewer bundle (analyzer/web/viewer.js with three.js),

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Automatic segmentation by physics (docs/analyze.md, "Automatic segmentation").
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Several luminaires of different colours lighting one region: the paper's superposed structures. With the
 // light-group component layers of a simulated image (light.<group>.R/G/B), each group's share of the region's

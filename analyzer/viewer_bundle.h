@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The report viewer (analyzer/web/viewer.js with three.js), bundled by esbuild into one IIFE at build time.
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The analyzer's histogram and cluster descriptors on a 24-megapixel 16-bit image, beside OpenCV's
 // calcHist of the same image in the same process (absolute times on a shared machine are noisy; the ratio
 // is what to read).

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # What the farm path costs: the same work — the paper box split into 2 seeds — as 2 Slurm array tasks of one
 # CPU each plus the combine job (chromatrace farm render --wait, on a single-node Slurm on localhost brought up
 # by tests/farm/local_slurm.sh; needs root and slurm-wlm, munge) against one local 2-thread run

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The baseline of bench_segment.sh: OpenCV's mean-shift filtering (pyrMeanShiftFiltering, Comaniciu & Meer)
 // of an 8-bit image, with the window the analyzer's former segmentation used (6 pixels, 3 % of full scale,
 // one pyramid level). Prints the seconds of the filtering alone; the script measures the process's time and

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // prepare-texture throughput and cache size against the I/O limit (bench/README.md, "Texture preparation").
 //
 // A synthetic texture (a 4096×4096 8-bit sRGB PNG reflectance by default; --hdr: a 4096×2048 float EXR

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The RGB upsampling table against the exact fit (bench/README.md, "RGB upsampling table").
 //
 // For each table resolution: the time to compute the table, then over a dense set of colours the error of the

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # analyze --segment on a 24-megapixel photograph: wall time, peak memory (max RSS) and output size, beside a
 # baseline run in the same script on the same image: OpenCV's mean-shift filtering (build/bench/bench_meanshift),
 # the core of the analyzer's former segmentation. Figures and their reading: bench/README.md.

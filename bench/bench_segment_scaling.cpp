@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The segmentation's time against the number of pixels and of parts: segment_image (analyzer/segmentation.h) on
 // synthetic mosaics — K Voronoi cells (seeds jittered on a grid, deterministic for the seed), each a random colour
 // shaded by its own gradient, a quarter of them with a white highlight, and noise that grows as the square root of

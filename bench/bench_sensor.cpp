@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Sensor simulator throughput and memory against the I/O limit (bench/README.md, "Sensor simulator").
 //
 // A 1024×1024, 31-band spectral EXR (130 MB of floats) goes through the sensor; beside it, in the same process,

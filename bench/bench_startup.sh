@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # Start-up cost: wall time and peak memory (max RSS, from /usr/bin/time) of `chromatrace --help` and of
 # `chromatrace check-scene` on the minimal scene (both run by the front executable), against /bin/true (the cost
 # of starting any process) and `oiiotool --help` (a tool built on the same image libraries); and of

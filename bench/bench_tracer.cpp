@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Reference tracer throughput and noise at a fixed time budget, on the paper box and the Cornell box.
 //
 // For each configuration, B independent renders (different seeds) each get the same time budget. Reported:

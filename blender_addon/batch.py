@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """Headless spectral rendering with Blender and Cycles.
 
     blender --background --factory-startup --python blender_addon/batch.py -- \

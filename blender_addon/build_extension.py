@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """Builds the add-on as a Blender extension zip (Blender 4.2 and later) with Blender's own packager.
 
     PYTHON blender_addon/build_extension.py OUT_DIR
@@ -5,7 +6,8 @@
 PYTHON is a Python with Blender's `bpy` module (build/bpy-4.5.15/bin/python after ./setup.sh); its packager,
 `blender_ext.py build` (what `blender --command extension build` runs), checks blender_manifest.toml and writes
 OUT_DIR/chromatrace-VERSION.zip. The package is staged with the one file it reads from outside its folder in the
-source tree, core/data/defaults.json, as data/defaults.json (defaults.py looks there first). The add-on's
+source tree, core/data/defaults.json, as data/defaults.json (defaults.py looks there first), and with its licence,
+blender_addon/LICENSE (GPL-3.0-or-later, as the manifest says), which Blender's extension platform requires. The add-on's
 `bl_info` version and the manifest's must be equal. `cmake --build build --target blender_extension` runs this.
 """
 
@@ -21,6 +23,7 @@ import tempfile
 HERE = os.path.dirname(os.path.abspath(__file__))
 PACKAGE = os.path.join(HERE, "chromatrace")
 DEFAULTS = os.path.join(HERE, "..", "core", "data", "defaults.json")
+LICENSE = os.path.join(HERE, "LICENSE")
 
 
 def packager():
@@ -51,6 +54,7 @@ def main(out_dir):
         shutil.copytree(PACKAGE, source, ignore=shutil.ignore_patterns("__pycache__", "*.pyc"))
         os.makedirs(os.path.join(source, "data"))
         shutil.copy(DEFAULTS, os.path.join(source, "data", "defaults.json"))
+        shutil.copy(LICENSE, os.path.join(source, "LICENSE"))
         result = subprocess.run([sys.executable, packager(), "build", "--source-dir", source, "--output-dir", out_dir],
                                 capture_output=True, text=True)
         if result.returncode != 0:

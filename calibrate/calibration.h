@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // `chromatrace calibrate`: a photon-transfer series of frames in, the camera's EMVA 1288 parameters out — per
 // colour channel with their standard errors (calibration.json), and as sensor settings the simulator takes

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The frames of a photon-transfer series as the calibration reads them: a camera raw (DNG, CR2, NEF, … through
 // LibRaw, not demosaiced: each 2×2 tile's red, first green and blue, analyzer/raw_input.h) or a linear EXR/TIFF

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // A camera's EMVA 1288 "Linear" parameters from a photon-transfer series (EMVA Standard 1288, Release 4.0 Linear,
 // sections 6–8): pairs of flat fields at increasing exposure and pairs of dark frames at the same exposure times,

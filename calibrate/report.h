@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The calibration's report directory (`chromatrace calibrate --report DIR`): calibration.json (every estimate per
 // channel with its standard error, and the measured points) and index.html, a datasheet page as EMVA 1288 lays one

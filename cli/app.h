@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // What the two executables behind `chromatrace` share, so that they parse a command line alike: the top-level
 // app, the list of subcommands with their descriptions, the handling of parse errors and of an action's errors.

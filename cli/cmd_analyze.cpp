@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // chromatrace analyze IMAGE -o DIR: colour-histogram analysis of image regions (docs/analyze.md).
 #include <algorithm>
 #include <cmath>

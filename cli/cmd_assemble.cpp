@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // chromatrace assemble MANIFEST.json -o OUT.exr: builds a spectral EXR from band-multiplexed RGB renders (the
 // Blender add-on's Cycles renders). The manifest format and the assembly are in core/assembly.h.
 #include <filesystem>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // chromatrace calibrate --flat F… --dark D… -o CAMERA.json: a camera's EMVA 1288 parameters from a photon-transfer
 // series, as sensor settings the simulator takes and (--report) every estimate per channel with its standard error.
 #include <filesystem>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // chromatrace check-scene: validates a scene or an experiment series file and summarises it.
 #include <algorithm>
 #include <cstdio>

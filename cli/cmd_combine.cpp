@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // chromatrace combine PART.exr... -o OUT.exr: the parts of a reference-tracer render split by seed (render
 // --seeds K --part I, or chromatrace farm render) combined sample-weighted (reference_tracer/seed_split.h).
 #include <filesystem>

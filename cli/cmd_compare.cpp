@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // chromatrace compare A.exr B.exr -o DIR: cross-validation of two spectral renders of one scene.
 #include <cmath>
 #include <cstdio>

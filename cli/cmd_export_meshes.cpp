@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // chromatrace export-meshes SCENE.json DIR: the triangles of every object and light as PLY files, made by the
 // one tessellation rule (core/geometry.h), so that another renderer (Cycles through the Blender add-on) sees
 // exactly the triangles the reference tracer traces.

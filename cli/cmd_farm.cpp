@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // chromatrace farm render|cycles|series ... -o DIR: work split into Slurm jobs on a cluster (docs/farm.md). The
 // scripts, submission and following are in farm/slurm.h; this file says what the tasks of each kind run.
 #include <filesystem>

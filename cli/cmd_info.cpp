@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // chromatrace info FILE: describes an image (spectral EXR or any other EXR, or a camera raw), like
 // `oiiotool --info -v`.
 #include <cmath>

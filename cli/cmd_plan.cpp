@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // chromatrace plan SCENE.json -o PLAN.json: the fewest bands and bounces for a colour-error target (docs/plan.md).
 #include <filesystem>
 #include <string>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // chromatrace prepare-texture IMAGE -o DIR: per-band-group textures for Cycles (the Blender add-on), upsampled
 // per texel exactly as the tracer upsamples the original texture (core/texture_prep.h).
 #include <cmath>

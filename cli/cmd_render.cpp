@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // chromatrace render SCENE.json -o OUT.exr: the reference path tracer.
 #include <filesystem>
 #include <optional>

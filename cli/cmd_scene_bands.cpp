@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // chromatrace scene-bands FILE: the band averages of every spectrum a scene (or a spectra list) uses, so that
 // a renderer working in RGB (Cycles through the Blender add-on) only has to plug numbers into colour inputs.
 #include <algorithm>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // chromatrace sensor IN.exr -o OUT.{exr,tif,png,dng}: the camera simulator (docs/sensor.md).
 #include <chrono>
 #include <cstdio>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // chromatrace series SERIES.json -o DIR and chromatrace paper -o DIR: experiment series end to end
 // (docs/series.md).
 #include <unistd.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // chromatrace study SCENE.json -o DIR: cost against error for the settings a user can choose (docs/study.md).
 #include <algorithm>
 #include <filesystem>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The `chromatrace` command: each subcommand lives in its own cmd_<name>.cpp and registers itself here.
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // chromatrace, the command users run: --help, --version and check-scene run here; every other command line is
 // handed, unchanged, to the full program (cli/main.cpp) by execv. This executable links no image library
 // (OpenImageIO, OpenCV, OpenEXR), so help and scene checks start in milliseconds (bench/README.md, "Start-up").

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The full chromatrace program: every subcommand. Installed as libexec/chromatrace/chromatrace-full and started by
 // the `chromatrace` front (cli/front.cpp) with the user's command line unchanged; cli/app.h says why there are two.
 #include <map>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The render options of an experiment series (chromatrace series, paper and farm series), parsed one way.
 

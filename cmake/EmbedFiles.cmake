@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # Turns data files into a C++ source that holds their bytes, so the tools need no data path at run time.
 # embed_files(OUTPUT <cpp> [NAMESPACE <ns>] FILES <name>=<path> ...) defines, in namespace <ns>
 # (default ct::embedded; each library that embeds files needs its own),

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # Script mode: writes OUTPUT, a C++ file holding each FILES entry (<name>=<path>) as a byte array, in
 # namespace NAMESPACE (default ct::embedded).
 if(NOT NAMESPACE)

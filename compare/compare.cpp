@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Cross-validation of two spectral renders (compare.h, docs/compare.md).
 #include "compare/compare.h"
 

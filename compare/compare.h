@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Cross-validation of two spectral renders of one scene (docs/compare.md): per object × band × component
 // the two means, their ratio with its Monte Carlo standard error, the z-score and a pass/fail against a

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // compare.json, compare.png, compare.html and the verdict (compare.h, docs/compare.md).
 #include <algorithm>
 #include <cmath>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Assembly of a spectral EXR from RGB renders that each carried up to three bands in their R, G and B
 // channels (the Blender add-on's band-multiplexed Cycles renders; `chromatrace assemble`, docs/blender.md).

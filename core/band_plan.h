@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Band-plan files (`chromatrace-bands/1`): bands that a `lo:hi:width` plan cannot express, e.g. narrower
 // bands where a spectrum changes fast, and optionally the reconstruction that turns their values into a finer

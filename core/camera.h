@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The pinhole camera every part shares: the scene format's camera (where it stands, where it looks, its field
 // of view), and the image plane that turns a pixel position into a ray, an off-axis angle α and the cos⁴α

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // CIE data shipped with chromatrace (core/data/, see its README for sources and licences): the CIE 1931
 // 2° standard observer, the standard illuminants and the daylight basis.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Colorimetry: spectra to XYZ, xyY, CIELAB, ΔE2000, linear sRGB and its transfer curve.
 //

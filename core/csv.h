@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Spectral CSV tables: a header row whose first column is `wavelength_nm`, then one row per wavelength,
 // strictly increasing. Empty cells mean "no data" and read as NaN.

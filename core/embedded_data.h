@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Data files compiled into the library (see cmake/EmbedFiles.cmake and core/data/README.md).
 

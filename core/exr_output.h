@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // One atomic OpenEXR output for every writer of the project (the spectral writer, the camera's): scanlines go
 // to a temporary file beside the target, finish() completes the file and renames it into place, and an

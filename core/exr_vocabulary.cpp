@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "core/exr_vocabulary.h"
 
 #include <charconv>

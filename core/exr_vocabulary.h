@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The words chromatrace's EXR files share, spectral (the renderers') and RGB (the camera's): the object-id
 // channel and its names, the component list, and the camera's numbers. Every part that reads or writes them

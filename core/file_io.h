@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Reading whole input files, and writing outputs so that a file appears under its name only when complete.
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The one geometry representation that the reference tracer and the exporters share: world-space triangle
 // meshes, and the analytic shapes of the scene format with the exact rule that turns each into triangles.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Text for self-contained HTML pages (the analyzer's report, the series' figure page): escaping and the
 // base64 of data: URIs.

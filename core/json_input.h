@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Reading JSON input files so that every complaint names the file and the JSON path of the value at fault,
 // e.g. "box.json: materials.red_plastic.roughness: must be in [0, 1], got 1.5".

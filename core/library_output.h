@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Image libraries that print their own lines to stderr, kept quiet so that every error is one line of chromatrace's.
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Ceilings checked before allocating, so that a mistyped size is one line of bad input (exit 2) instead of a
 // process that grows until the system kills it (docs/errors.md, "Sizes and memory").

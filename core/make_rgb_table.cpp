@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Build-time generator of the RGB upsampling table compiled into the library (core/rgb_to_spectrum.h,
 // RgbCoefficientTable): make_rgb_table <resolution> <output file>. The bytes do not depend on the thread count.
 #include <cstdio>

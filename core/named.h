@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Items found by their `name` (a scene's materials, spectra and objects, a series' variants), and the list of
 // names an error message offers.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // PLY triangle meshes (Greg Turk's polygon file format), the mesh format of chromatrace scenes.
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The principal axes of a set of 3-vectors (colours, normals): the eigen-decomposition of their moment matrix,
 // about their mean or about the origin. The analyzer's line and plane fits and the plots' principal plane use it.

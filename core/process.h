@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Running another program and waiting for it (Blender for a series' Cycles renders, Slurm's client commands
 // for the farm). posix_spawn: no code of ours runs between fork and exec.

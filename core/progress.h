@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // A progress bar with elapsed time and ETA on stderr, for anything that can take over a second.
 //

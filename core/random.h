@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Counter-based random numbers: every draw is a pure function of (seed, stream, index), so results do not
 // depend on thread scheduling. A stream is e.g. one pixel sample of a render; `dimension` counts the

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // ΔE00 between two renders of one scene, pixel by pixel: the one definition that `compare`, `plan` (its measured
 // error, plan/plan.h measure_delta_e, and its model's predictions) and `study` use.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // RGB -> smooth spectrum, after W. Jakob and J. Hanika, "A Low-Dimensional Function Space for Efficient
 // Spectral Upsampling", Computer Graphics Forum 38(2), 2019.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The upsampling every part of chromatrace uses (core/rgb_to_spectrum.h): the coefficient table that
 // core/make_rgb_table.cpp computes at build time, compiled in by the assembler's .incbin.
 #include <algorithm>

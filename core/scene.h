@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Scenes (`chromatrace-scene/1`): reading, validation and the resolved data model that the reference tracer and the exporters use. The format, every key, its
 // units and each material's BRDF are documented in docs/scene-format.md.

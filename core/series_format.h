@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Experiment series (`chromatrace-series/1`, docs/scene-format.md): a base scene, variants that patch it (and
 // the sensor settings), and what each variant expects the analyzer to find. Reading and validation.

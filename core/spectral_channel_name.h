@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Channel names of spectral OpenEXR files (the layout of Fichet, Pacanowski and Wilkie, JCGT 10(3), 2021,
 // with chromatrace's component layers; see docs/spectral-exr.md).

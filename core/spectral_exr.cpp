@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "core/spectral_exr.h"
 
 #include <unistd.h>

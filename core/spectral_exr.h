@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Spectral OpenEXR files: reads any file in the Fichet–Pacanowski–Wilkie layout (JCGT 10(3), 2021) and
 // writes chromatrace's own (total, component layers, object ids, RGB preview; docs/spectral-exr.md).

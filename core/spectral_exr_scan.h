@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // One streamed pass over a spectral EXR's pixels: non-finite values per channel, per-band statistics of
 // the total, and whether each family of component layers sums to the total (docs/spectral-exr.md).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The statistics every part uses: quantiles, the mean with its standard error, and the k-sigma factors that
 // tests compare Monte Carlo estimates with.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The vocabulary of colour-histogram structures: the classes the analyzer assigns to a cluster, and so the
 // words an experiment series may `expect` (docs/analyze.md defines each by numbers). One list, used by the

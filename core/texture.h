@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Image textures: a colour input of the scene format (a reflectance, a diffuse colour, an emitter's or the
 // environment's radiance) that varies over a surface's (u, v) or over directions (docs/scene-format.md,

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Image textures read with OpenImageIO: the part of core/texture.h that needs an image library, kept out of
 // chromatrace_scene (core/CMakeLists.txt) so that what only loads and checks scenes does not load OpenImageIO.
 #include "core/texture.h"

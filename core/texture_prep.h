@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Per-band-group textures for a renderer that works in RGB (Cycles through the Blender add-on), made from an
 // artist's image texture or HDRI (`chromatrace prepare-texture`, docs/blender.md).

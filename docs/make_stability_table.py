@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: Apache-2.0
 """Writes docs/stability.md: where each way of saving render time breaks, measured by `chromatrace study`.
 
     python3 docs/make_stability_table.py [--exe build/cli/chromatrace] [--resolution 32] [--cycles-resolution 16]

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Writes the results table of docs/validation.md: each scene rendered by the reference tracer and by Cycles
 (real Blender, through the add-on) at the cross-validation CTests' settings, held to each other with
 `chromatrace compare`, and the figures of the verdict put between the table's markers. Each renderer also

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The Blender add-on batch's pre-flight check (batch.py --explain -), run before a farm's Cycles tasks are
 // submitted: it refuses bad input here and now, and says how many tasks there are (band groups, and a render per

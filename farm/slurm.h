@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Work split into Slurm jobs (docs/farm.md): a job array whose tasks are independent, then one assembly job
 // that runs when every task succeeded (--dependency=afterok). Slurm's own client commands (sbatch, squeue,

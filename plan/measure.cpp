@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // measure_delta_e: ΔE00 between two spectral EXR renders. Apart from plan.cpp so that plan's model, which
 // `chromatrace check-scene` runs, is linked without OpenEXR (chromatrace_plan_model).
 #include <algorithm>

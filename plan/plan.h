@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // `chromatrace plan`: the fewest bands and bounces that keep a scene's image within a colour-error target,
 // with the error they are predicted to cause (docs/plan.md).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The radiosity model behind plan's predictions (plan/plan.h): one patch per object and light, transfer factors
 // between them from cosine-weighted rays, and the colour each surface shows after k scattering events.

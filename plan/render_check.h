@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // What a render's settings leave out, said before rendering (check-scene, render; docs/stability.md): the band
 // plan's colour errors (plan/spectral_check.h), and, by plan's model (plan/plan.h), a bounce limit that drops

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Where a band plan cannot hold a scene's colours, found before rendering (check-scene, render, the study's
 // stability table; docs/stability.md). A band-mode render multiplies band averages: light E and reflectance R give

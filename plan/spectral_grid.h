@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The 1 nm grid on which plan's model (plan/radiosity.h) and the band-plan check (plan/spectral_check.h) evaluate
 // spectra, and tristimulus values on it: the one place where a spectrum is sampled every nanometre and integrated

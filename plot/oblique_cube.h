@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The oblique view of the RGB cube that the histogram plots share (analyzer/plots.h, series/figure_plots.h): the
 // unit cube [0, 1]³ (the shown range scaled) seen from azimuth 35°, elevation 25°, from above and from black's side:

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // A plot as PNG bytes, for a file or a page that embeds it.
 

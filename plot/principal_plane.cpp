@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "plot/principal_plane.h"
 
 #include "core/principal_axes.h"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The plane a histogram is projected onto (series/figure_plots.h, projection_plot): that of the points' two
 // largest principal axes about their mean (core/principal_axes.h), oriented for reading.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Text on plots and figures drawn with OpenCV (series' figure, study's charts): OpenCV's Hershey font draws ASCII
 // only, so typographic characters are replaced, and an exponent written with a caret ("10^5", "I^0.45") is drawn

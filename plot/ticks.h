@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Tick values and their labels for the axes of every plot (analyzer, series, study, calibrate): one rule for a
 // nice step, one for the labels of linear axes and one for logarithmic axes.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Ray queries against world-space triangle meshes, through Embree.
 //

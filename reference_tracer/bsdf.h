@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The BRDFs of the scene format, each written once. Both renderers implement exactly these (docs/materials.md).
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Unidirectional spectral path tracing with next-event estimation and multiple importance sampling (power
 // heuristic) on area lights, and unbiased Russian roulette.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Spectral lanes: the wavelengths one path carries at once.
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Renders a scene with the reference tracer into a spectral EXR (spectral-exr.md).
 

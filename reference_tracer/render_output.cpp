@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // write_render: a render written as a spectral EXR. Apart from render.cpp so that the tracer itself, which
 // `chromatrace check-scene` runs through plan's model, is linked without OpenEXR (chromatrace_tracer_core).
 #include <cmath>

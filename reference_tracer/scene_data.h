@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The scene as the reference tracer uses it: triangles in an Embree accelerator, each triangle knowing its
 // object or light, materials reduced to their lobes and spectra, and a light-sampling distribution.

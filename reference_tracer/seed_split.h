@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // A reference-tracer render split into independent parts that differ only in their seed, and their exact
 // combination (docs/farm.md).

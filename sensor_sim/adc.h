@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The end of stage 5 (docs/sensor.md): conversion gain, black level and the analogue-to-digital converter.
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Stage 4 of the sensor model (docs/sensor.md): a Bayer colour filter array keeps one channel per pixel, and
 // OpenCV's demosaicing (bilinear, VNG, edge-aware) brings back three from the digital numbers, as a camera's

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The sensor simulator's settings (docs/sensor.md): one plain struct per stage of the sensor model, presets,
 // and reading them from JSON (`chromatrace-sensor/1`).

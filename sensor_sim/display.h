@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The display layer of the sensor's EXR output (docs/sensor.md, "Display layer"): the noise-free linear
 // camera signal rendered the way a camera renders a picture for people, beside the raw numbers (which it

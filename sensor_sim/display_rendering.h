@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The display rendering of an image (display.h: the display layer's equations) chosen from the exposure survey
 // (exposure.h): the white balance's illuminant and the scale that sets the display's brightness; and the

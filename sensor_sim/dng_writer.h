@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The sensor simulator's Bayer mosaic as a DNG 1.4 file (Adobe Digital Negative, libtiff), so that raw
 // developers (dcraw, LibRaw, darktable, RawTherapee) open a simulated capture as they open a camera's

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The camera curves of sensor_sim/cameras/, compiled into the library (see cmake/EmbedFiles.cmake).
 

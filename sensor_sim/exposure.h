@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The exposure (docs/sensor.md, "2. Exposure and pixel area"): one pass over the image at unit exposure (T = 1 s) — the survey —
 // and the automatic exposure time chosen from it. The survey also gathers what the display rendering

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The light a spectral reflectance image is lit by (docs/sensor.md, "Reflectance images"): `sensor
 // chart.exr --illuminant D50` turns each band's reflectance ρ_b into the radiance L_b = ρ_b · S̄_b, with S̄_b

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Stages 1–3 of the sensor model together (docs/sensor.md): the noise-free linear camera signal, the mean
 // number of photo-electrons per sensor pixel and channel,

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Stage 5 of the sensor model up to the ADC (EMVA 1288 linear camera model, docs/sensor.md): the electrons a
 // pixel holds at the end of the exposure and the read noise added as they are read out.

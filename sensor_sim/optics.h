@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Stage 1 of the sensor model (paper eq. 2, docs/sensor.md): the lens turns scene radiance L into irradiance
 // on the sensor, E(x, y, λ) = (π/4)·(1/N)²·cos⁴α(x, y)·τ(λ)·L(x, y, λ).

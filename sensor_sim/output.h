@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Writing the sensor simulator's image (docs/sensor.md, "Output"), block by block and atomically: the rows go
 // to a temporary file beside the target, renamed into place by finish(); a writer destroyed before finish()

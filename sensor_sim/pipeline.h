@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The sensor simulator end to end (docs/sensor.md): a spectral EXR in, the camera's image out, streamed in
 // blocks of rows.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The presets: patches on the defaults of config.h. Their numbers, and where they come from, are tabulated in
 // docs/sensor.md ("Presets"); what is not a published measurement is a representative value and says so.
 #include <fmt/core.h>

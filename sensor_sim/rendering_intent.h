@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Stage 6 of the sensor model (docs/sensor.md): from the sensor's signal to an encoded image value.
 //

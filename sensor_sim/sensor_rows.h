@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // A spectral EXR's rendered rows read as sensor rows, and their noise-free linear signal (stages 1–3,
 // linear_signal.h): what the exposure survey (exposure.h) and the sensor's blocks (pipeline.cpp) both read.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Stage 3 of the sensor model (paper eq. 3, docs/sensor.md): a camera's spectral sensitivities and the
 // electrons that each band of irradiance makes in each channel.

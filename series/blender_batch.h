@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The command line of the Blender add-on's headless batch (blender_addon/batch.py, docs/blender.md): Blender
 // and its own options, then batch.py's options after "--". The one builder for the series runner's Cycles

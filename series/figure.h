@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The figure page of an experiment series run (docs/series.md): DIR/index.html (self-contained, offline)
 // and, for a series whose variants name panels of the paper's figures, DIR/figure3.png and DIR/figure4.png

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // What the figure page (series/figure.h) shows of one variant: its entry in series.json, its findings, and,
 // read from its files, the camera image and the whole image's histogram plots.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The figure page's histogram plots (series/figure.h): the whole image's colour histogram as an oblique view
 // of the RGB cube and as a projection onto the plane of its two largest principal axes. Points are drawn in

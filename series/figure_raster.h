@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // figure3.png and figure4.png of the figure page (series/figure.h): the paper's four panels side by side, each
 // with its caption, the camera image above, the oblique histogram and the principal-plane projection below,

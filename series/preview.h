@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The camera image as a person would look at it, for the figure page: the sensor's display layer (the
 // camera's rendering intent, docs/sensor.md) when the file has one; otherwise the noise-free linear camera

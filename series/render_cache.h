@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The render cache of a series run (series/runner.h: renders/<key>.exr): what a render depends on, and the key
 // that names it. A changed spectrum or mesh file changes the key (files are named by a hash of their bytes); a

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // An experiment series end to end (docs/series.md): for each variant, the resolved scene is rendered (by the
 // reference tracer or by Cycles through the Blender add-on's headless batch), seen by the variant's camera,

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The study's charts (docs/study.md), PNG drawn with OpenCV and the plotting kit (plot/): error against render
 // cost on logarithmic axes, one marker per setting coloured by the knob it changes (a circle for the tracer, a

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The study's page, index.html (docs/study.md): self-contained (charts inlined), it says how the reference was
 // made, shows the three charts, and lists every setting with its cost, its error split into Monte Carlo and

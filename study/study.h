@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // `chromatrace study`: what each setting a user can choose costs, and how far from the truth it leaves the image
 // and its histograms (docs/study.md).

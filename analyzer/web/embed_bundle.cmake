@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # Script mode: writes OUTPUT, a C++ source defining ct::analyzer::viewer_bundle() as the bytes of BUNDLE
 # (the esbuild output), so that report.html can inline the viewer without any file at run time.
 file(READ "${BUNDLE}" bundle)

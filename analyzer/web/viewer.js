@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The report's viewer: the analysed image beside a rotatable 3D colour histogram, linked both ways.
 //
 // report.html (analyzer/report.cpp) holds the data as JSON in <script id="analysis-data"> and this file,

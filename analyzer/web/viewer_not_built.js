@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Stands in for the report's 3D viewer (viewer.js with three.js) in a chromatrace built without it
 // (CHROMATRACE_WEB_REPORT=OFF, no npm): lists the regions with their classes and says what is missing.
 (function () {

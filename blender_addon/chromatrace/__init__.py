@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """chromatrace for Blender: spectral rendering with Cycles by band multiplexing.
 
 Each render carries three bands of the spectrum in R, G and B: every spectral colour input (reflectances,

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """Band multiplexing: which bands share a Cycles render, and what goes into each colour channel.
 
 Pure Python (no bpy). Band edges and band averages come from the `chromatrace` command (core/spectrum.h);

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """Command line of blender_addon/batch.py (pure Python, no bpy).
 
     blender --background --factory-startup --python blender_addon/batch.py -- \

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """What differs between the Blenders the add-on supports (3.4 to 5.0), each in one function, chosen by what the
 running Blender has wherever its API can say so; the rest of the add-on asks here and never looks at a version.
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """Where finished band-group renders wait for a resumed run (pure Python, no bpy).
 
 A run's renders go to <root>/<key>/, the key a hash of everything that decides their pixels (scene content,

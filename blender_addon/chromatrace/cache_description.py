@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """The description of everything that decides a spectral render's pixels — the add-on and Blender, bands and
 band values, textures, samples and bounces, passes, geometry, node trees, camera, world and every Cycles and
 render setting the render does not set itself — which cache.cache_key hashes into the name of its cache."""

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """The scene format's pinhole camera in Blender's terms, and Blender's camera in the header's (pure Python, no
 bpy).
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """Every colour that reaches Cycles, found by following a node tree backwards from its output.
 
 A material's, a light's or the world's tree is walked from the active output node through the links, into node

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """Which Cycles renders and passes make each output component (pure Python, no bpy).
 
 Cycles counts bounces after the first hit: its `max_bounces` = 0 still computes direct light. chromatrace

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """Cycles settings that keep every colour channel linear and unbiased on its own, so that each channel of a
 render is an independent estimate of its band (applied through the journal, so they are undone after).
 

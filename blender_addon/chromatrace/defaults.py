@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """The defaults chromatrace's parts share, from core/data/defaults.json — the file the C++ library embeds — so
 that the add-on renders what the tracer renders when a scene leaves a setting out (pure Python, no bpy)."""
 

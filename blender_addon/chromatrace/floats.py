@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """Numbers through Blender's single-precision properties (pure Python).
 
 Blender keeps float properties in 32 bits: 0.1 comes back as 0.10000000149011612. Writing the shortest

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """Digests that tell whether an imported object or camera is still as imported (then export writes the
 analytic shape or camera of the scene file, exactly, instead of what Blender's float32 data says)."""
 

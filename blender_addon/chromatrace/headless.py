@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """The headless spectral render: batch.py's arguments (batch_args.py) to a spectral EXR, or to the pre-flight
 summary with --explain (batch.py's docstring says what each does). The add-on's one entry for scripts: batch.py
 runs it from the source tree or an install, and an add-on installed as an extension runs it as

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """Undo journal: every change the spectral render makes to Blender data is made through it, so that it
 can put back exactly what was there (pure Python; it works on any object with attributes).
 

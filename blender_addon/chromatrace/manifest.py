@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """The manifest that `chromatrace assemble` turns into a spectral EXR (pure Python, no bpy).
 
 Format `chromatrace-assemble/1`, documented in core/assembly.h.

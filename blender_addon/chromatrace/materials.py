@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """Node trees: building the ones for chromatrace's material models, and the spectral colour inputs of any
 material's, light's or world's tree (found by colour_walk.py, checked by node_rules.py)."""
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """Where each spectral colour of a render comes from: the colour walks of the materials, lights and world (what
 their node trees do to colour, colour_walk.py), what the render refuses or renders one band at a time, and the
 source of every spectral input — a spectrum of the add-on's, a Blackbody node's Planck's law, a grey, a colour

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """Which shader nodes break band multiplexing (pure Python, no bpy).
 
 Multiplexing puts three different bands in R, G and B and reads each channel back as its own band. That is

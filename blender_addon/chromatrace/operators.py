@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """Operators: the spectral render (modal, with progress and Esc to cancel), scene import and export, and
 small helpers for materials and the spectrum table."""
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """PLY triangle meshes, the subset chromatrace uses (pure Python, no bpy; docs/scene-format.md, "PLY meshes").
 
 Reads `format ascii 1.0` and `binary_little_endian 1.0` with vertex x, y, z (and nx, ny, nz; and texture

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """The pre-flight check of a spectral render (batch.py --explain, the panel's Check button): what a render would
 do, without rendering or changing anything."""
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """chromatrace's settings on Blender data: spectra of materials and lights, the scene's spectrum table and
 render settings, what an import remembers for a lossless export, and the add-on preferences."""
 

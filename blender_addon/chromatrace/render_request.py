@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """What a spectral render is asked to do (Request: the scene's chromatrace settings, batch.py's options over
 them) and what it decided to do (RenderPlan)."""
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """A render plan applied to the scene for Cycles, every change through the Journal (put back when the render
 ends): Cycles' settings and device, the world dark or lit, Blackbody nodes replaced by colours, the prepared
 textures, light groups, object indices, and each band group's colours."""

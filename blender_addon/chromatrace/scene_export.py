@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """Exporting a Blender scene to a `chromatrace-scene/1` file, meshes as PLY files beside it.
 
 An object or camera still as imported is written as the scene file had it (its analytic shape, camera

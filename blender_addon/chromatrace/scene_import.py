@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """Importing a `chromatrace-scene/1` file into a Blender scene.
 
 `chromatrace check-scene` validates the file (and gives the camera's focal length), `chromatrace

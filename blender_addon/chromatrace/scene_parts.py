@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """What of a scene a spectral render renders: the view layer, the objects and lights it shows, the materials they
 use, the light groups that split the light by emitter, and the object ids."""
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """Spectrum sources as the scene format writes them (pure Python, no bpy): building the JSON source object
 from the add-on's settings, and reading one back into settings. The spectra themselves (CSV columns,
 illuminants, blackbodies, RGB upsampling) are evaluated only by the `chromatrace` command.

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """The spectral render: Cycles renders three bands at a time, chromatrace assembles the spectral EXR.
 
     render = SpectralRender(scene, Request.from_scene(scene, output="out.exr"), Tool(executable))

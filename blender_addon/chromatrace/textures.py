@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """Image textures in a spectral render: each texture's per-band-group images (`chromatrace prepare-texture`,
 cached by content in <cache root>/textures), loaded into Blender for the renders; and the pre-flight's look at a
 texture's capture noise."""

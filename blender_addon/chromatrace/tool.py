@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """Running the `chromatrace` command, which owns every spectrum operation, the tessellation and the spectral
 EXR writer (pure Python, no bpy).
 

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
 """Panels: spectral settings in the Render, Material, Light and Object properties."""
 
 import textwrap

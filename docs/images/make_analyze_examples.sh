@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # Makes the pictures of docs/analyze.md: one plot per histogram class from the synthetic test images
 # (tests/analyzer/synthetic.h), plots of the synthetic scene coloured by density and by component, and a
 # screenshot of report.html in headless Chromium (through the browser test, tests/browser).

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # Makes docs/images/calibrate_report.png, the calibration report of docs/sensor.md: a photon-transfer series (two
 # flats and two darks at each of tests/calibrate's 16 exposure times) simulated by `sensor` for a camera with
 # K = 0.25 DN/e-, 5 e- dark noise, a 20 000 e- full well, 100 e-/s dark current, DSNU 2 e-, PRNU 1 % and

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # Makes docs/images/analyze_coffee.png, the report of docs/analyze.md on skimage's coffee.png (Debian's
 # python3-skimage; Rachel Michetti, CC0): analysed on its segments, the white cup's segment picked (the segment that
 # holds the cup's body, pixel (300, 200)), in headless Chromium.

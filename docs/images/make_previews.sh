@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # Renders the preview images of docs/render.md: the paper box and the Cornell box at 256×256.
 # Usage: docs/images/make_previews.sh [build-dir]   (needs oiiotool from openimageio-tools)
 set -euo pipefail

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # Makes docs/images/analyze_stilllife.png, the report of docs/analyze.md on the cut of ILM's StillLife photograph
 # (tests/data/photos/StillLife-table.exr): analysed on its segments and the glazed bagel's mask (its outline in
 # tests/data/photos/masks.json: an ellipse less the napkin over its lower edge), with the napkin's mean colour as the

@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: Apache-2.0
 """Writes meshes/*.ply: the Cornell Box geometry in chromatrace's frame (metres, Z up, right-handed).
 
 Source: the Cornell University Program of Computer Graphics "Cornell Box Data" as reproduced by

@@ -1,4 +1,5 @@
 #!/usr/bin/env python3
+# SPDX-License-Identifier: Apache-2.0
 """Writes synthetic_reflectances.csv: smooth reflectance curves made up for chromatrace's scenes.
 
 They are not measurements. Each is one of three shapes, lo and hi being the reflectance far from and at the

@@ -1,4 +1,5 @@
 #!/bin/sh
+# SPDX-License-Identifier: Apache-2.0
 # Makes the textured scene's images with OpenImageIO's oiiotool (./setup.sh installs it):
 #   floor.png  16×16 8-bit sRGB: 4×4 blocks of eight saturated and pale colours (a checker of colours)
 #   panel.png  16×16 8-bit sRGB: a left-to-right ramp from orange to teal over a top-to-bottom darkening

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Writes the synthetic test images (tests/analyzer/synthetic.h) into a directory, for the end-to-end and
 // browser tests and for the example plots of docs/analyze.md.
 //   analyzer_synthetic_images DIR

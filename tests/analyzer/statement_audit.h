@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The statement audit: every sentence of every region's interpretation checked against its premises, recomputed
 // from analysis.json and the region's pixels by code that shares nothing with the code that wrote the sentence

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Synthetic images of known histogram structure, made by the tests (nothing binary is committed).
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // chromatrace analyze end to end: outputs, regions, and bad input (unreadable image, empty, one-pixel,
 // all-black and all-NaN regions) answered with a reason, never a crash.
 #include <cmath>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // What bends a cluster, on synthetic images whose bend has one known cause: a highlight leaving a matte line (an
 // L, the glossy component), interreflected light whose share falls as the direct light grows (the indirect
 // component), pixels mixing two objects along an edge, and a response curve over a line that misses black. Each is

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // What the camera did, as the analyzer reads it (docs/analyze.md, "Input"): the black level subtracted before
 // any fit through black, clipping levels from the white level, wholly clipped regions, analysis.json's
 // "input", and the display layer as the report's image.

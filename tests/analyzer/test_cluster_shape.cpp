@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Synthetic clusters of known structure are classified right, and noise-free fits find the true
 // directions (the dichromatic body and illuminant colours, the plane they span) within 0.5°.
 #include <algorithm>

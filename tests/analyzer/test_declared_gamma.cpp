@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // On an image whose values a power curve encoded, the γ fitted to the bent cluster is compared with the curve the
 // input declared: the true curve agrees within the fit's uncertainty, a different one does not.
 #include <cmath>

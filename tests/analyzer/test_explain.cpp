@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Attributing a cluster to light paths: energy shares per component, direct / indirect and diffuse /
 // glossy splits, dominant components, and the indirect light's share of the spread off the direct light's
 // dichromatic plane.

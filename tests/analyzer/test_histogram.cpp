@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Histograms and moments: counts, ranges for integer and HDR float images, sparse and dense counting
 // agree, projections and chromaticity, accurate moments of large 16-bit data, thread independence.
 #include <cmath>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The illuminant colour from several dichromatic objects: within 1° noise-free, within 3° with shot and
 // read noise; grey world reported beside it (and, on coloured objects, far off).
 #include <fmt/core.h>

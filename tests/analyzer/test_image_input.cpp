@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Reading images: integer files in digital numbers, float files as stored, the sensor simulator's EXR
 // layers and object ids, and one-line errors naming the file.
 #include <fstream>

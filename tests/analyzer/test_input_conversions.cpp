@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // A file that stores something other than R, G, B — CMYK inks, or indices into a palette — is converted by
 // OpenImageIO as it is read; the analysis says so (analysis.json's notes and stderr), and a plain RGB file gets
 // no such note.

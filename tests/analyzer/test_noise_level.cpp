@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The noise a cluster is judged against is the image's, measured where the image is flat: a surface whose
 // shading varies from pixel to pixel (texture along its body colour) is a line, not "a single colour", and a
 // flat noisy patch is still a point.

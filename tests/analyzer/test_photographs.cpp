@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Real photographs available on Debian 12 (tests/data/photos/masks.json: files, packages, licences, hand-drawn
 // masks of named objects, white references, clipped faces and findings). On each photograph:
 //  - every named object is one segment (IoU ≥ 0.8 with its mask) that keeps its highlight, at 1× and in a

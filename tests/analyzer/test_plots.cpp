@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Plots and the report a person can read: the unit of the values said, and the regions listed by size with their
 // pixel counts (the tick values on every axis: tests/plot/test_ticks.cpp).
 #include <algorithm>

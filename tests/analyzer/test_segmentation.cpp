@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Automatic segmentation (analyzer/segmentation.h) on synthetic scenes of known masks: dichromatic spheres
 // with shading, highlights and sensor noise, on black and on a shaded wall. Every finding is checked over
 // sizes and noise seeds, not on one image.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The statement audit (statement_audit.h) sees each kind of false sentence: for every kind, a region whose numbers
 // make the sentence true passes, and the same sentence over numbers that make it false fails — the false sentences
 // an earlier analyzer wrote on photographs (a blue body colour for a white cup, a direction with a negative

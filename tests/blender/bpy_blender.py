@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Blender's command line, for Blender as a Python module (PyPI's `bpy`): the add-on's tests run every Blender
 they support through the one command line they were written for.
 
@@ -59,7 +60,10 @@ def main(argv):
             else:
                 runpy.run_path(value, run_name="__main__")
         except SystemExit as e:
-            return e.code if isinstance(e.code, int) else (0 if e.code is None else 1)
+            if isinstance(e.code, int) or e.code is None:
+                return e.code or 0
+            print(e.code, file=sys.stderr)  # sys.exit("message"): Python prints it and exits with 1
+            return 1
         except BaseException:  # Blender prints the traceback and goes on, or exits with --python-exit-code
             traceback.print_exc()
             if exit_code:

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Cycles (through the add-on, real Blender) held to the reference tracer with `chromatrace compare`.
 
     python3 cross_validate.py agree SCENE.json        # every object × band × component must agree

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """What every test script that runs inside Blender shares: the add-on loaded from the source tree and
 registered, the chromatrace command, the source tree's scenes as this Blender renders them, and failures
 collected as the script goes and reported at its end."""

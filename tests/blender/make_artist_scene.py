@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Test helper: an ordinary artist's scene, built from Blender's default file, saved as a .blend.
 
     blender -b --factory-startup --python make_artist_scene.py -- library OUT.blend [--only "NAME|NAME|..."]

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Test helper: blender -b --factory-startup --python make_blend.py -- SCENE.json OUT.blend
 imports a chromatrace scene with the add-on and saves it as a .blend."""
 

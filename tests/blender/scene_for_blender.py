@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Test helper (plain Python): a copy of a scene file as a given Blender's Cycles can render it, its GGX materials
 with that Cycles' Smith masking (separable up to Blender 3.x, height-correlated from 4.0; the add-on refuses a
 scene that asks for the other), its file paths made absolute as core/scene.cpp's rebase_scene_paths does (the

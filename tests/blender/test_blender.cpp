@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The Blender add-on in the real Blender, headless (blender --background --python blender_addon/batch.py):
 // the paper box to a checked spectral EXR, bad input, band multiplexing against one band per render, the
 // emission convention against a closed form, resuming a killed run, and a .blend that is never written.

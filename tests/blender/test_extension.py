@@ -1,5 +1,7 @@
+# SPDX-License-Identifier: Apache-2.0
 """The add-on as a Blender extension (4.2 and later), as an artist installs it: the zip that
-`cmake --build build --target blender_extension` builds, installed headless into a user repository
+`cmake --build build --target blender_extension` builds, accepted by the running Blender's own `extension validate`
+and holding its licence (GPL-3.0-or-later, the manifest's, which Blender's extension platform requires), installed headless into a user repository
 (Preferences > Get Extensions > Install from Disk), enabled, and rendering the paper box through the installed
 package's own headless entry, with nothing of the source tree on the path.
 
@@ -12,6 +14,7 @@ import importlib
 import os
 import subprocess
 import sys
+import zipfile
 
 import bpy
 
@@ -21,6 +24,16 @@ if not user:
     sys.exit("test_extension.py: set BLENDER_USER_RESOURCES to an empty folder")
 if any(p.endswith("blender_addon") for p in sys.path) or "chromatrace" in sys.modules:
     sys.exit("test_extension.py: the source tree's add-on is on the path")
+
+packager = os.path.join(bpy.utils.system_resource("SCRIPTS"), "addons_core", "bl_pkg", "cli", "blender_ext.py")
+validate = subprocess.run([sys.executable, packager, "validate", zip_path], capture_output=True, text=True)
+if validate.returncode != 0:
+    sys.exit(f"FAIL: Blender's extension validate refuses {zip_path}: {(validate.stdout + validate.stderr).strip()}")
+with zipfile.ZipFile(zip_path) as package_zip:
+    names = package_zip.namelist()
+    licence = package_zip.read("LICENSE").decode() if "LICENSE" in names else ""
+if "GNU GENERAL PUBLIC LICENSE" not in licence or "Version 3, 29 June 2007" not in licence:
+    sys.exit(f"FAIL: {zip_path} holds no GPL-3.0 LICENSE at its root (the manifest's licence): {sorted(names)[:8]} ...")
 
 result = bpy.ops.extensions.package_install_files(filepath=zip_path, repo="user_default", enable_on_install=True)
 if result != {"FINISHED"}:

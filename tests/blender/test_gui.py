@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Inside a real Blender window (under Xvfb): the artist's path from an imported scene to the picture.
 
 The textured scene (image textures, an HDRI world) is imported; Check Spectra fills the pre-flight panel

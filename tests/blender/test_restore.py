@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Inside Blender: after a spectral render that succeeds, fails in the middle, is cancelled or refuses, every
 material, light, object and render setting is exactly what it was, and the .blend on disk is untouched.
 

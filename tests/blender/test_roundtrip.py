@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Inside Blender: importing a chromatrace scene and exporting it again loses nothing the format holds.
 
 For the paper box (analytic shapes, named spectra), the Cornell box (PLY meshes, a light that also reflects, an

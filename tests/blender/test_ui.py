@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Inside Blender: the add-on's panels, operators and property updates, as an artist uses them.
 
 Panels are drawn into a stand-in layout that checks every property and operator they name exists (Blender

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The figure page of `chromatrace paper` (index.html) in a real browser: Debian's Chromium, headless, driven by
 // playwright-core.
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // A page of ours in Debian's Chromium, headless, driven by playwright-core, that must work offline: console
 // errors and uncaught exceptions are collected into `problems`, and any request other than file: and data:
 // URLs is refused and counted as one.

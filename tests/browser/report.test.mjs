@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // report.html in a real browser: Debian's Chromium, headless, driven by playwright-core.
 //
 // The test makes its own input (the synthetic scene of tests/analyzer/synthetic.h, written by

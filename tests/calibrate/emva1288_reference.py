@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """The EMVA 1288 reference implementation (PyPI's emva1288, pinned in setup.sh) on a descriptor file: prints its
 results as JSON, for tests/calibrate/test_calibrate.cpp to compare with chromatrace calibrate.
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // chromatrace calibrate: photon-transfer series simulated by the sensor simulator with known EMVA 1288 parameters,
 // and every parameter recovered — within 2 %, or within 3 standard errors where the frames cannot give 2 % (the
 // row and column parts, measured on a few hundred lines whatever the frame count; a DSNU below the temporal noise).

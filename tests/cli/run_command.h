@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Runs the real `chromatrace` executable for end-to-end tests and captures what it printed.
 

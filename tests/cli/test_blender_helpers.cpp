@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The `chromatrace` subcommands the Blender add-on calls: scene-bands, export-meshes and assemble, end to end
 // through the executable, with good and bad input.
 #include <algorithm>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Camera raw both ways: the sensor's DNG read by independent raw readers, analyze on a DNG against analyze on
 // the sensor's EXR of the same capture, reflectance images lit by an illuminant, and bad raw input.
 #include <fmt/core.h>

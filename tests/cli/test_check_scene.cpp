@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // End to end: `chromatrace check-scene` on the shipped scenes, the series and every bad test scene.
 #include <algorithm>
 #include <string>

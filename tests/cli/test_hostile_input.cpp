@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The thirteen families of a hostile sweep (docs/errors.md, "Every command: outputs, special files, JSON and
 // files" and the sections after it), each with more than one instance, end to end through the executable: exit 2
 // (or 1 for a failed write), one line, nothing written outside the output, no partial output, no hang.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // `chromatrace info` end to end, through the real executable.
 #include <algorithm>
 #include <cmath>

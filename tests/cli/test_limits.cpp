@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Sizes checked against documented ceilings and the machine's memory before anything is allocated
 // (docs/errors.md, "Sizes and memory"), end to end through the executable.
 #include <gtest/gtest.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // A write that fails for want of space (a file-size limit, as a full disk does) exits 1 and leaves nothing
 // at a final path, with the previous output intact; an output location the user cannot write in is bad input
 // (exit 2) for every command (docs/errors.md, "Outputs that cannot be written").

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Outputs never destroy inputs and never replace special files; JSON numbers beyond a double and
 // directories given as files are bad input — for every command, end to end through the executable.
 #include <gtest/gtest.h>

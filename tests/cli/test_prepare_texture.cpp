@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // `chromatrace prepare-texture`: per-band-group textures for Cycles, end to end through the executable. The
 // texel values must be the band averages of the tracer's own per-texel spectra (core/texture.h).
 #include <unistd.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // `chromatrace render` end to end: a real render through the executable, and bad input.
 #include <gtest/gtest.h>
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // `chromatrace sensor` end to end: outputs in each format, and bad input.
 #include <gtest/gtest.h>
 

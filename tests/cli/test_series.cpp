@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // End to end: `chromatrace paper` and `chromatrace series` — every variant rendered, seen by its camera,
 // analysed and judged; renders cached and reused; bad series refused before any work.
 #include <sys/stat.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // What `chromatrace` loads to start: --help, --version and check-scene run in the front executable, which links
 // no image library (cli/front.cpp); every other command line is handed over, unchanged, to the full program.
 // The shared libraries a run loads are read from the dynamic loader's own report (LD_DEBUG=files), which names

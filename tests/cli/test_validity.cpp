@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Input that the renderers cannot represent, and files that claim more than they hold, are refused with one
 // line naming the field (docs/errors.md, "Ranges the renderers represent" and "Files that claim more than
 // they hold"), end to end through the executable.

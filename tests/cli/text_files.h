@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Small file helpers the end-to-end tests share: what a command printed is checked by lines, and inputs and
 // outputs are read and written whole.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // chromatrace compare on synthetic renders with known means and known noise: agreement, a known
 // disagreement found in exactly its cells, standard errors from one render and from several seeds, nested
 // band plans, and incomparable or bad input (exit 2, one line, nothing written).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The bad scenes in tests/data/scenes/bad/ and the one-line error each must get, shared by the library
 // tests (tests/core/test_scene.cpp) and the end-to-end tests of `chromatrace check-scene`.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // A small image file for a test: float for .exr, 8-bit otherwise (values as fractions of 255), rows from the top.
 #include <filesystem>

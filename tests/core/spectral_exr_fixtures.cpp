@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "tests/core/spectral_exr_fixtures.h"
 
 #include <unistd.h>

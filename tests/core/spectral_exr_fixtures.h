@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Spectral EXR files made by the tests themselves (good ones through SpectralExrWriter, bad ones through
 // OpenEXR directly) in a temporary directory, so that no generated binary is committed.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Assembly of a spectral EXR from band-multiplexed renders (core/assembly.h): the manifest read into its
 // typed form, the summing families, and the per-pixel reconciliation of each family with the total, on
 // hand-computed numbers (binary fractions, so that every expected value is exact).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Colorimetry against published values: CIE white points, Sharma–Wu–Dalal ΔE2000 data, sRGB.
 #include <gtest/gtest.h>
 

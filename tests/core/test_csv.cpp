@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Spectral CSV tables: parsing, empty cells, and errors that name the file and the line.
 #include <gtest/gtest.h>
 

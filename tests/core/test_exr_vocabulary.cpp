@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The EXR words every part shares (core/exr_vocabulary.h) and the one atomic EXR output (core/exr_output.h).
 #include <gtest/gtest.h>
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Outputs that never destroy inputs or replace special files (core/file_io.h), and JSON input whose numbers
 // no double holds (core/json_input.h).
 #include <gtest/gtest.h>

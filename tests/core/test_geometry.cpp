@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Tessellation of the scene format's shapes (exact areas, convergence rates, outward normals) and PLY I/O.
 #include <cmath>
 #include <cstdint>

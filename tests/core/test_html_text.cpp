@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Text for self-contained HTML pages: base64 against RFC 4648's test vectors, and escaping.
 #include <gtest/gtest.h>
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The one check every reader makes of its input (core/file_io.h: check_input_file, read_file), the ceilings on
 // images read (core/limits.h: check_image_size), names from input files that become file names, outputs that
 // must differ, error text kept to one line, and directory outputs that appear whole.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // RGB upsampling (Jakob & Hanika 2019): the fitted spectra reproduce their colour and are smooth, bounded; the
 // coefficient table every part of chromatrace upsamples with reproduces the exact fit within the bound measured
 // by bench/bench_rgb_table (bench/README.md, "RGB upsampling table").

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The scene format: validation messages, spectrum sources, the data model, the shipped scenes and series.
 #include <algorithm>
 #include <cmath>

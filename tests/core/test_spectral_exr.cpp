@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Spectral EXR reading and writing: channel-name grammar, the three reference sample files, bit-exact
 // round trips, atomic and deterministic writing, and a clear error for each kind of bad file.
 #include <algorithm>

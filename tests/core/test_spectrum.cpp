@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Spectra and bands: Planck's law, Wien's peak, band averages and resampling against analytic answers.
 #include <gtest/gtest.h>
 

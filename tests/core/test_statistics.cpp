@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // core/statistics.h: the one quantile rule, the mean's standard error and the k-sigma factors, on known answers.
 #include <cmath>
 #include <vector>

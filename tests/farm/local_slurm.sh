@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # A single-node Slurm cluster on localhost for tests/farm: its munge key, munged, slurm.conf, state, spool and
 # logs all live in DIR; nothing outside DIR is read or changed. Needs root (slurmd runs jobs as their user).
 #   local_slurm.sh start DIR   starts munged, slurmctld and slurmd; prints SLURM_CONF=DIR/slurm.conf once the

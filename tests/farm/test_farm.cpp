@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // chromatrace farm on a real single-node Slurm cluster on localhost (tests/farm/local_slurm.sh: munged,
 // slurmctld and slurmd with a generated slurm.conf, all in a temporary directory, stopped after each test):
 // the split render of the cluster is the same bytes as the same split run locally, also after a task was

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Band-plan files as `--bands-file` reads them: read_band_plan.
 #include <cstddef>
 #include <cstdint>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Camera raw files as `analyze` and `info` read them: LibRaw's open and unpack, the sizes checked before
 // allocating, then the demosaiced linear camera RGB (read_camera_raw), here of a file named like a DNG.
 #include <cstddef>

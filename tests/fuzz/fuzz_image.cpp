@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Images as `analyze` (and every command that reads an ordinary image) reads them: OpenImageIO's header, the
 // size it claims checked against the file and the memory budget, then the pixels, R, G, B and the extra layers
 // (read_analysis_image). The file is named by its magic number, as a user's file is by its format, so that

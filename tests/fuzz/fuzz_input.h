@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // What every harness shares: the fuzzed bytes as a file, since the commands read files (a directory of this
 // process's own under the system's temporary directory, reused by every run).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // PLY meshes as a scene's "mesh" shape reads them: read_ply.
 #include <cstddef>
 #include <cstdint>

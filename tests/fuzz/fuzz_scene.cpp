@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The scene reader as `check-scene` and `render` use it: load_scene on a file (its mesh, CSV and texture
 // references resolve in the scratch directory, where there are none).
 #include <cstddef>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Sensor settings files as `sensor --config` reads them: the JSON patch (read_config_patch), then the settings it
 // resolves to over its preset (resolve_config), every key checked.
 #include <cstddef>

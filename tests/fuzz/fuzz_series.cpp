@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Experiment-series files as `series` and `check-scene` read them: load_series on a file beside the base scene
 // its seeds name ("minimal.json", a copy of tests/data/scenes/minimal.json written at start-up).
 #include <cstddef>

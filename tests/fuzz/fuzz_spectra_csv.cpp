@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Spectrum CSV tables as scenes, sensor settings and CSV cameras read them: read_csv, then every column as a
 // spectrum.
 #include <cstddef>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Spectral EXR files as `info --check` reads them: the header (SpectralExrReader), then every pixel of every
 // layer, object ids and component sums (scan_spectral_exr).
 #include <cstddef>

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # Installs the build into a fresh prefix and checks that the command, its data and the scenes land where
 # a user expects them, and that the installed command runs from there.
 set -euo pipefail

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // `chromatrace plan`: its predicted ΔE00 against the ΔE00 measured between a render with the planned bands and
 // bounce limit and a 5 nm reference at the scene's own bounce limit (same seed, so most of the Monte Carlo
 // noise is common to both); the band counts; bad input.

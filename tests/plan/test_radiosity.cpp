@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // plan/radiosity.h on known answers: the transfer factors of a closed cube (they sum to 1, and each is the
 // analytic form factor between two of its faces), a small patch under a rectangle (the analytic view factor the
 // tracer's tests use), and the bounce recursion on a hand-made transfer.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // plan::render_warnings: what a render's bounce limit and samples leave out, said before rendering by check-scene and
 // render (plan/render_check.h, docs/stability.md). Known answers: the share of the luminance that arrives after more
 // than 2 bounces in the paper box, measured by the tracer at 2 bounces against the model's reference depth (and that

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // plan::check_band_plan: where a band plan cannot hold a scene's colours, said before rendering. Known answers:
 // a smooth light and smooth reflectances (the paper box under D65) give nothing at the scene's 10 nm bands; a
 // narrow-band LED (10 nm wide) and a narrow-band reflectance are named, with the right cause, at bands of 40–45 nm

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The oblique view of the RGB cube: where its corners are seen (closed forms in the azimuth and elevation), which
 // lies nearest, its twelve edges and its placement on an image.
 #include <algorithm>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The principal plane of a set of colours: for points spread along two known orthogonal directions the plane is
 // theirs, with the variance shares their spreads give, oriented for reading.
 #include <cmath>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Text on OpenCV images: what the Hershey font cannot draw is replaced, an exponent is raised, lines wrap within
 // their width; PNG bytes decode to the image.
 #include <string>

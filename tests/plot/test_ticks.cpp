@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Ticks and their labels: round numbers inside the range by Heckbert's rule, labels with the decimals the step
 // needs, logarithmic axes in decades.
 #include <cmath>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // The directional albedo ρ(wo) = ∫ f cos θi dωi of a lobe, estimated from the lobe's own samples as the mean
 // of their weights (eval / pdf), with its standard error: a known answer the tracer's tests hold lobes and

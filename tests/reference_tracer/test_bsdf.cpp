@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // BSDF tests: sampling against evaluation (chi-square), sample weights, reciprocity and energy conservation.
 #include <gtest/gtest.h>
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The environment light and image textures against known answers: the furnace under a constant environment,
 // a constant latitude-longitude image against the constant spectrum, the irradiance from one bright patch of
 // the image (which also pins the mapping of directions to the image and the rotation), textured reflectance

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Reference tracer against known answers: the furnace, a plane under a rectangular emitter, component sums,
 // determinism across thread counts, and bands versus continuous spectral sampling.
 //

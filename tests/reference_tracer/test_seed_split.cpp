@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // A render split by seed (reference_tracer/seed_split.h): the shares of the samples, and the combination —
 // each part weighted by its samples, exactly (Σ nᵢ·vᵢ / Σ nᵢ in double, rounded once) — and what it refuses.
 #include <unistd.h>

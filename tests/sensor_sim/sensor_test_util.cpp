@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "tests/sensor_sim/sensor_test_util.h"
 
 #include <cmath>

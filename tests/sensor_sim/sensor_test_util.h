@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #pragma once
 // Inputs and readers for the sensor simulator's tests: spectral EXRs written on the spot (nothing binary is
 // committed), sensor runs on them, and the layers of the result.

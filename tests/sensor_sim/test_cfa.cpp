@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Stage 4: the Bayer pattern, OpenCV's demosaicing, and blocks that overlap so that their borders do not show.
 #include <gtest/gtest.h>
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Sensor settings: presets, patches in order, and errors that name the document and the JSON path.
 #include <gtest/gtest.h>
 

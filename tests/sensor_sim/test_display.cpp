@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Automatic exposure keyed on the surfaces, the camera's numbers in the output's metadata, and the display
 // layer (docs/sensor.md): known answers on synthetic spectral images.
 #include <gtest/gtest.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Stage 5: noise and limits. The EMVA 1288 parameters are recovered from simulated flat fields and dark
 // frames by the photon transfer method, as a camera would be characterised, and compared with the settings.
 #include <gtest/gtest.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Stage 1: cos⁴ fall-off from the camera's field of view, the aperture factor, and the lens transmittance.
 #include <gtest/gtest.h>
 

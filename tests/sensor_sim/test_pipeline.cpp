@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The simulator end to end: the output layout the analyzer relies on, streaming, determinism, supersampling,
 // automatic exposure, and TIFF/PNG output.
 #include <gtest/gtest.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Stage 6 and clipping: what the response curve does to histogram lines, and where over-exposure puts pixels.
 #include <gtest/gtest.h>
 

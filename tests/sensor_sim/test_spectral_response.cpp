@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Stage 3: camera curves, and the ideal XYZ camera against direct integration of known spectra.
 #include <gtest/gtest.h>
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The figure page (series/figure.h) from hand-made series results: variants that failed, a variant whose files
 // are gone, a series without figure panels, the figure images and the histogram points' range and subsample.
 #include <gtest/gtest.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The render cache's key (series/render_cache.h): the same inputs give the same key; the renderer, a render
 // setting and, for Cycles, another Blender or one changed in place give another.
 #include <gtest/gtest.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // `chromatrace study` on the paper box at a small size: its files, the laws its numbers must follow (Monte Carlo
 // noise falls as 1/√samples; truncating the bounces or coarsening the bands adds a systematic error that noise
 // cannot hide), the Pareto front and the chart axes; bad input.

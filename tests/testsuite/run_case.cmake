@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # Script mode: one CLI regression case in the OpenImageIO style. Runs CASE/run with sh in the source tree,
 # with CHROMATRACE set to the executable, and compares its whole text output (stdout and stderr, merged in the
 # order written) with CASE/ref/out.txt. -DUPDATE=ON writes the reference instead.

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Plain-Python tests of the add-on's bpy-free modules (python3 -m unittest, no Blender needed)."""
 
 import json
