@@ -16,6 +16,7 @@ defaults).
 
 import json
 import os
+import shutil
 import signal
 import sys
 import traceback
@@ -136,6 +137,13 @@ def main(argv=None, prog="chromatrace.headless"):
     _exit(0)
 
 
+def _remove_session_folder(folder):
+    """Removes Blender's session folder (TMPDIR/blender_XXXXXX/), which its teardown would have removed."""
+    folder = os.path.normpath(folder or "")
+    if os.path.basename(folder).startswith("blender_") and os.path.isdir(folder):
+        shutil.rmtree(folder, ignore_errors=True)
+
+
 def _exit(status):
     """Ends the process with `status`. Blender itself leaves without the interpreter's teardown; a Python that
     imported Blender as a module (PyPI's bpy) must too, as its teardown can stall on the render threads."""
@@ -143,5 +151,6 @@ def _exit(status):
     if getattr(bpy.app, "module", False):
         sys.stdout.flush()
         sys.stderr.flush()
+        _remove_session_folder(bpy.app.tempdir)
         os._exit(status)
     sys.exit(status)

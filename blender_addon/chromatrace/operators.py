@@ -9,7 +9,7 @@ import tempfile
 import webbrowser
 
 import bpy
-from bpy.props import StringProperty
+from bpy.props import EnumProperty, StringProperty
 from bpy_extras.io_utils import ExportHelper, ImportHelper
 
 from . import blender_compat, materials, scene_export, scene_import, spectral_render, tool
@@ -66,7 +66,7 @@ class CHROMATRACE_OT_render_spectral(bpy.types.Operator):
 
     def _done(self, context):
         """Reports the output (and its preview) and shows the preview in an Image Editor."""
-        output = bpy.path.abspath(context.scene.chromatrace.output_path)
+        output = context.scene.chromatrace.output_file()
         preview = self._render.preview
         # What the render itself warned of (the world left out, one band per render), as the batch prints it.
         for message in self._messages:
@@ -146,7 +146,7 @@ class CHROMATRACE_OT_analyze_render(bpy.types.Operator):
 
     def execute(self, context):
         s = context.scene.chromatrace
-        render = bpy.path.abspath(s.output_path)
+        render = s.output_file()
         if not os.path.isfile(render):
             self.report({"ERROR"}, f"no spectral render at {render}: Render Spectral first")
             return {"CANCELLED"}
@@ -219,11 +219,18 @@ class CHROMATRACE_OT_import_scene(bpy.types.Operator, ImportHelper):
     bl_options = {"REGISTER", "UNDO"}
     filename_ext = ".json"
     filter_glob: StringProperty(default="*.json", options={"HIDDEN"})
+    ggx_masking: EnumProperty(
+        name="GGX masking",
+        items=[("SCENE", "Scene's", "Refuse a GGX material whose masking this Cycles does not have"),
+               ("CYCLES", "Cycles'", "Give GGX materials this Cycles' masking, with a warning naming each one")],
+        default="SCENE")
 
     def execute(self, context):
         try:
             scene_import.import_scene(self.filepath, context.scene, _tool(context),
-                                      lambda m: self.report({"INFO"}, m))
+                                      lambda m: self.report({"INFO"}, m), ggx_masking=self.ggx_masking.lower(),
+                                      warn=lambda m: self.report({"WARNING"}, m.removeprefix("warning: ")),
+                                      masking_option="Import's \"GGX masking: Cycles'\" option")
         except BadInput as e:
             self.report({"ERROR"}, str(e))
             return {"CANCELLED"}

@@ -3,6 +3,8 @@
 render settings, what an import remembers for a lossless export, and the add-on preferences."""
 
 import json
+import os
+import tempfile
 
 import bpy
 from bpy.props import (BoolProperty, CollectionProperty, EnumProperty, FloatProperty, FloatVectorProperty,
@@ -241,6 +243,17 @@ class CHROMATRACE_PG_scene(bpy.types.PropertyGroup):
     description: StringProperty(name="Description")
     source_file: StringProperty(description="The scene file this scene was imported from")
     source_json: StringProperty(description="The imported scene document")
+
+    def output_file(self):
+        """The output's absolute path. A path relative to the .blend ("//name.exr", the default) has no folder to be
+        relative to while the file was never saved: it then goes to Blender's temporary folder (Preferences > File
+        Paths > Temporary Files, else the system's), never to the folder Blender happened to start in."""
+        path = self.output_path or "//spectral.exr"
+        if path.startswith("//") and not bpy.data.filepath:
+            folder = getattr(getattr(bpy.context, "preferences", None), "filepaths", None)
+            folder = bpy.path.abspath(folder.temporary_directory) if folder and folder.temporary_directory else ""
+            return os.path.join(os.path.abspath(folder or tempfile.gettempdir()), path[2:])
+        return os.path.abspath(bpy.path.abspath(path))
 
     def bands_argument(self):
         if self.band_plan == "FILE":

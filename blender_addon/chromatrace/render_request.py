@@ -59,7 +59,7 @@ class Request:
                       families=s.families(), object_ids=s.use_object_ids, point_filter=s.pixel_filter == "point",
                       on_mixing_nodes="one-band" if s.on_mixing_nodes == "ONE_BAND" else "refuse",
                       on_world="omit" if s.on_world == "OMIT" else "refuse",
-                      output=bpy.path.abspath(s.output_path),
+                      output=s.output_file(),
                       cache_root=bpy.path.abspath(s.cache_dir) if s.cache_dir else None)
         values.update({k: v for k, v in overrides.items() if v is not None})
         return cls(**values)

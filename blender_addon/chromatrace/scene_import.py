@@ -46,11 +46,6 @@ def _material(name, entry, scene_dir):
         s.lobe = entry.get("lobe", "ggx")
         if s.lobe == "ggx":
             s.roughness = entry["roughness"]
-            masking, cycles = _ggx_masking(entry), blender_compat.cycles_ggx_masking()
-            if masking != cycles:
-                raise BadInput(f"materials.{name}.masking: \"{masking}\", but the GGX of Cycles in Blender "
-                               f"{bpy.app.version_string} has {cycles} masking: Cycles would render another material "
-                               f"(--ggx-masking cycles renders it with Cycles' masking, and says so)")
         else:
             s.exponent = entry["exponent"]
     else:
@@ -170,7 +165,19 @@ def _ensure_lightgroup(view_layer, group):
         view_layer.lightgroups.add(name=group)
 
 
-def _use_cycles_masking(document, log):
+def _refuse_other_masking(document, path, option):
+    """Refuses, before anything is added to the scene, a GGX material whose masking is not this Cycles': Cycles
+    would render another material. `option` names what renders it with Cycles' masking instead."""
+    cycles = blender_compat.cycles_ggx_masking()
+    for name, entry in document["materials"].items():
+        masking = _ggx_masking(entry)
+        if masking is not None and masking != cycles:
+            raise BadInput(f"{path}: materials.{name}.masking: \"{masking}\", but the GGX of Cycles in Blender "
+                           f"{bpy.app.version_string} has {cycles} masking: Cycles would render another material "
+                           f"({option} renders it with Cycles' masking, and says so)")
+
+
+def _use_cycles_masking(document, log, option):
     """Gives every GGX material this Cycles' masking, with a warning naming each one changed (--ggx-masking cycles):
     the document, which the output's header carries, then says what was rendered."""
     cycles = blender_compat.cycles_ggx_masking()
@@ -179,18 +186,20 @@ def _use_cycles_masking(document, log):
         if masking is not None and masking != cycles:
             entry["masking"] = cycles
             log(f"warning: materials.{name}.masking: \"{masking}\" rendered with the {cycles} masking of Cycles in "
-                f"Blender {bpy.app.version_string} (--ggx-masking cycles)")
+                f"Blender {bpy.app.version_string} ({option})")
 
 
-def import_scene(path, scene, tool, log=print, ggx_masking="scene", warn=None):
+def import_scene(path, scene, tool, log=print, ggx_masking="scene", warn=None, masking_option="--ggx-masking cycles"):
     """Adds the scene file's objects, lights and camera to `scene` and sets its chromatrace settings. With
     `ggx_masking` "cycles", GGX materials take this Cycles' masking instead of being refused for the other, each
-    one changed said through `warn` (`log` when None)."""
+    one changed said through `warn` (`log` when None); the refusal and the warnings name `masking_option`, the
+    caller's way to ask for that."""
     summary = tool.check_scene(path)["scene"]
     with open(path) as f:
         document = json.load(f)
     if ggx_masking == "cycles":
-        _use_cycles_masking(document, warn or log)
+        _use_cycles_masking(document, warn or log, masking_option)
+    _refuse_other_masking(document, path, masking_option)
     scene_dir = os.path.dirname(os.path.abspath(path))
     s = scene.chromatrace
     s.scene_name = document.get("name", "")

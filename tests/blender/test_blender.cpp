@@ -570,6 +570,18 @@ TEST_F(Blender, ChangedFStopOrRayVisibilityRendersAgain) {
   EXPECT_NE(unshadowed.err.find("(2 renders made, 0 from the cache)"), std::string::npos) << unshadowed.err;
 }
 
+// A batch leaves nothing in the temporary folder: Blender's session folder (blender_XXXXXX) goes with it, also
+// under a Blender module, whose batch leaves the process without Blender's own teardown.
+TEST_F(Blender, BatchLeavesNothingInTheTemporaryFolder) {
+  const CommandResult r = batch({"--scene", box(), "--out", dir_.file("box.exr").string(), "--resolution", "8x8",
+                                 "--samples", "1", "--bands", "400:700:100", "--quiet"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  std::vector<std::string> left;
+  for (const auto& entry : fs::directory_iterator(dir_.path()))
+    if (entry.path().filename().string().rfind("blender_", 0) == 0) left.push_back(entry.path().filename().string());
+  EXPECT_TRUE(left.empty()) << "left in $TMPDIR: " << left.front();
+}
+
 // A .blend with chromatrace settings renders headless, and the file on disk stays byte for byte the same.
 TEST_F(Blender, BlendFileRendersAndIsNeverWritten) {
   const fs::path blend = dir_.file("box.blend"), out = dir_.file("blend.exr");

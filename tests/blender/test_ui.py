@@ -132,6 +132,32 @@ sc = scene.chromatrace
 if (sc.bands_argument(), sc.samples, sc.max_bounces) != ("380:780:10", 256, 8):
     failures.append(f"the paper preset set {sc.bands_argument()}, {sc.samples} samples, {sc.max_bounces} bounces")
 
+# File > Import of a scene whose GGX masking this Cycles lacks (the paper box as written for the tracer, on Blender
+# 4.0 and later; a height-correlated one on 3.x): refused before anything is added, the file named and the
+# import's own option offered (not a batch flag); with that option it imports, each material named in a warning.
+from chromatrace import scene_import  # noqa: E402
+from chromatrace.errors import BadInput  # noqa: E402
+other = (os.path.join(SOURCE, "scenes", "paper", "box.json") if bpy.app.version >= (4, 0, 0)
+         else os.path.join(SOURCE, "tests", "data", "scenes", "ggx_height_correlated.json"))
+held = (len(bpy.data.objects), len(bpy.data.materials), len(bpy.data.collections))
+try:  # an operator that reports an error raises it when called from Python
+    failures.append(f"Import of {other} (the other GGX masking) was not refused: {bpy.ops.chromatrace.import_scene(filepath=other)}")
+except RuntimeError as e:
+    if f"{other}: materials." not in str(e):
+        failures.append(f"Import's refusal does not name the file: {e}")
+try:
+    scene_import.import_scene(other, bpy.context.scene, TOOL, masking_option="Import's \"GGX masking: Cycles'\" option")
+    failures.append(f"import_scene of {other} did not refuse the other GGX masking")
+except BadInput as e:
+    if not str(e).startswith(other + ": materials.") or "GGX masking: Cycles'" not in str(e) or "--ggx-masking" in str(e):
+        failures.append(f"the masking refusal does not name the file and the import's option: {e}")
+if (len(bpy.data.objects), len(bpy.data.materials), len(bpy.data.collections)) != held:
+    failures.append("a refused import left objects, materials or collections behind")
+if bpy.ops.chromatrace.import_scene(filepath=other, ggx_masking="CYCLES") != {"FINISHED"}:
+    failures.append(f"Import of {other} with GGX masking: Cycles' did not finish")
+for ob in [o for o in bpy.data.objects if o.users_collection and o.users_collection[0].name != "Collection"]:
+    bpy.data.objects.remove(ob)
+
 # Import, render (synchronously in background mode) and export through the operators.
 work = tempfile.mkdtemp(prefix="chromatrace-ui-")
 bpy.ops.chromatrace.import_scene(filepath=scene_file("paper", "box.json"))
@@ -186,6 +212,22 @@ if bpy.ops.chromatrace.render_spectral() != {"FINISHED"}:
 if not any(w.startswith("rendered without the world's light") for w in RENDER_WARNINGS.get(scene.name, [])):
     failures.append(f"Render Spectral did not say it left the world out: {RENDER_WARNINGS.get(scene.name)}")
 scene.world, s.on_world = dark_world, "REFUSE"
+# A file never saved has no folder for "//": the default output goes to Blender's temporary folder, named in full,
+# not to the folder Blender was started in.
+if bpy.data.filepath:
+    failures.append(f"the test's file was saved ({bpy.data.filepath}): the unsaved case is not tested")
+temporary = os.path.join(work, "blender temporary")
+os.makedirs(temporary)
+bpy.context.preferences.filepaths.temporary_directory = temporary
+s.output_path = "//unsaved.exr"
+started_in = os.getcwd()
+if s.output_file() != os.path.join(temporary, "unsaved.exr"):
+    failures.append(f"the unsaved file's output is {s.output_file()}, not in the temporary folder {temporary}")
+if bpy.ops.chromatrace.render_spectral() != {"FINISHED"} or not os.path.isfile(os.path.join(temporary, "unsaved.exr")):
+    failures.append(f"Render Spectral of an unsaved file wrote nothing to {temporary}")
+if os.path.exists(os.path.join(started_in, "unsaved.exr")):
+    os.remove(os.path.join(started_in, "unsaved.exr"))
+    failures.append(f"Render Spectral of an unsaved file wrote into the folder Blender started in ({started_in})")
 if bpy.ops.chromatrace.preflight() != {"FINISHED"}:
     failures.append("Check Spectra did not finish")
 drawn = draw(ui.CHROMATRACE_PT_preflight, context)
