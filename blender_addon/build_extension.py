@@ -6,7 +6,9 @@
 PYTHON is a Python with Blender's `bpy` module (build/bpy-4.5.15/bin/python after ./setup.sh); its packager,
 `blender_ext.py build` (what `blender --command extension build` runs), checks blender_manifest.toml and writes
 OUT_DIR/chromatrace-VERSION.zip. The package is staged with the one file it reads from outside its folder in the
-source tree, core/data/defaults.json, as data/defaults.json (defaults.py looks there first), and with its licence,
+source tree, core/data/defaults.json, as data/defaults.json (defaults.py looks there first), with the spectra
+library, scenes/spectra's tables and their README (sources and licences), as data/spectra (spectra.py looks there
+first), and with its licence,
 blender_addon/LICENSE (GPL-3.0-or-later, as the manifest says), which Blender's extension platform requires. The add-on's
 `bl_info` version and the manifest's must be equal. `cmake --build build --target blender_extension` runs this.
 """
@@ -24,6 +26,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 PACKAGE = os.path.join(HERE, "chromatrace")
 DEFAULTS = os.path.join(HERE, "..", "core", "data", "defaults.json")
 LICENSE = os.path.join(HERE, "LICENSE")
+SPECTRA = os.path.join(HERE, "..", "scenes", "spectra")
 
 
 def packager():
@@ -55,6 +58,9 @@ def main(out_dir):
         os.makedirs(os.path.join(source, "data"))
         shutil.copy(DEFAULTS, os.path.join(source, "data", "defaults.json"))
         shutil.copy(LICENSE, os.path.join(source, "LICENSE"))
+        os.makedirs(os.path.join(source, "data", "spectra"))
+        for table in glob.glob(os.path.join(SPECTRA, "*.csv")) + [os.path.join(SPECTRA, "README.md")]:
+            shutil.copy(table, os.path.join(source, "data", "spectra"))
         result = subprocess.run([sys.executable, packager(), "build", "--source-dir", source, "--output-dir", out_dir],
                                 capture_output=True, text=True)
         if result.returncode != 0:

@@ -14,9 +14,13 @@ ILLUMINANTS = defaults.ILLUMINANTS + ["D"]
 
 
 def library_directory():
-    """The project's spectra library: scenes/spectra beside the add-on, in the source tree and once installed
-    (<prefix>/share/chromatrace/{blender_addon,scenes})."""
+    """The project's spectra library: data/spectra inside the add-on when it is installed as an extension
+    (blender_addon/build_extension.py puts scenes/spectra there); otherwise scenes/spectra beside the add-on, in
+    the source tree and once installed (<prefix>/share/chromatrace/{blender_addon,scenes})."""
     here = os.path.dirname(os.path.realpath(__file__))  # through a symlink in Blender's add-ons folder
+    packaged = os.path.join(here, "data", "spectra")
+    if os.path.isdir(packaged):
+        return packaged
     return os.path.normpath(os.path.join(here, "..", "..", "scenes", "spectra"))
 
 

@@ -2,7 +2,7 @@
 """The add-on as a Blender extension (4.2 and later), as an artist installs it: the zip that
 `cmake --build build --target blender_extension` builds, accepted by the running Blender's own `extension validate`
 and holding its licence (GPL-3.0-or-later, the manifest's, which Blender's extension platform requires), installed headless into a user repository
-(Preferences > Get Extensions > Install from Disk), enabled, and rendering the paper box through the installed
+(Preferences > Get Extensions > Install from Disk), enabled, its spectra library found by Check Spectra, and rendering the paper box through the installed
 package's own headless entry, with nothing of the source tree on the path.
 
     blender -b --factory-startup --python-exit-code 1 --python test_extension.py -- ZIP SCENE.json OUT.exr
@@ -43,6 +43,18 @@ if package not in bpy.context.preferences.addons:
     sys.exit(f"FAIL: {package} is not enabled: {list(bpy.context.preferences.addons.keys())}")
 if not hasattr(bpy.types.Scene, "chromatrace"):
     sys.exit("FAIL: the extension did not register its scene settings")
+# The spectra library travels with the extension: a material's Reflectance > Library spectrum is found and Check
+# Spectra reads it (the zip once held no library: "…/extensions/scenes/spectra/cornell_box.csv: cannot open file").
+spectra = importlib.import_module(package + ".spectra")
+if "cornell_box.csv:red" not in spectra.library_entries():
+    sys.exit(f"FAIL: the installed extension's spectra library lacks cornell_box.csv:red: {spectra.library_entries()}")
+material = bpy.data.objects["Cube"].material_slots[0].material
+material.chromatrace.reflectance.kind = "LIBRARY"
+material.chromatrace.reflectance.library = "cornell_box.csv:red"
+try:
+    bpy.ops.chromatrace.preflight()
+except RuntimeError as e:
+    sys.exit(f"FAIL: Check Spectra with the library's cornell_box.csv:red: {e}")
 headless = importlib.import_module(package + ".headless")
 if not os.path.realpath(headless.__file__).startswith(os.path.realpath(user)):
     sys.exit(f"FAIL: headless came from {headless.__file__}, not from the installed extension")
