@@ -200,13 +200,8 @@ std::pair<double, double> PathTracer::film_position(int x, int y, std::uint64_t 
 }
 
 int PathTracer::object_id_at(int x, int y) const {
-  // A hair off the centre: in a symmetric scene a seam can run through pixel centres (the box's floor-to-wall
-  // corners lie on the diagonals of a square image), where both surfaces meet the ray at the same distance and the
-  // id would be the ray tracer's tie, decided differently on different processors. This point lies at least
-  // 0.009 pixel off every line through pixel centres of slope 0, ±1/2, ±1, ±2 or ∞, well clear of a tie.
-  constexpr double kNudgeX = 0.5 + 0.04, kNudgeY = 0.5 + 0.009;
   const Camera& camera = scene_.scene().camera;
-  const auto hit = scene_.accel().intersect(camera.position, camera.ray_direction(x + kNudgeX, y + kNudgeY),
+  const auto hit = scene_.accel().intersect(camera.position, camera.ray_direction(x + 0.5, y + 0.5),
                                             std::numeric_limits<double>::infinity());
   return hit ? static_cast<int>(hit->mesh) + 1 : 0;
 }

@@ -75,7 +75,7 @@ class PathTracer {
   void trace(double px, double py, std::uint64_t stream, PixelAccumulator& pixel) const;
   // The film position of sample `stream` in pixel (x, y): the centre, or uniform over the pixel (box).
   std::pair<double, double> film_position(int x, int y, std::uint64_t stream) const;
-  // Object id seen through (a hair off) the centre of pixel (x, y); 0 for the background.
+  // Object id seen through the centre of pixel (x, y); 0 for the background.
   int object_id_at(int x, int y) const;
 
   const LayerPlan& layers() const { return layers_; }
