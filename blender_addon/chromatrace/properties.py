@@ -230,7 +230,7 @@ class CHROMATRACE_PG_scene(bpy.types.PropertyGroup):
         default="REFUSE")
     on_world: EnumProperty(
         name="World light",
-        items=[("REFUSE", "Refuse", "Do not render when the world's light cannot be a spectrum (an HDRI)"),
+        items=[("REFUSE", "Refuse", "Do not render when the world's light cannot be a spectrum (a Sky Texture, or nodes that mix its channels); an HDRI can"),
                ("OMIT", "Omit", "Render without the world's light; a warning is printed and noted in the file")],
         default="REFUSE")
     output_path: StringProperty(name="Output", subtype="FILE_PATH", default="//spectral.exr")

@@ -24,7 +24,16 @@ def installed_executable():
 
 
 def find_executable(preference=""):
-    candidates = [preference, os.environ.get(ENV_VAR, ""), installed_executable()]
+    """The chromatrace executable: the add-on preference when one is set — a preference naming no executable is
+    an error that says so, never skipped for another chromatrace — else $CHROMATRACE_EXE, the installed one, or
+    chromatrace on PATH."""
+    if preference:
+        if os.path.isfile(preference) and os.access(preference, os.X_OK):
+            return preference
+        raise BadInput(f"the add-on preference 'chromatrace executable' is {preference}, which is "
+                       f"{'not executable' if os.path.isfile(preference) else 'not a file'}: correct it, or clear it "
+                       f"to use $CHROMATRACE_EXE, the installed chromatrace or the one on PATH")
+    candidates = [os.environ.get(ENV_VAR, ""), installed_executable()]
     for path in candidates:
         if path and os.path.isfile(path) and os.access(path, os.X_OK):
             return path

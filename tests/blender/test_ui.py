@@ -98,6 +98,11 @@ if len(scene.chromatrace.spectra) != 1:
 draw(ui.CHROMATRACE_PT_spectra, context)
 bpy.ops.chromatrace.spectrum_remove()
 
+# The World light tooltip says what cannot be a spectrum, and not an HDRI, which the add-on upsamples.
+refuse = scene.chromatrace.bl_rna.properties["on_world"].enum_items["REFUSE"].description
+if "(an HDRI)" in refuse or "Sky Texture" not in refuse:
+    failures.append(f"the World light tooltip says an HDRI cannot be a spectrum: {refuse}")
+
 # Choosing a model builds its nodes; the spectral inputs are the ct_ nodes.
 material.chromatrace.emissive = False
 material.chromatrace.reflectance.kind = "LIBRARY"

@@ -10,7 +10,7 @@ import unittest
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "..", "..", "blender_addon"))
 
 from chromatrace import bands, batch_args, cache, camera_math, components, defaults, floats, manifest, node_rules, ply, spectra  # noqa: E402
-from chromatrace import scene_parts  # noqa: E402
+from chromatrace import scene_parts, tool  # noqa: E402
 from types import SimpleNamespace  # noqa: E402
 from chromatrace.errors import BadInput  # noqa: E402
 from chromatrace.journal import Journal  # noqa: E402
@@ -29,6 +29,23 @@ class Bands(unittest.TestCase):
         self.assertEqual(bands.group_colour(values, [3]), (0.4, 0.0, 0.0))
         self.assertEqual(bands.group_colour(values, [3], replicate=True), (0.4, 0.4, 0.4))
         self.assertEqual(bands.channel_of([3, 4, 5], 5), "B")
+
+
+class FindExecutable(unittest.TestCase):
+    def test_a_preference_naming_no_executable_is_an_error_not_skipped(self):
+        """The add-on preference, when set, is the executable; one naming no file (or a file that cannot run) says
+        so, instead of silently running another chromatrace from the environment or PATH."""
+        self.assertEqual(tool.find_executable(sys.executable), sys.executable)
+        with tempfile.TemporaryDirectory() as d:
+            missing = os.path.join(d, "chromatrace")
+            with self.assertRaises(BadInput) as refused:
+                tool.find_executable(missing)
+            self.assertIn(f"'chromatrace executable' is {missing}, which is not a file", str(refused.exception))
+            with open(missing, "w") as f:
+                f.write("#!/bin/sh\n")
+            with self.assertRaises(BadInput) as refused:
+                tool.find_executable(missing)
+            self.assertIn("not executable", str(refused.exception))
 
 
 class Defaults(unittest.TestCase):
