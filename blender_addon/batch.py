@@ -7,7 +7,7 @@
         [--on-mixing-nodes refuse|one-band] [--on-world refuse|omit] [--explain [FILE]] [--band-group G [--bounce-limit NAME]]
     (or --blend FILE.blend instead of --scene; the .blend is never written)
     python blender_addon/batch.py --scene SCENE.json --out OUT.exr ...
-        the same from a Python with Blender as a module (PyPI's bpy 4.5 or 5.0), arguments with or without `--`
+        the same from a Python with Blender as a module (PyPI's bpy 4.5, 5.2 or 5.3), arguments with or without `--`
 
 The add-on installed as an extension (Blender 4.2+) carries the same entry as chromatrace.headless:
     blender -b --python-expr "import bl_ext.user_default.chromatrace.headless as h; h.main()" -- --scene ...

@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
-"""What differs between the Blenders the add-on supports (3.4 to 5.0), each in one function, chosen by what the
+"""What differs between the Blenders the add-on supports (3.4 to 5.3), each in one function, chosen by what the
 running Blender has wherever its API can say so; the rest of the add-on asks here and never looks at a version.
 
 - Node trees: up to 4.x a material, world or light renders its node tree only with `use_nodes` on; from 5.0
