@@ -37,18 +37,32 @@ fi
 
 npm ci --no-audit --no-fund
 
-# Blender 4.5 LTS and 5.0 as Python modules (PyPI's bpy, pinned), each in its own virtual environment in build/,
-# for the add-on's tests against the Blenders artists run (tests/blender; Debian's blender above is 3.4). They are
-# built for CPython 3.11, Debian 12's python3.
-bpy_versions=(4.5.15 5.0.1)
+# Blender 4.5 LTS, 5.2 LTS and 5.3 as Python modules (PyPI's bpy, pinned), each in its own virtual environment in
+# build/, for the add-on's tests against the Blenders artists run (tests/blender; Debian's blender above is 3.4).
+# bpy 4.5 is built for CPython 3.11, Debian 12's python3; bpy 5.x for CPython 3.13, which Debian 12 lacks: it is
+# taken from the PATH (python3.13, if it runs: pyenv's shim does not unless 3.13 is selected) or from pyenv's
+# versions.
+bpy_versions=(4.5.15 5.2.3 5.3.0)
+python313() {
+  local p
+  for p in "$(command -v python3.13 || true)" "$(pyenv root 2>/dev/null || echo "$HOME/.pyenv")"/versions/3.13*/bin/python3.13; do
+    [ -n "$p" ] && "$p" -c 'import sys; sys.exit(sys.version_info[:2] != (3, 13))' 2>/dev/null && { echo "$p"; return 0; }
+  done
+  return 1
+}
 for v in "${bpy_versions[@]}"; do
   venv="build/bpy-$v"
   if ! "$venv/bin/python" -c "import importlib.metadata as m, sys; sys.exit(m.version('bpy') != '$v')" 2>/dev/null; then
+    python=/usr/bin/python3
+    if [ "${v%%.*}" -ge 5 ]; then
+      python=$(python313) || { echo "setup.sh: error: bpy $v (Blender ${v%.*}) needs CPython 3.13: no python3.13 on the PATH or under pyenv (pyenv install 3.13)" >&2; exit 2; }
+    fi
     rm -rf "$venv"
-    /usr/bin/python3 -m venv "$venv"
+    "$python" -m venv "$venv"
     "$venv/bin/pip" install --quiet --disable-pip-version-check "bpy==$v"
   fi
 done
+rm -rf build/bpy-5.0.1  # Blender 5.0, out of support, tested no more
 
 # The EMVA 1288 reference implementation (PyPI's emva1288 and what it needs, pinned), a test-only oracle for
 # chromatrace calibrate (tests/calibrate).
