@@ -26,9 +26,12 @@ Clipping find_clipping(std::span<const float> rgb, const std::array<double, 3>& 
   std::array<std::array<std::array<float, 2>, 2>, 3> lo{}, hi{};
   for (auto& a : lo) for (auto& b : a) b.fill(std::numeric_limits<float>::max());
   for (auto& a : hi) for (auto& b : a) b.fill(std::numeric_limits<float>::lowest());
+  // Per sample, the faces it lies on: bit 2c for channel c's lower face, bit 2c + 1 for its upper one.
+  std::vector<std::uint8_t> sides(n, 0);
   for (std::size_t i = 0; i < n; ++i)
     for (int c = 0; c < 3; ++c)
       if (const int s = side(i, c); s >= 0) {
+        sides[i] |= static_cast<std::uint8_t>(1u << (2 * c + s));
         ++count[c][s];
         for (int o = 1; o < 3; ++o) {
           const float v = rgb[i * 3 + static_cast<std::size_t>((c + o) % 3)];
@@ -66,14 +69,18 @@ Clipping find_clipping(std::span<const float> rgb, const std::array<double, 3>& 
     std::vector<double> brightest;
     brightest.reserve(count[c][0]);
     for (std::size_t i = 0; i < n; ++i)
-      if (side(i, c) == 0) brightest.push_back(std::max({rgb[i * 3], rgb[i * 3 + 1], rgb[i * 3 + 2]}));
+      if (sides[i] & (1u << (2 * c))) brightest.push_back(std::max({rgb[i * 3], rgb[i * 3 + 1], rgb[i * 3 + 2]}));
     result.black_brightest_median[c] = quantile_in_place(brightest, 0.5);
   }
-  result.on_face.assign(n, 0);
-  for (std::size_t i = 0; i < n; ++i)
-    for (int c = 0; c < 3; ++c)
-      if (const int s = side(i, c); s >= 0 && kept[c][s]) result.on_face[i] = 1;
-  for (const std::uint8_t f : result.on_face) result.clipped += f;
+  std::uint8_t kept_faces = 0;
+  for (int c = 0; c < 3; ++c)
+    for (int s = 0; s < 2; ++s)
+      if (kept[c][s]) kept_faces |= static_cast<std::uint8_t>(1u << (2 * c + s));
+  result.on_face.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    result.on_face[i] = (sides[i] & kept_faces) != 0;
+    result.clipped += result.on_face[i];
+  }
   result.fraction = static_cast<double>(result.clipped) / static_cast<double>(n);
   return result;
 }

@@ -138,32 +138,6 @@ std::string negative_channels(const Vec3& v) {
   return fmt::format("{}", fmt::join(names, " and "));
 }
 
-// 4-connected parts of the region holding at least 1 % of its pixels.
-std::size_t separate_areas(const Region& r, int width) {
-  const std::vector<std::uint32_t>& p = r.pixels;
-  if (p.empty() || width <= 0) return 0;
-  std::vector<std::size_t> parent(p.size());
-  std::iota(parent.begin(), parent.end(), std::size_t{0});
-  auto root = [&](std::size_t i) {
-    while (parent[i] != i) i = parent[i] = parent[parent[i]];
-    return i;
-  };
-  auto join = [&](std::size_t i, std::uint32_t neighbour) {
-    const auto it = std::lower_bound(p.begin(), p.end(), neighbour);
-    if (it == p.end() || *it != neighbour) return;
-    const std::size_t a = root(i), b = root(static_cast<std::size_t>(it - p.begin()));
-    if (a != b) parent[std::max(a, b)] = std::min(a, b);
-  };
-  const auto w = static_cast<std::uint32_t>(width);
-  for (std::size_t i = 0; i < p.size(); ++i) {
-    if (p[i] % w > 0) join(i, p[i] - 1);
-    if (p[i] >= w) join(i, p[i] - w);
-  }
-  std::vector<std::size_t> size(p.size(), 0);
-  for (std::size_t i = 0; i < p.size(); ++i) ++size[root(i)];
-  const double least = 0.01 * static_cast<double>(p.size());
-  return static_cast<std::size_t>(std::count_if(size.begin(), size.end(), [&](std::size_t n) { return n > 0 && static_cast<double>(n) >= least; }));
-}
 
 // (+ 0.0 turns a −0 into 0: a direction in the positive octant is never printed with a minus sign.)
 std::string rgb3(const Vec3& v) { return fmt::format("({:.3f}, {:.3f}, {:.3f})", v[0] + 0.0, v[1] + 0.0, v[2] + 0.0); }
@@ -365,6 +339,36 @@ BlackReach black_reach(const Line& line, double min_line_angle_deg) {
   r.measured = std::isfinite(se) && r.uncertainty_deg <= min_line_angle_deg;
   r.reaches = r.measured && r.angle_deg <= r.allowed_deg;
   return r;
+}
+
+std::size_t separate_areas(const Region& r, int width) {
+  const std::vector<std::uint32_t>& p = r.pixels;
+  if (p.empty() || width <= 0) return 0;
+  std::vector<std::size_t> parent(p.size());
+  std::iota(parent.begin(), parent.end(), std::size_t{0});
+  auto root = [&](std::size_t i) {
+    while (parent[i] != i) i = parent[i] = parent[parent[i]];
+    return i;
+  };
+  auto join = [&](std::size_t i, std::size_t j) {
+    const std::size_t a = root(i), b = root(j);
+    if (a != b) parent[std::max(a, b)] = std::min(a, b);
+  };
+  // The pixels are sorted, so the left neighbour is the one before and the one above is found by a pointer that
+  // only moves forward: one pass, no search.
+  const auto w = static_cast<std::uint32_t>(width);
+  std::size_t up = 0;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    if (i > 0 && p[i] % w > 0 && p[i - 1] == p[i] - 1) join(i, i - 1);
+    if (p[i] >= w) {
+      while (p[up] < p[i] - w) ++up;
+      if (p[up] == p[i] - w) join(i, up);
+    }
+  }
+  std::vector<std::size_t> size(p.size(), 0);
+  for (std::size_t i = 0; i < p.size(); ++i) ++size[root(i)];
+  const double least = 0.01 * static_cast<double>(p.size());
+  return static_cast<std::size_t>(std::count_if(size.begin(), size.end(), [&](std::size_t n) { return n > 0 && static_cast<double>(n) >= least; }));
 }
 
 Interpretation interpret_region(const RegionAnalysis& region, const Region& pixels, int width,

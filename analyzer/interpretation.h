@@ -45,6 +45,10 @@ struct BlackReach {
 };
 BlackReach black_reach(const Line& line, double min_line_angle_deg);
 
+// How many 4-connected areas of at least 1 % of its pixels a region is (its pixels sorted, as every region's are),
+// in one pass over them.
+std::size_t separate_areas(const Region& region, int width);
+
 struct Interpretation {
   std::string light_class;   // the class in linear light (the stored values' when they are linear)
   std::string stored_class;  // the class of the values as stored

@@ -277,12 +277,18 @@ ImageNoise estimate_image_noise(const RgbImage& image, const std::array<double, 
   return noise;
 }
 
+constexpr std::size_t kWeightSamples = std::size_t{1} << 20;
+
 std::vector<double> band_weights(const ImageNoise& noise, std::span<const float> rgb) {
   std::vector<double> weights(noise.bands.size(), 0.0);
   const std::size_t n = rgb.size() / 3;
   if (n == 0 || weights.empty()) return weights;
-  for (std::size_t i = 0; i < n; ++i)
-    weights[noise.band_of((double(rgb[i * 3]) + rgb[i * 3 + 1] + rgb[i * 3 + 2]) / 3.0)] += 1.0 / static_cast<double>(n);
+  // Shares of the samples: from at most 2²⁰ of them at an even stride (a share's standard error under 0.001).
+  const std::size_t stride = (n + kWeightSamples - 1) / kWeightSamples;
+  std::size_t used = 0;
+  for (std::size_t i = 0; i < n; i += stride, ++used)
+    weights[noise.band_of((double(rgb[i * 3]) + rgb[i * 3 + 1] + rgb[i * 3 + 2]) / 3.0)] += 1.0;
+  for (double& w : weights) w /= static_cast<double>(used);
   return weights;
 }
 

@@ -130,7 +130,7 @@ ImageNoise estimate_image_noise(const RgbImage& image, const std::array<double, 
 // takes the model's variance at the mean R, G, B of the layer's pixels in it.
 void use_camera_noise(ImageNoise& noise, const RgbImage& layer, const CameraNoiseModel& model);
 
-// The share of samples [i][channel] in each band of `noise`.
+// The share of samples in each band of `noise` (from at most 2²⁰ of them, at an even stride).
 std::vector<double> band_weights(const ImageNoise& noise, std::span<const float> rgb);
 
 // The noise standard deviation along the unit vector u for samples with those band weights; never below the floor.

@@ -85,17 +85,21 @@ RegionSamples gather_samples(const RgbImage& image, const Region& region) {
       return s;
     }
   }
-  s.own_rgb_.reserve(pixels.size() * 3);
-  s.own_pixels_.reserve(pixels.size());
+  s.own_rgb_.resize(pixels.size() * 3);
+  s.own_pixels_.resize(pixels.size());
+  std::size_t kept = 0;
   for (const std::uint32_t p : pixels) {
     const float* v = &image.rgb[static_cast<std::size_t>(p) * 3];
     if (!std::isfinite(v[0]) || !std::isfinite(v[1]) || !std::isfinite(v[2])) {
       ++s.non_finite;
       continue;
     }
-    s.own_rgb_.insert(s.own_rgb_.end(), v, v + 3);
-    s.own_pixels_.push_back(p);
+    float* to = &s.own_rgb_[kept * 3];
+    to[0] = v[0], to[1] = v[1], to[2] = v[2];
+    s.own_pixels_[kept++] = p;
   }
+  s.own_rgb_.resize(kept * 3);
+  s.own_pixels_.resize(kept);
   s.rgb = s.own_rgb_;
   s.pixels = s.own_pixels_;
   return s;

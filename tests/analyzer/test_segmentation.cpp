@@ -5,12 +5,14 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <random>
 #include <set>
 
 #include <gtest/gtest.h>
 
 #include <nlohmann/json.hpp>
 
+#include "analyzer/interpretation.h"
 #include "analyzer/segmentation.h"
 #include "core/file_io.h"
 #include "tests/analyzer/synthetic.h"
@@ -316,6 +318,66 @@ TEST(SegmentCommand, BadParametersAreOneLineErrorsNamingTheOption) {
     EXPECT_NE(r.err.find(option), std::string::npos) << r.err;
     EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
   }
+}
+
+// A segment's separate areas (the interpretation's "this segment is N separate areas"): 4-connected parts of at
+// least 1 % of its pixels, against a flood fill over random regions of every density, and on shapes whose answer
+// is known — a U is one area, a pixel at a row's end and the next row's first are two, a diagonal step is two.
+TEST(SeparateAreas, CountsFourConnectedPartsOfAtLeastOnePercent) {
+  auto region = [](const std::vector<std::uint8_t>& in) {
+    analyzer::Region r;
+    for (std::size_t p = 0; p < in.size(); ++p)
+      if (in[p]) r.pixels.push_back(static_cast<std::uint32_t>(p));
+    return r;
+  };
+  auto flood = [](std::vector<std::uint8_t> in, int w) {
+    const int h = static_cast<int>(in.size()) / w;
+    const std::size_t n = static_cast<std::size_t>(std::count(in.begin(), in.end(), 1));
+    std::size_t areas = 0;
+    for (int start = 0; start < w * h; ++start) {
+      if (in[static_cast<std::size_t>(start)] != 1) continue;
+      std::vector<int> stack{start};
+      in[static_cast<std::size_t>(start)] = 2;
+      std::size_t size = 0;
+      while (!stack.empty()) {
+        const int p = stack.back();
+        stack.pop_back();
+        ++size;
+        const int x = p % w, y = p / w;
+        for (const auto& [dx, dy] : {std::pair{1, 0}, {-1, 0}, {0, 1}, {0, -1}}) {
+          if (x + dx < 0 || x + dx >= w || y + dy < 0 || y + dy >= h) continue;
+          const auto q = static_cast<std::size_t>((y + dy) * w + x + dx);
+          if (in[q] == 1) in[q] = 2, stack.push_back(static_cast<int>(q));
+        }
+      }
+      if (static_cast<double>(size) >= 0.01 * static_cast<double>(n)) ++areas;
+    }
+    return areas;
+  };
+  std::mt19937 random(7);
+  for (const int w : {1, 2, 13, 40})
+    for (const double density : {0.2, 0.45, 0.6, 0.9}) {
+      std::bernoulli_distribution in(density);
+      std::vector<std::uint8_t> pixels(static_cast<std::size_t>(w) * 31);
+      for (auto& p : pixels) p = in(random);
+      EXPECT_EQ(analyzer::separate_areas(region(pixels), w), flood(pixels, w)) << w << " wide, density " << density;
+    }
+  const int w = 10;
+  std::vector<std::uint8_t> u(100, 0);
+  for (int y = 1; y <= 8; ++y) u[static_cast<std::size_t>(y * w + 1)] = u[static_cast<std::size_t>(y * w + 8)] = 1;
+  for (int x = 1; x <= 8; ++x) u[static_cast<std::size_t>(8 * w + x)] = 1;
+  EXPECT_EQ(analyzer::separate_areas(region(u), w), 1u);
+  std::vector<std::uint8_t> wrap(100, 0);
+  wrap[9] = wrap[10] = 1;  // (9, 0) and (0, 1): one after the other in memory, not neighbours
+  EXPECT_EQ(analyzer::separate_areas(region(wrap), w), 2u);
+  std::vector<std::uint8_t> diagonal(100, 0);
+  diagonal[11] = diagonal[22] = 1;
+  EXPECT_EQ(analyzer::separate_areas(region(diagonal), w), 2u);
+  std::vector<std::uint8_t> speck(100 * 100, 0);  // a 10 × 11 block and one pixel apart: under 1 % of 111
+  for (int y = 0; y < 11; ++y)
+    for (int x = 0; x < 10; ++x) speck[static_cast<std::size_t>(y * 100 + x)] = 1;
+  speck[50 * 100 + 50] = 1;
+  EXPECT_EQ(analyzer::separate_areas(region(speck), 100), 1u);
 }
 
 }  // namespace
