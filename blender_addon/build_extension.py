@@ -8,9 +8,10 @@ PYTHON is a Python with Blender's `bpy` module (build/bpy-4.5.15/bin/python afte
 OUT_DIR/chromatrace-VERSION.zip. The package is staged with the one file it reads from outside its folder in the
 source tree, core/data/defaults.json, as data/defaults.json (defaults.py looks there first), with the spectra
 library, scenes/spectra's tables and their README (sources and licences), as data/spectra (spectra.py looks there
-first), and with its licence,
-blender_addon/LICENSE (GPL-3.0-or-later, as the manifest says), which Blender's extension platform requires. The add-on's
-`bl_info` version and the manifest's must be equal. `cmake --build build --target blender_extension` runs this.
+first), and with its licence, blender_addon/LICENSE (GPL-3.0-or-later, as the manifest says), which Blender's
+extension platform requires. The add-on's `bl_info` version and the manifest's must be equal. Beside it,
+OUT_DIR/chromatrace-VERSION-legacy.zip holds the same package as a folder, the form Blender 3.x installs from
+Preferences > Add-ons > Install…. `cmake --build build --target blender_extension` runs this.
 """
 
 import glob
@@ -21,6 +22,7 @@ import shutil
 import subprocess
 import sys
 import tempfile
+import zipfile
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 PACKAGE = os.path.join(HERE, "chromatrace")
@@ -66,6 +68,20 @@ def main(out_dir):
         if result.returncode != 0:
             sys.exit(f"build_extension.py: error: {(result.stdout + result.stderr).strip()}")
         print(result.stdout.strip().splitlines()[-1])
+        # The same package as a legacy add-on zip for Blender 3.x (Preferences > Add-ons > Install…): the folder
+        # chromatrace/ at its root, which 3.x unpacks into its add-ons folder as one module. (The extension zip
+        # holds the package's files at its root, which 3.x would spill into the add-ons folder one by one.)
+        with open(os.path.join(source, "blender_manifest.toml")) as f:
+            version = re.search(r'^version\s*=\s*"([^"]+)"', f.read(), re.M)
+        legacy = os.path.join(out_dir, f"chromatrace-{version.group(1)}-legacy.zip")
+        with zipfile.ZipFile(legacy + ".partial", "w", zipfile.ZIP_DEFLATED) as z:
+            for folder, dirs, files in os.walk(source):
+                dirs.sort()
+                for name in sorted(files):
+                    path = os.path.join(folder, name)
+                    z.write(path, os.path.relpath(path, stage))
+        os.replace(legacy + ".partial", legacy)
+        print(f"created: \"{legacy}\" (Blender 3.x add-on)")
 
 
 if __name__ == "__main__":
