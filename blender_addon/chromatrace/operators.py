@@ -152,7 +152,7 @@ class CHROMATRACE_OT_analyze_render(bpy.types.Operator):
             return {"CANCELLED"}
         folder = os.path.splitext(render)[0] + "_analysis"
         chromatrace_tool = _tool(context)
-        commands, report = chromatrace_tool.analysis_commands(render, folder, s.camera_preset)
+        commands, report = chromatrace_tool.analysis_commands(render, folder, s.camera_preset, s.camera_curves)
         os.makedirs(folder, exist_ok=True)
         try:
             chromatrace_tool.run_commands(commands)

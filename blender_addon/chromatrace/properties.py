@@ -10,7 +10,7 @@ import bpy
 from bpy.props import (BoolProperty, CollectionProperty, EnumProperty, FloatProperty, FloatVectorProperty,
                        IntProperty, PointerProperty, StringProperty)
 
-from . import defaults, spectra
+from . import cameras, defaults, spectra
 from .floats import short_float
 
 _KIND_ITEMS = [
@@ -234,9 +234,10 @@ class CHROMATRACE_PG_scene(bpy.types.PropertyGroup):
                ("OMIT", "Omit", "Render without the world's light; a warning is printed and noted in the file")],
         default="REFUSE")
     output_path: StringProperty(name="Output", subtype="FILE_PATH", default="//spectral.exr")
-    camera_preset: StringProperty(name="Camera", default="canon_eos_5d_mkiii",
-                                  description="The camera that sees the render when it is analysed "
-                                              "(`chromatrace sensor --preset`; `chromatrace sensor --help` lists them)")
+    camera_preset: EnumProperty(name="Sensor", items=cameras.sensor_items(), default="canon_eos_5d_mkiii",
+                                description="The sensor that sees the render when it is analysed: pixel, noise and ADC")
+    camera_curves: EnumProperty(name="Camera", items=cameras.curve_items(), default="canon_eos_5d_mkiii",
+                                description="The camera whose spectral response sees the render when it is analysed")
     cache_dir: StringProperty(name="Cache", subtype="DIR_PATH",
                               description="Band groups already rendered, for resuming (empty: the user cache)")
     scene_name: StringProperty(name="Name")

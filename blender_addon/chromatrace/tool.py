@@ -99,13 +99,14 @@ class Tool:
         return self.run("prepare-texture", image, "--kind", kind, "--colour-space", colour_space, "--check",
                         json_output=True)
 
-    def analysis_commands(self, spectral_exr, analysis_dir, camera_preset):
+    def analysis_commands(self, spectral_exr, analysis_dir, sensor_preset, camera_curves=None):
         """The command lines that take a spectral render to its histogram report: the camera (`chromatrace sensor`
-        with a preset and automatic exposure) and the analyzer (`chromatrace analyze`). Returns
-        ([[argv], [argv]], report.html)."""
+        with a sensor preset, a camera's curves — the preset's own when None — and automatic exposure) and the
+        analyzer (`chromatrace analyze`). Returns ([[argv], [argv]], report.html)."""
         camera = os.path.join(analysis_dir, "camera.exr")
-        return ([[self.executable, "sensor", spectral_exr, "-o", camera, "--preset", camera_preset, "--exposure-s",
-                  "auto", "--quiet"],
+        curves = ["--camera", camera_curves] if camera_curves else []
+        return ([[self.executable, "sensor", spectral_exr, "-o", camera, "--preset", sensor_preset, *curves,
+                  "--exposure-s", "auto", "--quiet"],
                  [self.executable, "analyze", camera, "-o", os.path.join(analysis_dir, "analysis"), "--quiet"]],
                 os.path.join(analysis_dir, "analysis", "report.html"))
 

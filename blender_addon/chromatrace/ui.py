@@ -22,13 +22,13 @@ class CHROMATRACE_PT_render(_Panel, bpy.types.Panel):
         s = context.scene.chromatrace
         layout = self.layout
         layout.use_property_split = True
-        row = layout.row(align=True)
-        row.operator("chromatrace.render_spectral", icon="RENDER_STILL")
-        row.operator_menu_enum("chromatrace.apply_preset", "preset", text="Presets", icon="PRESET")
+        # One button per row, so that their labels are whole at the panel's default width.
+        layout.operator("chromatrace.render_spectral", icon="RENDER_STILL")
+        layout.operator_menu_enum("chromatrace.apply_preset", "preset", text="Presets", icon="PRESET")
         layout.prop(s, "output_path")
-        row = layout.row(align=True)
-        row.operator("chromatrace.analyze_render", icon="GRAPH")
-        row.prop(s, "camera_preset", text="")
+        layout.operator("chromatrace.analyze_render", icon="GRAPH")
+        layout.prop(s, "camera_curves")
+        layout.prop(s, "camera_preset")
         analysis = operators.ANALYSES.get(context.scene.name)
         if analysis:  # the command lines, to repeat the analysis by hand
             box = layout.box()

@@ -187,12 +187,17 @@ if (not any(w.startswith("render.max_bounces 2 leaves") for w in said)
 # From the render to the histogram: Analyze Histogram runs the camera and the analyzer on the render and keeps the
 # two command lines it ran (shown in the panel, so the analysis can be repeated by hand); the report is written.
 from chromatrace.operators import ANALYSES  # noqa: E402
+# The camera is chosen by name from every camera chromatrace ships (a list, not free text to mistype).
+curves = [item.identifier for item in s.bl_rna.properties["camera_curves"].enum_items]
+if len(curves) != 18 or "nikon_d850" not in curves or "cie1931" not in curves:
+    failures.append(f"the camera list is not the 17 shipped cameras and the CIE observer: {curves}")
+s.camera_curves = "nikon_d850"
 if bpy.ops.chromatrace.analyze_render() != {"FINISHED"}:
     failures.append("Analyze Histogram failed")
 analysis = ANALYSES.get(scene.name, {})
 commands = analysis.get("commands", [])
 if len(commands) != 2 or " sensor " not in commands[0] or " analyze " not in commands[1] \
-        or s.output_path not in commands[0] or "--preset canon_eos_5d_mkiii" not in commands[0]:
+        or s.output_path not in commands[0] or "--preset canon_eos_5d_mkiii --camera nikon_d850" not in commands[0]:
     failures.append(f"Analyze Histogram kept the wrong command lines: {commands}")
 report = analysis.get("report", "")
 if not report.startswith(os.path.join(work, "ui_analysis")) or not os.path.isfile(report):

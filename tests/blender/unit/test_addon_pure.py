@@ -3,6 +3,7 @@
 
 import json
 import os
+import re
 import sys
 import tempfile
 import unittest
@@ -10,7 +11,7 @@ import unittest
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "..", "..", "blender_addon"))
 
 from chromatrace import bands, batch_args, cache, camera_math, components, defaults, floats, manifest, node_rules, ply, spectra  # noqa: E402
-from chromatrace import scene_parts, tool  # noqa: E402
+from chromatrace import cameras, scene_parts, tool  # noqa: E402
 from types import SimpleNamespace  # noqa: E402
 from chromatrace.errors import BadInput  # noqa: E402
 from chromatrace.journal import Journal  # noqa: E402
@@ -29,6 +30,25 @@ class Bands(unittest.TestCase):
         self.assertEqual(bands.group_colour(values, [3]), (0.4, 0.0, 0.0))
         self.assertEqual(bands.group_colour(values, [3], replicate=True), (0.4, 0.4, 0.4))
         self.assertEqual(bands.channel_of([3, 4, 5], 5), "B")
+
+
+class Cameras(unittest.TestCase):
+    SOURCE = os.path.join(os.path.dirname(__file__), "..", "..", "..")
+
+    def test_every_shipped_camera_by_its_name(self):
+        """The panel's camera list is every curve sensor_sim/cameras/ ships, named as its README names them, and
+        the CIE observer; the sensor list is docs/sensor.md's presets."""
+        folder = os.path.join(self.SOURCE, "sensor_sim", "cameras")
+        shipped = sorted(f[:-4] for f in os.listdir(folder) if f.endswith(".csv"))
+        self.assertEqual(sorted(k for k, _ in cameras.CURVES if k != "cie1931"), shipped)
+        with open(os.path.join(folder, "README.md")) as f:
+            readme = f.read()
+        for key, name in cameras.CURVES:
+            if key != "cie1931":
+                self.assertIn(f"| `{key}.csv` | {name} |", readme)
+        with open(os.path.join(self.SOURCE, "docs", "sensor.md")) as f:
+            presets = re.findall(r"^\| `([a-z0-9_]+)` \| [0-9.]+ µm", f.read(), re.M)
+        self.assertEqual(sorted(k for k, _, _ in cameras.SENSORS), sorted(presets))
 
 
 class FindExecutable(unittest.TestCase):
