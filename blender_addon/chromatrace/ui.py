@@ -5,7 +5,7 @@ import textwrap
 
 import bpy
 
-from . import operators
+from . import materials, operators
 from .properties import MODEL_ITEMS
 
 
@@ -152,7 +152,17 @@ class CHROMATRACE_PT_light(_Panel, bpy.types.Panel):
         s = context.light.chromatrace
         layout = self.layout
         layout.use_property_split = True
-        s.emission.draw(layout.column())
+        # Colours the light's nodes give it (Cycles multiplies them by the light's Color, whose spectrum follows).
+        leaves = list(materials.walk_light(context.light).leaves.values())
+        if leaves:
+            box = layout.box()
+            for leaf in leaves:
+                what = (f"Blackbody {leaf.blackbody_k:g} K: Planck's law" if leaf.blackbody_k is not None
+                        else "an image: upsampled texel by texel" if leaf.texture is not None
+                        else f"{leaf.label}: upsampled from RGB")
+                box.label(text=f"Nodes: {what}", icon="NODETREE")
+            box.label(text="× the light's Color, below")
+        s.emission.draw(layout.column(heading="Color" if leaves else ""))
         layout.prop(s, "emission_scale")
 
 

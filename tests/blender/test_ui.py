@@ -49,7 +49,7 @@ class Layout:
         self.drawn.append("list")
 
     def label(self, **kwargs):
-        pass
+        self.drawn.append(("label", kwargs.get("text", "")))
 
     def row(self, **kwargs):
         return self
@@ -91,6 +91,16 @@ for kind in ("RGB", "LIBRARY", "CONSTANT", "CSV", "ILLUMINANT", "BLACKBODY", "SA
     draw(ui.CHROMATRACE_PT_material, context)
     draw(ui.CHROMATRACE_PT_light, context)
 light.chromatrace.emission.kind = material.chromatrace.emission.kind = "RGB"
+# A light whose colour a Blackbody node gives: the Light panel says so (it showed only "From RGB").
+glow = bpy.data.lights.new("glow", "AREA")
+glow.use_nodes = True
+blackbody = glow.node_tree.nodes.new("ShaderNodeBlackbody")
+blackbody.inputs["Temperature"].default_value = 5500
+glow.node_tree.links.new(blackbody.outputs["Color"], glow.node_tree.nodes["Emission"].inputs["Color"])
+said = [text for kind, text in [d for d in draw(ui.CHROMATRACE_PT_light, Context(light=glow)) if isinstance(d, tuple)]]
+if not any("Blackbody 5500 K" in text for text in said):
+    failures.append(f"the Light panel of a Blackbody-node light does not say so: {said}")
+bpy.data.lights.remove(glow)
 draw(ui.CHROMATRACE_PT_object, context)
 bpy.ops.chromatrace.spectrum_add()
 if len(scene.chromatrace.spectra) != 1:
