@@ -189,6 +189,19 @@ def show_image(context, path):
 PREFLIGHT = {}
 
 
+# Per scene name: the settings the last Check Spectra ran with (checked_settings), so that the panel does not show
+# a summary those settings no longer give.
+PREFLIGHT_SETTINGS = {}
+
+
+def checked_settings(scene):
+    """The settings a Check Spectra summary depends on besides the scene's colours: the band plan (how many Cycles
+    renders) and what is refused or left out."""
+    s = scene.chromatrace
+    return (s.band_plan, s.bands_argument(), s.bands_file if s.band_plan == "FILE" else "", s.on_mixing_nodes,
+            s.on_world)
+
+
 class CHROMATRACE_OT_preflight(bpy.types.Operator):
     """Check which colours become spectra: every material, light and the world exact, upsampled or refused"""
 
@@ -203,6 +216,7 @@ class CHROMATRACE_OT_preflight(bpy.types.Operator):
             self.report({"ERROR"}, str(e))
             return {"CANCELLED"}
         PREFLIGHT[context.scene.name] = summary
+        PREFLIGHT_SETTINGS[context.scene.name] = checked_settings(context.scene)
         refused = [o for o in summary["owners"] if o["status"] == "refused"]
         if refused:
             self.report({"WARNING"}, "; ".join(o["reasons"][0] if o["reasons"] else o["name"] for o in refused[:3]))

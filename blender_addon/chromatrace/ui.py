@@ -66,11 +66,14 @@ class CHROMATRACE_PT_preflight(_Panel, bpy.types.Panel):
     bl_parent_id = "CHROMATRACE_PT_render"
 
     def draw(self, context):
-        from .operators import PREFLIGHT
+        from .operators import PREFLIGHT, PREFLIGHT_SETTINGS, checked_settings
         layout = self.layout
         layout.operator("chromatrace.preflight", icon="CHECKMARK")
         summary = PREFLIGHT.get(context.scene.name)
         if summary is None:
+            return
+        if PREFLIGHT_SETTINGS.get(context.scene.name) != checked_settings(context.scene):
+            layout.label(text="The bands or the refusals changed since: check again", icon="INFO")
             return
         col = layout.column(align=True)
         col.label(text=f"{summary['renders']} Cycles renders" if summary["ok"] else "Refused: nothing renders")

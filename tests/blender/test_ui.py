@@ -253,7 +253,16 @@ if bpy.ops.chromatrace.preflight() != {"FINISHED"}:
 drawn = draw(ui.CHROMATRACE_PT_preflight, context)
 if "chromatrace.preflight" not in drawn:
     failures.append(f"the spectra check panel lacks its button: {drawn}")
+# After a band change the summary's count of Cycles renders is no longer true: the panel says to check again.
 from chromatrace.operators import PREFLIGHT  # noqa: E402
+renders = f"{PREFLIGHT[scene.name]['renders']} Cycles renders"
+if ("label", renders) not in drawn:
+    failures.append(f"the spectra check panel does not show its summary ({renders}): {drawn}")
+s.bands_width /= 2
+drawn = draw(ui.CHROMATRACE_PT_preflight, context)
+if ("label", renders) in drawn or not any(isinstance(d, tuple) and "check again" in d[1] for d in drawn):
+    failures.append(f"after a band change the spectra check panel still shows {renders}: {drawn}")
+s.bands_width *= 2
 if [o["status"] for o in PREFLIGHT[scene.name]["owners"] if o["kind"] == "world"] != ["dark"]:
     failures.append(f"the imported scene has no environment, so its world must be dark: {PREFLIGHT[scene.name]['owners']}")
 scene.world = bpy.data.worlds["World"]  # the factory world again, a grey background: exact
