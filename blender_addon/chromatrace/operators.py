@@ -14,7 +14,7 @@ from bpy_extras.io_utils import ExportHelper, ImportHelper
 
 from . import blender_compat, materials, scene_export, scene_import, spectral_render, tool
 from .errors import BadInput
-from .properties import MODEL_ITEMS, executable_preference
+from .properties import MODEL_ITEMS, analysis_of, executable_preference
 
 
 def _tool(context):
@@ -161,6 +161,8 @@ class CHROMATRACE_OT_analyze_render(bpy.types.Operator):
             return {"CANCELLED"}
         ANALYSES[context.scene.name] = {"commands": [" ".join(map(shlex.quote, argv)) for argv in commands],
                                         "report": report}
+        entry = analysis_of(context.window_manager, context.scene.name, create=True)
+        entry.sensor, entry.analyze = ANALYSES[context.scene.name]["commands"]
         for line in ANALYSES[context.scene.name]["commands"]:
             self.report({"INFO"}, line)
         self.report({"INFO"}, f"report {report}")

@@ -281,8 +281,18 @@ def executable_preference(context):
     return bpy.path.abspath(addon.preferences.executable) if addon and addon.preferences else ""
 
 
+class CHROMATRACE_PG_analysis(bpy.types.PropertyGroup):
+    """The command lines of a scene's last Analyze Histogram, as text fields a person can select and copy (labels
+    cannot be copied). Kept on the window manager: never saved into the .blend."""
+
+    scene: StringProperty()
+    sensor: StringProperty(name="Camera command", description="The chromatrace sensor command that was run")
+    analyze: StringProperty(name="Analyzer command", description="The chromatrace analyze command that was run")
+
+
 _classes = (CHROMATRACE_PG_spectrum, CHROMATRACE_PG_named_spectrum, CHROMATRACE_PG_material, CHROMATRACE_PG_object,
-            CHROMATRACE_PG_light, CHROMATRACE_PG_camera, CHROMATRACE_PG_scene, CHROMATRACE_preferences)
+            CHROMATRACE_PG_light, CHROMATRACE_PG_camera, CHROMATRACE_PG_scene, CHROMATRACE_PG_analysis,
+            CHROMATRACE_preferences)
 _owners = ((bpy.types.Material, CHROMATRACE_PG_material), (bpy.types.Object, CHROMATRACE_PG_object),
            (bpy.types.Light, CHROMATRACE_PG_light), (bpy.types.Camera, CHROMATRACE_PG_camera),
            (bpy.types.Scene, CHROMATRACE_PG_scene))
@@ -293,9 +303,23 @@ def register():
         bpy.utils.register_class(cls)
     for owner, group in _owners:
         owner.chromatrace = PointerProperty(type=group)
+    bpy.types.WindowManager.chromatrace_analyses = CollectionProperty(type=CHROMATRACE_PG_analysis)
+
+
+def analysis_of(window_manager, scene_name, create=False):
+    """The window manager's record of a scene's last analysis (made when `create`), or None."""
+    for entry in window_manager.chromatrace_analyses:
+        if entry.scene == scene_name:
+            return entry
+    if not create:
+        return None
+    entry = window_manager.chromatrace_analyses.add()
+    entry.scene = scene_name
+    return entry
 
 
 def unregister():
+    del bpy.types.WindowManager.chromatrace_analyses
     for owner, _group in reversed(_owners):
         del owner.chromatrace
     for cls in reversed(_classes):

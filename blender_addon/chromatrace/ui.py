@@ -6,7 +6,7 @@ import textwrap
 import bpy
 
 from . import materials, operators
-from .properties import MODEL_ITEMS
+from .properties import MODEL_ITEMS, analysis_of
 
 
 class _Panel:
@@ -29,12 +29,11 @@ class CHROMATRACE_PT_render(_Panel, bpy.types.Panel):
         layout.operator("chromatrace.analyze_render", icon="GRAPH")
         layout.prop(s, "camera_curves")
         layout.prop(s, "camera_preset")
-        analysis = operators.ANALYSES.get(context.scene.name)
-        if analysis:  # the command lines, to repeat the analysis by hand
+        analysis = analysis_of(context.window_manager, context.scene.name)
+        if analysis:  # the command lines, to repeat the analysis by hand: fields, so that they can be copied
             box = layout.box()
-            for line in analysis["commands"]:
-                for part in textwrap.wrap(line, 70):
-                    box.label(text=part)
+            box.prop(analysis, "sensor", text="")
+            box.prop(analysis, "analyze", text="")
         col = layout.column(heading="Bands")
         col.prop(s, "band_plan")
         if s.band_plan == "RANGE":

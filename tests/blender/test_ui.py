@@ -75,7 +75,8 @@ scene = bpy.context.scene
 cube = bpy.data.objects["Cube"]
 material = cube.material_slots[0].material
 light = bpy.data.objects["Light"].data
-context = Context(scene=scene, material=material, light=light, object=cube, preferences=bpy.context.preferences)
+context = Context(scene=scene, material=material, light=light, object=cube, preferences=bpy.context.preferences,
+                  window_manager=bpy.context.window_manager)
 
 drawn = draw(ui.CHROMATRACE_PT_render, context)
 if "chromatrace.render_spectral" not in drawn or "bands_width" not in drawn:
@@ -209,6 +210,14 @@ commands = analysis.get("commands", [])
 if len(commands) != 2 or " sensor " not in commands[0] or " analyze " not in commands[1] \
         or s.output_path not in commands[0] or "--preset canon_eos_5d_mkiii --camera nikon_d850" not in commands[0]:
     failures.append(f"Analyze Histogram kept the wrong command lines: {commands}")
+# The panel shows them as fields, which can be selected and copied (labels could not), kept out of the .blend.
+from chromatrace.properties import analysis_of  # noqa: E402
+kept = analysis_of(bpy.context.window_manager, scene.name)
+if kept is None or [kept.sensor, kept.analyze] != commands:
+    failures.append(f"the window manager does not hold the analysis's command lines: {kept and [kept.sensor, kept.analyze]}")
+drawn = draw(ui.CHROMATRACE_PT_render, Context(scene=scene, window_manager=bpy.context.window_manager))
+if drawn.count("sensor") != 1 or drawn.count("analyze") != 1:
+    failures.append(f"the render panel does not show the command lines as fields: {drawn}")
 report = analysis.get("report", "")
 if not report.startswith(os.path.join(work, "ui_analysis")) or not os.path.isfile(report):
     failures.append(f"Analyze Histogram wrote no report beside the render: {report}")
