@@ -3,6 +3,7 @@
 small helpers for materials and the spectrum table."""
 
 import os
+import re
 import shlex
 import shutil
 import tempfile
@@ -19,6 +20,19 @@ from .properties import MODEL_ITEMS, analysis_of, executable_preference
 
 def _tool(context):
     return tool.Tool(tool.find_executable(executable_preference(context)))
+
+
+# The batch's and the command's option names, as the panel names the fields that set them.
+_PANEL_WORDS = ((r"--bands-file\b", "Bands: Plan file"), (r"--bands\b", "Bands (From, To, Width)"),
+                (r"--samples\b", "Sampling: Samples"), (r"--max-bounces\b", "Sampling: Max bounces"),
+                (r"--seed\b", "Sampling: Seed"))
+
+
+def panel_words(message):
+    """An error message with the options it names said as the panel's fields (an artist sees no --bands)."""
+    for option, field in _PANEL_WORDS:
+        message = re.sub(option, field, message)
+    return message
 
 
 # Per scene name: what the last Render Spectral said: its settings' warnings (settings_warnings), then the
@@ -81,7 +95,7 @@ class CHROMATRACE_OT_render_spectral(bpy.types.Operator):
         try:
             self._start(context).run()
         except BadInput as e:
-            self.report({"ERROR"}, str(e))
+            self.report({"ERROR"}, panel_words(str(e)))
             return {"CANCELLED"}
         self._done(context)
         return {"FINISHED"}
@@ -92,7 +106,7 @@ class CHROMATRACE_OT_render_spectral(bpy.types.Operator):
         try:
             self._steps = self._start(context).steps()
         except BadInput as e:
-            self.report({"ERROR"}, str(e))
+            self.report({"ERROR"}, panel_words(str(e)))
             return {"CANCELLED"}
         wm = context.window_manager
         self._timer = wm.event_timer_add(0.05, window=context.window)
@@ -123,7 +137,7 @@ class CHROMATRACE_OT_render_spectral(bpy.types.Operator):
             return {"FINISHED"}
         except BadInput as e:
             self._finish(context)
-            self.report({"ERROR"}, str(e))
+            self.report({"ERROR"}, panel_words(str(e)))
             return {"CANCELLED"}
         except Exception as e:
             self._finish(context)
@@ -215,7 +229,7 @@ class CHROMATRACE_OT_preflight(bpy.types.Operator):
         try:
             summary = spectral_render.SpectralRender(context.scene, request, _tool(context)).preflight()
         except BadInput as e:
-            self.report({"ERROR"}, str(e))
+            self.report({"ERROR"}, panel_words(str(e)))
             return {"CANCELLED"}
         PREFLIGHT[context.scene.name] = summary
         PREFLIGHT_SETTINGS[context.scene.name] = checked_settings(context.scene)

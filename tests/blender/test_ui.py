@@ -241,6 +241,16 @@ if bpy.ops.chromatrace.render_spectral() != {"FINISHED"}:
 if not any(w.startswith("rendered without the world's light") for w in RENDER_WARNINGS.get(scene.name, [])):
     failures.append(f"Render Spectral did not say it left the world out: {RENDER_WARNINGS.get(scene.name)}")
 scene.world, s.on_world = dark_world, "REFUSE"
+# An error names the panel's fields, not the batch's options (it said "--bands: … not a whole number of 70 nm
+# bands" where the panel's field is Width (nm)).
+s.bands_width = 70
+try:
+    bpy.ops.chromatrace.render_spectral()
+    failures.append("Render Spectral with 70 nm bands over 400-700 nm did not refuse")
+except RuntimeError as e:
+    if "--bands" in str(e) or "Bands (From, To, Width)" not in str(e):
+        failures.append(f"the refusal of the band width names the batch's option, not the panel's fields: {e}")
+s.bands_width = 100
 # A file never saved has no folder for "//": the default output goes to Blender's temporary folder, named in full,
 # not to the folder Blender was started in.
 if bpy.data.filepath:
