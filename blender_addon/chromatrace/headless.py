@@ -14,6 +14,7 @@ values before every render (tests/blender/cross_validate.py shows that compare c
 defaults).
 """
 
+import contextlib
 import json
 import os
 import shutil
@@ -116,7 +117,29 @@ def run(argv):
                 max_bounces=args.max_bounces, resolution=args.resolution):
             _log(f"warning: {warning}")
     spectral_render.TEST_HOOK = _test_hook()
-    spectral_render.SpectralRender(scene, request, chromatrace_tool).run()
+    with _stdout_silenced(args.quiet):
+        spectral_render.SpectralRender(scene, request, chromatrace_tool).run()
+
+
+@contextlib.contextmanager
+def _stdout_silenced(quiet):
+    """With --quiet, what Blender and Cycles print to standard output while rendering ("Fra:1 Mem:…", "Saved: …")
+    goes nowhere: their printing is in C, so the file descriptor itself is pointed at /dev/null for the while.
+    chromatrace's own messages are on standard error."""
+    if not quiet:
+        yield
+        return
+    sys.stdout.flush()
+    saved = os.dup(1)
+    devnull = os.open(os.devnull, os.O_WRONLY)
+    try:
+        os.dup2(devnull, 1)
+        yield
+    finally:
+        sys.stdout.flush()
+        os.dup2(saved, 1)
+        os.close(saved)
+        os.close(devnull)
 
 
 def main(argv=None, prog="chromatrace.headless"):

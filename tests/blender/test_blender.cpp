@@ -570,6 +570,18 @@ TEST_F(Blender, ChangedFStopOrRayVisibilityRendersAgain) {
   EXPECT_NE(unshadowed.err.find("(2 renders made, 0 from the cache)"), std::string::npos) << unshadowed.err;
 }
 
+// --quiet is quiet: nothing on standard output, where Blender and Cycles print their render lines ("Fra:1 Mem:…"
+// on 3.x, "render | Saved: …" on 5.x), and nothing on standard error but chromatrace's warnings.
+TEST_F(Blender, QuietBatchPrintsNoRenderLines) {
+  const CommandResult r = batch({"--scene", box(), "--out", dir_.file("box.exr").string(), "--resolution", "8x8",
+                                 "--samples", "1", "--bands", "400:700:100", "--quiet"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  for (const std::string& noise : {"Fra:", "Saved:", "Mem:"}) {
+    EXPECT_EQ(r.out.find(noise), std::string::npos) << r.out;
+    EXPECT_EQ(r.err.find(noise), std::string::npos) << r.err;
+  }
+}
+
 // A batch leaves nothing in the temporary folder: Blender's session folder (blender_XXXXXX) goes with it, also
 // under a Blender module, whose batch leaves the process without Blender's own teardown.
 TEST_F(Blender, BatchLeavesNothingInTheTemporaryFolder) {
