@@ -576,7 +576,7 @@ TEST_F(Blender, QuietBatchPrintsNoRenderLines) {
   const CommandResult r = batch({"--scene", box(), "--out", dir_.file("box.exr").string(), "--resolution", "8x8",
                                  "--samples", "1", "--bands", "400:700:100", "--quiet"});
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  for (const std::string& noise : {"Fra:", "Saved:", "Mem:"}) {
+  for (const char* noise : {"Fra:", "Saved:", "Mem:"}) {
     EXPECT_EQ(r.out.find(noise), std::string::npos) << r.out;
     EXPECT_EQ(r.err.find(noise), std::string::npos) << r.err;
   }

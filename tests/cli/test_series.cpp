@@ -231,9 +231,11 @@ TEST_F(SeriesCommand, PaperPanelsHoldOverSeedsAndSizes) {
       {"2-object-spectra", {}}, {"3-specular", {}}, {"5-two-luminaires", {}}, {"6a-diffuse-global", {}},
       {"6b-dichromatic-global", {}}, {"7a-pixel-area", {}}, {"7c-clipping", {}}, {"7b-gamma", {}},
       {"7d-noise", {}}};  // empty: every expectation
-  for (const std::string size : {"128x128", "192x192"})
-    for (const std::string seed : {"1", "2", "3"}) {
-      const fs::path out = dir_ / (size + "-" + seed);
+  // Three seeds at the default size, and the larger size once (CI time).
+  for (const auto& [size, seeds] : {std::pair{"128x128", std::vector<std::string>{"1", "2", "3"}},
+                                   std::pair{"192x192", std::vector<std::string>{"2"}}})
+    for (const std::string& seed : seeds) {
+      const fs::path out = dir_ / (std::string(size) + "-" + seed);
       std::vector<std::string> args = {"paper", "-o", out.string(), "--resolution", size, "--seed", seed, "--quiet"};
       for (const auto& [variant, targets] : checked) args.insert(args.end(), {"--variant", variant});
       const auto r = run_chromatrace(args);
