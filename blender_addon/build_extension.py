@@ -49,10 +49,11 @@ def versions_agree():
         manifest = re.search(r'^version\s*=\s*"([^"]+)"', f.read(), re.M)
     if not legacy or not manifest or ".".join(legacy.groups()) != manifest.group(1):
         sys.exit("build_extension.py: error: bl_info's version in __init__.py and blender_manifest.toml's differ")
+    return manifest.group(1)
 
 
 def main(out_dir):
-    versions_agree()
+    version = versions_agree()
     os.makedirs(out_dir, exist_ok=True)
     with tempfile.TemporaryDirectory() as stage:
         source = os.path.join(stage, "chromatrace")
@@ -71,9 +72,7 @@ def main(out_dir):
         # The same package as a legacy add-on zip for Blender 3.x (Preferences > Add-ons > Install…): the folder
         # chromatrace/ at its root, which 3.x unpacks into its add-ons folder as one module. (The extension zip
         # holds the package's files at its root, which 3.x would spill into the add-ons folder one by one.)
-        with open(os.path.join(source, "blender_manifest.toml")) as f:
-            version = re.search(r'^version\s*=\s*"([^"]+)"', f.read(), re.M)
-        legacy = os.path.join(out_dir, f"chromatrace-{version.group(1)}-legacy.zip")
+        legacy = os.path.join(out_dir, f"chromatrace-{version}-legacy.zip")
         with zipfile.ZipFile(legacy + ".partial", "w", zipfile.ZIP_DEFLATED) as z:
             for folder, dirs, files in os.walk(source):
                 dirs.sort()
