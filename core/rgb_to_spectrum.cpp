@@ -79,6 +79,31 @@ const ForwardModel& model() {
   return m;
 }
 
+// rgb_white_at's samples at kLo + i.
+const std::array<double, kSamples>& white_samples() {
+  static const std::array<double, kSamples> white = [] {
+    const PiecewiseLinearSpectrum& d65 = cie::illuminant("D65");
+    std::array<double, kSamples> w{};
+    double d65_y = 0.0, flat_y = 0.0;
+    for (int i = 0; i < kSamples; ++i) {
+      const double nm = kLo + i, dl = (i == 0 || i == kSamples - 1) ? 0.5 : 1.0;
+      w[static_cast<std::size_t>(i)] = d65(nm);
+      d65_y += d65(nm) * cie::y_bar()(nm) * dl;
+      flat_y += cie::y_bar()(nm) * dl;
+    }
+    for (double& v : w) v *= flat_y / d65_y;
+    return w;
+  }();
+  return white;
+}
+
+// ScaledSigmoid's value at the grid wavelength kLo + i from the sigmoid's value p there: the one product every
+// evaluation (operator(), tabulated(), tabulated_band_averages) forms, so that they agree bit for bit.
+double scaled_sample(const ScaledSigmoid& s, double p, int i) {
+  const double v = s.scale == 1.0 ? p : s.scale * p;
+  return s.illuminant ? v * white_samples()[static_cast<std::size_t>(i)] : v;
+}
+
 // Damped Newton steps towards `target` from `c`; returns the residual norm reached.
 double solve(const Eigen::Vector3d& target, Eigen::Vector3d& c, int max_iterations) {
   Eigen::Matrix3d jac;
@@ -158,7 +183,7 @@ PiecewiseLinearSpectrum ScaledSigmoid::tabulated(double lo_nm, double hi_nm) con
   for (int i = first; i <= last; ++i) {
     const double nm = kLo + i;
     lambda.push_back(nm);
-    value.push_back(scale == 1.0 ? poly(nm) : scale * poly(nm));
+    value.push_back(scaled_sample(*this, poly(nm), i));
   }
   return PiecewiseLinearSpectrum(std::move(lambda), std::move(value), Extrapolation::Clamp, "rgb spectrum");
 }
@@ -182,7 +207,7 @@ void tabulated_band_averages(const ScaledSigmoid& s, const Bands& bands, double*
     const double t = (kLo + (first + i) - kLo) / (kHi - kLo);
     const double x = c[2] + t * (c[1] + t * c[0]);
     const double p = 0.5 + x / (2.0 * std::sqrt(1.0 + x * x));
-    v[static_cast<std::size_t>(i)] = s.scale == 1.0 ? p : s.scale * p;
+    v[static_cast<std::size_t>(i)] = scaled_sample(s, p, first + i);
   }
   // PiecewiseLinearSpectrum's operator() and integral() with clamping, on wavelengths front + i.
   const double front = kLo + first, back = kLo + last;
@@ -220,7 +245,17 @@ double ScaledSigmoid::tabulated_at(double nm) const {
   const double x = std::clamp(nm, kLo, kHi) - kLo;
   const double i = std::min(std::floor(x), kHi - kLo - 1.0);
   const double t = x - i;
-  const double a = (*this)(kLo + i), b = (*this)(kLo + i + 1.0);
+  const int k = static_cast<int>(i);
+  const double a = scaled_sample(*this, poly(kLo + i), k), b = scaled_sample(*this, poly(kLo + i + 1.0), k + 1);
+  return a + t * (b - a);
+}
+
+double rgb_white_at(double nm) {
+  const double x = std::clamp(nm, kLo, kHi) - kLo;
+  const double i = std::min(std::floor(x), kHi - kLo - 1.0);
+  const double t = x - i;
+  const std::size_t k = static_cast<std::size_t>(i);
+  const double a = white_samples()[k], b = white_samples()[k + 1];
   return a + t * (b - a);
 }
 

@@ -22,6 +22,9 @@
 //    tests/core/test_rgb_to_spectrum.cpp asserts are derived from these. A single {"rgb"} colour uses the
 //    table too (not the exact fit), so that a texture of one colour is that colour's spectrum and the tracer,
 //    the add-on and prepare-texture agree bit for bit.
+//  - An RGB colour that is emitted (a light's, the environment's, an HDR image's texel) is relative to the
+//    colour space's white: the upsampled shape times D65 of unit luminance (rgb_white_at), as in pbrt-v4 and
+//    Mitsuba 3, so that (1, 1, 1) is D65 and not the equal-energy spectrum.
 
 #include <array>
 #include <cstdint>
@@ -38,12 +41,23 @@ struct SigmoidPolynomial {
   double operator()(double nm) const;
 };
 
-// A fitted spectrum times a scale: scale · sigmoid polynomial. A reflectance has scale 1 (at most); an
-// emission colour (unbounded RGB) has scale 2·max(r, g, b), so its shape is the fit of rgb / scale.
+// The white of linear sRGB (Blender's scene-linear space) as an emitter's spectrum: CIE D65 scaled to the
+// luminance of the flat spectrum 1 (Σ D65·ȳ = Σ ȳ by the trapezoid rule on the 1 nm grid), linear between its
+// samples every 1 nm over 360–830 nm, clamped outside. An RGB emitter's spectrum is its upsampled shape times
+// this, as pbrt-v4's RGBIlluminantSpectrum and Mitsuba 3's emitters make it: RGB (1, 1, 1) emits D65, the
+// white Blender's RGB lights, world colours and HDR images mean, and a light's luminance is that of the flat
+// spectrum of its RGB's luminance. Its linear sRGB colour seen by the CIE 1931 observer is the RGB asked for
+// (within the upsampling's 7.4e-4 and the 1e-4 by which tabulated D65 misses the sRGB white point).
+double rgb_white_at(double nm);
+
+// A fitted spectrum times a scale: scale · sigmoid polynomial, and for an emitter (`illuminant`) times the
+// colour space's white, rgb_white_at. A reflectance has scale 1 (at most); an emission colour (unbounded RGB) has
+// scale 2·max(r, g, b), so its shape is the fit of rgb / scale.
 struct ScaledSigmoid {
   double scale = 1.0;
   SigmoidPolynomial poly;
-  double operator()(double nm) const { return scale * poly(nm); }
+  bool illuminant = false;  // times rgb_white_at: an RGB emitter's spectrum, relative to D65
+  double operator()(double nm) const { return illuminant ? scale * poly(nm) * rgb_white_at(nm) : scale * poly(nm); }
   // The value of the tabulated spectrum (samples every 1 nm over 360–830 nm, linear between them, clamped
   // outside): what tabulated() gives, without building it.
   double tabulated_at(double nm) const;
@@ -122,5 +136,8 @@ SigmoidPolynomial upsample_rgb_reflectance(const std::array<double, 3>& linear_s
 ScaledSigmoid upsample_rgb_unbounded(const std::array<double, 3>& linear_srgb);
 // upsample_rgb_reflectance tabulated every 1 nm over 360–830 nm (clamped outside): an {"rgb": ...} spectrum.
 PiecewiseLinearSpectrum rgb_to_spectrum(const std::array<double, 3>& linear_srgb);
+// The same shape times the colour space's white (rgb_white_at), tabulated alike: an {"rgb": ...} spectrum where a
+// radiance is expected (a light, an emissive material, the environment), relative to D65.
+PiecewiseLinearSpectrum rgb_to_emission_spectrum(const std::array<double, 3>& linear_srgb);
 
 }  // namespace ct

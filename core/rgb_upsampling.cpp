@@ -47,4 +47,8 @@ PiecewiseLinearSpectrum rgb_to_spectrum(const std::array<double, 3>& linear_srgb
   return ScaledSigmoid{1.0, upsample_rgb_reflectance(linear_srgb)}.tabulated();
 }
 
+PiecewiseLinearSpectrum rgb_to_emission_spectrum(const std::array<double, 3>& linear_srgb) {
+  return ScaledSigmoid{1.0, upsample_rgb_reflectance(linear_srgb), true}.tabulated();
+}
+
 }  // namespace ct

@@ -244,11 +244,12 @@ class SceneReader {
   std::vector<NamedSpectrum> read_spectra(const JsonNode& root);
 
  private:
-  PiecewiseLinearSpectrum spectrum_source(const JsonNode& node);
+  // `emitted`: where a radiance is expected, so that an {"rgb"} colour is relative to D65 (rgb_to_emission_spectrum).
+  PiecewiseLinearSpectrum spectrum_source(const JsonNode& node, bool emitted = false);
   PiecewiseLinearSpectrum csv_spectrum(const JsonNode& node);
   PiecewiseLinearSpectrum illuminant_spectrum(const JsonNode& node);
   PiecewiseLinearSpectrum samples_spectrum(const JsonNode& node);
-  SpectrumRef spectrum_ref(const JsonNode& node);
+  SpectrumRef spectrum_ref(const JsonNode& node, bool emitted = false);
   SpectrumRef texture_ref(const JsonNode& node, TextureUse use);
   SpectrumRef radiance(const JsonNode& node);
   SpectrumRef reflectance(const JsonNode& node);
@@ -266,10 +267,17 @@ class SceneReader {
   Scene scene_;
 };
 
+// The colour of an {"rgb": [r, g, b]} spectrum source (already checked by spectrum_source), else nothing.
+std::optional<std::array<double, 3>> rgb_colour(const JsonNode& node) {
+  if (!node.json().is_object() || !node.has("rgb")) return std::nullopt;
+  const std::vector<JsonNode> c = node["rgb"].elements();
+  return std::array<double, 3>{c[0].number(), c[1].number(), c[2].number()};
+}
+
 constexpr std::string_view kSpectrumObject =
     "an object with one of \"csv\", \"constant\", \"blackbody_k\", \"illuminant\", \"samples\", \"rgb\"";
 
-PiecewiseLinearSpectrum SceneReader::spectrum_source(const JsonNode& node) {
+PiecewiseLinearSpectrum SceneReader::spectrum_source(const JsonNode& node, bool emitted) {
   static constexpr std::string_view kinds[] = {"csv", "constant", "blackbody_k", "illuminant", "samples", "rgb"};
   if (!node.json().is_object())
     node.fail(fmt::format("must be {}, got {}", kSpectrumObject, describe_json(node.json())));
@@ -301,7 +309,8 @@ PiecewiseLinearSpectrum SceneReader::spectrum_source(const JsonNode& node) {
     const JsonNode rgb = node["rgb"];
     const std::vector<JsonNode> c = rgb.elements();
     if (c.size() != 3) rgb.fail(fmt::format("must be [r, g, b], got {} numbers", c.size()));
-    spectrum = rgb_to_spectrum({c[0].number_in(0.0, 1.0), c[1].number_in(0.0, 1.0), c[2].number_in(0.0, 1.0)});
+    const std::array<double, 3> colour = {c[0].number_in(0.0, 1.0), c[1].number_in(0.0, 1.0), c[2].number_in(0.0, 1.0)};
+    spectrum = emitted ? rgb_to_emission_spectrum(colour) : rgb_to_spectrum(colour);
   }
 
   const Sample lowest = extreme_sample(spectrum, false);
@@ -380,12 +389,13 @@ PiecewiseLinearSpectrum SceneReader::samples_spectrum(const JsonNode& node) {
                                  clamp ? Extrapolation::Clamp : Extrapolation::Zero, samples.location());
 }
 
-SpectrumRef SceneReader::spectrum_ref(const JsonNode& node) {
-  if (node.json().is_object()) return {"", spectrum_source(node), nullptr};
+SpectrumRef SceneReader::spectrum_ref(const JsonNode& node, bool emitted) {
+  if (node.json().is_object()) return {"", spectrum_source(node, emitted), nullptr};
   if (!node.json().is_string())
     node.fail(fmt::format("must be a spectrum name or {}, got {}", kSpectrumObject, describe_json(node.json())));
   const std::string name = node.string();
-  if (const NamedSpectrum* named = scene_.find_spectrum(name)) return {name, named->spectrum, nullptr};
+  if (const NamedSpectrum* named = scene_.find_spectrum(name))
+    return {name, emitted && named->rgb ? rgb_to_emission_spectrum(*named->rgb) : named->spectrum, nullptr};
   node.fail(scene_.spectra.empty()
                 ? fmt::format("unknown spectrum \"{}\" (the scene defines no spectra)", name)
                 : fmt::format("unknown spectrum \"{}\" (spectra: {})", name, names_of(scene_.spectra)));
@@ -424,7 +434,7 @@ SpectrumRef SceneReader::texture_ref(const JsonNode& node, TextureUse use) {
 }
 
 SpectrumRef SceneReader::radiance(const JsonNode& node) {
-  return is_texture_source(node) ? texture_ref(node, TextureUse::Radiance) : spectrum_ref(node);
+  return is_texture_source(node) ? texture_ref(node, TextureUse::Radiance) : spectrum_ref(node, true);
 }
 
 SpectrumRef SceneReader::reflectance(const JsonNode& node) {
@@ -589,7 +599,8 @@ Scene SceneReader::read(const JsonNode& root) {
   if (const auto render = root.find("render")) scene_.render = read_render(*render);
 
   if (const auto spectra = root.find("spectra"))
-    for (const auto& [name, node] : spectra->members()) scene_.spectra.push_back({name, spectrum_source(node)});
+    for (const auto& [name, node] : spectra->members())
+      scene_.spectra.push_back({name, spectrum_source(node), rgb_colour(node)});
   for (const auto& [name, node] : root["materials"].members()) scene_.materials.push_back(material(name, node));
 
   // Objects and lights share one namespace, as their names label the same object-id image.
@@ -625,9 +636,17 @@ Scene SceneReader::read(const JsonNode& root) {
 std::vector<NamedSpectrum> SceneReader::read_spectra(const JsonNode& root) {
   const std::string format = root["format"].string();
   if (format != kSpectraFormat) root["format"].fail(fmt::format("must be \"{}\", got \"{}\"", kSpectraFormat, format));
-  root.expect_object({"format", "spectra"});
+  root.expect_object({"format", "spectra", "radiance"});
   std::vector<NamedSpectrum> spectra;
-  for (const auto& [name, node] : root["spectra"].members()) spectra.push_back({name, spectrum_source(node)});
+  if (const auto reflectances = root.find("spectra"))
+    for (const auto& [name, node] : reflectances->members()) spectra.push_back({name, spectrum_source(node), std::nullopt});
+  if (const auto radiances = root.find("radiance"))
+    for (const auto& [name, node] : radiances->members()) {
+      if (find_by_name(spectra, name))
+        node.fail(fmt::format("\"{}\" is already the name of an entry of \"spectra\"", name));
+      spectra.push_back({name, spectrum_source(node, true), std::nullopt});
+    }
+  if (!root.find("spectra") && !root.find("radiance")) root.fail("needs \"spectra\" or \"radiance\"");
   return spectra;
 }
 

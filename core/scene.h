@@ -36,6 +36,9 @@ inline constexpr std::string_view kSpectraFormat = "chromatrace-spectra/1";
 struct NamedSpectrum {
   std::string name;
   PiecewiseLinearSpectrum spectrum;
+  // The colour of an {"rgb"} source: where a radiance names this spectrum it is that colour relative to D65
+  // (rgb_to_emission_spectrum), not `spectrum`, the colour's reflectance.
+  std::optional<std::array<double, 3>> rgb;
 };
 
 // A spectrum as a material or light uses it: resolved, and named when it came from `spectra`. A colour input

@@ -32,8 +32,10 @@ std::size_t ImageTexture::texel_at(double u, double v) const {
 }
 
 ScaledSigmoid texel_spectrum(const std::array<double, 3>& linear_srgb, TextureUse use) {
-  return use == TextureUse::Reflectance ? ScaledSigmoid{1.0, upsample_rgb_reflectance(linear_srgb)}
-                                        : upsample_rgb_unbounded(linear_srgb);
+  if (use == TextureUse::Reflectance) return ScaledSigmoid{1.0, upsample_rgb_reflectance(linear_srgb)};
+  ScaledSigmoid emitted = upsample_rgb_unbounded(linear_srgb);
+  emitted.illuminant = true;  // relative to the colour space's white, D65
+  return emitted;
 }
 
 TexelSpectra upsample_texels(const ImageTexture& texture, int threads) {

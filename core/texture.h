@@ -23,7 +23,8 @@ namespace ct {
 
 enum class TextureColourSpace { Srgb, Linear };
 // What the texels mean, which fixes how they are upsampled: a reflectance must lie in [0, 1] and is upsampled as
-// an {"rgb"} spectrum is; a radiance may exceed 1 and is upsampled in the unbounded form (upsample_rgb_unbounded).
+// an {"rgb"} spectrum is; a radiance may exceed 1 and is upsampled in the unbounded form (upsample_rgb_unbounded),
+// times the colour space's white (rgb_white_at): relative to D65, as an emitted {"rgb"} colour is.
 enum class TextureUse { Reflectance, Radiance };
 
 // Negative texels of an image, which a real HDRI has where the camera's and the stitcher's noise pushed a dark

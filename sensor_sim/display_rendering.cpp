@@ -26,6 +26,14 @@ DisplayRendering display_rendering(const Survey& survey, const LinearModel& unit
   } else if (!lighting.empty()) {
     light = lighting;
     source = fmt::format("illuminant {} lighting the reflectance image (--illuminant)", lit_by);
+  } else if (const auto white = info.metadata.find("chromatrace.white"); white != info.metadata.end()) {
+    // The white the renderer says the scene's colours are relative to (the Blender add-on: D65, Blender's).
+    try {
+      light = band_averages(cie::illuminant(white->second), bands);
+    } catch (const InputError& e) {
+      throw InputError(fmt::format("{}: chromatrace.white: {}", info.file, e.what()));
+    }
+    source = fmt::format("illuminant {}, the white of the scene's colours (chromatrace.white)", white->second);
   } else {
     const std::array<std::vector<double>, 3> xyz = xyz_band_weights(bands);
     double best = 0;

@@ -18,7 +18,8 @@
 namespace ct::sensor {
 
 // The display rendering at unit exposure: the white balance's illuminant (display.white_balance, else the
-// illuminant lighting a reflectance image, else the brightest emitter the survey saw, else D65), its matrix, and
+// illuminant lighting a reflectance image, else the white the file says its colours are relative to
+// (chromatrace.white), else the brightest of the scene's lights the survey saw, else D65), its matrix, and
 // the scale that puts the display.percentile of the surfaces' brightest linear sRGB channel at display.level.
 // `description` says what was chosen, as JSON; `scene_light` is the illuminant's band values.
 DisplayRendering display_rendering(const Survey& survey, const LinearModel& unit_model, const SensorConfig& config,

@@ -80,6 +80,9 @@ Survey survey_image(SpectralExrReader& reader, const SensorRun& unit_run, const 
           if (sampled) s.display_samples.insert(s.display_samples.end(), c, c + 3);
           continue;
         }
+        // A white to balance on is a light's: where the file names its objects, only the scene's lights seen
+        // directly count, never a surface or the environment showing through at an edge.
+        if (!ids.empty() && !lights.contains(id)) continue;
         // The emitter's spectrum as seen: its emission (or, without that layer, its total) over the k×k
         // rendered pixels.
         const std::vector<float>& spectra = emission_spectra.empty() ? total_spectra : emission_spectra;

@@ -19,11 +19,31 @@ def is_texture(source):
     return isinstance(source, dict) and "texture" in source
 
 
-def rgb_source(source):
-    """A grey RGB source as the constant it upsamples to (Jakob-Hanika's grey is flat): exact, not upsampled."""
-    if isinstance(source, dict) and "rgb" in source and max(source["rgb"]) == min(source["rgb"]):
+def rgb_source(source, emitted=False):
+    """A grey RGB reflectance as the constant it upsamples to (Jakob-Hanika's grey is flat): exact, not upsampled.
+    An emitted RGB colour stays RGB: `chromatrace` makes it relative to D65, Blender's white (so an emitted grey
+    is D65, not flat)."""
+    if not emitted and isinstance(source, dict) and "rgb" in source and max(source["rgb"]) == min(source["rgb"]):
         return {"constant": source["rgb"][0]}
     return source
+
+
+def upsampled(source):
+    """Whether a source's spectrum is upsampled from RGB: a colour or a texture (a grey is exact: flat, or D65
+    where emitted)."""
+    return is_texture(source) or (isinstance(source, dict) and "rgb" in source
+                                  and max(source["rgb"]) != min(source["rgb"]))
+
+
+def source_text(source, role):
+    """The JSON text that keys a source in a role: an emitted RGB colour is another spectrum than the same
+    colour's reflectance (`chromatrace scene-bands` reads it from the spectra list's "radiance"), and a texture is
+    prepared once per use."""
+    if is_texture(source):
+        return json.dumps({**source, "use": "radiance" if role == "emission" else "reflectance"}, sort_keys=True)
+    if role == "emission" and isinstance(source, dict) and "rgb" in source:
+        return json.dumps({"radiance": source}, sort_keys=True)
+    return json.dumps(source, sort_keys=True)
 
 
 # ---- the colour walks and what they refuse --------------------------------------------------------------
@@ -157,7 +177,7 @@ def node_source(spectral_input, what):
         _reflectance_colour_check(spectral_input, rgb, what)
         return rgb_source({"rgb": [max(0.0, float(c)) for c in rgb]}), 1.0
     rgb, factor = rgb_for_upsampling(rgb)
-    return rgb_source({"rgb": rgb}), factor
+    return rgb_source({"rgb": rgb}, emitted=spectral_input.role == "emission"), factor
 
 
 def input_source(scene, material, spectral_input):
@@ -184,10 +204,10 @@ def input_source(scene, material, spectral_input):
         scale = 1.0 if spectral_input.managed else s.emission_scale
         if settings.kind == "RGB" and settings.use_current_colour:
             rgb, factor = rgb_for_upsampling(rgb)
-            return rgb_source(resolve(scene, settings, rgb, what)), scale * factor
+            return rgb_source(resolve(scene, settings, rgb, what), emitted=True), scale * factor
         return resolve(scene, settings, None, what), scale
     rgb, factor = rgb_for_upsampling(rgb)
-    return rgb_source({"rgb": rgb}), factor
+    return rgb_source({"rgb": rgb}, emitted=spectral_input.role == "emission"), factor
 
 
 def owner_inputs(scene, kind, thing, walk):
@@ -203,7 +223,7 @@ def owner_inputs(scene, kind, thing, walk):
         settings = light.chromatrace
         if settings.emission.kind == "RGB" and settings.emission.use_current_colour:
             rgb, factor = rgb_for_upsampling(tuple(light.color))
-            source = rgb_source(resolve(scene, settings.emission, rgb, what))
+            source = rgb_source(resolve(scene, settings.emission, rgb, what), emitted=True)
             scale = settings.emission_scale * factor
         else:
             source, scale = resolve(scene, settings.emission, None, what), settings.emission_scale
@@ -221,12 +241,10 @@ def spectral_inputs(scene, used, lights, all_walks, world):
     keys, inputs, emitters, texture_sources = {}, [], set(), {}
 
     def key_of(source, role):
-        if is_texture(source):  # one image is prepared once per use: a reflectance or a radiance
-            text = json.dumps({**source, "use": "radiance" if role == "emission" else "reflectance"}, sort_keys=True)
-            key = keys.setdefault(text, f"s{len(keys)}")
+        key = keys.setdefault(source_text(source, role), f"s{len(keys)}")
+        if is_texture(source):
             texture_sources[key] = source
-            return key
-        return keys.setdefault(json.dumps(source, sort_keys=True), f"s{len(keys)}")
+        return key
 
     owners = [("material", m, all_walks[("material", m.name)]) for m in used]
     owners += [("light", ob, all_walks[("light", ob.name)]) for ob in lights]
@@ -245,10 +263,12 @@ def spectral_inputs(scene, used, lights, all_walks, world):
 def evaluate(tool, request, work_dir, keys):
     """`chromatrace scene-bands` of every source that is no texture: the band edges and each one's averages."""
     request_file = os.path.join(work_dir, "spectra.json")
-    spectra = {k: json.loads(t) for t, k in keys.items() if not is_texture(json.loads(t))}
+    sources = {k: json.loads(t) for t, k in keys.items()}
+    spectra = {k: s for k, s in sources.items() if not is_texture(s) and "radiance" not in s}
+    radiance = {k: s["radiance"] for k, s in sources.items() if "radiance" in s}
     spectra = spectra or {"flat": {"constant": 1.0}}  # no spectra: the band edges all the same
     with open(request_file, "w") as f:
-        json.dump({"format": "chromatrace-spectra/1", "spectra": spectra}, f)
+        json.dump({"format": "chromatrace-spectra/1", "spectra": spectra, "radiance": radiance}, f)
     return tool.band_averages(request_file, request.bands, request.bands_file)
 
 

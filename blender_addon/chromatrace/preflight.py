@@ -28,7 +28,8 @@ def _owner_entry(scene, tool, request, kind, thing, walk, issues, key_of, status
     for spectral_input, source, scale in inputs:
         texture = node_resolution.is_texture(source)
         colour = {"input": spectral_input.label, "role": spectral_input.role, "source": source,
-                  "scale": scale, "key": key_of(source), "upsampled": "rgb" in source or texture}
+                  "scale": scale, "key": key_of(source, spectral_input.role),
+                  "upsampled": node_resolution.upsampled(source)}
         if texture:
             try:
                 colour["negative_texels"] = textures.texture_noise(tool, source, spectral_input.role)
@@ -77,8 +78,8 @@ def preflight(scene, request, tool):
     hard, mixing = node_resolution.node_issues(used, walks, world)
     keys = {}
 
-    def key_of(source):
-        return keys.setdefault(json.dumps(source, sort_keys=True), f"s{len(keys)}")
+    def key_of(source, role):
+        return keys.setdefault(node_resolution.source_text(source, role), f"s{len(keys)}")
 
     def report(kind, thing, walk, status_override=None):
         issues = [i for i in hard + mixing if i["kind"] == kind and i["material"] == thing.name]

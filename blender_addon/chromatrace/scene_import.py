@@ -95,10 +95,11 @@ def _mesh_object(name, path, collection):
     return ob
 
 
-def _world(environment, scene_dir, view_layer):
+def _world(environment, scene_dir, view_layer, warn):
     """Blender's world for the scene's environment: a Background (strength = scale) fed by an Environment Texture
     (nearest texel, as the tracer looks it up; rotation_deg α as a Mapping node turning the vector by −α about Z)
-    or by the colour of an rgb or constant spectrum."""
+    or by the colour of an rgb or constant spectrum. A world's colour is RGB, relative to D65: a constant (flat)
+    spectrum becomes D65 of the same luminance, said through `warn`."""
     world = bpy.data.worlds.new("environment")
     tree = blender_compat.enable_nodes(world)
     nodes, links = tree.nodes, tree.links
@@ -126,6 +127,10 @@ def _world(environment, scene_dir, view_layer):
     elif isinstance(radiance, dict) and ("rgb" in radiance or "constant" in radiance):
         rgb = radiance["rgb"] if "rgb" in radiance else [radiance["constant"]] * 3
         background.inputs["Color"].default_value = (*rgb, 1.0)
+        if "constant" in radiance:
+            warn(f"warning: environment.radiance: the flat spectrum {radiance['constant']:g} becomes the world colour "
+                 f"{radiance['constant']:g} (grey), which is D65 of that luminance: Blender's colours are relative to "
+                 "its white, D65")
     else:
         raise BadInput("environment.radiance: only a texture, an rgb or a constant spectrum can be imported as "
                        "Blender's world")
@@ -262,7 +267,7 @@ def import_scene(path, scene, tool, log=print, ggx_masking="scene", warn=None, m
                 _ensure_lightgroup(view_layer, group)
                 ob.lightgroup = group
         if "environment" in document:
-            scene.world = _world(document["environment"], scene_dir, view_layer)
+            scene.world = _world(document["environment"], scene_dir, view_layer, warn or log)
         elif scene.world is not None and not _dark(scene.world):
             # The scene's light is the file's: a world that lights the scene would add light the file has not.
             dark = _dark_world("no environment")

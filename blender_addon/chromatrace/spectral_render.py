@@ -290,5 +290,7 @@ class SpectralRender:
             "chromatrace.samples": str(request.samples),
             "chromatrace.seed": str(request.seed),
             "chromatrace.scene": source,
+            # Blender's colours (RGB lights, worlds, HDRIs, Blackbody nodes) are relative to D65: the preview's white.
+            "chromatrace.white": "D65",
             "chromatrace.camera": json.dumps(camera_description(scene, self._resolution())),
         }

@@ -174,6 +174,7 @@ TEST(RgbToSpectrum, DirectBandAveragesAreThoseOfTheTabulatedSpectrum) {
     const Vec3d rgb = {random.uniform(), random.uniform(), random.uniform()};
     spectra.push_back(i % 2 ? ScaledSigmoid{1.0, upsample_rgb_reflectance(rgb)}
                             : upsample_rgb_unbounded({30 * rgb[0], 30 * rgb[1], 30 * rgb[2]}));
+    spectra.back().illuminant = i % 4 < 2;  // emitted colours, relative to D65, as well
   }
   for (const Bands& bands : plans)
     for (const ScaledSigmoid& s : spectra) {
@@ -181,6 +182,43 @@ TEST(RgbToSpectrum, DirectBandAveragesAreThoseOfTheTabulatedSpectrum) {
       tabulated_band_averages(s, bands, direct.data());
       ASSERT_EQ(direct, band_averages(s.tabulated(), bands)) << bands.min_wavelength() << "-" << bands.max_wavelength();
     }
+}
+
+// An emitted RGB colour is relative to D65 (pbrt-v4's RGBIlluminantSpectrum): (1, 1, 1) is D65 itself, with the
+// luminance of the flat spectrum 1, and a colour is the sigmoid of its reflectance times that white. Bounds: the
+// white's samples are D65's times one factor (double rounding, 1e-15 relative); its luminance is set by the
+// trapezoid rule on the 1 nm grid, which differs from the exact integral of the linear interpolants by
+// O(h²/12 · max|(D65·ȳ)''|) per nm, below 1e-3 relative for h = 1 nm.
+TEST(RgbToSpectrum, EmittedRgbIsRelativeToD65) {
+  const PiecewiseLinearSpectrum& d65 = cie::illuminant("D65");
+  const PiecewiseLinearSpectrum white = rgb_to_emission_spectrum({1.0, 1.0, 1.0});
+  const double factor = white(560.0) / d65(560.0);
+  for (double nm = 360.0; nm <= 830.0; nm += 1.0) EXPECT_NEAR(white(nm), factor * d65(nm), 1e-13 * d65(nm)) << nm;
+  const double y_white = spectrum_to_xyz(white)[1], y_flat = spectrum_to_xyz(PiecewiseLinearSpectrum::constant(1.0))[1];
+  EXPECT_NEAR(y_white / y_flat, 1.0, 1e-3);
+  // Its chromaticity is D65's (x, y) = (0.31272, 0.32903) to the 5 decimals CIE 15 gives.
+  const Vec3d xyy = xyz_to_xyY(spectrum_to_xyz(white));
+  EXPECT_NEAR(xyy[0], 0.31272, 1e-5);
+  EXPECT_NEAR(xyy[1], 0.32903, 1e-5);
+  // A colour: the reflectance's shape times the white, sample for sample; its emitted linear sRGB (XYZ / Y of
+  // the flat spectrum 1) is the reflectance's D65-lit colour. The two differ by the quadrature above (5e-4, as in
+  // ExactFitReproducesColoursInsideTheCube) and the white's normalisation (1e-3 relative at most).
+  for (const Vec3d& rgb : {Vec3d{0.8, 0.3, 0.1}, Vec3d{0.05, 0.2, 0.9}, Vec3d{0.5, 0.5, 0.5}, Vec3d{0.0, 1.0, 0.2}}) {
+    const PiecewiseLinearSpectrum emitted = rgb_to_emission_spectrum(rgb), shape = rgb_to_spectrum(rgb);
+    for (double nm = 360.0; nm <= 830.0; nm += 1.0) EXPECT_NEAR(emitted(nm), shape(nm) * white(nm), 1e-15 * white(nm));
+    const Vec3d xyz = spectrum_to_xyz(emitted);
+    const Vec3d seen = xyz_to_linear_srgb({xyz[0] / y_flat, xyz[1] / y_flat, xyz[2] / y_flat});
+    const Vec3d lit = seen_under_d65(shape);
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(seen[c], lit[c], 5e-4 + 1e-3 * lit[c]) << rgb[0] << "," << rgb[1] << "," << rgb[2];
+  }
+  // A radiance texel (unbounded form) and the same colour given as {"rgb"}, scaled into [0, 1], have one shape.
+  ScaledSigmoid texel = upsample_rgb_unbounded({4.0, 2.0, 1.0});
+  texel.illuminant = true;
+  const PiecewiseLinearSpectrum tabulated = texel.tabulated();
+  for (double nm : {360.0, 400.5, 555.0, 700.25, 830.0}) {
+    EXPECT_NEAR(tabulated(nm), texel.tabulated_at(nm), 1e-15 * tabulated(nm)) << nm;
+    EXPECT_NEAR(texel(nm), texel.scale * texel.poly(nm) * rgb_white_at(nm), 1e-15 * texel(nm)) << nm;
+  }
 }
 
 TEST(RgbToSpectrum, TableIsTheSameWhateverTheThreadCount) {

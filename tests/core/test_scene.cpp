@@ -167,6 +167,11 @@ TEST(Scene, SpectrumSources) {
   const PiecewiseLinearSpectrum rgb = wall_reflectance({{"rgb", {0.2, 0.5, 0.3}}});
   EXPECT_EQ(rgb.values(), rgb_to_spectrum({0.2, 0.5, 0.3}).values());
 
+  // rgb as a light's radiance: relative to D65 (rgb_to_emission_spectrum), so (1, 1, 1) is D65, not flat
+  EXPECT_EQ(lamp_radiance({{"rgb", {0.2, 0.5, 0.3}}}).values(), rgb_to_emission_spectrum({0.2, 0.5, 0.3}).values());
+  const PiecewiseLinearSpectrum white_lamp = lamp_radiance({{"rgb", {1.0, 1.0, 1.0}}});
+  EXPECT_NEAR(white_lamp(450.0) / white_lamp(650.0), cie::illuminant("D65")(450.0) / cie::illuminant("D65")(650.0), 1e-12);
+
   // illuminants, as tabulated (relative, 100 at 560 nm)
   EXPECT_EQ(lamp_radiance({{"illuminant", "D65"}}).values(), cie::illuminant("D65").values());
   EXPECT_EQ(lamp_radiance({{"illuminant", "D"}, {"cct_k", 5500}}).values(), cie::daylight(5500).values());
@@ -190,6 +195,39 @@ TEST(Scene, NamedAndInlineSpectraAreResolved) {
   EXPECT_EQ(plastic.specular, 0.1);
   ASSERT_TRUE(std::holds_alternative<DichromaticMaterial::Ggx>(plastic.lobe));
   EXPECT_DOUBLE_EQ(std::get<DichromaticMaterial::Ggx>(plastic.lobe).alpha(), 0.04);  // roughness 0.2, squared
+}
+
+// A named {"rgb"} spectrum is the colour's reflectance where a material uses it and the colour relative to D65
+// where a light or the environment emits it; a spectra list reads its "radiance" entries as emitted.
+TEST(Scene, NamedRgbSpectrumIsEmittedRelativeToD65) {
+  Json document = minimal_document();
+  document["spectra"]["paint"] = {{"rgb", {0.9, 0.6, 0.2}}};
+  document["materials"]["wall"]["reflectance"] = "paint";
+  document["lights"][0]["radiance"] = "paint";
+  document["environment"] = {{"radiance", "paint"}};
+  const Scene scene = parse_scene(document, "test.json", kTestScenes);
+  EXPECT_EQ(std::get<LambertMaterial>(scene.find_material("wall")->model).reflectance.spectrum.values(),
+            rgb_to_spectrum({0.9, 0.6, 0.2}).values());
+  EXPECT_EQ(scene.lights[0].radiance.spectrum.values(), rgb_to_emission_spectrum({0.9, 0.6, 0.2}).values());
+  EXPECT_EQ(scene.environment->radiance.spectrum.values(), rgb_to_emission_spectrum({0.9, 0.6, 0.2}).values());
+
+  const Json list = {{"format", "chromatrace-spectra/1"},
+                     {"spectra", {{"paint", {{"rgb", {0.9, 0.6, 0.2}}}}}},
+                     {"radiance", {{"lamp", {{"rgb", {0.9, 0.6, 0.2}}}}, {"tube", {{"illuminant", "F11"}}}}}};
+  const std::vector<NamedSpectrum> spectra = parse_spectra(list, "list.json", kTestScenes);
+  ASSERT_EQ(spectra.size(), 3u);
+  EXPECT_EQ(spectra[0].spectrum.values(), rgb_to_spectrum({0.9, 0.6, 0.2}).values());
+  EXPECT_EQ(spectra[1].name, "lamp");
+  EXPECT_EQ(spectra[1].spectrum.values(), rgb_to_emission_spectrum({0.9, 0.6, 0.2}).values());
+  EXPECT_EQ(spectra[2].spectrum.values(), cie::illuminant("F11").values());
+  Json clash = list;
+  clash["radiance"]["paint"] = {{"constant", 1.0}};
+  try {
+    parse_spectra(clash, "list.json", kTestScenes);
+    ADD_FAILURE() << "a name in both sections was accepted";
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()), "list.json: radiance.paint: \"paint\" is already the name of an entry of \"spectra\"");
+  }
 }
 
 TEST(Scene, CsvErrorsNameTheScenePathAndTheCsv) {

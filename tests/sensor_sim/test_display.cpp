@@ -14,6 +14,7 @@
 #include "core/cie.h"
 #include "core/colour.h"
 #include "core/csv.h"
+#include "core/error.h"
 #include "core/rgb_to_spectrum.h"
 #include "core/spectral_exr.h"
 #include "sensor_sim/display.h"
@@ -267,6 +268,75 @@ TEST(Display, WhiteBalancesOnTheEmitterInViewWithACameraMatrix) {
     SpectralExrReader reader(out);
     EXPECT_NE(reader.info().metadata.at("chromatrace.display").find("the brightest emitter in view"), std::string::npos);
   }
+}
+
+// The white comes from the scene's lights or from what the file says is white, never from a surface's pixels
+// where the environment shows through. A floor (id 1, white, top half) and a red wall (id 2) lit by `surfaces`,
+// two floor pixels at the edge that are mostly a bright blue sky (emission layer), and, when `lamp` is given,
+// a lamp (id 3) of that spectrum in the bottom row. chromatrace.scene names the lamp as a light.
+void write_edge_scene(const fs::path& path, const Bands& bands, const std::vector<double>& surfaces,
+                      const std::vector<double>* lamp, const std::map<std::string, std::string>& extra = {}) {
+  const PiecewiseLinearSpectrum red =
+      read_csv(fs::path(CHROMATRACE_SOURCE_DIR) / "scenes" / "spectra" / "cornell_box.csv").spectrum("red");
+  const std::vector<double> white(bands.size(), 1.0), wall = band_averages(red, bands);
+  const std::vector<double> sky = scaled(band_averages(cie::daylight(20000), bands), 0.5);
+  std::map<std::string, std::string> attributes = extra;
+  attributes["chromatrace.scene"] = R"({"lights": [{"name": "lamp"}]})";
+  write_scene(
+      path, bands, 10, 10,
+      [&](int x, int y) {
+        Pixel p;
+        p.id = y < 5 ? 1 : 2;
+        if (y == 0 && x >= 8) {  // the floor's far edge, where the sky shows
+          p.emitter = true;
+          p.radiance = sky;
+        } else if (lamp && y == 9 && x < 2) {
+          p.emitter = true;
+          p.id = 3;
+          p.radiance = scaled(*lamp, 1e3);
+        } else {
+          p.radiance = lit(surfaces, y < 5 ? white : wall, 1.0 / std::numbers::pi);
+        }
+        return p;
+      },
+      true, {{1, "floor"}, {2, "wall"}, {3, "lamp"}}, attributes);
+}
+
+TEST(Display, WhiteComesFromTheScenesLightsNeverFromASurfacesEdge) {
+  test::TempDir dir;
+  const Bands bands = Bands::uniform(380, 780, 10);
+  const Json patch = {{"preset", "canon_eos_5d_mkiii"}, {"exposure", {{"time_s", "auto"}}}};
+  const std::vector<double> d65 = scaled(band_averages(cie::illuminant("D65"), bands), 0.01);
+  const std::vector<double> a = scaled(band_averages(cie::illuminant("A"), bands), 0.01);
+  const auto white_balance = [](const fs::path& out) {
+    SpectralExrReader reader(out);
+    return Json::parse(reader.info().metadata.at("chromatrace.display"))["white_balance"].get<std::string>();
+  };
+  // No light in view: the sky at the floor's edge is not the white; D65 is.
+  write_edge_scene(dir.file("edge.exr"), bands, d65, nullptr);
+  test::run_sensor(dir.file("edge.exr"), dir.file("edge_out.exr"), test::config_of(patch));
+  expect_white_and_red(dir.file("edge_out.exr"), "sky at an edge");
+  EXPECT_EQ(white_balance(dir.file("edge_out.exr")), "illuminant D65 (no emitter in view)");
+  // The scene's lamp in view is the white (the sky's pixels stay left out).
+  write_edge_scene(dir.file("lamp.exr"), bands, a, &a);
+  test::run_sensor(dir.file("lamp.exr"), dir.file("lamp_out.exr"), test::config_of(patch));
+  expect_white_and_red(dir.file("lamp_out.exr"), "lamp A in view");
+  EXPECT_EQ(white_balance(dir.file("lamp_out.exr")).rfind("the brightest emitter in view, object 3 (lamp)", 0), 0u)
+      << white_balance(dir.file("lamp_out.exr"));
+  // What the file says is white comes first: a D65-lit scene with an A lamp in view, from the Blender add-on.
+  write_edge_scene(dir.file("said.exr"), bands, d65, &a, {{"chromatrace.white", "D65"}});
+  test::run_sensor(dir.file("said.exr"), dir.file("said_out.exr"), test::config_of(patch));
+  expect_white_and_red(dir.file("said_out.exr"), "chromatrace.white D65");
+  EXPECT_EQ(white_balance(dir.file("said_out.exr")), "illuminant D65, the white of the scene's colours (chromatrace.white)");
+  // A white that is no illuminant's name is an error naming the file and the attribute.
+  write_edge_scene(dir.file("bad.exr"), bands, d65, nullptr, {{"chromatrace.white", "D66"}});
+  try {
+    test::run_sensor(dir.file("bad.exr"), dir.file("bad_out.exr"), test::config_of(patch));
+    ADD_FAILURE() << "chromatrace.white D66 was accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("bad.exr: chromatrace.white: "), std::string::npos) << e.what();
+  }
+  EXPECT_FALSE(fs::exists(dir.file("bad_out.exr")));
 }
 
 // No emitter in view: D65. A named illuminant overrides the emitter.
