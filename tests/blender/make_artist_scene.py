@@ -11,6 +11,10 @@
         seen from above by an orthographic camera; no lights
     blender -b --factory-startup --python make_artist_scene.py -- blackbody OUT.blend KELVIN
         a grey diffuse plane under an area light whose node tree's colour is a Blackbody node at KELVIN, no world
+    blender -b --factory-startup --python make_artist_scene.py -- grey_floor OUT.blend (hdri | R,G,B)
+        a large diffuse floor whose colour is an Image Texture node of a 2×2 float image of greys (R = G = B: 0.25
+        and 0.6), packed into the .blend, seen at a slant by a perspective camera with the sky above the horizon;
+        the world is Blender's studio HDRI courtyard.exr, or the RGB colour R,G,B; no lights
 
     blender -b --factory-startup --python make_artist_scene.py -- studio OUT.blend
         what an artist starts from in this version: the default file kept (its cube, with the default material, and
@@ -184,6 +188,45 @@ def studio_scene(out):
     world.node_tree.links.new(environment.outputs["Color"], world.node_tree.nodes["Background"].inputs["Color"])
 
 
+def grey_floor_scene(out, world_colour):
+    bpy.ops.mesh.primitive_plane_add(size=200.0, location=(0.0, 0.0, 0.0))
+    floor = bpy.context.object
+    floor.name = "floor"
+    greys = [v for i in range(4) for v in ((0.6,) * 3 + (1.0,) if (i + i // 2) % 2 else (0.25,) * 3 + (1.0,))]
+    image = packed_float_image("greys", 2, 2, greys, out)
+    material = bpy.data.materials.new("grey tiles")
+    material.use_nodes = True
+    nodes = material.node_tree.nodes
+    nodes.remove(nodes["Principled BSDF"])
+    diffuse = nodes.new("ShaderNodeBsdfDiffuse")
+    coordinates = nodes.new("ShaderNodeTexCoord")
+    mapping = nodes.new("ShaderNodeMapping")  # 50 tiles across the floor: every tile a few pixels or more
+    mapping.inputs["Scale"].default_value = (50.0, 50.0, 1.0)
+    texture = nodes.new("ShaderNodeTexImage")
+    texture.image = image
+    texture.interpolation = "Closest"
+    links = material.node_tree.links
+    links.new(coordinates.outputs["UV"], mapping.inputs["Vector"])
+    links.new(mapping.outputs["Vector"], texture.inputs["Vector"])
+    links.new(texture.outputs["Color"], diffuse.inputs["Color"])
+    links.new(diffuse.outputs[0], nodes["Material Output"].inputs["Surface"])
+    floor.data.materials.append(material)
+    world = bpy.context.scene.world
+    world.use_nodes = True
+    background = world.node_tree.nodes["Background"]
+    if world_colour == "hdri":
+        environment = world.node_tree.nodes.new("ShaderNodeTexEnvironment")
+        environment.image = bpy.data.images.load(os.path.join(STUDIO_WORLDS, "courtyard.exr"))
+        world.node_tree.links.new(environment.outputs["Color"], background.inputs["Color"])
+    else:
+        background.inputs["Color"].default_value = (*(float(c) for c in world_colour.split(",")), 1.0)
+    background.inputs["Strength"].default_value = 1.0
+    camera = bpy.context.scene.camera
+    camera.data.type = "PERSP"
+    camera.location = (0.0, -8.0, 1.6)
+    camera.rotation_euler = (math.radians(78.0), 0.0, 0.0)  # the horizon in the picture's top fifth
+
+
 def textured_scene(out):
     bpy.ops.mesh.primitive_plane_add(size=4.0, location=(0.0, 0.0, 0.0))  # u = (x + 2) / 4
     plane = bpy.context.object
@@ -218,6 +261,8 @@ elif mode == "textured":
     textured_scene(out)
 elif mode == "studio":
     studio_scene(out)
+elif mode == "grey_floor":
+    grey_floor_scene(out, argv[2])
 elif mode == "blackbody":
     blackbody_scene(float(argv[2]))
 else:
