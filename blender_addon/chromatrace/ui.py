@@ -192,11 +192,22 @@ _classes = (CHROMATRACE_PT_render, CHROMATRACE_PT_preflight, CHROMATRACE_UL_spec
             CHROMATRACE_PT_light, CHROMATRACE_PT_object)
 
 
+def draw_render_buttons(self, context):
+    """The two actions at the top of the Render tab, under the engine (RENDER_PT_context, the first panel): found
+    without scrolling past the engine's dozen panels, where the settings panel sits. One per row, so that their
+    labels are whole at the editor's default width."""
+    col = self.layout.column(align=True)
+    col.operator("chromatrace.render_spectral", icon="RENDER_STILL")
+    col.operator("chromatrace.analyze_render", icon="GRAPH")
+
+
 def register():
     for cls in _classes:
         bpy.utils.register_class(cls)
+    bpy.types.RENDER_PT_context.append(draw_render_buttons)
 
 
 def unregister():
+    bpy.types.RENDER_PT_context.remove(draw_render_buttons)
     for cls in reversed(_classes):
         bpy.utils.unregister_class(cls)

@@ -81,6 +81,14 @@ context = Context(scene=scene, material=material, light=light, object=cube, pref
 drawn = draw(ui.CHROMATRACE_PT_render, context)
 if "chromatrace.render_spectral" not in drawn or "bands_width" not in drawn:
     failures.append(f"render panel lacks the render button or the band plan: {drawn}")
+# The two actions sit at the top of the Render tab, in the engine's panel (RENDER_PT_context), one per row: they were
+# only in the chromatrace panel, under a dozen Cycles panels (about 40 wheel notches down).
+if ui.draw_render_buttons not in getattr(bpy.types.RENDER_PT_context, "_dyn_ui_initialize")():
+    failures.append("the Render tab's first panel does not draw the chromatrace buttons")
+holder = Context(layout=Layout())
+ui.draw_render_buttons(holder, context)
+if holder.layout.drawn != ["chromatrace.render_spectral", "chromatrace.analyze_render"]:
+    failures.append(f"the Render tab's first panel draws {holder.layout.drawn}")
 scene.chromatrace.band_plan = "FILE"
 draw(ui.CHROMATRACE_PT_render, context)
 scene.chromatrace.band_plan = "RANGE"

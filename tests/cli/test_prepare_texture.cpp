@@ -15,6 +15,7 @@
 
 #include "core/colour.h"
 #include "core/error.h"
+#include "core/rgb_to_spectrum.h"
 #include "core/spectrum.h"
 #include "core/texture.h"
 #include "tests/core/image_fixtures.h"
@@ -108,18 +109,27 @@ TEST_F(PrepareTexture, GroupTexelsAreTheTracersBandAverages) {
   }
 }
 
-TEST_F(PrepareTexture, GreyIsFlat) {
+// A grey reflectance is flat; an emitted grey is that grey times the colour space's white, D65 of unit luminance
+// (rgb_white_at), band by band. Bound: the float the band value is stored as (2⁻²⁴ relative) and the
+// double rounding of the band average (1e-15).
+TEST_F(PrepareTexture, GreyIsFlatOrTheWhitesSpectrum) {
   const fs::path grey = write_image("grey.exr", 4, 2, std::vector<float>(4 * 2 * 3, 0.5f));
-  for (const char* kind : {"reflectance", "radiance"}) {
+  const Bands bands = Bands::parse("400:700:20");
+  const std::vector<double> white = band_averages(rgb_to_emission_spectrum({1.0, 1.0, 1.0}), bands);
+  for (const std::string kind : {"reflectance", "radiance"}) {
     const json summary = run_json({grey.string(), "--bands", "400:700:20", "--kind", kind});
     ASSERT_TRUE(summary.is_object());
     EXPECT_EQ(summary["colour_space"], "linear");
     EXPECT_EQ(summary["distinct_colours"], 1);
     ASSERT_EQ(summary["groups"].size(), 5u);
-    for (const json& g : summary["groups"]) {
+    for (std::size_t group = 0; group < 5; ++group) {
       int w = 0, h = 0;
-      const std::vector<float> out = read_rgb(g["file"].get<std::string>(), w, h);
-      for (const float v : out) EXPECT_NEAR(v, 0.5f, 1e-6) << kind << " " << g["file"];
+      const std::string file = summary["groups"][group]["file"].get<std::string>();
+      const std::vector<float> out = read_rgb(file, w, h);
+      for (std::size_t i = 0; i < out.size(); ++i) {
+        const double want = kind == "reflectance" ? 0.5 : 0.5 * white[3 * group + i % 3];
+        EXPECT_NEAR(out[i], want, 1e-7 * want) << kind << " " << file << " channel " << i % 3;
+      }
     }
   }
 }

@@ -106,13 +106,14 @@ const json kSphereCamera = {{"position", {0, -4, 0.5}}, {"look_at", {0, 0, 0}}, 
 // sampling techniques lose the directions below it): (1 + cos δ) / 2, δ the angle between the two normals
 // (the lost part of the lobe projects onto the half-disc minus a half-ellipse of semi-axes 1 and cos δ).
 // The background is the environment itself, all of it "emission" and light group "environment".
-void expect_furnace(const Scene& scene, const RenderedImage& image, double rho, double radiance) {
+void expect_furnace(const Scene& scene, const RenderedImage& image, double rho, const std::vector<double>& band_radiance) {
   const TracerScene tracer_scene(scene, 1);
   const Camera& cam = scene.camera;
   const int emission = layer_of(image, "emission"), group = layer_of(image, "light.environment");
   ASSERT_GT(emission, 0);
   ASSERT_GT(group, 0);
   for (int b = 0; b < 3; ++b) {
+    const double radiance = band_radiance[static_cast<std::size_t>(b)];
     Residuals sphere;
     int background = 0;
     for (int y = 0; y < cam.height; ++y)
@@ -143,18 +144,21 @@ void expect_furnace(const Scene& scene, const RenderedImage& image, double rho, 
 TEST_F(EnvironmentTest, FurnaceUnderAConstantEnvironment) {
   const Scene s = scene(base_scene({{"radiance", {{"constant", 1.0}}}, {"scale", 2.0}}, kSphere, kSphereCamera, 64, 1));
   const RenderedImage image = render(s, quiet({true, true, false}));
-  expect_furnace(s, image, 0.7, 2.0);
+  expect_furnace(s, image, 0.7, {2.0, 2.0, 2.0});
 }
 
 TEST_F(EnvironmentTest, ConstantImageIsTheConstantEnvironment) {
-  // A grey image upsamples to a flat spectrum, so an 8 × 4 image of 2.0 is the constant environment 2, and
-  // its importance sampling must give the same answer.
+  // An emitted grey is that grey times the colour space's white (D65 of unit luminance), so an 8 × 4 image of 2.0
+  // is the constant environment 2·W(λ), band by band, and its importance sampling must give the same answer.
   const fs::path sky = write_image("grey.exr", 8, 4, std::vector<float>(8 * 4 * 3, 2.0f));
   const Scene s = scene(base_scene({{"radiance", {{"texture", sky.string()}}}, {"rotation_deg", 30}}, kSphere,
                                    kSphereCamera, 64, 1));
   ASSERT_TRUE(s.environment->radiance.texture);
   EXPECT_EQ(s.environment->radiance.texture->colour_space, TextureColourSpace::Linear);
-  expect_furnace(s, render(s, quiet({true, true, false})), 0.7, 2.0);
+  const RenderedImage image = render(s, quiet({true, true, false}));
+  std::vector<double> white = band_averages(rgb_to_emission_spectrum({1.0, 1.0, 1.0}), image.bands);
+  for (double& v : white) v *= 2.0;
+  expect_furnace(s, image, 0.7, white);
 }
 
 // A black 16 × 8 image with one patch of radiance 5 (columns 4–7, rows 1–2: longitudes from +X to +Y, polar
@@ -206,7 +210,9 @@ TEST_F(EnvironmentTest, BrightPatchLightsAPlaneAsTheIntegralSays) {
     const Scene s = scene(base_scene({{"radiance", {{"texture", sky.string()}}}, {"rotation_deg", c.rotation_deg}},
                                      objects, camera, 64, 1));
     const RenderedImage image = render(s, quiet());
-    const double expected = patch_radiance(c.normal, c.rotation_deg, 0.7, 5.0);
+    // The patch's texels (5, 5, 5) emit 5·W(λ), W the colour space's white: band 1 has W's average there.
+    const double white = band_averages(rgb_to_emission_spectrum({1.0, 1.0, 1.0}), image.bands)[1];
+    const double expected = patch_radiance(c.normal, c.rotation_deg, 0.7, 5.0 * white);
     Residuals r;
     for (int y = 0; y < 16; ++y)
       for (int x = 0; x < 16; ++x) r.add(value(image, 0, x, y, 1) - expected);
@@ -300,7 +306,8 @@ TEST_F(EnvironmentTest, TexturedEmitterShowsEachTexelsSpectrumExactly) {
     for (int x = 0; x < 32; ++x) {
       const auto [tx, ty] = texel_under(s.camera, x, y);
       const std::vector<double> expected =
-          band_averages(upsample_rgb_unbounded(texture.texel(static_cast<std::size_t>(ty * 4 + tx))).tabulated(), image.bands);
+          band_averages(texel_spectrum(texture.texel(static_cast<std::size_t>(ty * 4 + tx)), TextureUse::Radiance).tabulated(),
+                        image.bands);
       for (int b = 0; b < 3; ++b) {
         const double e = 6.0 * expected[static_cast<std::size_t>(b)];
         EXPECT_NEAR(value(image, 0, x, y, b), e, 1e-6 * e) << x << ", " << y;
