@@ -224,7 +224,7 @@ class CHROMATRACE_PG_scene(bpy.types.PropertyGroup):
                               description="One component per number of bounces: max bounces renders per band group")
     use_object_ids: BoolProperty(name="Object ids", default=True)
     on_mixing_nodes: EnumProperty(
-        name="Channel-mixing nodes",
+        name="Mixing nodes",  # whole at the panel's default width ("Channel-mixing nodes" was cut)
         items=[("REFUSE", "Refuse", "Do not render; list the nodes"),
                ("ONE_BAND", "One band per render", "Render each band alone (3× slower)")],
         default="REFUSE")

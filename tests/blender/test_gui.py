@@ -4,8 +4,9 @@
 The textured scene (image textures, an HDRI world) is imported; Check Spectra fills the pre-flight panel
 (every material and the world upsampled, nothing refused); Render Spectral runs as a modal operator (progress,
 one Cycles render per step) until it ends; its preview opens in an Image Editor, which must then show the
-preview file. A screenshot of the window is written to CHROMATRACE_SCREENSHOT when that is set
-(docs/images/blender_gui.png is made this way).
+preview file. A screenshot of the window is written to CHROMATRACE_SCREENSHOT when that is set, and one of the
+render tab as it opens beside it (NAME_render_tab.png); docs/images/blender_gui.png and
+blender_render_tab.png are made this way.
 
 Run: CHROMATRACE_EXE=... CHROMATRACE_SOURCE_DIR=... xvfb-run -a -s "-screen 0 1600x1000x24" \
          blender --factory-startup --python tests/blender/test_gui.py
@@ -71,7 +72,11 @@ def script():
     statuses = {(o["kind"], o["name"]): o["status"] for o in (summary or {}).get("owners", [])}
     expect(statuses.get(("world", "environment")) == "upsampled", f"the HDRI world is not upsampled: {statuses}")
     expect(statuses.get(("material", "floor")) == "upsampled", f"the textured floor is not upsampled: {statuses}")
-    for _ in range(60):  # the chromatrace panels follow Cycles' on the render tab
+    yield 0.5
+    if SCREENSHOT:  # the render tab as it opens: Render Spectral and Analyze Histogram under the engine
+        with bpy.context.temp_override(window=window):
+            bpy.ops.screen.screenshot(filepath=os.path.splitext(SCREENSHOT)[0] + "_render_tab.png")
+    for _ in range(60):  # the chromatrace panel follows Cycles' on the render tab
         with bpy.context.temp_override(window=window, area=properties, region=region):
             bpy.ops.view2d.scroll_down(deltay=200)
         yield 0.02
