@@ -58,6 +58,34 @@ def settings_warnings(scene, chromatrace_tool, request):
         shutil.rmtree(work, ignore_errors=True)
 
 
+# Scene names with a spectral render running modally, and those whose render Esc has cancelled in a window other
+# than the one it runs in (a modal operator hears only its own window's events).
+RENDERING = set()
+ESCAPED = set()
+
+
+class CHROMATRACE_OT_render_escape(bpy.types.Operator):
+    """Esc in this window cancels the spectral render running in another (the preview's window has the focus)"""
+
+    bl_idname = "chromatrace.render_escape"
+    bl_label = "Cancel Spectral Render"
+    bl_options = {"INTERNAL"}
+
+    scene: StringProperty()
+
+    def invoke(self, context, event):
+        context.window_manager.modal_handler_add(self)
+        return {"RUNNING_MODAL"}
+
+    def modal(self, context, event):
+        if self.scene not in RENDERING:
+            return {"FINISHED", "PASS_THROUGH"}
+        if event.type == "ESC" and event.value == "PRESS":
+            ESCAPED.add(self.scene)
+            return {"FINISHED"}
+        return {"PASS_THROUGH"}
+
+
 class CHROMATRACE_OT_render_spectral(bpy.types.Operator):
     """Render the scene spectrally with Cycles (bands multiplexed three per render) into a spectral EXR"""
 
@@ -111,18 +139,26 @@ class CHROMATRACE_OT_render_spectral(bpy.types.Operator):
         wm = context.window_manager
         self._timer = wm.event_timer_add(0.05, window=context.window)
         wm.modal_handler_add(self)
+        RENDERING.add(context.scene.name)
+        ESCAPED.discard(context.scene.name)
+        for window in wm.windows:  # Esc in any other window (a preview's) cancels too
+            if window != context.window:
+                with context.temp_override(window=window):
+                    bpy.ops.chromatrace.render_escape("INVOKE_DEFAULT", scene=context.scene.name)
         wm.progress_begin(0, 1)
         context.workspace.status_text_set("chromatrace: preparing the spectral render (Esc cancels)")
         return {"RUNNING_MODAL"}
 
     def _finish(self, context):
+        RENDERING.discard(context.scene.name)
+        ESCAPED.discard(context.scene.name)
         wm = context.window_manager
         wm.event_timer_remove(self._timer)
         wm.progress_end()
         context.workspace.status_text_set(None)
 
     def modal(self, context, event):
-        if event.type == "ESC":
+        if event.type == "ESC" or context.scene.name in ESCAPED:
             self._steps.close()  # the render's finally restores every setting
             self._finish(context)
             self.report({"WARNING"}, "spectral render cancelled; finished band groups stay in the cache")
@@ -423,7 +459,7 @@ def _menu_export(self, context):
     self.layout.operator(CHROMATRACE_OT_export_scene.bl_idname, text="chromatrace scene (.json)")
 
 
-_classes = (CHROMATRACE_OT_render_spectral, CHROMATRACE_OT_analyze_render, CHROMATRACE_OT_preflight, CHROMATRACE_OT_import_scene, CHROMATRACE_OT_export_scene,
+_classes = (CHROMATRACE_OT_render_escape, CHROMATRACE_OT_render_spectral, CHROMATRACE_OT_analyze_render, CHROMATRACE_OT_preflight, CHROMATRACE_OT_import_scene, CHROMATRACE_OT_export_scene,
             CHROMATRACE_OT_build_material, CHROMATRACE_OT_set_model, CHROMATRACE_OT_apply_preset, CHROMATRACE_OT_spectrum_add, CHROMATRACE_OT_spectrum_remove)
 
 
