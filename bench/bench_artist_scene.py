@@ -40,8 +40,10 @@ BATCH = os.path.join(ROOT, "blender_addon", "batch.py")
 
 def default_blenders():
     found = [("3.4", "blender")]
-    for shim in sorted(glob.glob(os.path.join(ROOT, "build", "tests", "blender", "blender-*"))):
-        found.append((os.path.basename(shim)[len("blender-"):], shim))
+    for shim in sorted(glob.glob(os.path.join(ROOT, "build", "tests", "blender", "blender-[0-9]*"))):
+        name = os.path.basename(shim)[len("blender-"):]
+        if os.access(shim, os.X_OK) and re.fullmatch(r"[0-9]+\.[0-9]+", name):
+            found.append((name, shim))
     return found
 
 

@@ -44,3 +44,30 @@ def finish(name):
             print(f"FAIL: {f}", file=sys.stderr)
         sys.exit(1)
     print(f"{name}: all ok")
+
+
+def run_in_window(steps, name, work):
+    """Runs a GUI script in Blender's window: `steps` is a generator that yields the seconds to wait before its next
+    step (the window redraws meanwhile). At its end, or at any exception, removes `work`, reports every failure
+    and quits Blender with exit code 1 on failure (from a timer, sys.exit would only end the timer)."""
+    def quit_blender():
+        shutil.rmtree(work, ignore_errors=True)
+        shutil.rmtree(_SCENES, ignore_errors=True)
+        for f in failures:
+            print(f"FAIL: {f}", file=sys.stderr, flush=True)
+        if not failures:
+            print(f"{name}: all ok", flush=True)
+        os._exit(1 if failures else 0)
+
+    def tick():
+        try:
+            return next(steps)
+        except StopIteration:
+            quit_blender()
+        except Exception as e:  # a failure inside a timer must still end Blender
+            failures.append(f"{type(e).__name__}: {e}")
+            quit_blender()
+        return None
+
+    bpy.context.preferences.view.show_splash = False
+    bpy.app.timers.register(tick, first_interval=1.0)

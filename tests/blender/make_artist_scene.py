@@ -188,29 +188,35 @@ def studio_scene(out):
     world.node_tree.links.new(environment.outputs["Color"], world.node_tree.nodes["Background"].inputs["Color"])
 
 
+def diffuse_image_material(name, image, tiles=None):
+    """A Diffuse BSDF whose colour is an Image Texture node of `image` (nearest texel), repeated `tiles` times
+    across the UV square when given."""
+    material = bpy.data.materials.new(name)
+    material.use_nodes = True
+    nodes, links = material.node_tree.nodes, material.node_tree.links
+    nodes.remove(nodes["Principled BSDF"])
+    diffuse = nodes.new("ShaderNodeBsdfDiffuse")
+    texture = nodes.new("ShaderNodeTexImage")
+    texture.image = image
+    texture.interpolation = "Closest"
+    if tiles is not None:
+        coordinates = nodes.new("ShaderNodeTexCoord")
+        mapping = nodes.new("ShaderNodeMapping")
+        mapping.inputs["Scale"].default_value = (tiles, tiles, 1.0)
+        links.new(coordinates.outputs["UV"], mapping.inputs["Vector"])
+        links.new(mapping.outputs["Vector"], texture.inputs["Vector"])
+    links.new(texture.outputs["Color"], diffuse.inputs["Color"])
+    links.new(diffuse.outputs[0], nodes["Material Output"].inputs["Surface"])
+    return material
+
+
 def grey_floor_scene(out, world_colour):
     bpy.ops.mesh.primitive_plane_add(size=200.0, location=(0.0, 0.0, 0.0))
     floor = bpy.context.object
     floor.name = "floor"
     greys = [v for i in range(4) for v in ((0.6,) * 3 + (1.0,) if (i + i // 2) % 2 else (0.25,) * 3 + (1.0,))]
     image = packed_float_image("greys", 2, 2, greys, out)
-    material = bpy.data.materials.new("grey tiles")
-    material.use_nodes = True
-    nodes = material.node_tree.nodes
-    nodes.remove(nodes["Principled BSDF"])
-    diffuse = nodes.new("ShaderNodeBsdfDiffuse")
-    coordinates = nodes.new("ShaderNodeTexCoord")
-    mapping = nodes.new("ShaderNodeMapping")  # 50 tiles across the floor: every tile a few pixels or more
-    mapping.inputs["Scale"].default_value = (50.0, 50.0, 1.0)
-    texture = nodes.new("ShaderNodeTexImage")
-    texture.image = image
-    texture.interpolation = "Closest"
-    links = material.node_tree.links
-    links.new(coordinates.outputs["UV"], mapping.inputs["Vector"])
-    links.new(mapping.outputs["Vector"], texture.inputs["Vector"])
-    links.new(texture.outputs["Color"], diffuse.inputs["Color"])
-    links.new(diffuse.outputs[0], nodes["Material Output"].inputs["Surface"])
-    floor.data.materials.append(material)
+    floor.data.materials.append(diffuse_image_material("grey tiles", image, tiles=50.0))  # a tile: a few pixels
     world = bpy.context.scene.world
     world.use_nodes = True
     background = world.node_tree.nodes["Background"]
@@ -232,17 +238,7 @@ def textured_scene(out):
     plane = bpy.context.object
     plane.name = "plane"
     image = packed_float_image("two colours", 2, 1, (0.8, 0.05, 0.05, 1.0, 0.05, 0.1, 0.8, 1.0), out)
-    material = bpy.data.materials.new("painted")
-    material.use_nodes = True
-    nodes = material.node_tree.nodes
-    nodes.remove(nodes["Principled BSDF"])
-    diffuse = nodes.new("ShaderNodeBsdfDiffuse")
-    texture = nodes.new("ShaderNodeTexImage")
-    texture.image = image
-    texture.interpolation = "Closest"
-    material.node_tree.links.new(texture.outputs["Color"], diffuse.inputs["Color"])
-    material.node_tree.links.new(diffuse.outputs[0], nodes["Material Output"].inputs["Surface"])
-    plane.data.materials.append(material)
+    plane.data.materials.append(diffuse_image_material("painted", image))
     world = bpy.context.scene.world
     world.node_tree.nodes["Background"].inputs["Color"].default_value = (1.0, 1.0, 1.0, 1.0)
     world.node_tree.nodes["Background"].inputs["Strength"].default_value = 1.0

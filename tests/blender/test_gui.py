@@ -14,14 +14,13 @@ Run: CHROMATRACE_EXE=... CHROMATRACE_SOURCE_DIR=... xvfb-run -a -s "-screen 0 16
 """
 
 import os
-import shutil
 import sys
 import tempfile
 
 import bpy
 
 sys.path.insert(0, os.path.join(os.environ["CHROMATRACE_SOURCE_DIR"], "tests", "blender"))
-from harness import SOURCE, expect, failures  # noqa: E402
+from harness import SOURCE, expect, run_in_window  # noqa: E402
 from chromatrace.operators import PREFLIGHT  # noqa: E402
 
 WORK = tempfile.mkdtemp(prefix="chromatrace-gui-")
@@ -33,15 +32,6 @@ def window_area(kind):
     window = bpy.context.window_manager.windows[0]
     areas = sorted(window.screen.areas, key=lambda a: -a.width * a.height)
     return window, next(a for a in areas if a.type == kind)
-
-
-def quit_blender():
-    shutil.rmtree(WORK, ignore_errors=True)
-    for f in failures:
-        print(f"FAIL: {f}", file=sys.stderr, flush=True)
-    if not failures:
-        print("gui: all ok", flush=True)
-    os._exit(1 if failures else 0)  # from a timer, sys.exit would only end the timer
 
 
 def script():
@@ -110,19 +100,4 @@ def script():
         expect(os.path.isfile(SCREENSHOT), f"no screenshot at {SCREENSHOT}")
 
 
-bpy.context.preferences.view.show_splash = False
-STEPS = script()
-
-
-def tick():
-    try:
-        return next(STEPS)
-    except StopIteration:
-        quit_blender()
-    except Exception as e:  # a failure inside a timer must still end Blender
-        failures.append(f"{type(e).__name__}: {e}")
-        quit_blender()
-    return None
-
-
-bpy.app.timers.register(tick, first_interval=1.0)
+run_in_window(script(), "gui", WORK)

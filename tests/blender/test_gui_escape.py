@@ -9,27 +9,17 @@ Run: CHROMATRACE_EXE=... CHROMATRACE_SOURCE_DIR=... xvfb-run -a -s "-screen 0 16
 """
 
 import os
-import shutil
 import sys
 import tempfile
 
 import bpy
 
 sys.path.insert(0, os.path.join(os.environ["CHROMATRACE_SOURCE_DIR"], "tests", "blender"))
-from harness import SOURCE, expect, failures  # noqa: E402,F401
+from harness import expect, run_in_window  # noqa: E402
 from chromatrace import operators  # noqa: E402
 
 WORK = tempfile.mkdtemp(prefix="chromatrace-escape-")
 TIMEOUT_S = 120
-
-
-def quit_blender():
-    shutil.rmtree(WORK, ignore_errors=True)
-    for f in failures:
-        print(f"FAIL: {f}", file=sys.stderr, flush=True)
-    if not failures:
-        print("escape: all ok", flush=True)
-    os._exit(1 if failures else 0)
 
 
 def script():
@@ -61,21 +51,6 @@ def script():
         waited += 0.5
     expect(scene.name not in operators.RENDERING, f"Esc in the second window did not cancel in {TIMEOUT_S} s")
     expect(not os.path.exists(s.output_path), "the cancelled render wrote its output")
-    quit_blender()
 
 
-bpy.context.preferences.view.show_splash = False
-STEPS = script()
-
-
-def step():
-    try:
-        return next(STEPS)
-    except StopIteration:
-        quit_blender()
-    except Exception as e:  # noqa: BLE001 - any failure ends the test
-        failures.append(f"{type(e).__name__}: {e}")
-        quit_blender()
-
-
-bpy.app.timers.register(step, first_interval=2.0)
+run_in_window(script(), "escape", WORK)
