@@ -15,6 +15,11 @@ WORLD_HINT = ("; to render without the world's light choose World light: Omit in
               "(batch.py --on-world omit)")
 
 
+# The role of a light's own colour where its nodes give the emitted colour: it multiplies that colour, as a
+# reflectance would (a grey is flat), and it shows where emitters alone are rendered.
+FILTER = "filter"
+
+
 def is_texture(source):
     return isinstance(source, dict) and "texture" in source
 
@@ -218,18 +223,23 @@ def owner_inputs(scene, kind, thing, walk):
             found.append((spectral_input, *input_source(scene, thing, spectral_input)))
         return found
     what = f"{kind} \"{thing.name}\""
+    leaves = materials.leaf_inputs(walk)
     if kind == "light":
         light = thing.data
         settings = light.chromatrace
+        # Where the light's nodes give its colour (a Blackbody node, a colour), its own colour multiplies that: a
+        # filter, whose white is flat. Otherwise its colour is what it emits, relative to D65.
+        emitted = not any(leaf.role == "emission" for leaf in leaves)
         if settings.emission.kind == "RGB" and settings.emission.use_current_colour:
             rgb, factor = rgb_for_upsampling(tuple(light.color))
-            source = rgb_source(resolve(scene, settings.emission, rgb, what), emitted=True)
+            source = rgb_source(resolve(scene, settings.emission, rgb, what), emitted=emitted)
             scale = settings.emission_scale * factor
         else:
             source, scale = resolve(scene, settings.emission, None, what), settings.emission_scale
-        found.append((materials.SpectralInput(light, "color", "emission", tuple(light.color), None, what, False),
+        role = "emission" if emitted else FILTER
+        found.append((materials.SpectralInput(light, "color", role, tuple(light.color), None, what, False),
                       source, scale))
-    for spectral_input in materials.leaf_inputs(walk):
+    for spectral_input in leaves:
         found.append((spectral_input, *node_source(spectral_input, what)))
     return found
 

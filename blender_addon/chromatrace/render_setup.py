@@ -5,7 +5,7 @@ textures, light groups, object indices, and each band group's colours."""
 
 import bpy
 
-from . import blender_compat, cycles_setup, textures
+from . import blender_compat, cycles_setup, node_resolution, textures
 from .bands import group_colour
 
 
@@ -83,6 +83,10 @@ def apply_settings(journal, scene, request, plan, resolution):
             journal.set(ob, "pass_index", plan.ids[ob.name])
 
 
+# The roles whose colours show where emitters alone are rendered (max bounces 0).
+EMITTING_ROLES = ("emission", node_resolution.FILTER)
+
+
 def set_colours(journal, plan, group, max_bounces):
     """Every spectral input's colour (or prepared image) for the band group `group`; with `max_bounces` 0 only
     the emitters show, the reflectances black."""
@@ -91,13 +95,13 @@ def set_colours(journal, plan, group, max_bounces):
     for spectral_input, key, scale, _owner in plan.inputs:
         if key in plan.textures:
             image = plan.texture_images[key][index]
-            if no_reflection and spectral_input.role != "emission":
+            if no_reflection and spectral_input.role not in EMITTING_ROLES:
                 image = plan.texture_images[None][0]
             journal.set(spectral_input.target, "image", image)
             continue
         values = plan.bands["spectra"][key]["bands"]
         r, g, b = group_colour(values, group, plan.replicate)
-        factor = 0.0 if no_reflection and spectral_input.role != "emission" else scale
+        factor = 0.0 if no_reflection and spectral_input.role not in EMITTING_ROLES else scale
         colour = (r * factor, g * factor, b * factor)
         if spectral_input.alpha is not None:
             colour = (*colour, spectral_input.alpha)

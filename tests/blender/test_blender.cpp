@@ -937,8 +937,9 @@ TEST_F(ArtistScene, DefaultFileWithStudioHdriTintedPrincipledTextureAndBlackbody
   for (const std::string name : {"Cube", "tinted sphere", "floor"}) EXPECT_TRUE(objects.count(name)) << name;
 }
 
-// A Blackbody node (the light's node tree) at 3000 K and 6500 K lights a grey diffuse plane: the light group's
-// band shape (each band's share of the sum over bands) is Planck's law's. The statistic per band is the
+// A Blackbody node (the light's node tree; the light's own colour white, which multiplies it) at 3000 K and 6500 K
+// lights a grey diffuse plane: the light group's band shape (each band's share of the sum over bands) is Planck's
+// law's. The statistic per band is the
 // per-pixel residual x_b − e_b · Σ x; its mean must be within 4 standard errors (from the pixels) plus the
 // difference between Planck's integral and the 1 nm table's average (the maths) of 0.
 TEST_F(ArtistScene, BlackbodyLightBandShapeIsPlancksLaw) {
@@ -946,7 +947,16 @@ TEST_F(ArtistScene, BlackbodyLightBandShapeIsPlancksLaw) {
     const std::string k = std::to_string(static_cast<int>(kelvin));
     const fs::path blend = make({"blackbody", k}, "blackbody" + k + ".blend");
     const json plan = explain(blend);
-    EXPECT_EQ((*owner(plan, "light", "Area"))["status"], "exact") << plan.dump(1);
+    const json& area = *owner(plan, "light", "Area");
+    EXPECT_EQ(area["status"], "exact") << plan.dump(1);
+    // The light's own colour (white) multiplies the Blackbody node's: a filter, flat, not an emitted white (D65).
+    int filters = 0;
+    for (const json& c : area["colours"])
+      if (c["role"] == "filter") {
+        ++filters;
+        EXPECT_EQ(c["source"], json({{"constant", 1.0}})) << c.dump();
+      }
+    EXPECT_EQ(filters, 1) << area.dump(1);
     const fs::path out = dir_.file("blackbody" + k + ".exr");
     const CommandResult r = batch({"--blend", blend.string(), "--out", out.string(), "--bands", "400:700:50",
                                    "--resolution", "24x24", "--samples", "64", "--max-bounces", "1",
