@@ -144,5 +144,17 @@ expect(shift < 1e-6, f"moved sphere: vertices off by {shift}")
 expect(len(after.normals) == len(after.positions), "moved sphere: smooth shading (vertex normals) lost")
 expect(document["objects"][0]["shape"]["type"] == "quad", "an unmoved quad was not written as a quad")
 
+# A flat (constant) environment becomes Blender's world colour, which is relative to D65: said as it is imported.
+with open(scene_file("cornell_box", "cornell_box.json")) as f:
+    flat = json.load(f)
+flat["environment"] = {"radiance": {"constant": 0.5}}
+flat_file = os.path.join(WORK, "flat_environment.json")
+with open(flat_file, "w") as f:
+    json.dump(flat, f)
+said = []
+scene_import.import_scene(flat_file, fresh_scene(), TOOL, print, warn=said.append)
+expect(any("environment.radiance: the flat spectrum 0.5 becomes the world colour 0.5" in m and "D65" in m for m in said),
+       f"no warning that the flat environment becomes D65: {said}")
+
 shutil.rmtree(WORK, ignore_errors=True)
 finish("round trip")
