@@ -1,0 +1,99 @@
+// SPDX-License-Identifier: Apache-2.0
+#include "analyzer/colour_constancy.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include <opencv2/imgproc.hpp>
+
+namespace ct::analyzer {
+namespace {
+
+constexpr double kInfinity = std::numeric_limits<double>::infinity();
+
+int gaussian_radius(double sigma) { return static_cast<int>(std::ceil(3.0 * sigma)); }
+
+// The per-pixel magnitude of the order-n derivative of one smoothed channel.
+cv::Mat derivative_magnitude(const cv::Mat& channel, int order, double sigma) {
+  cv::Mat smooth;
+  if (sigma > 0) {  // the kernel cut at 3σ, as the literature's code has it (and as the usable mask's erosion assumes)
+    const int side = 2 * gaussian_radius(sigma) + 1;
+    cv::GaussianBlur(channel, smooth, cv::Size(side, side), sigma, sigma, cv::BORDER_REFLECT);
+  }
+  else
+    smooth = channel;
+  if (order == 0) return cv::abs(smooth);
+  // Central differences (OpenCV's Sobel with ksize 1 is [-1 0 1] along one axis, no smoothing across it), halved.
+  const auto derivative = [&](const cv::Mat& m, int dx, int dy) {
+    cv::Mat d;
+    cv::Sobel(m, d, CV_64F, dx, dy, 1, dx + dy == 1 ? 0.5 : 1.0, 0.0, cv::BORDER_REFLECT);
+    return d;
+  };
+  cv::Mat out;
+  if (order == 1) {
+    const cv::Mat fx = derivative(smooth, 1, 0), fy = derivative(smooth, 0, 1);
+    cv::sqrt(fx.mul(fx) + fy.mul(fy), out);
+  } else {
+    const cv::Mat fxx = derivative(smooth, 2, 0), fyy = derivative(smooth, 0, 2);
+    const cv::Mat fxy = derivative(derivative(smooth, 1, 0), 0, 1);
+    cv::sqrt(fxx.mul(fxx) + 4.0 * fxy.mul(fxy) + fyy.mul(fyy), out);
+  }
+  return out;
+}
+
+}  // namespace
+
+const std::vector<MinkowskiSettings>& baseline_methods() {
+  static const std::vector<MinkowskiSettings> methods = {{"grey world", 0, 1.0, 0.0},
+                                                         {"white patch", 0, kInfinity, 0.0},
+                                                         {"shades of grey", 0, 6.0, 0.0},
+                                                         {"grey edge 1", 1, 6.0, 1.0},
+                                                         {"grey edge 2", 2, 6.0, 1.0}};
+  return methods;
+}
+
+Vec3 minkowski_estimate(std::span<const float> rgb, int width, int height, std::span<const std::uint8_t> usable,
+                        const MinkowskiSettings& method) {
+  const std::size_t pixels = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
+  if (rgb.size() != 3 * pixels || (!usable.empty() && usable.size() != pixels) || method.order < 0 || method.order > 2)
+    throw std::invalid_argument("minkowski_estimate: sizes or order out of range");
+  // Which pixels count: usable and finite, and for derivatives their whole neighbourhood so.
+  cv::Mat keep(height, width, CV_8U);
+  for (std::size_t i = 0; i < pixels; ++i) {
+    const bool finite = std::isfinite(rgb[3 * i]) && std::isfinite(rgb[3 * i + 1]) && std::isfinite(rgb[3 * i + 2]);
+    keep.data[i] = (usable.empty() || usable[i]) && finite ? 1 : 0;
+  }
+  if (method.order > 0) {
+    const int reach = (method.sigma > 0 ? gaussian_radius(method.sigma) : 0) + method.order;
+    cv::erode(keep, keep, cv::getStructuringElement(cv::MORPH_RECT, cv::Size(2 * reach + 1, 2 * reach + 1)),
+              cv::Point(-1, -1), 1, cv::BORDER_CONSTANT, cv::Scalar(0));
+  }
+  Vec3 e = Vec3::Zero();
+  std::size_t counted = 0;
+  for (int c = 0; c < 3; ++c) {
+    cv::Mat channel(height, width, CV_64F);
+    for (std::size_t i = 0; i < pixels; ++i) {
+      const float v = rgb[3 * i + static_cast<std::size_t>(c)];
+      channel.at<double>(static_cast<int>(i)) = std::isfinite(v) ? v : 0.0;
+    }
+    const cv::Mat magnitude = derivative_magnitude(channel, method.order, method.sigma);
+    double sum = 0.0, peak = 0.0;
+    counted = 0;
+    for (std::size_t i = 0; i < pixels; ++i) {
+      if (!keep.data[i]) continue;
+      const double m = magnitude.at<double>(static_cast<int>(i));
+      ++counted;
+      if (std::isinf(method.p))
+        peak = std::max(peak, m);
+      else
+        sum += std::pow(m, method.p);
+    }
+    e[c] = std::isinf(method.p) ? peak : std::pow(sum / std::max<std::size_t>(counted, 1), 1.0 / method.p);
+  }
+  const double norm = e.norm();
+  if (counted == 0 || !(norm > 0)) return Vec3::Zero();
+  return e / norm;
+}
+
+}  // namespace ct::analyzer

@@ -1,0 +1,45 @@
+// SPDX-License-Identifier: Apache-2.0
+#pragma once
+// The colour-constancy literature's statistical baselines: the light's colour from image statistics alone, each
+// under its own assumption about the world's surfaces. van de Weijer, Gevers and Gijsenij (2007, "Edge-based
+// colour constancy") write them as one family, per channel c:
+//
+//     e_c ∝ ( Σ_x |∂ⁿ f_c,σ(x)|^p )^(1/p)
+//
+// f_c,σ the channel smoothed by a Gaussian of σ pixels, ∂ⁿ its derivative of order n (n = 0: the value itself;
+// n = 1: the gradient's magnitude √(f_x² + f_y²); n = 2: √(f_xx² + 4 f_xy² + f_yy²), as their code has it):
+//  - grey world (Buchsbaum 1980): n = 0, p = 1 — the mean surface is grey;
+//  - white patch, max-RGB (Land 1977): n = 0, p = ∞ — the brightest surface is white;
+//  - shades of grey (Finlayson and Trezzi 2004): n = 0, p = 6;
+//  - grey edge, first and second order: n = 1 or 2, p = 6, σ = 1 — the mean edge is grey.
+// Not used by the analysis yet: the estimators the illuminant estimate is to be chosen among (issue of the light's
+// colour from photographs).
+
+#include <cstdint>
+#include <limits>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "analyzer/moments.h"
+
+namespace ct::analyzer {
+
+struct MinkowskiSettings {
+  std::string name;  // "grey world", "white patch", "shades of grey", "grey edge 1", "grey edge 2"
+  int order = 0;     // derivative order n: 0, 1 or 2
+  double p = 1.0;    // Minkowski norm; infinity for the maximum
+  double sigma = 0.0;  // Gaussian smoothing in pixels before the derivatives (0: none)
+};
+
+// The five methods above, with the literature's usual parameters.
+const std::vector<MinkowskiSettings>& baseline_methods();
+
+// The estimate of one method: a unit RGB direction with a positive sum, or zero when no pixel counts (every
+// pixel left out, or no edge). `rgb` holds width × height × 3 linear values, rows from the top; `usable` (empty:
+// every finite pixel) is nonzero for a pixel to count. With derivatives, a pixel counts only when every pixel its
+// derivative reads (within 3σ + order) is usable, so that a clipped or black pixel's edge is no edge of the scene.
+Vec3 minkowski_estimate(std::span<const float> rgb, int width, int height, std::span<const std::uint8_t> usable,
+                        const MinkowskiSettings& method);
+
+}  // namespace ct::analyzer
