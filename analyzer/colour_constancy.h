@@ -42,4 +42,19 @@ const std::vector<MinkowskiSettings>& baseline_methods();
 Vec3 minkowski_estimate(std::span<const float> rgb, int width, int height, std::span<const std::uint8_t> usable,
                         const MinkowskiSettings& method);
 
+// The estimate with how much it depends on which surfaces happen to be in view: a block bootstrap. The image is cut
+// into about 64 blocks; each of `replicates` resamples draws as many blocks with replacement (a seeded generator:
+// the same inputs give the same numbers) and recomputes the estimate from their sums (their maxima for white
+// patch); `uncertainty_deg` is the root-mean-square angle of the resamples to the estimate. It measures the
+// spread of the statistic over the scene's parts, not whether the method's assumption holds: a scene of grey
+// surfaces gives 0 and so does a scene of one uniform colour, on which grey world is wrong. For white patch (a
+// maximum) the bootstrap is coarse: a resample either holds the brightest block or not.
+struct BaselineEstimate {
+  Vec3 rgb = Vec3::Zero();
+  double uncertainty_deg = 0.0;
+  std::size_t pixels = 0;  // the pixels that counted
+};
+BaselineEstimate baseline_estimate(std::span<const float> rgb, int width, int height, std::span<const std::uint8_t> usable,
+                                   const MinkowskiSettings& method, int replicates = 200, std::uint64_t seed = 1);
+
 }  // namespace ct::analyzer

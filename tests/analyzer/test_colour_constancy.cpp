@@ -89,5 +89,50 @@ TEST(ColourConstancy, PixelsLeftOutDoNotCount) {
   EXPECT_EQ(minkowski_estimate(image, kW, kH, none, baseline_methods()[0]), Vec3::Zero());
 }
 
+// The block bootstrap's spread: nil where every block says the same (grey surfaces under one light), larger the
+// more the blocks disagree (coloured blocks whose colours spread more about grey; for the edges, which are the
+// colours' differences and scale with the spread, the same), the same numbers for the same seed, and
+// another seed within the bootstrap's own sampling error (200 replicates: about 1/√400 = 5 % of σ for a smooth
+// statistic; 25 % allowed).
+TEST(ColourConstancy, BootstrapUncertaintyFollowsHowMuchTheBlocksDisagree) {
+  const Vec3 light(0.9, 0.6, 0.3);
+  const std::vector<float> grey = lit_image(light, [](int x, int y) {
+    const double g = ((x / 6 + y / 4) % 3 + 1) * 0.25;
+    return Vec3(g, g, g);
+  });
+  for (const MinkowskiSettings& method : baseline_methods()) {
+    const BaselineEstimate e = baseline_estimate(grey, kW, kH, {}, method);
+    EXPECT_LT(e.uncertainty_deg, 1e-4) << method.name;
+    EXPECT_EQ(e.pixels > 0, true) << method.name;
+  }
+  // Blocks of random colours whose chroma is scaled by `spread` about grey.
+  const auto coloured = [&](double spread) {
+    Random random(3, 5);
+    std::vector<Vec3> colours;
+    for (int i = 0; i < 48; ++i) {
+      const Vec3 offset(random.uniform() - 0.5, random.uniform() - 0.5, random.uniform() - 0.5);
+      colours.push_back(Vec3::Constant(0.5) + spread * offset);
+    }
+    return lit_image(light, [&](int x, int y) { return colours[static_cast<std::size_t>((y / 4) * 8 + x / 6) % 48]; });
+  };
+  const std::vector<float> narrow = coloured(0.2), wide = coloured(0.8);
+  for (const MinkowskiSettings& method : baseline_methods()) {
+    const BaselineEstimate a = baseline_estimate(narrow, kW, kH, {}, method), b = baseline_estimate(wide, kW, kH, {}, method);
+    EXPECT_GT(a.uncertainty_deg, 0.01) << method.name;
+    if (method.order == 0) {
+      EXPECT_GT(b.uncertainty_deg, a.uncertainty_deg) << method.name;
+    } else {  // the edges are the colours' differences, which scale with the spread: the same directions, the same σ
+      EXPECT_NEAR(b.uncertainty_deg, a.uncertainty_deg, 1e-6 * a.uncertainty_deg) << method.name;
+    }
+    const BaselineEstimate again = baseline_estimate(wide, kW, kH, {}, method);
+    EXPECT_EQ(again.uncertainty_deg, b.uncertainty_deg) << method.name;
+    // A maximum's bootstrap is coarse (a resample misses the brightest block or not), so white patch's σ is only
+    // held to a factor of two between seeds.
+    const BaselineEstimate other = baseline_estimate(wide, kW, kH, {}, method, 200, 2);
+    const double tolerance = std::isinf(method.p) ? 1.0 : 0.25;
+    EXPECT_NEAR(other.uncertainty_deg, b.uncertainty_deg, tolerance * b.uncertainty_deg) << method.name;
+  }
+}
+
 }  // namespace
 }  // namespace ct::analyzer
