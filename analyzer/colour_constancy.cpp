@@ -80,6 +80,14 @@ BaselineEstimate baseline_estimate(std::span<const float> rgb, int width, int he
   }
   // Per block (about 8 × 8 of them) and channel: Σ m^p, or the maximum of m, and the pixels counted.
   const bool maximum = std::isinf(method.p);
+  const auto power = [&](double m) {  // m^p: by multiplications for the usual p (1 and 6), std::pow otherwise
+    if (method.p == 1.0) return m;
+    if (method.p == 6.0) {
+      const double m3 = m * m * m;
+      return m3 * m3;
+    }
+    return std::pow(m, method.p);
+  };
   const int side = std::max(1, (std::max(width, height) + 7) / 8);
   const int bx = (width + side - 1) / side, by = (height + side - 1) / side;
   const std::size_t blocks = static_cast<std::size_t>(bx) * static_cast<std::size_t>(by);
@@ -99,7 +107,7 @@ BaselineEstimate baseline_estimate(std::span<const float> rgb, int width, int he
         const std::size_t b = static_cast<std::size_t>(y / side) * static_cast<std::size_t>(bx) + static_cast<std::size_t>(x / side);
         const double m = magnitude.at<double>(y, x);
         double& sum = block_sum[b][static_cast<std::size_t>(c)];
-        sum = maximum ? std::max(sum, m) : sum + std::pow(m, method.p);
+        sum = maximum ? std::max(sum, m) : sum + power(m);
         if (c == 0) ++block_count[b];
       }
   }
