@@ -97,6 +97,16 @@ const std::array<double, kSamples>& white_samples() {
   return white;
 }
 
+// A function known at the grid wavelengths kLo + k (`sample(k)`), linear between them and clamped outside, at nm.
+template <typename Sample>
+double on_grid(double nm, Sample sample) {
+  const double x = std::clamp(nm, kLo, kHi) - kLo;
+  const double i = std::min(std::floor(x), kHi - kLo - 1.0);
+  const int k = static_cast<int>(i);
+  const double a = sample(k), b = sample(k + 1);
+  return a + (x - i) * (b - a);
+}
+
 // ScaledSigmoid's value at the grid wavelength kLo + i from the sigmoid's value p there: the one product every
 // evaluation (operator(), tabulated(), tabulated_band_averages) forms, so that they agree bit for bit.
 double scaled_sample(const ScaledSigmoid& s, double p, int i) {
@@ -242,21 +252,11 @@ void tabulated_band_averages(const ScaledSigmoid& s, const Bands& bands, double*
 }
 
 double ScaledSigmoid::tabulated_at(double nm) const {
-  const double x = std::clamp(nm, kLo, kHi) - kLo;
-  const double i = std::min(std::floor(x), kHi - kLo - 1.0);
-  const double t = x - i;
-  const int k = static_cast<int>(i);
-  const double a = scaled_sample(*this, poly(kLo + i), k), b = scaled_sample(*this, poly(kLo + i + 1.0), k + 1);
-  return a + t * (b - a);
+  return on_grid(nm, [&](int k) { return scaled_sample(*this, poly(kLo + k), k); });
 }
 
 double rgb_white_at(double nm) {
-  const double x = std::clamp(nm, kLo, kHi) - kLo;
-  const double i = std::min(std::floor(x), kHi - kLo - 1.0);
-  const double t = x - i;
-  const std::size_t k = static_cast<std::size_t>(i);
-  const double a = white_samples()[k], b = white_samples()[k + 1];
-  return a + t * (b - a);
+  return on_grid(nm, [](int k) { return white_samples()[static_cast<std::size_t>(k)]; });
 }
 
 std::array<double, 3> reflectance_linear_srgb(const SigmoidPolynomial& poly) {
