@@ -392,7 +392,12 @@ json analysis_to_json(const ImageAnalysis& a, const std::vector<bool>& plotted) 
             {"choice", il.choice},
             {"highlight_lines", optional_json(il.highlight_lines, estimate_json)},
             {"dichromatic_planes", optional_json(il.planes, estimate_json)},
-            {"grey_world", estimate_json(il.grey_world)},
+            {"inverse_intensity_chromaticity", optional_json(il.iic, estimate_json)},
+            {"statistical", [&] {
+               json list = json::array();
+               for (const IlluminantEstimate& e : il.statistical) list.push_back(estimate_json(e));
+               return list;
+             }()},
             {"known", optional_json(il.known, vec)},
             {"camera_white_balance", optional_json(il.camera_white, vec)},
             {"notes", il.notes}}},

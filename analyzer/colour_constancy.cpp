@@ -49,11 +49,12 @@ cv::Mat derivative_magnitude(const cv::Mat& channel, int order, double sigma) {
 }  // namespace
 
 const std::vector<MinkowskiSettings>& baseline_methods() {
-  static const std::vector<MinkowskiSettings> methods = {{"grey world", 0, 1.0, 0.0},
-                                                         {"white patch", 0, kInfinity, 0.0},
-                                                         {"shades of grey", 0, 6.0, 0.0},
-                                                         {"grey edge 1", 1, 6.0, 1.0},
-                                                         {"grey edge 2", 2, 6.0, 1.0}};
+  static const std::vector<MinkowskiSettings> methods = {
+      {"grey world", 0, 1.0, 0.0, "the scene's surfaces average to grey"},
+      {"white patch", 0, kInfinity, 0.0, "the brightest unclipped surface in each channel is white"},
+      {"shades of grey", 0, 6.0, 0.0, "the surfaces' sixth-power mean is grey (between grey world and white patch)"},
+      {"grey edge 1", 1, 6.0, 1.0, "the differences between neighbouring surfaces average to grey"},
+      {"grey edge 2", 2, 6.0, 1.0, "the surfaces' second differences average to grey"}};
   return methods;
 }
 

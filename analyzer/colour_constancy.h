@@ -12,8 +12,6 @@
 //  - white patch, max-RGB (Land 1977): n = 0, p = ∞ — the brightest surface is white;
 //  - shades of grey (Finlayson and Trezzi 2004): n = 0, p = 6;
 //  - grey edge, first and second order: n = 1 or 2, p = 6, σ = 1 — the mean edge is grey.
-// Not used by the analysis yet: the estimators the illuminant estimate is to be chosen among (issue of the light's
-// colour from photographs).
 
 #include <cstdint>
 #include <limits>
@@ -30,6 +28,7 @@ struct MinkowskiSettings {
   int order = 0;     // derivative order n: 0, 1 or 2
   double p = 1.0;    // Minkowski norm; infinity for the maximum
   double sigma = 0.0;  // Gaussian smoothing in pixels before the derivatives (0: none)
+  std::string assumption;  // what the world's surfaces must be for it to hold, in words
 };
 
 // The five methods above, with the literature's usual parameters.

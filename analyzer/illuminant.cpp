@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "analyzer/illuminant.h"
 
+#include "analyzer/colour_constancy.h"
+
 #include <algorithm>
 #include <cmath>
 #include <numbers>
@@ -260,6 +262,26 @@ void estimate_from_planes(const Evidence& e, IlluminantAnalysis& out) {
   finish(out, planes, *v, out.planes);
 }
 
+// Inverse-intensity chromaticity over the segments' pixels.
+void estimate_from_iic(const IlluminantContext& context, IlluminantAnalysis& out) {
+  if (context.surfaces.empty()) return;
+  const IicResult r = estimate_iic(context.surfaces);
+  if (!r.estimate) {
+    out.notes.push_back("inverse-intensity chromaticity: " + r.reason);
+    return;
+  }
+  IlluminantEstimate e;
+  e.method = "inverse-intensity chromaticity";
+  e.uncertainty_deg = r.estimate->uncertainty_deg;
+  e.systematic = "shading that changes across every highlight tilts each line towards its body colour, which no "
+                 "resampling of the same surfaces shows";
+  if (r.estimate->disagreeing > 0)
+    out.notes.push_back(fmt::format("inverse-intensity chromaticity: {} surface{} with a highlight line point{} to another "
+                                    "light than the {} that agree", r.estimate->disagreeing, r.estimate->disagreeing == 1 ? "" : "s",
+                                    r.estimate->disagreeing == 1 ? "s" : "", r.estimate->surfaces));
+  finish(out, e, r.estimate->rgb, out.iic);
+}
+
 // Where both exist they must agree within their errors (3 σ combined); when they do not, the planes' estimate
 // is not trusted (the highlight branch checks its own model on its two halves), and with three or more planes,
 // which check each other, neither is.
@@ -279,7 +301,6 @@ void cross_check(std::size_t plane_count, IlluminantAnalysis& out) {
   }
 }
 
-// The image's mean colour: a guess, always marked so.
 // Every light's colour lies within 54.7° of grey (arccos(1/√3), grey to a primary): an estimate whose 2σ reaches
 // that far could be any light's colour, so it says nothing of this one.
 void refuse_if_uninformative(std::optional<IlluminantEstimate>& e) {
@@ -290,59 +311,145 @@ void refuse_if_uninformative(std::optional<IlluminantEstimate>& e) {
                                      "light's colour", 2 * *e->uncertainty_deg, octant_deg);
 }
 
-void estimate_grey_world(std::span<const float> rgb, IlluminantAnalysis& out) {
-  Vec3 mean = Vec3::Zero();
-  std::size_t count = 0;
-  for (std::size_t i = 0; i + 2 < rgb.size(); i += 3)
-    if (std::isfinite(rgb[i]) && std::isfinite(rgb[i + 1]) && std::isfinite(rgb[i + 2]))
-      mean += Vec3(rgb[i], rgb[i + 1], rgb[i + 2]), ++count;
-  out.grey_world.method = "grey world";
-  out.grey_world.reliable = false;
-  out.grey_world.unreliable_reason = "a guess: the image's mean colour is the light's only if its surfaces average to grey";
-  if (count > 0 && mean.norm() > 0) {
-    out.grey_world.rgb = positive(mean.normalized());
-    if (out.known) out.grey_world.error_deg = angular_error_deg(out.grey_world.rgb, *out.known);
-    if (out.camera_white) out.grey_world.camera_angle_deg = angular_error_deg(out.grey_world.rgb, *out.camera_white);
-  } else {
-    out.notes.push_back("the image has no finite, non-black pixels: no grey-world estimate");
+// A pixel counts in the statistical methods when it is finite and no channel is at or past a clipping level or at
+// the file's black: there the light's colour was cut off.
+std::vector<std::uint8_t> usable_pixels(const RgbImage& image, const IlluminantContext& context) {
+  std::vector<std::uint8_t> usable(image.pixel_count(), 0);
+  for (std::size_t i = 0; i < usable.size(); ++i) {
+    bool ok = true;
+    for (std::size_t c = 0; c < 3; ++c) {
+      const float v = image.rgb[3 * i + c];
+      ok = ok && std::isfinite(v) && v > context.low_levels[c] && v < context.high_levels[c];
+    }
+    usable[i] = ok ? 1 : 0;
   }
+  return usable;
+}
+
+// Each statistical method: the light's colour under its assumption about the world's surfaces. Its uncertainty
+// joins how far that assumption fails on real scenes (statistical_prior_deg) with the block bootstrap's spread —
+// how much the answer depends on which parts of the scene are in view.
+void estimate_statistical(const RgbImage& image, const IlluminantContext& context, IlluminantAnalysis& out) {
+  const std::vector<std::uint8_t> usable = usable_pixels(image, context);
+  for (const MinkowskiSettings& method : baseline_methods()) {
+    IlluminantEstimate e;
+    e.method = method.name;
+    const BaselineEstimate b = baseline_estimate(image.rgb, image.width, image.height, usable, method);
+    if (b.pixels == 0) {
+      e.reliable = false;
+      e.unreliable_reason = "no pixel counts: every pixel is clipped, black or not finite";
+      out.statistical.push_back(std::move(e));
+      continue;
+    }
+    e.rgb = positive(b.rgb);
+    e.uncertainty_deg = std::hypot(statistical_prior_deg(method.name), b.uncertainty_deg);
+    if (out.known) e.error_deg = angular_error_deg(e.rgb, *out.known);
+    if (out.camera_white) e.camera_angle_deg = angular_error_deg(e.rgb, *out.camera_white);
+    out.statistical.push_back(std::move(e));
+  }
+}
+
+// An estimate whose 2σ is wider than kReliableTwoSigmaDeg says too little of the light to build on; one whose σ
+// passes 90° fixes no direction at all, and states none.
+void refuse_if_too_uncertain(IlluminantEstimate& e) {
+  if (!e.uncertainty_deg) return;
+  if (*e.uncertainty_deg > 90) {
+    e.reliable = false;
+    e.unreliable_reason = fmt::format("its standard error ({:.0f}°) passes 90°: the evidence fixes no direction", *e.uncertainty_deg);
+    e.uncertainty_deg.reset();
+    return;
+  }
+  if (!e.reliable || 2 * *e.uncertainty_deg <= kReliableTwoSigmaDeg) return;
+  e.reliable = false;
+  e.unreliable_reason = fmt::format("its 2σ ({:.1f}°) is wider than {:.0f}°", 2 * *e.uncertainty_deg, kReliableTwoSigmaDeg);
 }
 
 // Which estimate is used, and why the others are not.
 std::string choice_text(const IlluminantAnalysis& out) {
+  const ChoiceRule& rule = choice_rule();
   const IlluminantEstimate& chosen = out.best();
   std::string why_not;
-  for (const auto* e : {out.planes ? &*out.planes : nullptr, out.highlight_lines ? &*out.highlight_lines : nullptr})
-    if (e && !e->reliable) why_not += fmt::format("; the {} are not used: {}", e->method, e->unreliable_reason);
-  auto sigma = [](const std::optional<IlluminantEstimate>& e) { return e && e->uncertainty_deg ? *e->uncertainty_deg : 0.0; };
+  for (const auto* e : {out.planes ? &*out.planes : nullptr, out.highlight_lines ? &*out.highlight_lines : nullptr,
+                        out.iic ? &*out.iic : nullptr}) {
+    if (!e || e == &chosen) continue;
+    if (!e->reliable) why_not += fmt::format("; the {} estimate is not used: {}", e->method, e->unreliable_reason);
+    else if (e->uncertainty_deg && *e->uncertainty_deg > rule.max_physics_sigma_deg)
+      why_not += fmt::format("; the {} estimate (± {:.2f}°) is not used: its standard error is above {:.1f}°", e->method,
+                             *e->uncertainty_deg, rule.max_physics_sigma_deg);
+  }
+  auto sigma = [](const IlluminantEstimate& e) { return e.uncertainty_deg.value_or(0.0); };
   const auto& lines = out.highlight_lines;
   if (out.planes && &chosen == &*out.planes)
     return fmt::format("dichromatic planes: every dichromatic object's plane holds the light's colour, and {} planes "
-                       "meet in one direction (± {:.2f}°){}{}", out.planes->regions.size(), sigma(out.planes),
+                       "meet in one direction (± {:.2f}°){}{}", out.planes->regions.size(), sigma(chosen),
                        !lines || !lines->reliable ? ""
                        : !lines->systematic.empty()
-                           ? fmt::format(", preferred to the highlight lines (± {:.2f}°): {}", sigma(lines), lines->systematic)
+                           ? fmt::format(", preferred to the highlight lines (± {:.2f}°): {}", sigma(*lines), lines->systematic)
                            : fmt::format(", the first choice when reliable; the highlight lines (± {:.2f}°) agree with "
-                                         "them within their errors", sigma(lines)),
+                                         "them within their errors", sigma(*lines)),
                        why_not);
   if (lines && &chosen == &*lines)
-    return fmt::format("highlight lines: a highlight branch adds the light's colour (± {:.2f}°){}", sigma(lines), why_not);
-  return "grey world, a guess: no reliable dichromatic planes or highlight line" + why_not;
+    return fmt::format("highlight lines: a highlight branch adds the light's colour (± {:.2f}°){}", sigma(chosen), why_not);
+  if (out.iic && &chosen == &*out.iic)
+    return fmt::format("inverse-intensity chromaticity: the highlights' lines meet at the light's chromaticity (± {:.2f}°){}",
+                       sigma(chosen), why_not);
+  const auto method = std::find_if(baseline_methods().begin(), baseline_methods().end(),
+                                   [&](const MinkowskiSettings& m) { return m.name == chosen.method; });
+  return fmt::format("{}, a statistical method: no physics estimate is reliable with a standard error within {:.1f}°{}. It "
+                     "gives the light's colour if {}; of the statistical methods it has the least median error on the test "
+                     "set of photographs, and its uncertainty (± {:.2f}°) is its error's spread there with the "
+                     "bootstrap's over this image", chosen.method, rule.max_physics_sigma_deg, why_not,
+                     method == baseline_methods().end() ? "its assumption holds" : method->assumption, sigma(chosen));
 }
 
 }  // namespace
 
-IlluminantAnalysis estimate_illuminant(const std::vector<RegionAnalysis>& regions, std::span<const float> rgb,
-                                       const std::optional<Vec3>& known, const std::array<double, 3>& high_levels,
-                                       const std::optional<Vec3>& camera_white, const std::string& assumed_curve) {
+const ChoiceRule& choice_rule() {
+  static const ChoiceRule rule{5.0, "shades of grey"};
+  return rule;
+}
+
+double statistical_prior_deg(const std::string& method) {
+  static const std::vector<std::pair<std::string, double>> priors = {
+      {"grey world", 8.0}, {"white patch", 8.0}, {"shades of grey", 8.0}, {"grey edge 1", 8.0}, {"grey edge 2", 8.0}};
+  for (const auto& [name, sigma] : priors)
+    if (name == method) return sigma;
+  return 0.0;
+}
+
+const IlluminantEstimate& choose(const IlluminantAnalysis& a, const ChoiceRule& rule) {
+  for (const auto* e : {&a.planes, &a.highlight_lines, &a.iic})
+    if (*e && (*e)->reliable && (*e)->uncertainty_deg && *(*e)->uncertainty_deg <= rule.max_physics_sigma_deg) return **e;
+  for (const IlluminantEstimate& e : a.statistical)
+    if (e.method == rule.fallback) return e;
+  return a.statistical.front();
+}
+
+const IlluminantEstimate& IlluminantAnalysis::best() const { return choose(*this, choice_rule()); }
+
+std::vector<const IlluminantEstimate*> IlluminantAnalysis::all() const {
+  std::vector<const IlluminantEstimate*> list;
+  for (const auto* e : {&planes, &highlight_lines, &iic})
+    if (*e) list.push_back(&**e);
+  for (const IlluminantEstimate& e : statistical) list.push_back(&e);
+  return list;
+}
+
+IlluminantAnalysis estimate_illuminant(const std::vector<RegionAnalysis>& regions, const RgbImage& image,
+                                       const IlluminantContext& context) {
   IlluminantAnalysis out;
-  if (known) out.known = known->normalized();
-  if (camera_white) out.camera_white = camera_white->normalized();
-  const Evidence evidence = gather_evidence(regions, high_levels, out.notes);
+  if (context.known) out.known = context.known->normalized();
+  if (context.camera_white) out.camera_white = context.camera_white->normalized();
+  const std::string& assumed_curve = context.assumed_curve;
+  const Evidence evidence = gather_evidence(regions, context.high_levels, out.notes);
   estimate_from_lines(evidence, out);
   estimate_from_planes(evidence, out);
   cross_check(evidence.normals.size(), out);
-  for (auto* e : {&out.planes, &out.highlight_lines}) refuse_if_uninformative(*e);
+  estimate_from_iic(context, out);
+  for (auto* e : {&out.planes, &out.highlight_lines, &out.iic}) {
+    refuse_if_uninformative(*e);
+    if (*e) refuse_if_too_uncertain(**e);
+  }
   // A plane through black is one only in the true linear light: a response curve that was guessed, not declared,
   // tilts every plane alike when it is wrong, which their agreement cannot show.
   if (out.planes && !assumed_curve.empty() && out.planes->reliable) {
@@ -351,7 +458,8 @@ IlluminantAnalysis estimate_illuminant(const std::vector<RegionAnalysis>& region
                                                 "through black only in the true linear light, and a wrong curve tilts every "
                                                 "plane alike, which their agreement cannot show", assumed_curve);
   }
-  estimate_grey_world(rgb, out);
+  estimate_statistical(image, context, out);
+  for (IlluminantEstimate& e : out.statistical) refuse_if_too_uncertain(e);
   out.choice = choice_text(out);
   return out;
 }

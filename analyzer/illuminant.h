@@ -6,7 +6,9 @@
 //  - plane intersection: every dichromatic object's plane through black holds the illuminant's
 //    direction, so that direction is the one closest to all the planes (the eigenvector of Σ n nᵀ with
 //    the smallest eigenvalue; for two planes, the cross product of their normals);
-//  - grey world, beside them for comparison: the image's mean colour.
+//  - the colour-constancy literature's statistical methods (analyzer/colour_constancy.h: grey world, white patch,
+//    shades of grey, grey edge), each under its own assumption about the world's surfaces: what the physics must
+//    beat, and what stands in when the physics finds no evidence.
 // Directions are unit RGB vectors in the analysed layer's space, oriented with a positive sum.
 
 #include <optional>
@@ -14,6 +16,8 @@
 #include <string>
 #include <vector>
 
+#include "analyzer/analysis_image.h"
+#include "analyzer/iic.h"
 #include "analyzer/region_analysis.h"
 
 namespace ct::analyzer {
@@ -39,37 +43,70 @@ struct IlluminantEstimate {
 
 struct IlluminantAnalysis {
   std::optional<IlluminantEstimate> highlight_lines, planes;
-  IlluminantEstimate grey_world;
+  // Inverse-intensity chromaticity (analyzer/iic.h): the highlights' lines in (1/ΣI, σ), when the regions' pixels
+  // were given and a highlight moves a surface's chromaticity.
+  std::optional<IlluminantEstimate> iic;
+  // The statistical methods in the order of baseline_methods(): grey world first.
+  std::vector<IlluminantEstimate> statistical;
   std::optional<Vec3> known;  // as given, normalised
   // The light's colour the camera assumed (the inverse of a raw file's as-shot white-balance multipliers), unit.
   std::optional<Vec3> camera_white;
   std::vector<std::string> notes;  // why an estimate is missing, and regions left out
   std::string choice;              // which estimate best() is, and why
 
-  // The estimate to trust most: the planes' intersection when reliable, else the highlight lines when reliable,
-  // else grey world (a guess, never reliable). The planes come first although their standard error is often the
-  // larger: it looks conservative — on the analyzer's synthetic component render and on StillLife with the bagel
-  // (two images, not a sweep) their error is a tenth and a half of it, where the highlight branches' errors are
-  // about one of theirs — and the lines may carry a
-  // systematic tilt (`systematic`). Choosing by standard error instead puts a synthetic render's light 8.4° off
-  // rather than 2.0° (tests/analyzer/test_analyze_command.cpp).
-  const IlluminantEstimate& best() const {
-    if (planes && planes->reliable) return *planes;
-    if (highlight_lines && highlight_lines->reliable) return *highlight_lines;
-    return grey_world;
-  }
+  const IlluminantEstimate& grey_world() const { return statistical.front(); }
+
+  // The estimate to trust: choose(*this, choice_rule()).
+  const IlluminantEstimate& best() const;
+  // Every estimate made: the physics' first (planes, highlight lines, inverse-intensity chromaticity), then the
+  // statistical methods.
+  std::vector<const IlluminantEstimate*> all() const;
 };
 
-// From the regions other than the whole image (which mixes objects) when there are any. The grey world
-// averages `rgb`, the whole layer's finite pixels. A highlight line whose bright end lies within 2τ of a
-// clipping level (`high_levels`, +∞ where none is known) is left out: past the level the highlight is cut off,
-// and what remains bends towards the face of the cube, not along the light. `assumed_curve` names a response curve
-// that was guessed rather than declared ("" when declared or none): the planes' estimate is then unreliable.
-IlluminantAnalysis estimate_illuminant(const std::vector<RegionAnalysis>& regions, std::span<const float> rgb,
-                                       const std::optional<Vec3>& known,
-                                       const std::array<double, 3>& high_levels = {kNoLevel, kNoLevel, kNoLevel},
-                                       const std::optional<Vec3>& camera_white = std::nullopt,
-                                       const std::string& assumed_curve = "");
+// How the estimate to trust is chosen among those made: a physics estimate (the planes first, then the highlight
+// lines, then inverse-intensity chromaticity) when it is reliable and its standard error is at most `max_physics_sigma_deg`, else the statistical method
+// `fallback`. Neither value is set by hand: they are those with the least median error on the tuned part of the
+// test set of photographs (tests/data/photos), and leave-one-out over that part judges the rule; the held-out part
+// never tunes it (tests/analyzer/test_photographs.cpp, LightColour; the table in docs/analyze.md).
+struct ChoiceRule {
+  double max_physics_sigma_deg = 0;
+  std::string fallback;
+};
+const ChoiceRule& choice_rule();
+const IlluminantEstimate& choose(const IlluminantAnalysis& analysis, const ChoiceRule& rule);
+
+// A statistical method's error that its bootstrap leaves out — how far the method's assumption fails on real
+// scenes — as a standard error per axis in degrees: √(mean e² / 2) over its errors e on the tuned part of the test
+// set of photographs (fitted there, like the choice). 0 for a method not in the list.
+double statistical_prior_deg(const std::string& method);
+
+// The largest 2σ an estimate marked reliable may state, in degrees: beyond it the estimate says too little of the
+// light to build on, and is marked unreliable with its 2σ.
+inline constexpr double kReliableTwoSigmaDeg = 20.0;
+
+// What the estimate knows besides the regions.
+struct IlluminantContext {
+  std::optional<Vec3> known;  // the light's colour when given (for the errors), any length
+  // Clipping levels (+∞ where none is known) and the file's black: a pixel at or past either in any channel lost
+  // its colour, and counts in no statistical method.
+  std::array<double, 3> high_levels{kNoLevel, kNoLevel, kNoLevel};
+  std::array<double, 3> low_levels{-kNoLevel, -kNoLevel, -kNoLevel};
+  std::optional<Vec3> camera_white;  // a camera raw's as-shot white balance as a light's colour
+  // Each segment's usable pixels (linear, unclipped, above black), for inverse-intensity chromaticity; none: no
+  // such estimate.
+  std::vector<IicSurface> surfaces;
+  std::vector<std::string> surface_names;  // the regions they are, in the same order
+  // A response curve that was guessed rather than declared ("" when declared or none): the planes' estimate is
+  // then unreliable.
+  std::string assumed_curve;
+};
+
+// From the regions other than the whole image (which mixes objects) when there are any. The statistical methods
+// read `image`, the whole layer in linear light. A highlight line whose bright end lies within 2τ of a clipping
+// level is left out: past the level the highlight is cut off, and what remains bends towards the face of the cube,
+// not along the light.
+IlluminantAnalysis estimate_illuminant(const std::vector<RegionAnalysis>& regions, const RgbImage& image,
+                                       const IlluminantContext& context);
 
 // The angle between two colour directions, in degrees.
 double angular_error_deg(const Vec3& a, const Vec3& b);

@@ -285,8 +285,7 @@ std::string report_html(const AnalysisImage& input, const ImageAnalysis& a, std:
 
   std::string illuminant = "<table>";
   const IlluminantAnalysis& il = a.illuminant;
-  for (const auto* e : {il.planes ? &*il.planes : nullptr, il.highlight_lines ? &*il.highlight_lines : nullptr, &il.grey_world}) {
-    if (!e) continue;
+  for (const IlluminantEstimate* e : il.all()) {
     std::string against;
     if (e->error_deg) against += fmt::format("{:.2f}° from the known illuminant. ", *e->error_deg);
     if (e->camera_angle_deg) against += fmt::format("{:.2f}° from the camera's white balance. ", *e->camera_angle_deg);

@@ -43,7 +43,9 @@ TEST(AnalyzeCommand, WritesJsonPlotsHistogramsAndReport) {
   EXPECT_EQ(a["regions"][3]["name"], "object 3 (blue)");
   EXPECT_EQ(a["regions"][3]["explanation"]["families"][0]["family"], "path types");
   EXPECT_LT(a["illuminant"]["estimate"]["error_deg"].get<double>(), 3.0);
-  EXPECT_TRUE(a["illuminant"]["grey_world"]["error_deg"].is_number());
+  EXPECT_EQ(a["illuminant"]["statistical"][0]["method"], "grey world");
+  EXPECT_TRUE(a["illuminant"].contains("inverse_intensity_chromaticity"));
+  EXPECT_TRUE(a["illuminant"]["statistical"][0]["error_deg"].is_number());
   for (int i = 0; i < 5; ++i) {
     const std::string stem = "region-0" + std::to_string(i);
     EXPECT_TRUE(std::filesystem::is_regular_file(out / "plots" / (stem + ".png")));
