@@ -21,33 +21,16 @@ std::array<double, 3> known_levels(const LayerContext& context) {
   return context.clipping.known_high ? context.high_levels : std::array<double, 3>{kNoLevel, kNoLevel, kNoLevel};
 }
 
-// What the illuminant's estimate reads besides the regions' clusters: the levels, and each segment's usable pixels
-// (inside the clipping levels and above black) for inverse-intensity chromaticity, copied into `storage`.
-IlluminantContext illuminant_context(const LayerContext& layer, const RgbImage& image, const std::vector<Region>& regions,
-                                     const std::optional<Vec3>& known, const std::optional<Vec3>& camera_white,
-                                     std::vector<std::vector<float>>& storage) {
+IlluminantContext illuminant_context(const AnalysisImage& input, const LayerContext& layer, const std::vector<Region>& regions,
+                                     const std::optional<Vec3>& known, const std::optional<Vec3>& camera_white) {
   IlluminantContext c;
+  // A render made by chromatrace names its objects or its light paths, or carries its noise-free linear signal.
+  c.photograph = !input.linear && input.components.empty() && input.object_ids.empty();
   c.known = known;
   c.high_levels = known_levels(layer);
   c.low_levels = layer.clipping.low;
   c.camera_white = camera_white;
-  storage.clear();
-  std::vector<std::string> names;
-  for (const Region& r : regions) {
-    if (r.source != "segment") continue;
-    std::vector<float> usable;
-    for (const std::uint32_t p : r.pixels) {
-      const float* v = &image.rgb[3 * static_cast<std::size_t>(p)];
-      bool inside = true;
-      for (std::size_t k = 0; k < 3; ++k)
-        inside = inside && std::isfinite(v[k]) && v[k] > c.low_levels[k] && v[k] < c.high_levels[k];
-      if (inside) usable.insert(usable.end(), v, v + 3);
-    }
-    storage.push_back(std::move(usable));
-    names.push_back(r.name);
-  }
-  for (const std::vector<float>& s : storage) c.surfaces.push_back({s});
-  c.surface_names = std::move(names);
+  c.pixels = regions;
   return c;
 }
 
@@ -208,21 +191,18 @@ ImageAnalysis analyse_image(const AnalysisImage& input, const std::string& layer
   one.threads = 1;
   parallel_for(side_by_side.size(), options.threads, [&](std::size_t k) { analyse(side_by_side[k], one); });
   bar.finish();
-  std::vector<std::vector<float>> surfaces;  // the segments' usable pixels, while the estimate reads them
   if (curve) {
     std::vector<RegionAnalysis> light = a.results;
     for (RegionAnalysis& r : light) r.shape = *r.linear_light;
-    a.illuminant = estimate_illuminant(light, linear, illuminant_context(linear_context, linear, a.regions, known_illuminant,
-                                                                        input.camera_white, surfaces));
+    a.illuminant = estimate_illuminant(light, linear, illuminant_context(input, linear_context, a.regions, known_illuminant, input.camera_white));
     a.notes.push_back(fmt::format("R, G, B were encoded by {} ({}): classes are of the "
                                   "values as stored, each region's class in linear light is given beside it, and "
                                   "the illuminant is estimated in linear light", curve->describe(),
                                   a.encoding.curve_source.empty() ? "the file's chromatrace.curve_*" : a.encoding.curve_source));
   } else {
     a.illuminant = estimate_illuminant(a.results, pixels,
-                                       illuminant_context(a.context, pixels, a.regions, known_illuminant,
-                                                          a.layer == "final" || a.layer == "linear" ? input.camera_white : std::nullopt,
-                                                          surfaces));
+                                       illuminant_context(input, a.context, a.regions, known_illuminant,
+                                                          a.layer == "final" || a.layer == "linear" ? input.camera_white : std::nullopt));
   }
   const std::optional<Explanation> no_explanation;
   for (std::size_t i = 0; i < a.results.size(); ++i)

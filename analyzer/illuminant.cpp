@@ -161,13 +161,15 @@ bool add_highlight_line(const RegionAnalysis& r, const ClusterShape& s, const st
   return true;
 }
 
-Evidence gather_evidence(const std::vector<RegionAnalysis>& regions, const std::array<double, 3>& high_levels, std::vector<std::string>& notes) {
+Evidence gather_evidence(const std::vector<RegionAnalysis>& regions, const std::array<double, 3>& high_levels,
+                         const std::vector<std::string>& lights, std::vector<std::string>& notes) {
   Evidence e;
   // The whole image mixes objects; it stands in only when it is the one region.
   const bool parts = std::any_of(regions.begin(), regions.end(), [](const RegionAnalysis& r) { return r.source != "image"; });
   for (const RegionAnalysis& r : regions) {
     if (parts && r.source == "image") continue;
     if (r.source == "unassigned") continue;  // the pixels no segment holds: no one surface
+    if (std::find(lights.begin(), lights.end(), r.name) != lights.end()) continue;  // a light seen directly
     // A cluster clipped only at black (its darkest pixels at the file's lowest value) keeps its highlight whole:
     // its highlight line is read on the samples off the faces. Its plane is not (see below).
     const ClusterShape& s = only_at_black(r.shape.clipping) ? off_the_faces(r.shape) : r.shape;
@@ -262,10 +264,21 @@ void estimate_from_planes(const Evidence& e, IlluminantAnalysis& out) {
   finish(out, planes, *v, out.planes);
 }
 
-// Inverse-intensity chromaticity over the segments' pixels.
-void estimate_from_iic(const IlluminantContext& context, IlluminantAnalysis& out) {
-  if (context.surfaces.empty()) return;
-  const IicResult r = estimate_iic(context.surfaces);
+// Inverse-intensity chromaticity over the segments' usable pixels (lights seen directly are not usable).
+void estimate_from_iic(const RgbImage& image, const IlluminantContext& context, std::span<const std::uint8_t> usable,
+                       IlluminantAnalysis& out) {
+  std::vector<std::vector<float>> pixels;
+  for (const Region& r : context.pixels) {
+    if (r.source != "segment") continue;
+    std::vector<float> rgb;
+    for (const std::uint32_t p : r.pixels)
+      if (usable[p]) rgb.insert(rgb.end(), &image.rgb[3 * std::size_t{p}], &image.rgb[3 * std::size_t{p}] + 3);
+    pixels.push_back(std::move(rgb));
+  }
+  if (pixels.empty()) return;
+  std::vector<IicSurface> surfaces;
+  for (const std::vector<float>& rgb : pixels) surfaces.push_back({rgb});
+  const IicResult r = estimate_iic(surfaces);
   if (!r.estimate) {
     out.notes.push_back("inverse-intensity chromaticity: " + r.reason);
     return;
@@ -326,11 +339,33 @@ std::vector<std::uint8_t> usable_pixels(const RgbImage& image, const IlluminantC
   return usable;
 }
 
+// The lights seen directly: their pixels are taken out of `usable`, and the regions that are mostly light pixels
+// are named (left out of the dichromatic evidence).
+void find_lights(const RgbImage& image, std::span<const Region> regions, std::vector<std::uint8_t>& usable, IlluminantAnalysis& out) {
+  const LightsInView found = find_lights_in_view(image, usable);
+  if (found.lights.empty()) return;
+  for (std::size_t p = 0; p < usable.size(); ++p)
+    if (found.mask[p]) usable[p] = 0;
+  for (const LightInView& l : found.lights)
+    out.notes.push_back(fmt::format("{}: a light seen directly ({} pixels, up to {:.0f} times the image's median brightness), of "
+                                    "colour ({:.3f}, {:.3f}, {:.3f}): a reference, left out of every estimate", l.name, l.pixels,
+                                    l.brightness, l.rgb[0], l.rgb[1], l.rgb[2]));
+  out.lights = found.lights;
+  for (const Region& r : regions) {
+    if (r.source == "image" || r.source == "unassigned" || r.pixels.empty()) continue;
+    std::size_t on = 0;
+    for (const std::uint32_t p : r.pixels) on += found.mask[p] ? 1 : 0;
+    if (2 * on < r.pixels.size()) continue;
+    out.light_regions.push_back(r.name);
+    out.notes.push_back(fmt::format("{}: {:.0f} % of its pixels are a light seen directly: no dichromatic object, left out of the "
+                                    "planes and highlight lines", r.name, 100.0 * static_cast<double>(on) / static_cast<double>(r.pixels.size())));
+  }
+}
+
 // Each statistical method: the light's colour under its assumption about the world's surfaces. Its uncertainty
 // joins how far that assumption fails on real scenes (statistical_prior_deg) with the block bootstrap's spread —
 // how much the answer depends on which parts of the scene are in view.
-void estimate_statistical(const RgbImage& image, const IlluminantContext& context, IlluminantAnalysis& out) {
-  const std::vector<std::uint8_t> usable = usable_pixels(image, context);
+void estimate_statistical(const RgbImage& image, std::span<const std::uint8_t> usable, IlluminantAnalysis& out) {
   for (const MinkowskiSettings& method : baseline_methods()) {
     IlluminantEstimate e;
     e.method = method.name;
@@ -342,7 +377,7 @@ void estimate_statistical(const RgbImage& image, const IlluminantContext& contex
       continue;
     }
     e.rgb = positive(b.rgb);
-    e.uncertainty_deg = std::hypot(statistical_prior_deg(method.name), b.uncertainty_deg);
+    e.uncertainty_deg = std::hypot(method_prior_deg(method.name), b.uncertainty_deg);
     if (out.known) e.error_deg = angular_error_deg(e.rgb, *out.known);
     if (out.camera_white) e.camera_angle_deg = angular_error_deg(e.rgb, *out.camera_white);
     out.statistical.push_back(std::move(e));
@@ -405,13 +440,14 @@ std::string choice_text(const IlluminantAnalysis& out) {
 }  // namespace
 
 const ChoiceRule& choice_rule() {
-  static const ChoiceRule rule{5.0, "shades of grey"};
+  static const ChoiceRule rule{8.0, "shades of grey"};
   return rule;
 }
 
-double statistical_prior_deg(const std::string& method) {
+double method_prior_deg(const std::string& method) {
   static const std::vector<std::pair<std::string, double>> priors = {
-      {"grey world", 8.0}, {"white patch", 8.0}, {"shades of grey", 8.0}, {"grey edge 1", 8.0}, {"grey edge 2", 8.0}};
+      {"dichromatic planes", 9.9}, {"highlight lines", 9.0}, {"inverse-intensity chromaticity", 12.7},
+      {"grey world", 8.3}, {"white patch", 11.7}, {"shades of grey", 7.2}, {"grey edge 1", 9.2}, {"grey edge 2", 10.5}};
   for (const auto& [name, sigma] : priors)
     if (name == method) return sigma;
   return 0.0;
@@ -441,11 +477,16 @@ IlluminantAnalysis estimate_illuminant(const std::vector<RegionAnalysis>& region
   if (context.known) out.known = context.known->normalized();
   if (context.camera_white) out.camera_white = context.camera_white->normalized();
   const std::string& assumed_curve = context.assumed_curve;
-  const Evidence evidence = gather_evidence(regions, context.high_levels, out.notes);
+  std::vector<std::uint8_t> usable = usable_pixels(image, context);
+  find_lights(image, context.pixels, usable, out);
+  const Evidence evidence = gather_evidence(regions, context.high_levels, out.light_regions, out.notes);
   estimate_from_lines(evidence, out);
   estimate_from_planes(evidence, out);
   cross_check(evidence.normals.size(), out);
-  estimate_from_iic(context, out);
+  estimate_from_iic(image, context, usable, out);
+  if (context.photograph)
+    for (auto* e : {&out.planes, &out.highlight_lines, &out.iic})
+      if (*e && (*e)->uncertainty_deg) (*e)->uncertainty_deg = std::hypot(*(*e)->uncertainty_deg, method_prior_deg((*e)->method));
   for (auto* e : {&out.planes, &out.highlight_lines, &out.iic}) {
     refuse_if_uninformative(*e);
     if (*e) refuse_if_too_uncertain(**e);
@@ -458,7 +499,7 @@ IlluminantAnalysis estimate_illuminant(const std::vector<RegionAnalysis>& region
                                                 "through black only in the true linear light, and a wrong curve tilts every "
                                                 "plane alike, which their agreement cannot show", assumed_curve);
   }
-  estimate_statistical(image, context, out);
+  estimate_statistical(image, usable, out);
   for (IlluminantEstimate& e : out.statistical) refuse_if_too_uncertain(e);
   out.choice = choice_text(out);
   return out;

@@ -18,7 +18,9 @@
 
 #include "analyzer/analysis_image.h"
 #include "analyzer/iic.h"
+#include "analyzer/lights_in_view.h"
 #include "analyzer/region_analysis.h"
+#include "analyzer/regions.h"
 
 namespace ct::analyzer {
 
@@ -51,6 +53,10 @@ struct IlluminantAnalysis {
   std::optional<Vec3> known;  // as given, normalised
   // The light's colour the camera assumed (the inverse of a raw file's as-shot white-balance multipliers), unit.
   std::optional<Vec3> camera_white;
+  // Lights seen directly (analyzer/lights_in_view.h): references, left out of every estimate, and the regions
+  // that are mostly one (left out of the dichromatic evidence).
+  std::vector<LightInView> lights;
+  std::vector<std::string> light_regions;
   std::vector<std::string> notes;  // why an estimate is missing, and regions left out
   std::string choice;              // which estimate best() is, and why
 
@@ -75,10 +81,13 @@ struct ChoiceRule {
 const ChoiceRule& choice_rule();
 const IlluminantEstimate& choose(const IlluminantAnalysis& analysis, const ChoiceRule& rule);
 
-// A statistical method's error that its bootstrap leaves out — how far the method's assumption fails on real
-// scenes — as a standard error per axis in degrees: √(mean e² / 2) over its errors e on the tuned part of the test
-// set of photographs (fitted there, like the choice). 0 for a method not in the list.
-double statistical_prior_deg(const std::string& method);
+// A method's error that its own uncertainty leaves out — how far its assumption or model fails on real scenes — as a
+// standard error per axis in degrees, fitted on its errors e on the tuned part of the test set of photographs (like
+// the choice): the larger of √(ln 10 · mean e² / 4), the σ whose 2σ holds 90 % of a two-dimensional normal error of
+// that mean square, and half the errors' 90th percentile, where their tail is heavier than a normal one's. 0 for a method not in the list. The statistical methods carry it
+// always (their bootstrap sees nothing of their assumption); the physics estimates only on a photograph
+// (IlluminantContext::photograph): on a render the dichromatic model holds, and their fits' errors are the whole.
+double method_prior_deg(const std::string& method);
 
 // The largest 2σ an estimate marked reliable may state, in degrees: beyond it the estimate says too little of the
 // light to build on, and is marked unreliable with its 2σ.
@@ -92,10 +101,12 @@ struct IlluminantContext {
   std::array<double, 3> high_levels{kNoLevel, kNoLevel, kNoLevel};
   std::array<double, 3> low_levels{-kNoLevel, -kNoLevel, -kNoLevel};
   std::optional<Vec3> camera_white;  // a camera raw's as-shot white balance as a light's colour
-  // Each segment's usable pixels (linear, unclipped, above black), for inverse-intensity chromaticity; none: no
-  // such estimate.
-  std::vector<IicSurface> surfaces;
-  std::vector<std::string> surface_names;  // the regions they are, in the same order
+  // The regions' pixels, in the order of their analyses (empty: not given). Their segments give inverse-intensity
+  // chromaticity its surfaces; those that are mostly a light seen directly are no dichromatic object.
+  std::span<const Region> pixels;
+  // A photograph rather than a render made by chromatrace (which names its objects or light paths): the physics
+  // estimates then carry their priors on real scenes (method_prior_deg).
+  bool photograph = false;
   // A response curve that was guessed rather than declared ("" when declared or none): the planes' estimate is
   // then unreliable.
   std::string assumed_curve;

@@ -87,7 +87,7 @@ TEST(Illuminant, UncertaintyCoversTheErrorOverNoiseSeeds) {
   ASSERT_TRUE(q.planes && q.planes->uncertainty_deg);
   EXPECT_LT(*q.planes->uncertainty_deg, mean_uncertainty / 3) << "100 times the full well: about a tenth of the noise";
   // Grey world's uncertainty holds how far its assumption fails on real scenes, whatever the noise.
-  EXPECT_GE(q.grey_world().uncertainty_deg.value_or(0), statistical_prior_deg("grey world"));
+  EXPECT_GE(q.grey_world().uncertainty_deg.value_or(0), method_prior_deg("grey world"));
   EXPECT_NE(q.choice.find("dichromatic planes"), std::string::npos) << q.choice;
 }
 

@@ -26,6 +26,7 @@
 
 #include "analyzer/analysis.h"
 #include "analyzer/analysis_json.h"
+#include "analyzer/colour_constancy.h"
 #include "analyzer/illuminant.h"
 #include "analyzer/raw_input.h"
 #include "tests/analyzer/statement_audit.h"
@@ -74,6 +75,9 @@ Shape parse_shape(const nlohmann::json& j) {
 
 struct Photo {
   std::string file, package, kind;
+  std::string light_kind;  // daylight, tungsten, …: what lit it
+  bool held_out = false;   // kept out of tuning the light's colour (LightColour below)
+  std::vector<Shape> lights_in_view;  // light sources seen directly
   std::vector<Shape> objects, left_out, references;
   std::vector<std::pair<std::string, std::string>> separate;  // objects that must not share a segment
   std::vector<std::pair<std::string, std::string>> light;  // glossy object, white reference
@@ -94,7 +98,10 @@ std::vector<Photo> photos() {
     if (!photo.file.starts_with("/")) photo.file = photo_dir() + "/" + photo.file;
     photo.package = p["package"];
     photo.kind = p.value("kind", "");
-    for (const auto& o : p["objects"]) photo.objects.push_back(parse_shape(o));
+    photo.light_kind = p.value("light_kind", "");
+    photo.held_out = p.value("held_out", false);
+    for (const auto& o : p.value("objects", nlohmann::json::array())) photo.objects.push_back(parse_shape(o));
+    for (const auto& o : p.value("lights_in_view", nlohmann::json::array())) photo.lights_in_view.push_back(parse_shape(o));
     for (const auto& o : p.value("left_out", nlohmann::json::array())) photo.left_out.push_back(parse_shape(o));
     for (const auto& pair : p.value("separate", nlohmann::json::array())) photo.separate.emplace_back(pair[0], pair[1]);
     for (const auto& o : p.value("references", nlohmann::json::array())) photo.references.push_back(parse_shape(o));
@@ -521,10 +528,10 @@ std::string test_name(const Photo& photo) {
 
 class EachPhotograph : public ::testing::TestWithParam<Photo> {};
 
-// The chosen illuminant estimate lies within 2 of its own standard errors of the colour of every white or grey
-// object in view, measured on that object's unclipped pixels; or the analysis marks it unreliable and says why
-// (grey world, a guess, is never reliable). Each estimate's numbers are printed beside the object's.
-TEST_P(EachPhotograph, TheChosenIlluminantIsWithinTwoSigmaOfEachWhiteObjectOrMarkedUnreliable) {
+// The chosen illuminant estimate states its uncertainty when reliable, or the analysis says why it is not; each
+// estimate's numbers are printed beside every white or grey object's colour, measured on its unclipped pixels.
+// Whether the reliable ones fall within their 2σ is a property of the set: LightColour.ReliableEstimatesFallWithinTheirTwoSigma.
+TEST_P(EachPhotograph, TheChosenIlluminantStatesItsUncertaintyOrWhyItIsUnreliable) {
   const Photo& photo = GetParam();
   if (photo.references.empty()) GTEST_SKIP() << photo.file << ": no white or grey object in view";
   if (!available(photo)) GTEST_SKIP() << "install the Debian package " << photo.package;
@@ -532,8 +539,7 @@ TEST_P(EachPhotograph, TheChosenIlluminantIsWithinTwoSigmaOfEachWhiteObjectOrMar
   const analyzer::IlluminantEstimate& chosen = il.best();
   for (const Shape& white : photo.references) {
     const Vec3 light = measured_light(photo, white.name).normalized();
-    for (const auto* e : {il.planes ? &*il.planes : nullptr, il.highlight_lines ? &*il.highlight_lines : nullptr, &il.grey_world}) {
-      if (!e) continue;
+    for (const analyzer::IlluminantEstimate* e : il.all()) {
       std::cerr << fmt::format("{}: {} ({:.3f}, {:.3f}, {:.3f}) {:.2f}° from {} ({:.3f}, {:.3f}, {:.3f}); σ {}; {}{}\n", photo.file,
                                  e->method, e->rgb[0], e->rgb[1], e->rgb[2], analyzer::angular_error_deg(e->rgb, light), white.name,
                                  light[0], light[1], light[2], e->uncertainty_deg ? fmt::format("{:.2f}°", *e->uncertainty_deg) : "none",
@@ -541,7 +547,6 @@ TEST_P(EachPhotograph, TheChosenIlluminantIsWithinTwoSigmaOfEachWhiteObjectOrMar
     }
     if (chosen.reliable) {
       ASSERT_TRUE(chosen.uncertainty_deg) << chosen.method << " is reliable but states no uncertainty";
-      EXPECT_LE(analyzer::angular_error_deg(chosen.rgb, light), 2 * *chosen.uncertainty_deg) << chosen.method << " against " << white.name;
     } else {
       EXPECT_FALSE(chosen.unreliable_reason.empty()) << chosen.method << " is unreliable without a reason";
     }
@@ -658,14 +663,306 @@ TEST_P(EachPhotograph, ACameraRawsAsShotWhiteBalanceStandsBesideEachEstimate) {
   const Vec3 w = *il.camera_white;
   EXPECT_GT(w[1], w[0]);
   EXPECT_GT(w[1], w[2]);
-  for (const auto* e : {il.planes ? &*il.planes : nullptr, il.highlight_lines ? &*il.highlight_lines : nullptr, &il.grey_world}) {
-    if (!e) continue;
-    {
-      ASSERT_TRUE(e->camera_angle_deg) << e->method;
-      EXPECT_NEAR(*e->camera_angle_deg, analyzer::angular_error_deg(e->rgb, w), 1e-9);
-      std::cerr << fmt::format("{}: {} {:.2f}° from the camera's white balance ({:.3f}, {:.3f}, {:.3f})\n", photo.file, e->method,
-                               *e->camera_angle_deg, w[0], w[1], w[2]);
+  for (const analyzer::IlluminantEstimate* e : il.all()) {
+    ASSERT_TRUE(e->camera_angle_deg) << e->method;
+    EXPECT_NEAR(*e->camera_angle_deg, analyzer::angular_error_deg(e->rgb, w), 1e-9);
+    std::cerr << fmt::format("{}: {} {:.2f}° from the camera's white balance ({:.3f}, {:.3f}, {:.3f})\n", photo.file, e->method,
+                             *e->camera_angle_deg, w[0], w[1], w[2]);
+  }
+}
+
+// ---- The light's colour over the test set ----
+// Every photograph with a white or grey reference is a case: the light's colour measured on the reference (the mean
+// of its objects' measured directions) against each estimate the analysis makes. The tuned part chooses how the
+// estimate to trust is picked (analyzer::choice_rule) and each statistical method's prior; the held-out part never
+// does. Statistics as the colour-constancy literature reports them (Hordley and Finlayson 2006; Gijsenij, Gevers and
+// van de Weijer 2011): mean, median, trimean, and the mean of the best and of the worst 25 %.
+
+struct LightCase {
+  std::string name, light_kind;
+  bool held_out = false;
+  Vec3 measured = Vec3::Zero();
+  analyzer::IlluminantAnalysis illuminant;
+};
+
+const std::vector<LightCase>& light_cases() {
+  static const std::vector<LightCase> cases = [] {
+    std::vector<LightCase> out;
+    for (const Photo& photo : photos()) {
+      if (photo.references.empty() || !available(photo)) continue;
+      LightCase c{test_name(photo), photo.light_kind, photo.held_out, Vec3::Zero(), analysed(photo).illuminant};
+      for (const Shape& white : photo.references) c.measured += measured_light(photo, white.name).normalized();
+      c.measured.normalize();
+      out.push_back(std::move(c));
     }
+    return out;
+  }();
+  return cases;
+}
+
+double error_of(const LightCase& c, const analyzer::IlluminantEstimate& e) { return analyzer::angular_error_deg(e.rgb, c.measured); }
+
+const analyzer::IlluminantEstimate* estimate_named(const analyzer::IlluminantAnalysis& il, const std::string& method) {
+  for (const analyzer::IlluminantEstimate* e : il.all())
+    if (e->method == method) return e;
+  return nullptr;
+}
+
+struct Summary {
+  std::size_t n = 0;
+  double mean = 0, median = 0, trimean = 0, best25 = 0, worst25 = 0;
+};
+
+// Quantile q of sorted values, by linear interpolation between order statistics.
+double quantile(const std::vector<double>& sorted, double q) {
+  const double at = q * static_cast<double>(sorted.size() - 1);
+  const std::size_t i = static_cast<std::size_t>(at);
+  const double f = at - static_cast<double>(i);
+  return i + 1 < sorted.size() ? sorted[i] * (1 - f) + sorted[i + 1] * f : sorted[i];
+}
+
+Summary summarise(std::vector<double> e) {
+  Summary s;
+  s.n = e.size();
+  if (e.empty()) return s;
+  std::sort(e.begin(), e.end());
+  s.mean = std::accumulate(e.begin(), e.end(), 0.0) / static_cast<double>(e.size());
+  s.median = quantile(e, 0.5);
+  s.trimean = (quantile(e, 0.25) + 2 * s.median + quantile(e, 0.75)) / 4;
+  const std::size_t quarter = std::max<std::size_t>(1, (e.size() + 2) / 4);  // rounded to the nearest, at least one
+  s.best25 = std::accumulate(e.begin(), e.begin() + static_cast<std::ptrdiff_t>(quarter), 0.0) / static_cast<double>(quarter);
+  s.worst25 = std::accumulate(e.end() - static_cast<std::ptrdiff_t>(quarter), e.end(), 0.0) / static_cast<double>(quarter);
+  return s;
+}
+
+std::vector<const LightCase*> part(bool held_out) {
+  std::vector<const LightCase*> out;
+  for (const LightCase& c : light_cases())
+    if (c.held_out == held_out) out.push_back(&c);
+  return out;
+}
+
+// The rules the fit chooses among: every statistical method as the fallback, with the physics estimates used up to
+// a standard error of 0 (never) to 10°.
+std::vector<analyzer::ChoiceRule> candidate_rules() {
+  std::vector<analyzer::ChoiceRule> rules;
+  for (const double sigma : {0.0, 0.25, 0.5, 0.75, 1.0, 1.5, 2.0, 3.0, 4.0, 5.0, 6.0, 8.0, 10.0})
+    for (const analyzer::MinkowskiSettings& m : analyzer::baseline_methods()) rules.push_back({sigma, m.name});
+  return rules;
+}
+
+std::vector<double> rule_errors(const std::vector<const LightCase*>& cases, const analyzer::ChoiceRule& rule) {
+  std::vector<double> e;
+  for (const LightCase* c : cases) e.push_back(error_of(*c, analyzer::choose(c->illuminant, rule)));
+  return e;
+}
+
+// The rule with the least mean error on these cases; among rules the cases cannot tell apart (the same errors), the one
+// that trusts the physics furthest, which is exact where its model holds (renders), then the first listed. The mean,
+// not the median: over ten photographs the median jumps from one photograph to another as the rule changes, and a
+// rule fitted to it does not carry over to the one left out; the mean also weighs the failures.
+analyzer::ChoiceRule fit_rule(const std::vector<const LightCase*>& cases) {
+  analyzer::ChoiceRule best;
+  double best_mean = std::numeric_limits<double>::infinity();
+  for (const analyzer::ChoiceRule& rule : candidate_rules()) {
+    const double mean = summarise(rule_errors(cases, rule)).mean;
+    const bool same = std::abs(mean - best_mean) < 1e-9;
+    if (mean < best_mean - 1e-9 || (same && rule.fallback == best.fallback && rule.max_physics_sigma_deg > best.max_physics_sigma_deg))
+      best = rule, best_mean = mean;
+  }
+  return best;
+}
+
+// Each tuned case judged by the rule fitted on the other tuned cases.
+std::vector<double> leave_one_out_errors(const std::vector<const LightCase*>& tuned) {
+  std::vector<double> e;
+  for (std::size_t i = 0; i < tuned.size(); ++i) {
+    std::vector<const LightCase*> others = tuned;
+    others.erase(others.begin() + static_cast<std::ptrdiff_t>(i));
+    e.push_back(error_of(*tuned[i], analyzer::choose(tuned[i]->illuminant, fit_rule(others))));
+  }
+  return e;
+}
+
+std::string table_row(const std::string& name, const Summary& s) {
+  return fmt::format("| {} | {} | {:.2f} | {:.2f} | {:.2f} | {:.2f} | {:.2f} |", name, s.n, s.mean, s.median, s.trimean, s.best25, s.worst25);
+}
+
+std::vector<double> method_errors(const std::vector<const LightCase*>& cases, const std::string& method) {
+  std::vector<double> e;
+  for (const LightCase* c : cases)
+    if (const auto* m = estimate_named(c->illuminant, method)) e.push_back(error_of(*c, *m));
+  return e;
+}
+
+// Every method's estimate names, physics first.
+std::vector<std::string> method_names() {
+  std::vector<std::string> methods = {"dichromatic planes", "highlight lines", "inverse-intensity chromaticity"};
+  for (const analyzer::MinkowskiSettings& m : analyzer::baseline_methods()) methods.push_back(m.name);
+  return methods;
+}
+
+// The lights the analysis found whose brightest pixel lies in the shape.
+std::vector<const analyzer::LightInView*> lights_in(const Photo& photo, const Shape& shape) {
+  std::vector<const analyzer::LightInView*> out;
+  for (const analyzer::LightInView& l : analysed(photo).illuminant.lights)
+    if (shape.contains(l.x + 0.5, l.y + 0.5)) out.push_back(&l);
+  return out;
+}
+
+// Whether a drawn light is bright enough to be told from a white surface by its brightness alone: its brightest pixel
+// at least kLightSeed times the image's median brightness (analyzer/lights_in_view.h). In an 8-bit file it never is.
+bool bright_enough(const Photo& photo, const Shape& shape) {
+  const Read& r = read(photo);
+  const analyzer::RgbImage linear = analyzer::linear_light(r.input);
+  const auto mask = rasterise(shape, linear.width, linear.height, 1.0);
+  std::vector<double> all;
+  double peak = 0;
+  for (std::size_t p = 0; p < mask.size(); ++p) {
+    const double b = (linear.rgb[3 * p] + linear.rgb[3 * p + 1] + linear.rgb[3 * p + 2]) / 3;
+    if (!std::isfinite(b)) continue;
+    if (b > 0) all.push_back(b);
+    if (mask[p]) peak = std::max(peak, b);
+  }
+  std::nth_element(all.begin(), all.begin() + static_cast<std::ptrdiff_t>(all.size() / 2), all.end());
+  return !all.empty() && peak >= analyzer::kLightSeed * all[all.size() / 2];
+}
+
+// A light seen directly (a lamp, the sun, a window; the masks' lights_in_view) bright enough to be told from a surface
+// is named as a light — which every estimate leaves out — and no white or grey reference, a surface, ever is: no
+// light's brightest pixel lies in it, and no segment of it is called a light.
+TEST(LightColour, LightsInViewAreNamedAndNoSurfaceIs) {
+  int named = 0, dim = 0;
+  for (const Photo& photo : photos()) {
+    if (!available(photo) || (photo.lights_in_view.empty() && photo.references.empty())) continue;
+    const analyzer::IlluminantAnalysis& il = analysed(photo).illuminant;
+    for (const Shape& light : photo.lights_in_view) {
+      if (!bright_enough(photo, light)) {
+        std::cerr << fmt::format("{}: {}: below {} times the median brightness, cannot be told from a surface\n", photo.file,
+                                 light.name, analyzer::kLightSeed);
+        ++dim;
+        continue;
+      }
+      const auto found = lights_in(photo, light);
+      EXPECT_FALSE(found.empty()) << photo.file << ": " << light.name << " is not named a light";
+      for (const auto* l : found) std::cerr << fmt::format("{}: {} is {}\n", photo.file, light.name, l->name);
+      ++named;
+    }
+    for (const Shape& white : photo.references) {
+      EXPECT_TRUE(lights_in(photo, white).empty()) << photo.file << ": the reference " << white.name << " holds a light";
+      const Read& r = read(photo);
+      const Match m = best_segment(r.segmented.s, rasterise(white, r.input.image.width, r.input.image.height, 1.0));
+      for (const analyzer::Region& g : r.segmented.regions) {
+        if (g.source != "segment" || g.label != m.label) continue;
+        EXPECT_EQ(std::count(il.light_regions.begin(), il.light_regions.end(), g.name), 0)
+            << photo.file << ": the reference " << white.name << "'s segment is called a light";
+      }
+    }
+  }
+  std::cerr << fmt::format("{} lights in view named, {} too dim to tell from a surface\n", named, dim);
+  EXPECT_GE(named, 5) << "too few lights in view bright enough to check";
+}
+
+// The table docs/analyze.md quotes, per part: each method where it gives an estimate, and the choice (leave-one-out
+// on the tuned part; fitted on the whole tuned part for the held-out one). The chosen estimate's median error is at
+// most 0.8 × grey world's and at most 6° on both parts; and the rule the analysis uses is the one fitted on the
+// tuned part.
+TEST(LightColour, TheChoiceBeatsGreyWorldOnBothPartsOfTheTestSet) {
+  const std::vector<const LightCase*> tuned = part(false), held = part(true);
+  ASSERT_GE(tuned.size() + held.size(), 15u) << "the test set has fewer than 15 photographs with a white or grey reference";
+  ASSERT_GE(held.size(), 4u);
+  const std::vector<std::string> methods = method_names();
+  const analyzer::ChoiceRule fitted = fit_rule(tuned);
+  std::cerr << fmt::format("the rule fitted on the {} tuned photographs: the physics estimates up to σ {:.1f}°, else {}\n",
+                           tuned.size(), fitted.max_physics_sigma_deg, fitted.fallback);
+  EXPECT_EQ(fitted.fallback, analyzer::choice_rule().fallback) << "analyzer::choice_rule() is not the fitted rule";
+  EXPECT_EQ(fitted.max_physics_sigma_deg, analyzer::choice_rule().max_physics_sigma_deg) << "analyzer::choice_rule() is not the fitted rule";
+  for (const auto& [label, cases] : {std::pair{"tuned", tuned}, std::pair{"held out", held}}) {
+    std::cerr << fmt::format("\n{} part ({} photographs), angular error in degrees:\n\n", label, cases.size())
+              << "| method | photographs | mean | median | trimean | best 25 % | worst 25 % |\n|---|---|---|---|---|---|---|\n";
+    for (const std::string& m : methods) std::cerr << table_row(m, summarise(method_errors(cases, m))) << "\n";
+    const std::vector<double> chosen = label == std::string("tuned") ? leave_one_out_errors(cases) : rule_errors(cases, fitted);
+    const Summary choice = summarise(chosen), grey = summarise(method_errors(cases, "grey world"));
+    std::cerr << table_row(label == std::string("tuned") ? "the choice (leave-one-out)" : "the choice", choice) << "\n";
+    EXPECT_LE(choice.median, 0.8 * grey.median) << label;
+    EXPECT_LE(choice.median, 6.0) << label;
+  }
+  std::cerr << "\nper photograph (the fitted rule's estimate; grey world):\n";
+  for (const LightCase& c : light_cases()) {
+    const analyzer::IlluminantEstimate& e = analyzer::choose(c.illuminant, fitted);
+    std::cerr << fmt::format("  {}{} ({}): {} {:.2f}° ± {}{}; grey world {:.2f}°\n", c.name, c.held_out ? " [held out]" : "", c.light_kind,
+                             e.method, error_of(c, e), e.uncertainty_deg ? fmt::format("{:.2f}°", *e.uncertainty_deg) : "none",
+                             e.reliable ? "" : " (unreliable)", error_of(c, c.illuminant.grey_world()));
+  }
+}
+
+// Each method's prior (analyzer::method_prior_deg), from its errors e on the tuned part (where it gives an estimate),
+// is the larger of √(ln 10 · mean e² / 4) — the σ whose 2σ holds 90 % of a two-dimensional normal error of that mean
+// square — and half the errors' 90th percentile (their tail may be heavier than a normal one's), rounded up to a tenth
+// of a degree.
+TEST(LightColour, ThePriorsAreFittedOnTheTunedPart) {
+  const std::vector<const LightCase*> tuned = part(false);
+  ASSERT_GE(tuned.size(), 8u);
+  for (const std::string& method : method_names()) {
+    double sum = 0;
+    const std::vector<double> e = method_errors(tuned, method);
+    ASSERT_GE(e.size(), 4u) << method;
+    for (const double x : e) sum += x * x;
+    std::vector<double> sorted = e;
+    std::sort(sorted.begin(), sorted.end());
+    const double normal = std::sqrt(std::log(10.0) * sum / static_cast<double>(e.size()) / 4), tail = quantile(sorted, 0.9) / 2;
+    const double prior = std::ceil(10 * std::max(normal, tail)) / 10;
+    std::cerr << fmt::format("{}: prior {:.1f}° (normal {:.2f}°, tail {:.2f}°, over {} photographs)\n", method, prior, normal, tail, e.size());
+    EXPECT_NEAR(analyzer::method_prior_deg(method), prior, 1e-9) << method;
+  }
+}
+
+// The chosen estimate, when marked reliable, states a 2σ of at most 20° and lies within it on at least 90 % of the
+// photographs of both parts; no estimate states an uncertainty past 90°.
+TEST(LightColour, ReliableEstimatesFallWithinTheirTwoSigma) {
+  std::size_t reliable = 0, covered = 0;
+  for (const LightCase& c : light_cases()) {
+    for (const analyzer::IlluminantEstimate* e : c.illuminant.all()) {
+      EXPECT_LE(e->uncertainty_deg.value_or(0.0), 90.0) << c.name << ": " << e->method;
+      if (e->reliable) {
+        ASSERT_TRUE(e->uncertainty_deg) << c.name << ": " << e->method;
+        EXPECT_LE(2 * *e->uncertainty_deg, analyzer::kReliableTwoSigmaDeg) << c.name << ": " << e->method;
+      } else {
+        EXPECT_FALSE(e->unreliable_reason.empty()) << c.name << ": " << e->method;
+      }
+    }
+    const analyzer::IlluminantEstimate& e = c.illuminant.best();
+    if (!e.reliable) continue;
+    ++reliable;
+    const bool within = error_of(c, e) <= 2 * *e.uncertainty_deg;
+    covered += within;
+    if (!within) std::cerr << fmt::format("{}: {} {:.2f}° off, beyond its 2σ {:.2f}°\n", c.name, e.method, error_of(c, e), 2 * *e.uncertainty_deg);
+  }
+  std::cerr << fmt::format("{} of {} reliable chosen estimates within their 2σ\n", covered, reliable);
+  ASSERT_GT(reliable, 0u);
+  EXPECT_GE(static_cast<double>(covered), 0.9 * static_cast<double>(reliable));
+  // Each method's own reliable estimates, over both parts: their misses are as few as a coverage of 90 % allows, at
+  // the 1 % level (on 15 photographs even a method whose 2σ holds exactly 90 % misses twice or more with probability
+  // 0.45, so "at most 10 %" would fail for well-calibrated methods half the time).
+  for (const std::string& method : method_names()) {
+    std::size_t n = 0, in = 0;
+    for (const LightCase& c : light_cases()) {
+      const analyzer::IlluminantEstimate* e = estimate_named(c.illuminant, method);
+      if (!e || !e->reliable) continue;
+      ++n;
+      in += error_of(c, *e) <= 2 * *e->uncertainty_deg;
+    }
+    // The most misses k with P(X ≥ k) ≥ 1 % for X ~ Binomial(n, 0.1).
+    std::size_t allowed = 0;
+    for (std::size_t k = 1; k <= n; ++k) {
+      double tail = 0;
+      for (std::size_t j = k; j <= n; ++j)
+        tail += std::exp(std::lgamma(n + 1.0) - std::lgamma(j + 1.0) - std::lgamma(double(n - j) + 1.0) + double(j) * std::log(0.1) +
+                         double(n - j) * std::log(0.9));
+      if (tail >= 0.01) allowed = k;
+    }
+    std::cerr << fmt::format("{}: {} of {} reliable estimates within their 2σ ({} misses allowed)\n", method, in, n, allowed);
+    EXPECT_LE(n - in, allowed) << method;
   }
 }
 
