@@ -340,6 +340,12 @@ json analysis_to_json(const ImageAnalysis& a, const std::vector<bool>& plotted) 
   const HistogramSpec& spec = a.context.spec;
   const ShapeCriteria& k = a.options.criteria;
   const IlluminantAnalysis& il = a.illuminant;
+  // Every estimate with the angle between it and the chosen one.
+  const auto beside_chosen = [&](const IlluminantEstimate& e) {
+    json j = estimate_json(e);
+    j["angle_to_chosen_deg"] = angular_error_deg(e.rgb, il.best().rgb);
+    return j;
+  };
   return {{"format", kAnalysisFormat},
           {"image", {{"file", a.file}, {"width", a.width}, {"height", a.height}, {"layer", a.layer},
                      {"integer", a.encoding.integer}, {"bits", a.encoding.bits}, {"full_scale", a.encoding.full_scale}}},
@@ -390,14 +396,22 @@ json analysis_to_json(const ImageAnalysis& a, const std::vector<bool>& plotted) 
           {"illuminant",
            {{"estimate", estimate_json(il.best())},
             {"choice", il.choice},
-            {"highlight_lines", optional_json(il.highlight_lines, estimate_json)},
-            {"dichromatic_planes", optional_json(il.planes, estimate_json)},
-            {"inverse_intensity_chromaticity", optional_json(il.iic, estimate_json)},
+            {"highlight_lines", optional_json(il.highlight_lines, beside_chosen)},
+            {"dichromatic_planes", optional_json(il.planes, beside_chosen)},
+            {"inverse_intensity_chromaticity", optional_json(il.iic, beside_chosen)},
             {"statistical", [&] {
                json list = json::array();
-               for (const IlluminantEstimate& e : il.statistical) list.push_back(estimate_json(e));
+               for (const IlluminantEstimate& e : il.statistical) list.push_back(beside_chosen(e));
                return list;
              }()},
+            {"lights_in_view", [&] {
+               json list = json::array();
+               for (const LightInView& l : il.lights)
+                 list.push_back({{"name", l.name}, {"x", l.x}, {"y", l.y}, {"rgb", vec(l.rgb)}, {"brightness", l.brightness},
+                                 {"pixels", l.pixels}, {"angle_to_chosen_deg", angular_error_deg(l.rgb, il.best().rgb)}});
+               return list;
+             }()},
+            {"light_regions", il.light_regions},
             {"known", optional_json(il.known, vec)},
             {"camera_white_balance", optional_json(il.camera_white, vec)},
             {"notes", il.notes}}},

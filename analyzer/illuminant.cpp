@@ -384,9 +384,9 @@ void estimate_statistical(const RgbImage& image, std::span<const std::uint8_t> u
   }
 }
 
-// An estimate whose 2σ is wider than kReliableTwoSigmaDeg says too little of the light to build on; one whose σ
-// passes 90° fixes no direction at all, and states none.
-void refuse_if_too_uncertain(IlluminantEstimate& e) {
+// An estimate whose 2σ is wider than kReliableTwoSigmaDeg says too little of the light to build on (on a photograph,
+// where the priors make σ mean what it says); one whose σ passes 90° fixes no direction at all, and states none.
+void refuse_if_too_uncertain(IlluminantEstimate& e, bool photograph) {
   if (!e.uncertainty_deg) return;
   if (*e.uncertainty_deg > 90) {
     e.reliable = false;
@@ -394,7 +394,7 @@ void refuse_if_too_uncertain(IlluminantEstimate& e) {
     e.uncertainty_deg.reset();
     return;
   }
-  if (!e.reliable || 2 * *e.uncertainty_deg <= kReliableTwoSigmaDeg) return;
+  if (!photograph || !e.reliable || 2 * *e.uncertainty_deg <= kReliableTwoSigmaDeg) return;
   e.reliable = false;
   e.unreliable_reason = fmt::format("its 2σ ({:.1f}°) is wider than {:.0f}°", 2 * *e.uncertainty_deg, kReliableTwoSigmaDeg);
 }
@@ -408,7 +408,7 @@ std::string choice_text(const IlluminantAnalysis& out) {
                         out.iic ? &*out.iic : nullptr}) {
     if (!e || e == &chosen) continue;
     if (!e->reliable) why_not += fmt::format("; the {} estimate is not used: {}", e->method, e->unreliable_reason);
-    else if (e->uncertainty_deg && *e->uncertainty_deg > rule.max_physics_sigma_deg)
+    else if (out.photograph && e->uncertainty_deg && *e->uncertainty_deg > rule.max_physics_sigma_deg)
       why_not += fmt::format("; the {} estimate (± {:.2f}°) is not used: its standard error is above {:.1f}°", e->method,
                              *e->uncertainty_deg, rule.max_physics_sigma_deg);
   }
@@ -430,6 +430,9 @@ std::string choice_text(const IlluminantAnalysis& out) {
                        sigma(chosen), why_not);
   const auto method = std::find_if(baseline_methods().begin(), baseline_methods().end(),
                                    [&](const MinkowskiSettings& m) { return m.name == chosen.method; });
+  if (!out.photograph)
+    return fmt::format("{}, a statistical method: no physics estimate is reliable{}. It gives the light's colour if {}",
+                       chosen.method, why_not, method == baseline_methods().end() ? "its assumption holds" : method->assumption);
   return fmt::format("{}, a statistical method: no physics estimate is reliable with a standard error within {:.1f}°{}. It "
                      "gives the light's colour if {}; of the statistical methods it has the least median error on the test "
                      "set of photographs, and its uncertainty (± {:.2f}°) is its error's spread there with the "
@@ -455,7 +458,8 @@ double method_prior_deg(const std::string& method) {
 
 const IlluminantEstimate& choose(const IlluminantAnalysis& a, const ChoiceRule& rule) {
   for (const auto* e : {&a.planes, &a.highlight_lines, &a.iic})
-    if (*e && (*e)->reliable && (*e)->uncertainty_deg && *(*e)->uncertainty_deg <= rule.max_physics_sigma_deg) return **e;
+    if (*e && (*e)->reliable && (*e)->uncertainty_deg && (!a.photograph || *(*e)->uncertainty_deg <= rule.max_physics_sigma_deg))
+      return **e;
   for (const IlluminantEstimate& e : a.statistical)
     if (e.method == rule.fallback) return e;
   return a.statistical.front();
@@ -474,6 +478,7 @@ std::vector<const IlluminantEstimate*> IlluminantAnalysis::all() const {
 IlluminantAnalysis estimate_illuminant(const std::vector<RegionAnalysis>& regions, const RgbImage& image,
                                        const IlluminantContext& context) {
   IlluminantAnalysis out;
+  out.photograph = context.photograph;
   if (context.known) out.known = context.known->normalized();
   if (context.camera_white) out.camera_white = context.camera_white->normalized();
   const std::string& assumed_curve = context.assumed_curve;
@@ -489,7 +494,7 @@ IlluminantAnalysis estimate_illuminant(const std::vector<RegionAnalysis>& region
       if (*e && (*e)->uncertainty_deg) (*e)->uncertainty_deg = std::hypot(*(*e)->uncertainty_deg, method_prior_deg((*e)->method));
   for (auto* e : {&out.planes, &out.highlight_lines, &out.iic}) {
     refuse_if_uninformative(*e);
-    if (*e) refuse_if_too_uncertain(**e);
+    if (*e) refuse_if_too_uncertain(**e, context.photograph);
   }
   // A plane through black is one only in the true linear light: a response curve that was guessed, not declared,
   // tilts every plane alike when it is wrong, which their agreement cannot show.
@@ -500,7 +505,7 @@ IlluminantAnalysis estimate_illuminant(const std::vector<RegionAnalysis>& region
                                                 "plane alike, which their agreement cannot show", assumed_curve);
   }
   estimate_statistical(image, usable, out);
-  for (IlluminantEstimate& e : out.statistical) refuse_if_too_uncertain(e);
+  for (IlluminantEstimate& e : out.statistical) refuse_if_too_uncertain(e, context.photograph);
   out.choice = choice_text(out);
   return out;
 }

@@ -59,6 +59,7 @@ struct IlluminantAnalysis {
   std::vector<std::string> light_regions;
   std::vector<std::string> notes;  // why an estimate is missing, and regions left out
   std::string choice;              // which estimate best() is, and why
+  bool photograph = false;         // IlluminantContext::photograph: which choice and calibration applied
 
   const IlluminantEstimate& grey_world() const { return statistical.front(); }
 
@@ -69,9 +70,11 @@ struct IlluminantAnalysis {
   std::vector<const IlluminantEstimate*> all() const;
 };
 
-// How the estimate to trust is chosen among those made: a physics estimate (the planes first, then the highlight
-// lines, then inverse-intensity chromaticity) when it is reliable and its standard error is at most `max_physics_sigma_deg`, else the statistical method
-// `fallback`. Neither value is set by hand: they are those with the least median error on the tuned part of the
+// How the estimate to trust is chosen among those made, on a photograph: a physics estimate (the planes first, then
+// the highlight lines, then inverse-intensity chromaticity) when it is reliable and its standard error is at most
+// `max_physics_sigma_deg`, else the statistical method `fallback`. On a render made by chromatrace, where the
+// dichromatic model holds by construction, the first reliable physics estimate, whatever its standard error (as the
+// synthetic renders' tests validate), else `fallback`. Neither value is set by hand: they are those with the least median error on the tuned part of the
 // test set of photographs (tests/data/photos), and leave-one-out over that part judges the rule; the held-out part
 // never tunes it (tests/analyzer/test_photographs.cpp, LightColour; the table in docs/analyze.md).
 struct ChoiceRule {

@@ -289,6 +289,7 @@ std::string report_html(const AnalysisImage& input, const ImageAnalysis& a, std:
     std::string against;
     if (e->error_deg) against += fmt::format("{:.2f}° from the known illuminant. ", *e->error_deg);
     if (e->camera_angle_deg) against += fmt::format("{:.2f}° from the camera's white balance. ", *e->camera_angle_deg);
+    if (e != &il.best()) against += fmt::format("{:.2f}° from the chosen estimate. ", angular_error_deg(e->rgb, il.best().rgb));
     illuminant += fmt::format("<tr><th>{}{}</th><td>{}</td><td>{}</td><td>{}{}</td></tr>", escape_html(e->method),
                               e == &il.best() ? " (chosen)" : "", rgb_text(e->rgb),
                               e->uncertainty_deg ? fmt::format("± {:.2f}° (standard error)", *e->uncertainty_deg) : "no uncertainty",
@@ -296,6 +297,11 @@ std::string report_html(const AnalysisImage& input, const ImageAnalysis& a, std:
                                   (e->systematic.empty() ? "" : "Systematic: " + escape_html(e->systematic) + ". "),
                               against);
   }
+  for (const LightInView& l : il.lights)
+    illuminant += fmt::format("<tr><th>{}, seen directly</th><td>{}</td><td>a reference</td><td>a light in view ({} pixels, up to {:.0f} "
+                              "times the image's median brightness), left out of every estimate. {:.2f}° from the chosen "
+                              "estimate.</td></tr>", escape_html(l.name), rgb_text(l.rgb), l.pixels, l.brightness,
+                              angular_error_deg(l.rgb, il.best().rgb));
   if (il.camera_white)
     illuminant += fmt::format("<tr><th>camera's as-shot white balance</th><td>{}</td><td>a reference</td><td>the light the camera "
                               "assumed, not a measurement</td></tr>", rgb_text(*il.camera_white));

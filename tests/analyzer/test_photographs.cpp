@@ -29,6 +29,7 @@
 #include "analyzer/colour_constancy.h"
 #include "analyzer/illuminant.h"
 #include "analyzer/raw_input.h"
+#include "analyzer/report.h"
 #include "tests/analyzer/statement_audit.h"
 #include "tests/analyzer/synthetic.h"
 
@@ -964,6 +965,37 @@ TEST(LightColour, ReliableEstimatesFallWithinTheirTwoSigma) {
     std::cerr << fmt::format("{}: {} of {} reliable estimates within their 2σ ({} misses allowed)\n", method, in, n, allowed);
     EXPECT_LE(n - in, allowed) << method;
   }
+}
+
+// analysis.json gives every method's estimate with the angle between it and the chosen one, the choice and why, and
+// each light seen directly; the report says the same, naming each light as a reference.
+TEST(LightColour, TheReportAndAnalysisJsonGiveEveryEstimateTheChoiceAndTheLights) {
+  int checked = 0;
+  for (const Photo& photo : photos()) {
+    if (photo.lights_in_view.empty() || !available(photo)) continue;
+    const analyzer::ImageAnalysis& a = analysed(photo);
+    if (a.illuminant.lights.empty()) continue;
+    SCOPED_TRACE(photo.file);
+    const nlohmann::json j = nlohmann::json::parse(analyzer::analysis_to_json(a).dump())["illuminant"];
+    const Vec3 chosen = a.illuminant.best().rgb;
+    auto vec = [](const nlohmann::json& v) { return Vec3(v[0].get<double>(), v[1].get<double>(), v[2].get<double>()); };
+    EXPECT_LT(analyzer::angular_error_deg(vec(j["estimate"]["rgb"]), chosen), 1e-6);
+    EXPECT_FALSE(j["choice"].get<std::string>().empty());
+    ASSERT_EQ(j["statistical"].size(), analyzer::baseline_methods().size());
+    std::vector<nlohmann::json> estimates(j["statistical"].begin(), j["statistical"].end());
+    for (const char* key : {"dichromatic_planes", "highlight_lines", "inverse_intensity_chromaticity"})
+      if (!j[key].is_null()) estimates.push_back(j[key]);
+    EXPECT_EQ(estimates.size(), a.illuminant.all().size());
+    for (const nlohmann::json& e : estimates)
+      EXPECT_NEAR(e["angle_to_chosen_deg"].get<double>(), analyzer::angular_error_deg(vec(e["rgb"]), chosen), 1e-6) << e["method"];
+    ASSERT_EQ(j["lights_in_view"].size(), a.illuminant.lights.size());
+    const std::string html = analyzer::report_html(read(photo).input, a, 100);
+    for (const analyzer::LightInView& l : a.illuminant.lights)
+      EXPECT_NE(html.find(l.name + ", seen directly"), std::string::npos) << l.name;
+    for (const analyzer::IlluminantEstimate* e : a.illuminant.all()) EXPECT_NE(html.find(e->method), std::string::npos) << e->method;
+    ++checked;
+  }
+  EXPECT_GE(checked, 3);
 }
 
 INSTANTIATE_TEST_SUITE_P(Photographs, EachPhotograph, ::testing::ValuesIn(photos()),
