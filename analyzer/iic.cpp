@@ -158,7 +158,13 @@ SurfaceLine surface_line(std::span<const float> rgb, const IicSettings& settings
   SurfaceLine line;
   const std::vector<Vec3> colours = surface_colours(rgb);
   if (colours.size() < settings.min_surface_pixels) return line;
-  const std::vector<Vec3> highlight = highlight_pixels(colours, diffuse_body(colours, settings), settings);
+  std::vector<Vec3> highlight = highlight_pixels(colours, diffuse_body(colours, settings), settings);
+  if (highlight.size() > settings.max_line_pixels) {  // thinned by an even stride (IicSettings::max_line_pixels)
+    std::vector<Vec3> kept;
+    kept.reserve(settings.max_line_pixels);
+    for (std::size_t k = 0; k < settings.max_line_pixels; ++k) kept.push_back(highlight[k * highlight.size() / settings.max_line_pixels]);
+    highlight = std::move(kept);
+  }
   line.outcome = highlight.empty() ? Outcome::NoHighlight : Outcome::TooFewHighlightPixels;
   if (highlight.size() < settings.min_line_pixels) return line;
   const std::optional<Fit> first = fit_line(highlight);
