@@ -353,10 +353,12 @@ void find_lights(const RgbImage& image, std::span<const Region> regions, std::ve
   if (found.lights.empty()) return;
   for (std::size_t p = 0; p < usable.size(); ++p)
     if (found.mask[p]) usable[p] = 0;
-  for (const LightInView& l : found.lights)
-    out.notes.push_back(fmt::format("{}: a light seen directly ({} pixels, up to {:.0f} times the image's median brightness), of "
-                                    "colour ({:.3f}, {:.3f}, {:.3f}): a reference, left out of every estimate", l.name, l.pixels,
-                                    l.brightness, l.rgb[0], l.rgb[1], l.rgb[2]));
+  // One note for them all: the table of estimates lists each with its colour.
+  std::string names;
+  for (const LightInView& l : found.lights) names += (names.empty() ? "" : ", ") + l.name;
+  out.notes.push_back(fmt::format("{} light{} seen directly ({}): at least {:.0f} times the image's median brightness, no surface; "
+                                  "references, left out of every estimate", found.lights.size(), found.lights.size() == 1 ? "" : "s",
+                                  names, kLightSeed));
   out.lights = found.lights;
   for (const Region& r : regions) {
     if (r.source == "image" || r.source == "unassigned" || r.pixels.empty()) continue;
@@ -369,9 +371,6 @@ void find_lights(const RgbImage& image, std::span<const Region> regions, std::ve
   }
 }
 
-// Each statistical method: the light's colour under its assumption about the world's surfaces. Its uncertainty
-// joins how far that assumption fails on real scenes (statistical_prior_deg) with the block bootstrap's spread —
-// how much the answer depends on which parts of the scene are in view.
 // The statistical methods read at most kStatisticalPixels: a larger image is reduced by averaging f × f blocks (a block
 // counts when all its pixels do). The mean is unchanged; the maxima and the edges become those of a coarser scale,
 // the scale of the test photographs (0.2 to 2 megapixels, but for the 8-megapixel raw file).
@@ -399,6 +398,9 @@ Reduced reduced(const RgbImage& image, std::span<const std::uint8_t> usable) {
   return r;
 }
 
+// Each statistical method: the light's colour under its assumption about the world's surfaces. Its uncertainty
+// joins how far that assumption fails on real scenes (method_prior_deg) with the block bootstrap's spread — how much
+// the answer depends on which parts of the scene are in view.
 void estimate_statistical(const RgbImage& full, std::span<const std::uint8_t> full_usable, IlluminantAnalysis& out) {
   const Reduced r = reduced(full, full_usable);
   const RgbImage& image = r.image;
@@ -471,8 +473,8 @@ std::string choice_text(const IlluminantAnalysis& out) {
     return fmt::format("{}, a statistical method: no physics estimate is reliable{}. It gives the light's colour if {}",
                        chosen.method, why_not, method == baseline_methods().end() ? "its assumption holds" : method->assumption);
   return fmt::format("{}, a statistical method: no physics estimate is reliable with a standard error within {:.1f}°{}. It "
-                     "gives the light's colour if {}; of the statistical methods it has the least median error on the test "
-                     "set of photographs, and its uncertainty (± {:.2f}°) is its error's spread there with the "
+                     "gives the light's colour if {}; the rule fitted on the test set of photographs falls back on it (the "
+                     "least mean error there), and its uncertainty (± {:.2f}°) is its error's spread there with the "
                      "bootstrap's over this image", chosen.method, rule.max_physics_sigma_deg, why_not,
                      method == baseline_methods().end() ? "its assumption holds" : method->assumption, sigma(chosen));
 }
