@@ -227,6 +227,14 @@ json shape_to_json(const ClusterShape& s) {
                 {"used", g.used}};
   });
   if (!s.unclipped.empty()) j["unclipped"] = shape_to_json(s.unclipped.front());
+  if (!s.clear_of_black.empty()) {
+    const ClusterShape& c = s.clear_of_black.front();
+    json levels = json::object();
+    for (std::size_t k = 0; k < 3; ++k)
+      if (!std::isnan(s.clear_levels[k])) levels[std::string(1, "RGB"[k])] = s.clear_levels[k];
+    j["clear_of_black"] = {{"levels", levels}, {"samples", c.samples},
+                           {"class", class_name(c.shape)}, {"dichromatic_plane", optional_json(c.black_plane, plane_json)}};
+  }
   return j;
 }
 

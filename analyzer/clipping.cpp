@@ -91,4 +91,37 @@ bool reaches_the_top(const Clipping& c) {
 
 bool only_at_black(const Clipping& c) { return !c.faces.empty() && !reaches_the_top(c); }
 
+ClearOfBlack clear_of_black(std::span<const float> rgb, const Clipping& clipping, const std::array<double, 3>& low) {
+  ClearOfBlack out;
+  const std::size_t n = rgb.size() / 3;
+  auto at_black = [&](std::size_t i, std::size_t c) { return rgb[3 * i + c] <= low[c]; };
+  std::vector<std::uint8_t> keep(n, 1);
+  std::vector<std::pair<double, std::uint32_t>> order(n);
+  for (const ClippedFace& f : clipping.faces) {
+    if (f.high) continue;
+    const std::size_t c = static_cast<std::size_t>(f.channel);
+    for (std::size_t i = 0; i < n; ++i)
+      order[i] = {rgb[3 * i + (c + 1) % 3] + rgb[3 * i + (c + 2) % 3], static_cast<std::uint32_t>(i)};
+    std::sort(order.begin(), order.end(), [](const auto& a, const auto& b) { return a.first > b.first || (a.first == b.first && a.second < b.second); });
+    // Bins of a 64th of the samples (at least 32): fine enough to place the level, large enough to count a share.
+    const std::size_t bin = std::max<std::size_t>(32, n / 64);
+    std::size_t clear = 0;
+    for (std::size_t start = 0; start < n; start += bin) {
+      const std::size_t end = std::min(n, start + bin);
+      std::size_t black = 0;
+      for (std::size_t k = start; k < end; ++k) black += at_black(order[k].second, c) ? 1 : 0;
+      if (static_cast<double>(black) > kClearShare * static_cast<double>(end - start)) break;
+      clear = end;
+    }
+    if (clear == 0) return out;
+    out.level[c] = order[clear - 1].first;
+    for (std::size_t k = clear; k < n; ++k) keep[order[k].second] = 0;
+  }
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!keep[i] || at_black(i, 0) || at_black(i, 1) || at_black(i, 2)) continue;
+    out.rgb.insert(out.rgb.end(), rgb.begin() + static_cast<std::ptrdiff_t>(3 * i), rgb.begin() + static_cast<std::ptrdiff_t>(3 * i + 3));
+  }
+  return out;
+}
+
 }  // namespace ct::analyzer

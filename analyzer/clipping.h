@@ -6,6 +6,7 @@
 
 #include <array>
 #include <cstdint>
+#include <limits>
 #include <span>
 #include <vector>
 
@@ -71,4 +72,20 @@ bool reaches_the_top(const Clipping& c);
 bool only_at_black(const Clipping& c);
 
 
+// The samples clear of black. A channel held at its lower limit lost the noise below it, so the samples just above
+// the limit are those whose noise happened to be positive: biased off the face, they tilt the cluster's plane, and
+// cutting at any level of that channel only moves the bias to the cut. The other two channels carry noise of their
+// own, so for each channel with a face at black the samples are ordered by the sum of the other two instead: going
+// down from the brightest, that channel starts to reach black at some level of the sum. Above every face channel's
+// level (where fewer than kClearShare of the samples reach black) the samples kept their whole noise; those, less the
+// few still at black, are clear. Empty when even the brightest samples reach black.
+inline constexpr double kClearShare = 0.01;
+struct ClearOfBlack {
+  std::vector<float> rgb;  // the samples clear of black, [i][channel]
+  // Per channel with a face at black: the level of the other two channels' sum above which it no longer reaches
+  // black; NaN for the other channels.
+  std::array<double, 3> level{std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::quiet_NaN(),
+                              std::numeric_limits<double>::quiet_NaN()};
+};
+ClearOfBlack clear_of_black(std::span<const float> rgb, const Clipping& clipping, const std::array<double, 3>& low);
 }  // namespace ct::analyzer

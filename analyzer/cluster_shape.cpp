@@ -149,6 +149,13 @@ class ShapeDecision {
   // clipped: enough samples on faces of the RGB cube; the rest is classified on its own.
   bool clipped() {
     s_.clipping = find_clipping(rgb_, context_.high_levels, context_.clipping);
+    ShapeContext inner = context_;
+    inner.criteria.clipped_fraction = 2.0;  // the unclipped part is judged on its shape alone
+    if (only_at_black(s_.clipping)) {
+      const ClearOfBlack clear = clear_of_black(rgb_, s_.clipping, context_.clipping.low);
+      if (!clear.rgb.empty()) s_.clear_of_black.push_back(analyse_shape(clear.rgb, inner));
+      s_.clear_levels = clear.level;
+    }
     if (!test("clipped fraction >= clipped_fraction", s_.clipping.fraction, k_.clipped_fraction,
               s_.clipping.fraction >= k_.clipped_fraction))
       return false;
@@ -156,24 +163,23 @@ class ShapeDecision {
     for (std::size_t i = 0; i < s_.samples; ++i)
       if (!s_.clipping.on_face[i])
         rest.insert(rest.end(), rgb_.begin() + static_cast<std::ptrdiff_t>(i * 3), rgb_.begin() + static_cast<std::ptrdiff_t>(i * 3 + 3));
-    ShapeContext inner = context_;
-    inner.criteria.clipped_fraction = 2.0;  // the unclipped part is judged on its shape alone
     ClusterShape off = analyse_shape(rest, inner);
     if (only_at_black(s_.clipping) &&
         test("faces only at black: clipped fraction < black_faces_fraction", s_.clipping.fraction, k_.black_faces_fraction,
              s_.clipping.fraction < k_.black_faces_fraction) &&
         off.samples > 0) {
-      // The cluster is its samples off the faces, with its clipping and all the decisions taken.
-      std::vector<Decision> decisions = std::move(s_.decisions);
-      decisions.insert(decisions.end(), off.decisions.begin(), off.decisions.end());
-      Clipping clipping = std::move(s_.clipping);
-      const std::size_t samples = s_.samples;
+      // The cluster is its samples off the faces, with its clipping, its samples clear of black and all the
+      // decisions taken.
+      ClusterShape whole = std::move(s_);
       s_ = std::move(off);
       s_.reason += fmt::format(" (read on its {} samples off the faces; {:.1f} % lie at black, on {} face{})", s_.samples,
-                               100 * clipping.fraction, clipping.faces.size(), clipping.faces.size() == 1 ? "" : "s");
-      s_.decisions = std::move(decisions);
-      s_.clipping = std::move(clipping);
-      s_.samples = samples;
+                               100 * whole.clipping.fraction, whole.clipping.faces.size(), whole.clipping.faces.size() == 1 ? "" : "s");
+      whole.decisions.insert(whole.decisions.end(), s_.decisions.begin(), s_.decisions.end());
+      s_.decisions = std::move(whole.decisions);
+      s_.clipping = std::move(whole.clipping);
+      s_.samples = whole.samples;
+      s_.clear_of_black = std::move(whole.clear_of_black);
+      s_.clear_levels = whole.clear_levels;
       return true;
     }
     s_.unclipped.push_back(std::move(off));

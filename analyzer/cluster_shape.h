@@ -130,6 +130,12 @@ struct ClusterShape {
   std::optional<PrincipalCurve> curve;
   std::optional<GammaFit> gamma;
   std::vector<ClusterShape> unclipped;  // for clipped clusters: the shape of the samples off the faces
+  // For clusters with faces only at black: the shape of the samples clear of black (analyzer/clipping.h), whose
+  // plane through black the truncated noise does not tilt, and per face channel the level of the other two
+  // channels' sum above which they lie (NaN for a channel without a face).
+  std::vector<ClusterShape> clear_of_black;
+  std::array<double, 3> clear_levels{std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::quiet_NaN(),
+                                     std::numeric_limits<double>::quiet_NaN()};
 };
 
 // The shape the light made, as far as it can be read: a clipped cluster's samples off its faces (`unclipped`)

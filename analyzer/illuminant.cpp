@@ -24,6 +24,17 @@ bool holds_a_plane(ShapeClass c) {
 
 constexpr double kDeg = 180.0 / std::numbers::pi;
 
+// "B once R + G passes 0.031": per channel with a level, the other two channels' sum above which it is clear of black.
+std::string clear_levels_text(const std::array<double, 3>& levels) {
+  std::string out;
+  for (std::size_t c = 0; c < 3; ++c) {
+    if (std::isnan(levels[c])) continue;
+    const std::size_t a = std::min((c + 1) % 3, (c + 2) % 3), b = std::max((c + 1) % 3, (c + 2) % 3);
+    out += fmt::format("{}{} once {} + {} passes {:.4g}", out.empty() ? "" : ", ", "RGB"[c], "RGB"[a], "RGB"[b], levels[c]);
+  }
+  return out;
+}
+
 // Standard error (radians) of a total-least-squares line's direction: the inliers' spread across it (rms distance,
 // over two axes) against their spread along it (taken as uniform over its extent), over √n.
 double line_direction_se(const Line& h) {
@@ -131,9 +142,16 @@ struct Evidence {
 bool told_from_body(const RegionAnalysis& r, const ClusterShape& s, std::vector<std::string>& notes) {
   const double turn = angular_error_deg(s.highlight_branch->direction, s.body_only->line.direction);
   if (turn > 2 * s.highlight_branch->uncertainty_deg) return true;
-  notes.push_back(fmt::format("{}: its highlight branch turns {:.1f}° from its body colour, within 2 × its standard "
-                              "error ({:.1f}°): it cannot be told from the body colour, so it is left out",
-                              r.name, turn, s.highlight_branch->uncertainty_deg));
+  const HighlightBranch& b = *s.highlight_branch;
+  // Say what made the error wide: the branch's lower and upper halves disagreeing (the shading, or another surface
+  // of the region, follows the highlight), or too few samples off the body line.
+  const std::string why = b.halves_deg / 2 > b.statistical_deg
+                              ? fmt::format(", most of it from its lower and upper halves, {:.1f}° apart: the shading or another "
+                                            "surface of the region follows the highlight", b.halves_deg)
+                              : fmt::format(", most of it statistical, from its {} samples off the body line", b.samples);
+  notes.push_back(fmt::format("{}: its highlight branch turns {:.1f}° from its body colour, within 2 × its standard error "
+                              "({:.1f}°{}): it cannot be told from the body colour, so it is left out",
+                              r.name, turn, b.uncertainty_deg, why));
   return false;
 }
 
@@ -191,10 +209,24 @@ Evidence gather_evidence(const std::vector<RegionAnalysis>& regions, const std::
       const ClippedFace& f = r.shape.clipping.faces.front();
       if (only_at_black(r.shape.clipping)) {
         // The samples left near a face at black are those whose noise happened to lie above it: biased off the face,
-        // they tilt the plane of the rest.
-        notes.push_back(fmt::format("{}: {:.1f} % of its pixels lie at black ({} low at {:.4g} …); the rest near them kept only "
-                                    "the noise above that level, which tilts its plane: left out of the planes' estimate",
-                                    r.name, 100 * r.shape.clipping.fraction, "RGB"[f.channel], f.level));
+        // they tilt the plane of the rest. The samples clear of black (clipping.h) are not, and hold the plane when
+        // they are enough to make one.
+        const ClusterShape* clear = r.shape.clear_of_black.empty() ? nullptr : &r.shape.clear_of_black.front();
+        const std::string at_black = fmt::format("{}: {:.1f} % of its pixels lie at black ({} low at {:.4g} …)", r.name,
+                                                 100 * r.shape.clipping.fraction, "RGB"[f.channel], f.level);
+        if (clear && holds_a_plane(clear->shape) && clear->black_plane) {
+          notes.push_back(fmt::format("{}; its plane is fitted on its {} samples clear of black, where no channel reaches it "
+                                      "any more ({})", at_black, clear->samples, clear_levels_text(r.shape.clear_levels)));
+          e.normals.push_back(clear->black_plane->normal);
+          e.normal_se.push_back(plane_normal_se(*clear, kNoiseFactor));
+          e.plane_regions.push_back(r.name);
+          continue;
+        }
+        notes.push_back(fmt::format("{}; the rest near them kept only the noise above that level, which tilts its plane, and "
+                                    "{}: left out of the planes' estimate", at_black,
+                                    clear ? fmt::format("its {} samples clear of black make a {} cluster, no plane", clear->samples,
+                                                        class_name(clear->shape))
+                                          : std::string("no samples are clear of black")));
         continue;
       }
       notes.push_back(fmt::format("{}: {:.1f} % of its pixels lie on clipping faces ({} {} at {:.4g} …), so its plane is "
@@ -355,10 +387,12 @@ void find_lights(const RgbImage& image, std::span<const Region> regions, std::ve
     if (found.mask[p]) usable[p] = 0;
   // One note for them all: the table of estimates lists each with its colour.
   std::string names;
-  for (const LightInView& l : found.lights) names += (names.empty() ? "" : ", ") + l.name;
-  out.notes.push_back(fmt::format("{} light{} seen directly ({}): at least {:.0f} times the image's median brightness, no surface; "
+  for (std::size_t k = 0; k < std::min(found.lights.size(), kLightsNamed); ++k) names += (names.empty() ? "" : ", ") + found.lights[k].name;
+  if (found.lights.size() > kLightsNamed) names += fmt::format(" and {} dimmer, listed in analysis.json", found.lights.size() - kLightsNamed);
+  out.notes.push_back(fmt::format("{} light{} seen directly or mirrored by a glossy surface ({}): at least {:.0f} times the image's "
+                                  "median brightness and {:.0f} times its 95th percentile, brighter than a surface they light; "
                                   "references, left out of every estimate", found.lights.size(), found.lights.size() == 1 ? "" : "s",
-                                  names, kLightSeed));
+                                  names, kLightSeed, kLightOverLit));
   out.lights = found.lights;
   for (const Region& r : regions) {
     if (r.source == "image" || r.source == "unassigned" || r.pixels.empty()) continue;
@@ -488,8 +522,8 @@ const ChoiceRule& choice_rule() {
 
 double method_prior_deg(const std::string& method) {
   static const std::vector<std::pair<std::string, double>> priors = {
-      {"dichromatic planes", 9.9}, {"highlight lines", 9.0}, {"inverse-intensity chromaticity", 12.9},
-      {"grey world", 8.3}, {"white patch", 11.7}, {"shades of grey", 7.2}, {"grey edge 1", 9.2}, {"grey edge 2", 10.5}};
+      {"dichromatic planes", 15.8}, {"highlight lines", 9.0}, {"inverse-intensity chromaticity", 12.9},
+      {"grey world", 8.2}, {"white patch", 11.0}, {"shades of grey", 5.3}, {"grey edge 1", 9.1}, {"grey edge 2", 10.5}};
   for (const auto& [name, sigma] : priors)
     if (name == method) return sigma;
   return 0.0;

@@ -21,13 +21,19 @@ LightsInView find_lights_in_view(const RgbImage& image, std::span<const std::uin
     if (std::isfinite(b) && b > 0 && (counted.empty() || counted[p])) values.push_back(b);
   }
   if (values.empty()) return out;
-  const auto mid = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
-  std::nth_element(values.begin(), mid, values.end());
-  out.median_brightness = *mid;
+  auto quantile = [&](double q) {
+    const auto at = values.begin() + static_cast<std::ptrdiff_t>(q * static_cast<double>(values.size() - 1));
+    std::nth_element(values.begin(), at, values.end());
+    return static_cast<double>(*at);
+  };
+  out.median_brightness = quantile(0.5);
+  out.lit_brightness = quantile(0.95);
   const double median = out.median_brightness;
+  out.seed_level = std::max(kLightSeed * median, kLightOverLit * out.lit_brightness);
+  const double grow_level = std::max(kLightGrow * median, out.lit_brightness);
   // Hysteresis: the components of the pixels above the lower level that hold a pixel above the upper one.
   cv::Mat grow(image.height, image.width, CV_8U);
-  for (std::size_t p = 0; p < n; ++p) grow.data[p] = brightness[p] >= kLightGrow * median ? 1 : 0;
+  for (std::size_t p = 0; p < n; ++p) grow.data[p] = brightness[p] >= grow_level ? 1 : 0;
   cv::Mat labels;
   const int count = cv::connectedComponents(grow, labels, 8, CV_32S);
   std::vector<std::size_t> brightest(static_cast<std::size_t>(count), n);
@@ -40,7 +46,7 @@ LightsInView find_lights_in_view(const RgbImage& image, std::span<const std::uin
   cv::Mat light = cv::Mat::zeros(image.height, image.width, CV_8U);
   std::vector<int> kept(static_cast<std::size_t>(count), 0);
   for (int l = 1; l < count; ++l)
-    if (brightest[static_cast<std::size_t>(l)] < n && brightness[brightest[static_cast<std::size_t>(l)]] >= kLightSeed * median)
+    if (brightest[static_cast<std::size_t>(l)] < n && brightness[brightest[static_cast<std::size_t>(l)]] >= out.seed_level)
       kept[static_cast<std::size_t>(l)] = 1;
   for (std::size_t p = 0; p < n; ++p) light.data[p] = kept[static_cast<std::size_t>(labels.at<int>(static_cast<int>(p)))] ? 255 : 0;
   cv::dilate(light, light, cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * kLightMargin + 1, 2 * kLightMargin + 1)));

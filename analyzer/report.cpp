@@ -297,11 +297,16 @@ std::string report_html(const AnalysisImage& input, const ImageAnalysis& a, std:
                                   (e->systematic.empty() ? "" : "Systematic: " + escape_html(e->systematic) + ". "),
                               against);
   }
-  for (const LightInView& l : il.lights)
-    illuminant += fmt::format("<tr><th>{}, seen directly</th><td>{}</td><td>a reference</td><td>a light in view ({} pixels, up to {:.0f} "
-                              "times the image's median brightness), left out of every estimate. {:.2f}° from the chosen "
-                              "estimate.</td></tr>", escape_html(l.name), rgb_text(l.rgb), l.pixels, l.brightness,
-                              angular_error_deg(l.rgb, il.best().rgb));
+  for (std::size_t k = 0; k < std::min(il.lights.size(), kLightsNamed); ++k) {
+    const LightInView& l = il.lights[k];
+    illuminant += fmt::format("<tr><th>{}, seen directly or mirrored</th><td>{}</td><td>a reference</td><td>a light in view or its "
+                              "mirror image ({} pixels, up to {:.0f} times the image's median brightness), left out of every "
+                              "estimate. {:.2f}° from the chosen estimate.</td></tr>", escape_html(l.name), rgb_text(l.rgb),
+                              l.pixels, l.brightness, angular_error_deg(l.rgb, il.best().rgb));
+  }
+  if (il.lights.size() > kLightsNamed)
+    illuminant += fmt::format("<tr><th>{} dimmer lights or mirror images</th><td></td><td></td><td>listed in analysis.json "
+                              "(lights_in_view), left out of every estimate</td></tr>", il.lights.size() - kLightsNamed);
   if (il.camera_white)
     illuminant += fmt::format("<tr><th>camera's as-shot white balance</th><td>{}</td><td>a reference</td><td>the light the camera "
                               "assumed, not a measurement</td></tr>", rgb_text(*il.camera_white));
