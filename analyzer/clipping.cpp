@@ -96,26 +96,52 @@ ClearOfBlack clear_of_black(std::span<const float> rgb, const Clipping& clipping
   const std::size_t n = rgb.size() / 3;
   auto at_black = [&](std::size_t i, std::size_t c) { return rgb[3 * i + c] <= low[c]; };
   std::vector<std::uint8_t> keep(n, 1);
-  std::vector<std::pair<double, std::uint32_t>> order(n);
+  std::vector<double> sum(n);
+  // The samples are ordered by the sum in kBuckets buckets, log-spaced over six decades below the largest sum (those
+  // below, and the sums at or under 0, share the lowest): linear time, and a level finer than a bin of samples.
+  constexpr int kBuckets = 4096;
+  std::vector<std::size_t> count(kBuckets), black(kBuckets);
   for (const ClippedFace& f : clipping.faces) {
     if (f.high) continue;
     const std::size_t c = static_cast<std::size_t>(f.channel);
-    for (std::size_t i = 0; i < n; ++i)
-      order[i] = {rgb[3 * i + (c + 1) % 3] + rgb[3 * i + (c + 2) % 3], static_cast<std::uint32_t>(i)};
-    std::sort(order.begin(), order.end(), [](const auto& a, const auto& b) { return a.first > b.first || (a.first == b.first && a.second < b.second); });
-    // Bins of a 64th of the samples (at least 32): fine enough to place the level, large enough to count a share.
-    const std::size_t bin = std::max<std::size_t>(32, n / 64);
-    std::size_t clear = 0;
-    for (std::size_t start = 0; start < n; start += bin) {
-      const std::size_t end = std::min(n, start + bin);
-      std::size_t black = 0;
-      for (std::size_t k = start; k < end; ++k) black += at_black(order[k].second, c) ? 1 : 0;
-      if (static_cast<double>(black) > kClearShare * static_cast<double>(end - start)) break;
-      clear = end;
+    double top = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+      sum[i] = static_cast<double>(rgb[3 * i + (c + 1) % 3]) + rgb[3 * i + (c + 2) % 3];
+      top = std::max(top, std::isfinite(sum[i]) ? sum[i] : 0.0);
     }
-    if (clear == 0) return out;
-    out.level[c] = order[clear - 1].first;
-    for (std::size_t k = clear; k < n; ++k) keep[order[k].second] = 0;
+    if (top <= 0) return out;
+    const double floor = top * 1e-6, decades = std::log(top / floor);
+    auto bucket = [&](double v) {
+      if (!(v > floor)) return 0;
+      return std::min(kBuckets - 1, static_cast<int>(std::log(v / floor) / decades * kBuckets));
+    };
+    std::fill(count.begin(), count.end(), 0);
+    std::fill(black.begin(), black.end(), 0);
+    for (std::size_t i = 0; i < n; ++i) {
+      const int b = bucket(sum[i]);
+      ++count[static_cast<std::size_t>(b)];
+      black[static_cast<std::size_t>(b)] += at_black(i, c) ? 1 : 0;
+    }
+    // From the top, bins of a 64th of the samples (at least 32; whole buckets): fine enough to place the level, large
+    // enough to count a share. The lowest bucket of the last bin that passes is where the channel is clear.
+    const std::size_t bin = std::max<std::size_t>(32, n / 64);
+    int clear_from = kBuckets;  // no bucket yet
+    std::size_t in_bin = 0, black_in_bin = 0;
+    for (int b = kBuckets - 1; b >= 0; --b) {
+      in_bin += count[static_cast<std::size_t>(b)];
+      black_in_bin += black[static_cast<std::size_t>(b)];
+      if (in_bin < bin && b > 0) continue;
+      if (static_cast<double>(black_in_bin) > kClearShare * static_cast<double>(in_bin)) break;
+      clear_from = b;
+      in_bin = black_in_bin = 0;
+    }
+    if (clear_from == kBuckets) return out;
+    double level = std::numeric_limits<double>::infinity();
+    for (std::size_t i = 0; i < n; ++i) {
+      if (bucket(sum[i]) < clear_from) keep[i] = 0;
+      else level = std::min(level, sum[i]);
+    }
+    out.level[c] = level;
   }
   for (std::size_t i = 0; i < n; ++i) {
     if (!keep[i] || at_black(i, 0) || at_black(i, 1) || at_black(i, 2)) continue;

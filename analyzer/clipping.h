@@ -76,7 +76,8 @@ bool only_at_black(const Clipping& c);
 // the limit are those whose noise happened to be positive: biased off the face, they tilt the cluster's plane, and
 // cutting at any level of that channel only moves the bias to the cut. The other two channels carry noise of their
 // own, so for each channel with a face at black the samples are ordered by the sum of the other two instead: going
-// down from the brightest, that channel starts to reach black at some level of the sum. Above every face channel's
+// down from the brightest (in log-spaced buckets of the sum, linear in time), that channel starts to reach black at
+// some level of the sum. Above every face channel's
 // level (where fewer than kClearShare of the samples reach black) the samples kept their whole noise; those, less the
 // few still at black, are clear. Empty when even the brightest samples reach black.
 inline constexpr double kClearShare = 0.01;
