@@ -416,7 +416,8 @@ json analysis_to_json(const ImageAnalysis& a, const std::vector<bool>& plotted) 
                json list = json::array();
                for (const LightInView& l : il.lights)
                  list.push_back({{"name", l.name}, {"x", l.x}, {"y", l.y}, {"rgb", vec(l.rgb)}, {"brightness", l.brightness},
-                                 {"pixels", l.pixels}, {"angle_to_chosen_deg", angular_error_deg(l.rgb, il.best().rgb)}});
+                                 {"pixels", l.pixels}, {"clipped_pixels", l.clipped},
+                                 {"angle_to_chosen_deg", angular_error_deg(l.rgb, il.best().rgb)}});
                return list;
              }()},
             {"light_regions", il.light_regions},

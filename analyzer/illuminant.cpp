@@ -128,6 +128,7 @@ struct Evidence {
   std::vector<double> line_weights, line_se, normal_se;
   std::vector<std::string> line_regions, plane_regions;
   bool line_fitted = false;  // a highlight line fitted across the highlight, not a branch's regression
+  std::size_t lines_left_out = 0;  // highlight lines or branches found but left out (each with a note)
 
   void add_line(const Vec3& direction, double weight, double se, const std::string& region) {
     line_directions.push_back(positive(direction));
@@ -169,8 +170,12 @@ bool add_highlight_line(const RegionAnalysis& r, const ClusterShape& s, const st
   if (clipped >= 0) {
     notes.push_back(fmt::format("{}: its highlight line ends at the clipping level of {} ({:.4g}), so it is left out of the "
                                 "highlight-line estimate", r.name, "RGB"[clipped], high_levels[clipped]));
+    ++e.lines_left_out;
   } else if (const auto& b = s.highlight_branch; b) {
-    if (!told_from_body(r, s, notes)) return false;
+    if (!told_from_body(r, s, notes)) {
+      ++e.lines_left_out;
+      return false;
+    }
     e.add_line(b->direction, static_cast<double>(b->samples), b->uncertainty_deg / kDeg, r.name);
   } else {
     e.add_line(h.direction, static_cast<double>(h.inliers), line_direction_se(h), r.name);
@@ -189,18 +194,22 @@ Evidence gather_evidence(const std::vector<RegionAnalysis>& regions, const std::
     if (r.source == "unassigned") continue;  // the pixels no segment holds: no one surface
     if (std::find(lights.begin(), lights.end(), r.name) != lights.end()) continue;  // a light seen directly
     // A cluster clipped only at black (its darkest pixels at the file's lowest value) keeps its highlight whole:
-    // its highlight line is read on the samples off the faces. Its plane is not (see below).
+    // its highlight line is read on the samples off the faces; its plane, on its samples clear of black (below).
     const ClusterShape& s = only_at_black(r.shape.clipping) ? off_the_faces(r.shape) : r.shape;
     if ((s.shape == ShapeClass::L || s.shape == ShapeClass::SkewedT || s.shape == ShapeClass::P) && s.two_lines &&
         !add_highlight_line(r, s, high_levels, e, notes))
       continue;
     // A planar cluster with a highlight branch (cluster_shape.h): several objects of one body colour with their
     // highlights. Its branch counts when no channel of it reaches a clipping level.
-    if (s.shape == ShapeClass::Planar && s.highlight_branch && told_from_body(r, s, notes)) {
-      if (!reaches_the_top(s.clipping))
+    if (s.shape == ShapeClass::Planar && s.highlight_branch) {
+      if (!told_from_body(r, s, notes)) {
+        ++e.lines_left_out;
+      } else if (!reaches_the_top(s.clipping)) {
         e.add_line(s.highlight_branch->direction, static_cast<double>(s.highlight_branch->samples), s.highlight_branch->uncertainty_deg / kDeg, r.name);
-      else
+      } else {
         notes.push_back(fmt::format("{}: its highlight branch reaches a clipping level, so it is left out of the highlight-line estimate", r.name));
+        ++e.lines_left_out;
+      }
     }
     if (!holds_a_plane(s.shape) || !s.black_plane) continue;
     // A cluster that reaches a face of the cube lost what lay beyond it: its plane through black is partly the
@@ -259,8 +268,12 @@ void finish(IlluminantAnalysis& out, IlluminantEstimate e, const Vec3& v, std::o
 // The highlight lines' weighted mean direction.
 void estimate_from_lines(const Evidence& e, IlluminantAnalysis& out) {
   if (e.line_regions.empty()) {
-    out.notes.push_back("no region is an L, skewed-T or P with a highlight line inside the clipping levels, nor a planar "
-                        "cluster with a highlight branch, so no highlight line gives the illuminant");
+    out.notes.push_back(e.lines_left_out
+                            ? fmt::format("the {} highlight line{} or branch{} found {} left out (above), so no highlight line "
+                                          "gives the illuminant", e.lines_left_out, e.lines_left_out == 1 ? "" : "s",
+                                          e.lines_left_out == 1 ? "" : "es", e.lines_left_out == 1 ? "is" : "are")
+                            : "no region is an L, skewed-T or P with a highlight line, nor a planar cluster with a highlight "
+                              "branch, so no highlight line gives the illuminant");
     return;
   }
   IlluminantEstimate lines;
@@ -380,8 +393,9 @@ std::vector<std::uint8_t> usable_pixels(const RgbImage& image, const IlluminantC
 
 // The lights seen directly: their pixels are taken out of `usable`, and the regions that are mostly light pixels
 // are named (left out of the dichromatic evidence).
-void find_lights(const RgbImage& image, std::span<const Region> regions, std::vector<std::uint8_t>& usable, IlluminantAnalysis& out) {
-  const LightsInView found = find_lights_in_view(image, usable);
+void find_lights(const RgbImage& image, std::span<const Region> regions, const std::array<double, 3>& high_levels,
+                 std::vector<std::uint8_t>& usable, IlluminantAnalysis& out) {
+  const LightsInView found = find_lights_in_view(image, usable, high_levels);
   if (found.lights.empty()) return;
   for (std::size_t p = 0; p < usable.size(); ++p)
     if (found.mask[p]) usable[p] = 0;
@@ -556,7 +570,7 @@ IlluminantAnalysis estimate_illuminant(const std::vector<RegionAnalysis>& region
   if (context.camera_white) out.camera_white = context.camera_white->normalized();
   const std::string& assumed_curve = context.assumed_curve;
   std::vector<std::uint8_t> usable = usable_pixels(image, context);
-  find_lights(image, context.pixels, usable, out);
+  find_lights(image, context.pixels, context.high_levels, usable, out);
   const Evidence evidence = gather_evidence(regions, context.high_levels, out.light_regions, out.notes);
   estimate_from_lines(evidence, out);
   estimate_from_planes(evidence, out);

@@ -9,7 +9,7 @@
 
 namespace ct::analyzer {
 
-LightsInView find_lights_in_view(const RgbImage& image, std::span<const std::uint8_t> counted) {
+LightsInView find_lights_in_view(const RgbImage& image, std::span<const std::uint8_t> counted, const std::array<double, 3>& high_levels) {
   LightsInView out;
   const std::size_t n = image.pixel_count();
   out.mask.assign(n, 0);
@@ -63,6 +63,7 @@ LightsInView find_lights_in_view(const RgbImage& image, std::span<const std::uin
     ++f.pixels;
     const Vec3 v(image.rgb[3 * p], image.rgb[3 * p + 1], image.rgb[3 * p + 2]);
     if (v.allFinite()) f.rgb += v;
+    if (v[0] >= high_levels[0] || v[1] >= high_levels[1] || v[2] >= high_levels[2]) ++f.clipped;
     std::size_t& b = peak[static_cast<std::size_t>(l - 1)];
     if (b == n || brightness[p] > brightness[b]) b = p;
   }

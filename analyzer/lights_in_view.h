@@ -23,7 +23,9 @@
 // cannot be told from a white surface by its brightness: in an 8-bit file, whose range is some 20 to 50 times its
 // median, a lamp is either clipped (and left out as such) or not found.
 
+#include <array>
 #include <cstdint>
+#include <limits>
 #include <span>
 #include <string>
 #include <vector>
@@ -47,6 +49,7 @@ struct LightInView {
   Vec3 rgb = Vec3::Zero();  // its mean colour, unit
   double brightness = 0;    // its brightest pixel's brightness over the image's median (brightness: the mean of R, G, B)
   std::size_t pixels = 0;   // with the margin
+  std::size_t clipped = 0;  // of those, at or above a channel's known clipping level: its colour is then cut, no reference
 };
 
 struct LightsInView {
@@ -58,7 +61,12 @@ struct LightsInView {
 };
 
 // `rgb`: width × height × 3 linear values; `counted` (empty: every finite pixel) marks the pixels whose brightness
-// makes the image's median (not clipped, not black). Lights are sought among every finite pixel.
-LightsInView find_lights_in_view(const RgbImage& image, std::span<const std::uint8_t> counted);
+// makes the image's median (not clipped, not black). Lights are sought among every finite pixel; `high_levels` are
+// the channels' known clipping levels (a camera's white level, an integer file's full scale; +∞ where none is
+// known), at which a light's pixels count as clipped.
+LightsInView find_lights_in_view(const RgbImage& image, std::span<const std::uint8_t> counted,
+                                 const std::array<double, 3>& high_levels = {std::numeric_limits<double>::infinity(),
+                                                                             std::numeric_limits<double>::infinity(),
+                                                                             std::numeric_limits<double>::infinity()});
 
 }  // namespace ct::analyzer

@@ -299,10 +299,13 @@ std::string report_html(const AnalysisImage& input, const ImageAnalysis& a, std:
   }
   for (std::size_t k = 0; k < std::min(il.lights.size(), kLightsNamed); ++k) {
     const LightInView& l = il.lights[k];
-    illuminant += fmt::format("<tr><th>{}, seen directly or mirrored</th><td>{}</td><td>a reference</td><td>a light in view or its "
+    // A light clipped in a channel has lost that channel's top: its colour is cut, not the light's.
+    const std::string what = l.clipped ? fmt::format("clipped in {} of its pixels: its colour is cut, no reference", l.clipped)
+                                       : std::string("a reference");
+    illuminant += fmt::format("<tr><th>{}, seen directly or mirrored</th><td>{}</td><td>{}</td><td>a light in view or its "
                               "mirror image ({} pixels, up to {:.0f} times the image's median brightness), left out of every "
                               "estimate. {:.2f}° from the chosen estimate.</td></tr>", escape_html(l.name), rgb_text(l.rgb),
-                              l.pixels, l.brightness, angular_error_deg(l.rgb, il.best().rgb));
+                              what, l.pixels, l.brightness, angular_error_deg(l.rgb, il.best().rgb));
   }
   if (il.lights.size() > kLightsNamed)
     illuminant += fmt::format("<tr><th>{} dimmer lights or mirror images</th><td></td><td></td><td>listed in analysis.json "

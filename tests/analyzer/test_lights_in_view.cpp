@@ -83,6 +83,17 @@ TEST(LightsInView, ADarkBackgroundDoesNotMakeTheLitSurfacesLights) {
   for (std::size_t q = 0; q < 800; ++q) EXPECT_EQ(found.mask[q], 0) << "the napkin's pixel " << q;
 }
 
+// A lamp that reaches a channel's clipping level has lost that channel's top: its pixels there are counted, and it is
+// no reference.
+TEST(LightsInView, AClippedLampCountsItsClippedPixels) {
+  Painter p(200, 100, 0.1f);
+  p.fill(120, 40, 126, 44, 120.0f, 100.0f, 80.0f);
+  EXPECT_EQ(find_lights_in_view(p.image, {}).lights.front().clipped, 0u);  // no level known: nothing clipped
+  const LightsInView found = find_lights_in_view(p.image, {}, {110.0, 1e9, 1e9});
+  ASSERT_EQ(found.lights.size(), 1u);
+  EXPECT_EQ(found.lights.front().clipped, 24u);  // the lamp's 6 × 4 pixels reach red's level, its margin does not
+}
+
 TEST(LightsInView, NoLightInAFlatImage) {
   Painter p(50, 50, 0.2f);
   const LightsInView found = find_lights_in_view(p.image, {});

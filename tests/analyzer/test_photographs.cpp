@@ -917,6 +917,16 @@ TEST(LightColour, TheWholeStillLifeSaysWhatItsHighlightsGive) {
     });
     ASSERT_NE(why, il.notes.end()) << bagel_name << " holds most of the bagel; no note says why its highlight is not used";
     std::cerr << "the bagel: " << *why << "\n";
+    // The summary counts the highlight lines and branches left out, each with its own note.
+    std::size_t left_out = 0;
+    for (const std::string& n : il.notes)
+      left_out += n.find(": its highlight branch turns") != std::string::npos ||
+                  n.find(": its highlight line ends at the clipping level") != std::string::npos ||
+                  n.find(": its highlight branch reaches a clipping level") != std::string::npos;
+    EXPECT_NE(std::find(il.notes.begin(), il.notes.end(),
+                        fmt::format("the {} highlight lines or branches found are left out (above), so no highlight line gives "
+                                    "the illuminant", left_out)),
+              il.notes.end());
   }
 }
 
