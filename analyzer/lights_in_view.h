@@ -15,13 +15,13 @@
 // A light is a connected set of pixels at least kLightSeed times the median and kLightOverLit times the 95th
 // percentile, grown (by hysteresis, as Canny grows edges) over its neighbours at least kLightGrow times the median and
 // above the 95th percentile — the glow around a sun, a lamp's rim — and then by kLightMargin pixels, where the
-// light's edge mixes with what lies behind it. A glossy surface mirrors a light at a few per cent of its radiance (a dielectric's Fresnel
-// reflectance), so the mirror image of a small bright light can pass too: the core of a glazed bagel's highlight under
-// an oil lamp is 64 times the 95th percentile. Either way it shows the light's colour whole, with no body colour:
-// every estimate of the light's colour leaves its pixels out, and it stands beside them as a reference, its colour
-// the mean of its pixels'. A region keeps them in its cluster unless they make most of it. A light dimmer than that
-// cannot be told from a white surface by its brightness: in an 8-bit file, whose range is some 20 to 50 times its
-// median, a lamp is either clipped (and left out as such) or not found.
+// light's edge mixes with what lies behind it. A glossy surface mirrors a light at a few per cent of its radiance
+// (a dielectric's Fresnel reflectance), so the mirror image of a small bright light can pass too: the core of a glazed
+// bagel's highlight under an oil lamp is 28 times the 95th percentile. Either way it shows the light's colour whole,
+// with no body colour: every estimate of the light's colour leaves its pixels out, and it stands beside them as a
+// reference, its colour the mean of its pixels'. A region keeps them in its cluster unless they make most of it. A
+// light dimmer than that cannot be told from a white surface by its brightness: in an 8-bit file, whose range is
+// some 20 to 50 times its median, a lamp is either clipped (and left out as such) or not found.
 
 #include <array>
 #include <cstdint>
