@@ -97,6 +97,7 @@ ClearOfBlack clear_of_black(std::span<const float> rgb, const Clipping& clipping
   auto at_black = [&](std::size_t i, std::size_t c) { return rgb[3 * i + c] <= low[c]; };
   std::vector<std::uint8_t> keep(n, 1);
   std::vector<double> sum(n);
+  std::vector<int> bucket_of(n);
   // The samples are ordered by the sum in kBuckets buckets, log-spaced over six decades below the largest sum (those
   // below, and the sums at or under 0, share the lowest): linear time, and a level finer than a bin of samples.
   constexpr int kBuckets = 4096;
@@ -118,7 +119,7 @@ ClearOfBlack clear_of_black(std::span<const float> rgb, const Clipping& clipping
     std::fill(count.begin(), count.end(), 0);
     std::fill(black.begin(), black.end(), 0);
     for (std::size_t i = 0; i < n; ++i) {
-      const int b = bucket(sum[i]);
+      const int b = bucket_of[i] = bucket(sum[i]);
       ++count[static_cast<std::size_t>(b)];
       black[static_cast<std::size_t>(b)] += at_black(i, c) ? 1 : 0;
     }
@@ -138,7 +139,7 @@ ClearOfBlack clear_of_black(std::span<const float> rgb, const Clipping& clipping
     if (clear_from == kBuckets) return out;
     double level = std::numeric_limits<double>::infinity();
     for (std::size_t i = 0; i < n; ++i) {
-      if (bucket(sum[i]) < clear_from) keep[i] = 0;
+      if (bucket_of[i] < clear_from) keep[i] = 0;
       else level = std::min(level, sum[i]);
     }
     out.level[c] = level;
