@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "calibrate/calibration.h"
 
+#include <algorithm>
 #include <cmath>
 #include <map>
 
@@ -93,6 +94,19 @@ Calibration calibrate(const CalibrationInput& input) {
                                      "cancels the fixed pattern)",
                                      kind == 0 ? "--flat" : "--dark", sets[static_cast<std::size_t>(kind)].size(),
                                      kind == 0 ? "flat" : "dark", sets[static_cast<std::size_t>(kind)].size() == 1 ? "" : "s", t));
+
+  // A frame grabber that hands the same buffer twice makes a pair of one image: its difference holds no noise.
+  for (const auto& [t, sets] : by_time)
+    for (int kind = 0; kind < 2; ++kind) {
+      const std::vector<Frame>& set = sets[static_cast<std::size_t>(kind)];
+      for (std::size_t a = 0; a < set.size(); ++a)
+        for (std::size_t b = a + 1; b < set.size(); ++b)
+          if (std::equal(set[a].channels.begin(), set[a].channels.end(), set[b].channels.begin(),
+                         [](const Plane& x, const Plane& y) { return x.values == y.values; }))
+            throw InputError(fmt::format("{}: the same image as {} (both {} frames at {} s): the frames of a pair must be two "
+                                         "exposures, whose difference holds the temporal noise",
+                                         set[b].file, set[a].file, kind == 0 ? "flat" : "dark", t));
+    }
 
   Calibration result;
   result.flats = input.flats.size();

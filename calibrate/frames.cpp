@@ -2,6 +2,7 @@
 #include "calibrate/frames.h"
 
 #include <cmath>
+#include <string>
 
 #include <fmt/format.h>
 #include <OpenImageIO/imageio.h>
@@ -22,7 +23,9 @@ std::optional<double> recorded_exposure(const std::filesystem::path& file) {
     return std::nullopt;
   }
   const OIIO::ImageSpec& spec = in->spec();
-  if (const float t = spec.get_float_attribute("ExposureTime", 0.0f); t > 0) return static_cast<double>(t);
+  // EXIF's time is a float here: read as the decimal it is the nearest float to (0.0012, not 0.0012000000569969416),
+  // so that it prints as the camera wrote it.
+  if (const float t = spec.get_float_attribute("ExposureTime", 0.0f); t > 0) return std::stod(fmt::format("{}", t));
   const std::string sensor = spec.get_string_attribute("chromatrace.sensor");
   if (!sensor.empty()) {
     const Json j = Json::parse(sensor, nullptr, false);

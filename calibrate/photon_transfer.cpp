@@ -148,11 +148,29 @@ ChannelCalibration calibrate_channel(const std::string& channel, const std::vect
     c.points.push_back({s.exposure_s, s.photons_per_pixel, flat.back().mean, flat.back().variance, dark.back().mean, dark.back().variance});
   }
 
+  // Flats no brighter than the darks (by 3 standard errors of the mean at every exposure) show no light at all.
+  bool none_brighter = true;
+  for (std::size_t k = 0; k < steps.size(); ++k)
+    none_brighter = none_brighter && !(flat[k].mean - dark[k].mean > 3 * std::sqrt((flat[k].variance + dark[k].variance) / static_cast<double>(n)));
+  if (none_brighter)
+    throw InputError(fmt::format("channel {}: no flat is brighter than the dark frames of its exposure time (by 3 standard errors of "
+                                 "the mean): are the flats dark frames?",
+                                 channel));
+
   // Saturation: where the temporal variance of the flats is largest. A series whose last step is the largest has
   // not shown it.
   const auto top = static_cast<std::size_t>(std::max_element(flat.begin(), flat.end(), [](const Temporal& a, const Temporal& b) {
                                               return a.variance < b.variance;
                                             }) - flat.begin());
+  // Every exposure beyond saturation, each pixel clipped: the flats' temporal variance no more than twice the darks'
+  // (as for the clip level below) while they are brighter.
+  bool all_clipped = true;
+  for (std::size_t k = 0; k < steps.size(); ++k)
+    all_clipped = all_clipped && flat[k].variance <= 2 * dark[k].variance && flat[k].mean > dark[k].mean;
+  if (all_clipped)
+    throw InputError(fmt::format("channel {}: every exposure clips every pixel (the flats' temporal variance is no more than twice "
+                                 "the dark frames'); add shorter exposures, from a few per cent of saturation",
+                                 channel));
   if (top + 1 == steps.size())
     throw InputError(fmt::format("channel {}: no exposure saturates (the flats' temporal variance still grows at the longest, "
                                  "{} s); add exposures up to and beyond saturation",
@@ -169,11 +187,22 @@ ChannelCalibration calibrate_channel(const std::string& channel, const std::vect
       y.push_back(flat[k].variance - dark[k].variance);
     }
   }
-  if (x.size() < 3)
+  if (x.size() < 3) {
+    // Why there are so few: saturation at the shortest exposure, or too few steps below 70 % of it.
+    if (top == 0)
+      throw InputError(fmt::format("channel {}: the shortest exposure, {} s, already saturates (its flats' temporal variance is "
+                                   "the largest of the series); add shorter exposures",
+                                   channel, steps[0].exposure_s));
     throw InputError(fmt::format("channel {}: {} exposure{} between black and 70 % of saturation; the gain needs at least three",
                                  channel, x.size(), x.size() == 1 ? "" : "s"));
+  }
   const LineFit gain = fit_line(x, y, true);
   const double K = gain.slope;
+  // A gain is a measurement only when it is positive and well away from zero: three standard errors.
+  if (!(K > 3 * gain.slope_se))
+    throw InputError(fmt::format("channel {}: the photon transfer gives a gain of {:.4g} ± {:.2g} DN/e⁻, which is no measurement: "
+                                 "the flats' temporal variance does not grow in proportion to their signal",
+                                 channel, K, gain.slope_se));
   c.gain_dn_per_e = {K, gain.slope_se};
   auto relative = [](double se, double value) { return value != 0 ? se / std::abs(value) : 0.0; };
   const double rK = relative(gain.slope_se, K);

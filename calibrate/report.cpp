@@ -37,8 +37,16 @@ class Plot {
     for (const Series& s : series_)
       for (const auto& [x, y] : s.xy)
         if (usable(x, log_x_) && usable(y, log_y_)) x0 = std::min(x0, x), x1 = std::max(x1, x), y0 = std::min(y0, y), y1 = std::max(y1, y);
-    if (!(x0 < x1)) x0 = 0, x1 = 1;
-    if (!(y0 < y1)) y0 = 0, y1 = 1;
+    // Fewer than two distinct values: a decade either side of the one there is, or [1, 10] on a logarithmic axis
+    // (whose ticks need a positive range), [0, 1] on a linear one.
+    auto widen = [](double& lo, double& hi, bool log) {
+      if (lo < hi) return;
+      const bool one = std::isfinite(lo) && (!log || lo > 0);
+      if (log) lo = one ? lo / 10 : 1, hi = one ? hi * 10 : 10;
+      else lo = one ? lo - 1 : 0, hi = one ? hi + 1 : 1;
+    };
+    widen(x0, x1, log_x_);
+    widen(y0, y1, log_y_);
     if (!log_x_) x0 = std::min(x0, 0.0);
     if (!log_y_) y0 = std::min(y0, 0.0);
     const Axis ax = axis(x0, x1, log_x_), ay = axis(y0, y1, log_y_);
@@ -255,13 +263,15 @@ std::vector<std::pair<std::string, std::string>> report_plots(const Calibration&
           {"dark_signal.svg", dark_signal(calibration)}};
 }
 
-void write_report(const Calibration& calibration, const std::filesystem::path& directory) {
-  StagedDirectory staged(directory, {"index.html"});
+std::vector<std::string> report_files() {
+  return {"index.html", "calibration.json", "photon_transfer.svg", "snr.svg", "linearity.svg", "dark_signal.svg"};
+}
+
+void write_report(const Calibration& calibration, const std::filesystem::path& staging) {
   const auto plots = report_plots(calibration);
-  write_text(staged.path() / "calibration.json", calibration.report.dump(2) + "\n");
-  for (const auto& [name, svg] : plots) write_text(staged.path() / name, svg);
-  write_text(staged.path() / "index.html", page(calibration, plots));
-  staged.commit();
+  write_text(staging / "calibration.json", calibration.report.dump(2) + "\n");
+  for (const auto& [name, svg] : plots) write_text(staging / name, svg);
+  write_text(staging / "index.html", page(calibration, plots));
 }
 
 }  // namespace ct::calibrate

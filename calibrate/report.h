@@ -16,7 +16,10 @@ namespace ct::calibrate {
 // The plots as SVG documents, by file name (photon_transfer.svg, …).
 std::vector<std::pair<std::string, std::string>> report_plots(const Calibration& calibration);
 
-// Writes the report into `directory` (which must not exist or be empty), staged and renamed into place.
-void write_report(const Calibration& calibration, const std::filesystem::path& directory);
+// The files the report writes (index.html, calibration.json and the plots).
+std::vector<std::string> report_files();
+
+// Writes the report's files into `staging`, a StagedDirectory's path (core/file_io.h), which the caller commits.
+void write_report(const Calibration& calibration, const std::filesystem::path& staging);
 
 }  // namespace ct::calibrate

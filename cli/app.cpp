@@ -95,7 +95,11 @@ std::optional<int> parse_command_line(CLI::App& app, int argc, char** argv) {
   } catch (const CLI::CallForVersion& e) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
-    fmt::print(stderr, "chromatrace: error: {}\n", one_line(e.what()));
+    // Named by the subcommand it is an error of (refuse_unknown_command has checked the name), as its other errors
+    // are.
+    const bool command = argc >= 2 && argv[1][0] != '-';
+    fmt::print(stderr, "chromatrace{}{}: error: {}\n", command ? " " : "", command ? one_line(argv[1]) : "",
+               one_line(e.what()));
     return 2;
   }
   return std::nullopt;

@@ -2,6 +2,7 @@
 // chromatrace calibrate --flat F… --dark D… -o CAMERA.json: a camera's EMVA 1288 parameters from a photon-transfer
 // series, as sensor settings the simulator takes and (--report) every estimate per channel with its standard error.
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -48,10 +49,16 @@ Action add_calibrate(CLI::App& app) {
     if (!o->report.empty()) outputs.emplace_back(o->report);
     check_distinct_outputs(outputs);
     check_output_file(o->output, inputs);
-    if (!o->report.empty()) check_output_directory(o->report, inputs);
+    if (!o->report.empty()) check_output_directory(o->report, inputs, calibrate::report_files());
     const calibrate::Calibration c = calibrate::calibrate(input);
-    if (!o->report.empty()) calibrate::write_report(c, o->report);
+    // Both outputs or neither: each staged in full before either is moved into place.
+    std::optional<StagedDirectory> report;
+    if (!o->report.empty()) {
+      report.emplace(o->report, std::vector<std::string>{"index.html"});
+      calibrate::write_report(c, report->path());
+    }
     write_file_atomically(o->output, c.sensor.dump(2) + "\n");
+    if (report) report->commit();
     if (!o->quiet)
       for (const calibrate::ChannelCalibration& ch : c.channels)
         fmt::print(stderr, "{}: K {:.5g} ± {:.2g} DN/e-, dark noise {:.4g} ± {:.2g} e-, saturation {:.6g} e-, dark current {:.4g} e-/s, "

@@ -237,9 +237,12 @@ std::string verdict(const Comparison& c, std::size_t max_lines) {
   if (c.failed == 0) {
     out += fmt::format("  AGREE: all {} cells (object × component × band) within tolerance ({}, + {:g} SE)", c.cells.size(),
                        c.tolerance_mode, c.sigmas);
-    if (!cells.empty())
-      out += fmt::format("; largest |z| {} ({} {} {})", z_text(cells.front()->z), cells.front()->object,
-                         cells.front()->component, band_label(*cells.front()));
+    // The largest finite |z|: a cell exact on both sides (a lamp seen directly, no standard error) whose values differ
+    // has an infinite z, passes on the tolerance alone and is not quoted.
+    const auto noisy = std::find_if(cells.begin(), cells.end(), [](const Cell* cell) { return std::isfinite(cell->z); });
+    if (noisy != cells.end())
+      out += fmt::format("; largest |z| {} ({} {} {})", z_text((*noisy)->z), (*noisy)->object, (*noisy)->component,
+                         band_label(**noisy));
     out += "\n";
     return out;
   }

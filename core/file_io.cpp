@@ -208,9 +208,14 @@ void check_output_file(const fs::path& output, const std::vector<fs::path>& inpu
   check_writable_directory(output, parent);
 }
 
-void check_output_directory(const fs::path& directory, const std::vector<fs::path>& inputs) {
+void check_output_directory(const fs::path& directory, const std::vector<fs::path>& inputs, const std::vector<std::string>& written) {
   check_name_length(directory);
   check_not_an_input(directory, inputs);
+  for (const std::string& name : written)
+    for (const fs::path& input : inputs)
+      if (!input.empty() && same_file(directory / name, input))
+        throw InputError(fmt::format("{}: is the input {}; writing {} there would destroy the input",
+                                     (directory / name).string(), input.string(), name));
   std::error_code error;
   if (fs::exists(directory, error) && !fs::is_directory(directory, error))
     throw InputError(fmt::format("{}: exists and is not a directory", directory.string()));

@@ -60,9 +60,11 @@ void check_not_an_input(const std::filesystem::path& output, const std::vector<s
 void check_output_file(const std::filesystem::path& output, const std::vector<std::filesystem::path>& inputs = {});
 
 // What an output directory may be: nothing yet (its parent must exist) or a directory. InputError naming
-// `directory` otherwise, or when it is one of `inputs`.
+// `directory` otherwise, or when it is one of `inputs`, or when one of `inputs` lies in it under a name in `written`
+// (the files the command writes there, which would replace it).
 void check_output_directory(const std::filesystem::path& directory,
-                            const std::vector<std::filesystem::path>& inputs = {});
+                            const std::vector<std::filesystem::path>& inputs = {},
+                            const std::vector<std::string>& written = {});
 
 // The file a write to `path` lands in: `path` with the symbolic links of its last component followed (a
 // link's target relative to the link's directory); `path` itself when it is not a link. InputError on a

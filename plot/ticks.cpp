@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 #include <string_view>
 
 #include <fmt/core.h>
@@ -51,6 +52,8 @@ std::string tick_label(double value, double step) {
 }
 
 std::vector<double> log_ticks(double lo, double hi) {
+  if (!(lo > 0 && lo <= hi && std::isfinite(hi)))
+    throw std::invalid_argument(fmt::format("log_ticks: the range [{}, {}] is not a range of positive numbers", lo, hi));
   std::vector<double> ticks;
   const bool fine = std::log10(hi) - std::log10(lo) < 3;
   for (int e = static_cast<int>(std::floor(std::log10(lo))); e <= static_cast<int>(std::ceil(std::log10(hi))); ++e)

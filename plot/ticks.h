@@ -41,7 +41,7 @@ std::string tick_label(double value, double step);
 
 // The ticks of a logarithmic axis over [lo, hi] (0 < lo < hi): the powers of ten inside, and 2 and 5 times them
 // when the range spans fewer than three decades; when fewer than two fall inside, the powers of ten just
-// outside both ends.
+// outside both ends. std::invalid_argument for any other range (a non-positive lo would never end).
 std::vector<double> log_ticks(double lo, double hi);
 
 // A tick value of a logarithmic axis: as a plain number from 0.01 to 1000 ("0.05", "200"), else in powers of

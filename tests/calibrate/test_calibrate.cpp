@@ -11,6 +11,7 @@
 #include <fstream>
 #include <filesystem>
 #include <numbers>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -154,6 +155,9 @@ TEST_F(Calibrate, RecoversAStrongColumnPatternApartFromThePixelsFromCameraRaw) {
   // A DNG has no ADC bits, only its white level (here black + K × full well = 7700): the fewest bits that hold it.
   EXPECT_EQ(s["adc"]["bits"].get<int>(), 13);
   EXPECT_NO_THROW(test::config_of(s));
+  // EXIF's exposure time, a float in the file, is read as the decimal written (0.04 s, not 0.03999999910593033 s).
+  ASSERT_EQ(cal.channels[1].points.size(), kExposureShares.size());
+  for (std::size_t k = 0; k < kExposureShares.size(); ++k) EXPECT_EQ(cal.channels[1].points[k].exposure_s, kExposureShares[k]);
 
   // A frame of another mosaic (BGGR: its "red" plane holds other photosites) is refused by name.
   Json patch = {{"exposure", {{"time_s", 0.04}}}, {"noise", {{"enabled", true}}}, {"adc", {{"enabled", true}}},
@@ -225,8 +229,13 @@ TEST_F(Calibrate, TheCommandWritesSettingsTheSensorTakesAndRefusesSeriesThatCann
       {one_flat_less, in.darks, "--flat: 1 flat frame at 0.04 s"},
       {in.flats, only(in.darks, {0.04, 0.11}), "--dark: 0 dark frames at 0.18 s"},
       {only(in.flats, unsaturated), only(in.darks, unsaturated), "no exposure saturates"},
-      {only(in.flats, {0.94, 0.97, 1.0, 1.03, 1.3, 1.6}), only(in.darks, {0.94, 0.97, 1.0, 1.03, 1.3, 1.6}),
+      {only(in.flats, {0.25, 0.67, 0.94, 0.97, 1.0, 1.03, 1.3, 1.6}), only(in.darks, {0.25, 0.67, 0.94, 0.97, 1.0, 1.03, 1.3, 1.6}),
        "between black and 70 % of saturation; the gain needs at least three"},
+      // The brightest pixels clip first (PRNU), so the temporal variance peaks at 0.94 of the full well's exposure.
+      {only(in.flats, {0.94, 0.97, 1.0, 1.03, 1.3, 1.6}), only(in.darks, {0.94, 0.97, 1.0, 1.03, 1.3, 1.6}),
+       "the shortest exposure, 0.94 s, already saturates"},
+      {only(in.flats, {1.3, 1.6}), only(in.darks, {1.3, 1.6}), "every exposure clips every pixel"},
+      {in.darks, in.darks, "no flat is brighter than the dark frames of its exposure time"},
   };
   for (const Case& k : cases) {
     const auto r = test::run_chromatrace(calibrate_args(k.flats, k.darks, bad));
@@ -254,6 +263,77 @@ TEST_F(Calibrate, TheCommandWritesSettingsTheSensorTakesAndRefusesSeriesThatCann
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.err.find(mosaic.string() + ": its pixels were interpolated from a colour filter array"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(bad));
+
+  // A frame grabber that hands one buffer twice: each exposure's second flat a copy of its first. Refused naming both
+  // files, with the report asked for too (its photon transfer would have no noise to plot), and nothing written.
+  std::vector<fs::path> copied;
+  for (const double share : kExposureShares) {
+    const std::vector<fs::path> pair = only(in.flats, {share});
+    ASSERT_EQ(pair.size(), 2u);
+    const fs::path copy = dir_.file(fmt::format("copy-{}.exr", share));
+    fs::copy_file(pair[0], copy);
+    copied.insert(copied.end(), {pair[0], copy});
+  }
+  const fs::path bad_report = dir_.file("bad-report");
+  std::vector<std::string> copied_args = calibrate_args(copied, in.darks, bad);
+  copied_args.insert(copied_args.end(), {"--report", bad_report.string()});
+  r = test::run_chromatrace(copied_args);
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find(fmt::format("copy-{}.exr: the same image as {} (both flat frames at", kExposureShares[0],
+                                   only(in.flats, {kExposureShares[0]})[0].string())),
+            std::string::npos) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  EXPECT_FALSE(fs::exists(bad));
+  EXPECT_FALSE(fs::exists(bad_report));
+
+  // An input frame inside the report's folder under a name the report writes is refused, and left as it was.
+  const fs::path inside = dir_.file("report-with-input");
+  fs::create_directory(inside);
+  fs::copy_file(in.darks[0], inside / "calibration.json");
+  const std::uintmax_t size = fs::file_size(inside / "calibration.json");
+  std::vector<fs::path> darks_inside = in.darks;
+  darks_inside[0] = inside / "calibration.json";
+  std::vector<std::string> inside_args = calibrate_args(in.flats, darks_inside, bad);
+  inside_args.insert(inside_args.end(), {"--report", inside.string()});
+  r = test::run_chromatrace(inside_args);
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find((inside / "calibration.json").string() + ": is the input"), std::string::npos) << r.err;
+  EXPECT_EQ(fs::file_size(inside / "calibration.json"), size);
+  EXPECT_FALSE(fs::exists(bad));
+}
+
+// Flats whose temporal variance does not grow in proportion to their signal (it alternates between 4 and 44 DN²
+// while the signal climbs in steps of 100 DN) give a slope through the origin of 0.045 ± 0.033 DN/e⁻ below 70 % of
+// saturation: no measurement of the gain, refused rather than written (its saturation capacity and read noise would
+// follow from it).
+TEST(CalibrateChannel, AGainThatIsNoMeasurementIsRefused) {
+  std::mt19937_64 random(3);
+  auto frame = [&](double mean, double variance) {
+    std::normal_distribution<double> noise(mean, std::sqrt(variance));
+    calibrate::Plane p{64, 64, std::vector<double>(64 * 64)};
+    for (double& v : p.values) v = noise(random);
+    return p;
+  };
+  const std::vector<double> above_dark = {0, 40, 0, 40, 0, 40, 0, 50};
+  std::vector<calibrate::ExposureStep> steps;
+  for (std::size_t k = 0; k <= above_dark.size(); ++k) {
+    calibrate::ExposureStep s;
+    s.exposure_s = 0.01 * double(k + 1);
+    const bool clipped = k == above_dark.size();  // every pixel at the top code: no temporal variance
+    for (int i = 0; i < 2; ++i) {
+      s.flats.push_back(clipped ? calibrate::Plane{64, 64, std::vector<double>(64 * 64, 4095.0)} : frame(100.0 * double(k + 1), 4 + above_dark[k]));
+      s.darks.push_back(frame(0, 4));
+    }
+    steps.push_back(s);
+  }
+  try {
+    calibrate::calibrate_channel("G", steps);
+    ADD_FAILURE() << "a gain that is no measurement was accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("channel G: the photon transfer gives a gain of"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("which is no measurement"), std::string::npos) << e.what();
+    std::cerr << e.what() << "\n";
+  }
 }
 
 }  // namespace

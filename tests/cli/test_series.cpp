@@ -231,9 +231,9 @@ TEST_F(SeriesCommand, PaperPanelsHoldOverSeedsAndSizes) {
       {"2-object-spectra", {}}, {"3-specular", {}}, {"5-two-luminaires", {}}, {"6a-diffuse-global", {}},
       {"6b-dichromatic-global", {}}, {"7a-pixel-area", {}}, {"7c-clipping", {}}, {"7b-gamma", {}},
       {"7d-noise", {}}};  // empty: every expectation
-  // Three seeds at the default size, and the larger size once (CI time).
-  for (const auto& [size, seeds] : {std::pair{"128x128", std::vector<std::string>{"1", "2", "3"}},
-                                   std::pair{"192x192", std::vector<std::string>{"2"}}})
+  // Three seeds over two sizes: two at the default size, the third at a larger one (CI time).
+  for (const auto& [size, seeds] : {std::pair{"128x128", std::vector<std::string>{"1", "2"}},
+                                   std::pair{"192x192", std::vector<std::string>{"3"}}})
     for (const std::string& seed : seeds) {
       const fs::path out = dir_ / (std::string(size) + "-" + seed);
       std::vector<std::string> args = {"paper", "-o", out.string(), "--resolution", size, "--seed", seed, "--quiet"};

@@ -131,7 +131,7 @@ TEST(Startup, CheckSceneErrorsLoadNoImageLibrary) {
 
   const TracedRun usage = run_traced({"check-scene"});
   EXPECT_EQ(usage.result.exit_code, 2);
-  EXPECT_EQ(usage.err, "chromatrace: error: file is required\n");
+  EXPECT_EQ(usage.err, "chromatrace check-scene: error: file is required\n");
   expect_no_image_library(usage, "check-scene without a file");
 }
 
@@ -180,7 +180,11 @@ TEST(Startup, HandedOverCommandsKeepTheirExitCodes) {
   EXPECT_EQ(missing.err, "chromatrace render: error: /nonexistent/scene.json: cannot open file\n");
   const test::CommandResult usage = test::run_chromatrace({"render", kMinimal, "--no-such-option"});
   EXPECT_EQ(usage.exit_code, 2);
-  EXPECT_EQ(usage.err.rfind("chromatrace: error: ", 0), 0u) << usage.err;
+  EXPECT_EQ(usage.err.rfind("chromatrace render: error: ", 0), 0u) << usage.err;
+  const test::CommandResult not_a_number = test::run_chromatrace({"render", kMinimal, "-o", out, "--spp", "abc"});
+  EXPECT_EQ(not_a_number.exit_code, 2);
+  EXPECT_EQ(not_a_number.err.rfind("chromatrace render: error: ", 0), 0u) << not_a_number.err;
+  EXPECT_NE(not_a_number.err.find("--spp"), std::string::npos) << not_a_number.err;
   fs::remove_all(dir);
 }
 

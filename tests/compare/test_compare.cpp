@@ -281,6 +281,21 @@ TEST_F(Compare, IdenticalRendersHaveZeroDeltaE) {
   EXPECT_LT(d2["image"]["delta_e00"]["max"].get<double>(), 10.0);
 }
 
+// Noiseless renders whose ball differs by 0.5 %, inside its 2 % tolerance: its cells have no standard error, so
+// their z is infinite and they pass on the tolerance alone. The verdict agrees and quotes the largest finite |z| (the
+// whole image's, whose pixels differ among themselves), never an infinite one.
+TEST_F(Compare, CellsExactOnBothSidesPassOnTheToleranceAndQuoteNoInfiniteZ) {
+  Synthetic a;
+  a.sigma = 0;
+  Synthetic b = a;
+  b.ball_diffuse_scale = 1.005;
+  const auto r = run({render("a.exr", a).string(), render("b.exr", b).string(), "-o", dir_.file("out").string()});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find("AGREE: all"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("; largest |z| "), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("inf"), std::string::npos) << r.err;
+}
+
 }  // namespace
 }  // namespace ct
 

@@ -3,6 +3,7 @@
 // needs, logarithmic axes in decades.
 #include <cmath>
 #include <limits>
+#include <stdexcept>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -94,6 +95,13 @@ TEST(Ticks, LogTicks) {
   EXPECT_EQ(log_ticks(0.1, 10), (std::vector<double>{0.1, 0.2, 0.5, 1, 2, 5, 10}));
   EXPECT_EQ(log_ticks(0.01, 1000), (std::vector<double>{0.01, 0.1, 1, 10, 100, 1000}));
   EXPECT_EQ(log_ticks(3, 4), (std::vector<double>{1, 10}));
+}
+
+// A range that is not one of positive numbers is refused, not looped over from log10(0) = −∞.
+TEST(Ticks, LogTicksRefuseARangeThatIsNotPositive) {
+  for (const auto& [lo, hi] : {std::pair{0.0, 10.0}, std::pair{-1.0, 10.0}, std::pair{10.0, 1.0}, std::pair{1.0, HUGE_VAL},
+                               std::pair{std::nan(""), 10.0}})
+    EXPECT_THROW(log_ticks(lo, hi), std::invalid_argument) << lo << " " << hi;
 }
 
 TEST(Ticks, LogLabelsArePlainFromAHundredthToAThousandElsePowersOfTen) {
