@@ -26,11 +26,12 @@ Action add_calibrate(CLI::App& app) {
     bool quiet = false;
   };
   auto o = std::make_shared<Options>();
-  cmd->add_option("--flat", o->flats, "Flat-field frames: at least two at each exposure time (camera raw, or linear EXR/TIFF)")
-      ->required();
-  cmd->add_option("--dark", o->darks, "Dark frames: at least two at each exposure time of the flats")->required();
-  cmd->add_option("-o,--output", o->output, "Sensor settings written (chromatrace-sensor/1), for chromatrace sensor --config")
-      ->required();
+  // Checked after parsing rather than marked required: CLI11 takes the word after an option with no value of its own
+  // as that value even when it is another option ("--flat --dark D…" gives --flat the frames and says "--dark is
+  // required"), so the frame lists are checked for option names first.
+  cmd->add_option("--flat", o->flats, "Flat-field frames: at least two at each exposure time (camera raw, or linear EXR/TIFF)");
+  cmd->add_option("--dark", o->darks, "Dark frames: at least two at each exposure time of the flats");
+  cmd->add_option("-o,--output", o->output, "Sensor settings written (chromatrace-sensor/1), for chromatrace sensor --config");
   cmd->add_option("--report", o->report,
                   "Report directory: index.html (the datasheet's curves and table), calibration.json (every estimate per "
                   "channel with its standard error, the measured points), the plots as SVG");
@@ -39,6 +40,14 @@ Action add_calibrate(CLI::App& app) {
   cmd->add_flag("-q,--quiet", o->quiet, "No summary on stderr");
 
   return [o, cmd] {
+    for (const auto& [name, values] : {std::pair{"--flat", &o->flats}, std::pair{"--dark", &o->darks}})
+      for (const std::string& v : *values)
+        for (const CLI::Option* option : cmd->get_options())
+          if (v.starts_with("-") && option->check_name(v))
+            throw InputError(fmt::format("{}: no frame given before the option {}", name, v));
+    if (o->flats.empty()) throw InputError("--flat: no flat frames");
+    if (o->darks.empty()) throw InputError("--dark: no dark frames");
+    if (o->output.empty()) throw InputError("--output: no settings file to write (-o CAMERA.json)");
     calibrate::CalibrationInput input;
     for (const std::string& f : o->flats) input.flats.emplace_back(f);
     for (const std::string& f : o->darks) input.darks.emplace_back(f);

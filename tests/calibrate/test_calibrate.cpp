@@ -264,6 +264,14 @@ TEST_F(Calibrate, TheCommandWritesSettingsTheSensorTakesAndRefusesSeriesThatCann
   EXPECT_NE(r.err.find(mosaic.string() + ": its pixels were interpolated from a colour filter array"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(bad));
 
+  // An option where the frames should be: named as what it is, not as a missing option.
+  auto no_frames = test::run_chromatrace({"calibrate", "--flat", "--dark", in.darks[0].string(), in.darks[1].string(), "-o", bad.string()});
+  EXPECT_EQ(no_frames.exit_code, 2);
+  EXPECT_EQ(no_frames.err, "chromatrace calibrate: error: --flat: no frame given before the option --dark\n");
+  no_frames = test::run_chromatrace({"calibrate", "--dark", in.darks[0].string(), "--flat", "-o", bad.string()});
+  EXPECT_EQ(no_frames.err, "chromatrace calibrate: error: --flat: no frame given before the option -o\n");
+  EXPECT_FALSE(fs::exists(bad));
+
   // A frame grabber that hands one buffer twice: each exposure's second flat a copy of its first. Refused naming both
   // files, with the report asked for too (its photon transfer would have no noise to plot), and nothing written.
   std::vector<fs::path> copied;
