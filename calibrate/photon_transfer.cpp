@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numeric>
 
 #include <fmt/format.h>
@@ -281,10 +282,23 @@ ChannelCalibration calibrate_channel(const std::string& channel, const std::vect
     }
   }
   if (u.size() >= 3 && u.front() < u.back()) {
-    const LineFit lin = fit_line(u, signal, false);
-    double lo = 0, hi = 0;
+    // EMVA 1288's fit: least squares of the relative deviations, each squared residual weighted by 1/y² (so a
+    // bright point, whose absolute residual is large, weighs no more than a dim one); LE = (δmax − δmin)/2.
+    double sw = 0, su = 0, ss = 0;
     for (std::size_t i = 0; i < u.size(); ++i) {
-      const double fitted = lin.intercept + lin.slope * u[i];
+      const double w = 1 / (signal[i] * signal[i]);
+      sw += w, su += w * u[i], ss += w * signal[i];
+    }
+    const double mu = su / sw, ms = ss / sw;
+    double suu = 0, sus = 0;
+    for (std::size_t i = 0; i < u.size(); ++i) {
+      const double w = 1 / (signal[i] * signal[i]);
+      suu += w * (u[i] - mu) * (u[i] - mu), sus += w * (u[i] - mu) * (signal[i] - ms);
+    }
+    const double slope = sus / suu, intercept = ms - slope * mu;
+    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+    for (std::size_t i = 0; i < u.size(); ++i) {
+      const double fitted = intercept + slope * u[i];
       const double d = (signal[i] - fitted) / fitted;
       lo = std::min(lo, d), hi = std::max(hi, d);
     }

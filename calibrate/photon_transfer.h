@@ -17,8 +17,9 @@
 //     means and of the column means, each less what the pixel part leaves in a mean); DSNU = s_y.dark/K (e⁻),
 //     PRNU = √(s_y.50² − s_y.dark²)/(μ_y.50 − μ_y.dark) at the flat level nearest half of saturation;
 //   - the linearity error: the half range of the relative deviations of μ_y − μ_y.dark from a line through the
-//     flats between 5 % and 95 % of saturation, against the photons per pixel (or the exposure time when the
-//     irradiance is not given: proportional to the photons at constant irradiance);
+//     flats between 5 % and 95 % of saturation, fitted as the standard fits it (weighted by 1/y: least squares of
+//     the relative deviations), against the photons per pixel (or the exposure time when the irradiance is not
+//     given: proportional to the photons at constant irradiance);
 //   - the quantum efficiency η = R/K, R the slope of μ_y − μ_y.dark against μ_p, when the photons per pixel are known.
 // Each estimate comes with its standard error: regression slopes from their residuals, variances from
 // var(s²) = 2σ⁴/(n − 1) for n pixels (the Gaussian value), propagated to first order.

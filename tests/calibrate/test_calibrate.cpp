@@ -310,6 +310,59 @@ TEST_F(Calibrate, TheCommandWritesSettingsTheSensorTakesAndRefusesSeriesThatCann
   EXPECT_FALSE(fs::exists(bad));
 }
 
+// A compressive response, signal = 1000·t·(1 − 0.03·t) DN over exposures t = 0.1 … 1 s, with flats and darks whose
+// means are exact (their noise drawn, then its mean removed) and whose temporal variance grows as a camera's: the
+// linearity error is EMVA 1288's, the half range of the relative deviations from the line fitted with weights 1/y
+// (the reference implementation's closed form, written out here), not an unweighted line's, which lies apart from it
+// by far more than the floating-point rounding both are computed to.
+TEST(CalibrateChannel, TheLinearityErrorIsTheStandardsWeightedFit) {
+  std::mt19937_64 random(5);
+  auto frame = [&](double mean, double variance) {
+    std::normal_distribution<double> noise(0.0, std::sqrt(variance));
+    calibrate::Plane p{64, 64, std::vector<double>(64 * 64)};
+    double sum = 0;
+    for (double& v : p.values) sum += (v = noise(random));
+    for (double& v : p.values) v += mean - sum / double(p.values.size());
+    return p;
+  };
+  auto response = [](double t) { return 1000 * t * (1 - 0.03 * t); };
+  std::vector<calibrate::ExposureStep> steps;
+  for (int k = 1; k <= 11; ++k) {
+    calibrate::ExposureStep s;
+    s.exposure_s = 0.1 * k;
+    const bool clipped = k == 11;  // beyond saturation: every pixel at the top code
+    for (int i = 0; i < 2; ++i) {
+      s.flats.push_back(clipped ? calibrate::Plane{64, 64, std::vector<double>(64 * 64, 4095.0)}
+                                : frame(100 + response(s.exposure_s), 4 + 0.5 * response(s.exposure_s)));
+      s.darks.push_back(frame(100, 4));
+    }
+    steps.push_back(s);
+  }
+  const calibrate::ChannelCalibration c = calibrate::calibrate_channel("G", steps);
+  // The points between 5 % and 95 % of saturation (the flats at t = 1 s): t = 0.1 … 0.9 s.
+  std::vector<double> x, y;
+  for (int k = 1; k <= 10; ++k)
+    if (response(0.1 * k) >= 0.05 * response(1.0) && response(0.1 * k) <= 0.95 * response(1.0)) x.push_back(0.1 * k), y.push_back(response(0.1 * k));
+  auto half_range = [&](double a, double b) {  // signal = a·x + b
+    double lo = HUGE_VAL, hi = -HUGE_VAL;
+    for (std::size_t i = 0; i < x.size(); ++i) lo = std::min(lo, (y[i] - (a * x[i] + b)) / (a * x[i] + b)), hi = std::max(hi, (y[i] - (a * x[i] + b)) / (a * x[i] + b));
+    return (hi - lo) / 2;
+  };
+  double xy = 0, xy2 = 0, x2y2 = 0, y1 = 0, y2 = 0;
+  for (std::size_t i = 0; i < x.size(); ++i)
+    xy += x[i] / y[i], xy2 += x[i] / (y[i] * y[i]), x2y2 += (x[i] / y[i]) * (x[i] / y[i]), y1 += 1 / y[i], y2 += 1 / (y[i] * y[i]);
+  const double b = (xy * xy2 - x2y2 * y1) / (xy2 * xy2 - x2y2 * y2), a = (xy - b * xy2) / x2y2;
+  const double weighted = half_range(a, b);
+  double mx = 0, my = 0, sxx = 0, sxy = 0;
+  for (std::size_t i = 0; i < x.size(); ++i) mx += x[i] / double(x.size()), my += y[i] / double(x.size());
+  for (std::size_t i = 0; i < x.size(); ++i) sxx += (x[i] - mx) * (x[i] - mx), sxy += (x[i] - mx) * (y[i] - my);
+  const double unweighted = half_range(sxy / sxx, my - sxy / sxx * mx);
+  std::cerr << fmt::format("linearity error {:.4f} %: the standard's fit {:.4f} %, an unweighted one {:.4f} %\n", 100 * c.linearity_error,
+                           100 * weighted, 100 * unweighted);
+  EXPECT_NEAR(c.linearity_error, weighted, 1e-9);
+  EXPECT_GT(std::abs(unweighted - weighted), 1e-4);
+}
+
 // Flats whose temporal variance does not grow in proportion to their signal (it alternates between 4 and 44 DN²
 // while the signal climbs in steps of 100 DN) give a slope through the origin of 0.045 ± 0.033 DN/e⁻ below 70 % of
 // saturation: no measurement of the gain, refused rather than written (its saturation capacity and read noise would
