@@ -87,11 +87,13 @@ SpatialVariance spatial_variance(const Plane& mean, double temporal_variance, st
   return s;
 }
 
-// Least squares y = a + b·x (or y = b·x through the origin) with the standard errors from the residuals.
+// Least squares y = a + b·x (or y = b·x through the origin) with the standard errors from the residuals; the line
+// not through the origin optionally with a weight per squared residual (none: all 1).
 struct LineFit {
   double intercept = 0, slope = 0, intercept_se = 0, slope_se = 0;
 };
-LineFit fit_line(const std::vector<double>& x, const std::vector<double>& y, bool through_origin) {
+LineFit fit_line(const std::vector<double>& x, const std::vector<double>& y, bool through_origin,
+                 const std::vector<double>& weights = {}) {
   const auto n = static_cast<double>(x.size());
   LineFit f;
   if (through_origin) {
@@ -103,16 +105,19 @@ LineFit fit_line(const std::vector<double>& x, const std::vector<double>& y, boo
     f.slope_se = n > 1 ? std::sqrt(r / (n - 1) / sxx) : 0.0;
     return f;
   }
-  const double mx = mean_of(x), my = mean_of(y);
+  auto w = [&](std::size_t i) { return weights.empty() ? 1.0 : weights[i]; };
+  double sw = 0, swx = 0, swy = 0;
+  for (std::size_t i = 0; i < x.size(); ++i) sw += w(i), swx += w(i) * x[i], swy += w(i) * y[i];
+  const double mx = swx / sw, my = swy / sw;
   double sxx = 0, sxy = 0;
-  for (std::size_t i = 0; i < x.size(); ++i) sxx += (x[i] - mx) * (x[i] - mx), sxy += (x[i] - mx) * (y[i] - my);
+  for (std::size_t i = 0; i < x.size(); ++i) sxx += w(i) * (x[i] - mx) * (x[i] - mx), sxy += w(i) * (x[i] - mx) * (y[i] - my);
   f.slope = sxy / sxx;
   f.intercept = my - f.slope * mx;
   double r = 0;
-  for (std::size_t i = 0; i < x.size(); ++i) r += std::pow(y[i] - f.intercept - f.slope * x[i], 2);
+  for (std::size_t i = 0; i < x.size(); ++i) r += w(i) * std::pow(y[i] - f.intercept - f.slope * x[i], 2);
   const double s2 = n > 2 ? r / (n - 2) : 0.0;
   f.slope_se = std::sqrt(s2 / sxx);
-  f.intercept_se = std::sqrt(s2 * (1.0 / n + mx * mx / sxx));
+  f.intercept_se = std::sqrt(s2 * (1.0 / sw + mx * mx / sxx));
   return f;
 }
 
@@ -284,21 +289,12 @@ ChannelCalibration calibrate_channel(const std::string& channel, const std::vect
   if (u.size() >= 3 && u.front() < u.back()) {
     // EMVA 1288's fit: least squares of the relative deviations, each squared residual weighted by 1/y² (so a
     // bright point, whose absolute residual is large, weighs no more than a dim one); LE = (δmax − δmin)/2.
-    double sw = 0, su = 0, ss = 0;
-    for (std::size_t i = 0; i < u.size(); ++i) {
-      const double w = 1 / (signal[i] * signal[i]);
-      sw += w, su += w * u[i], ss += w * signal[i];
-    }
-    const double mu = su / sw, ms = ss / sw;
-    double suu = 0, sus = 0;
-    for (std::size_t i = 0; i < u.size(); ++i) {
-      const double w = 1 / (signal[i] * signal[i]);
-      suu += w * (u[i] - mu) * (u[i] - mu), sus += w * (u[i] - mu) * (signal[i] - ms);
-    }
-    const double slope = sus / suu, intercept = ms - slope * mu;
+    std::vector<double> weights;
+    for (const double y : signal) weights.push_back(1 / (y * y));
+    const LineFit lin = fit_line(u, signal, false, weights);
     double lo = std::numeric_limits<double>::infinity(), hi = -lo;
     for (std::size_t i = 0; i < u.size(); ++i) {
-      const double fitted = intercept + slope * u[i];
+      const double fitted = lin.intercept + lin.slope * u[i];
       const double d = (signal[i] - fitted) / fitted;
       lo = std::min(lo, d), hi = std::max(hi, d);
     }
