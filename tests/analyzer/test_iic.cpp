@@ -24,7 +24,7 @@ using analyzer::IicResult;
 using analyzer::IicSurface;
 using analyzer::Vec3;
 
-const Vec3 kWarm(1.0, 0.8, 0.55);   // a tungsten-like light
+const Vec3 kTungsten(1.0, 0.8, 0.55);   // a tungsten-like light
 const Vec3 kBluish(0.6, 0.8, 1.0);  // a skylight-like light
 const std::vector<Vec3> kBodies = {{0.70, 0.20, 0.10}, {0.10, 0.50, 0.20}, {0.20, 0.30, 0.80},
                                    {0.60, 0.55, 0.10}, {0.50, 0.10, 0.45}};
@@ -76,7 +76,7 @@ Scene scene(const Vec3& light, std::uint32_t seed, double noise) {
 constexpr double kExactDeg = 1e-3;
 
 TEST(Iic, NoiseFreeSurfacesGiveTheLight) {
-  for (const Vec3& light : {kWarm, kBluish})
+  for (const Vec3& light : {kTungsten, kBluish})
     for (std::uint32_t seed = 1; seed <= 5; ++seed) {
       const Scene s = scene(light, seed, 0.0);
       const IicResult r = estimate_iic(s.surfaces());
@@ -100,7 +100,7 @@ TEST(Iic, NoiseFreeSurfacesGiveTheLight) {
 // (an exponential's mean: ±0.22 over 20), between 0.35 and 2: neither understated nor grossly overstated.
 TEST(Iic, WithNoiseTheErrorIsWithinTheStatedUncertainty) {
   constexpr double kNoise = 0.005;
-  for (const Vec3& light : {kWarm, kBluish}) {
+  for (const Vec3& light : {kTungsten, kBluish}) {
     int within_two = 0;
     double mean_square_ratio = 0;
     for (std::uint32_t seed = 1; seed <= 20; ++seed) {
@@ -127,7 +127,7 @@ TEST(Iic, SurfacesWithoutHighlightsGiveNoEstimate) {
   for (const double noise : {0.0, 0.005}) {
     std::mt19937 generator(7);
     Scene s;
-    for (const Vec3& body : kBodies) s.pixels.push_back(dichromatic_surface(body, kWarm, generator, noise, 400, 0));
+    for (const Vec3& body : kBodies) s.pixels.push_back(dichromatic_surface(body, kTungsten, generator, noise, 400, 0));
     const IicResult r = estimate_iic(s.surfaces());
     EXPECT_FALSE(r.estimate) << "noise " << noise;
     EXPECT_NE(r.reason.find("no surface gave a highlight line"), std::string::npos) << r.reason;
@@ -143,12 +143,12 @@ TEST(Iic, ABodyColourAtTheLightsGivesNoEvidence) {
   for (const double noise : {0.0, 0.005}) {
     std::mt19937 generator(11);
     Scene alone;
-    alone.pixels.push_back(dichromatic_surface(0.5 * kWarm, kWarm, generator, noise));
+    alone.pixels.push_back(dichromatic_surface(0.5 * kTungsten, kTungsten, generator, noise));
     const IicResult r = estimate_iic(alone.surfaces());
     EXPECT_FALSE(r.estimate) << "noise " << noise;
     EXPECT_FALSE(r.reason.empty());
 
-    Scene with_others = scene(kWarm, 12, noise);
+    Scene with_others = scene(kTungsten, 12, noise);
     with_others.pixels.push_back(alone.pixels.front());
     const IicResult both = estimate_iic(with_others.surfaces());
     ASSERT_TRUE(both.estimate) << both.reason;
@@ -160,10 +160,10 @@ TEST(Iic, ABodyColourAtTheLightsGivesNoEvidence) {
 // A body colour near the light's (chromaticity 0.007 away) has highlight pixels, but they change the chromaticity
 // by less than settings.min_chromaticity_change: an intercept extrapolated from so small a change is no evidence.
 TEST(Iic, AHighlightThatBarelyChangesTheChromaticityIsNoEvidence) {
-  const Vec3 near_light = kWarm / kWarm.sum() + Vec3(0.005, -0.005, 0.0);
+  const Vec3 near_light = kTungsten / kTungsten.sum() + Vec3(0.005, -0.005, 0.0);
   std::mt19937 generator(13);
   Scene s;
-  s.pixels.push_back(dichromatic_surface(near_light, kWarm, generator, 0.0));
+  s.pixels.push_back(dichromatic_surface(near_light, kTungsten, generator, 0.0));
   const IicResult r = estimate_iic(s.surfaces());
   EXPECT_FALSE(r.estimate);
   EXPECT_NE(r.reason.find("1 whose highlight changes the chromaticity by less than 0.01"), std::string::npos) << r.reason;
@@ -177,12 +177,12 @@ TEST(Iic, AHighlightThatBarelyChangesTheChromaticityIsNoEvidence) {
 TEST(Iic, TwoLightsGiveOneOfThemWithALargeUncertainty) {
   std::mt19937 generator(21);
   Scene s;
-  s.pixels.push_back(dichromatic_surface(kBodies[0], kWarm, generator, 0.0, 240, 200));
+  s.pixels.push_back(dichromatic_surface(kBodies[0], kTungsten, generator, 0.0, 240, 200));
   s.pixels.push_back(dichromatic_surface(kBodies[2], kBluish, generator, 0.0, 240, 160));
   const IicResult r = estimate_iic(s.surfaces());
   ASSERT_TRUE(r.estimate) << r.reason;
-  const double between = angle_deg(kWarm, kBluish);
-  EXPECT_LT(angle_deg(r.estimate->rgb, kWarm), kExactDeg);
+  const double between = angle_deg(kTungsten, kBluish);
+  EXPECT_LT(angle_deg(r.estimate->rgb, kTungsten), kExactDeg);
   EXPECT_EQ(r.estimate->surfaces, 1u);
   EXPECT_EQ(r.estimate->disagreeing, 1u);
   EXPECT_GT(r.estimate->uncertainty_deg, 0.3 * between);
@@ -190,12 +190,12 @@ TEST(Iic, TwoLightsGiveOneOfThemWithALargeUncertainty) {
 
   // Three surfaces under the warm light and one under the bluish: the majority's light; the bootstrap rarely
   // draws more bluish than warm surfaces, so the uncertainty is smaller, but still above the noise-free scatter.
-  Scene majority = scene(kWarm, 22, 0.0);
+  Scene majority = scene(kTungsten, 22, 0.0);
   majority.pixels.resize(3);
   majority.pixels.push_back(s.pixels[1]);
   const IicResult m = estimate_iic(majority.surfaces());
   ASSERT_TRUE(m.estimate) << m.reason;
-  EXPECT_LT(angle_deg(m.estimate->rgb, kWarm), kExactDeg);
+  EXPECT_LT(angle_deg(m.estimate->rgb, kTungsten), kExactDeg);
   EXPECT_EQ(m.estimate->surfaces, 3u);
   EXPECT_EQ(m.estimate->disagreeing, 1u);
   EXPECT_GT(m.estimate->uncertainty_deg, 0.05 * between);
@@ -209,10 +209,10 @@ TEST(Iic, ShadingAcrossTheHighlightsShowsInTheUncertainty) {
   for (std::uint32_t seed = 1; seed <= 10; ++seed) {
     std::mt19937 generator(200 + seed);
     Scene s;
-    for (const Vec3& body : kBodies) s.pixels.push_back(dichromatic_surface(body, kWarm, generator, 0.0, 240, 160, 0.05));
+    for (const Vec3& body : kBodies) s.pixels.push_back(dichromatic_surface(body, kTungsten, generator, 0.0, 240, 160, 0.05));
     const IicResult r = estimate_iic(s.surfaces());
     ASSERT_TRUE(r.estimate) << r.reason;
-    const double error = angle_deg(r.estimate->rgb, kWarm);
+    const double error = angle_deg(r.estimate->rgb, kTungsten);
     EXPECT_GT(error, kExactDeg) << "seed " << seed;
     EXPECT_LE(error, 3 * r.estimate->uncertainty_deg) << "seed " << seed;
   }

@@ -144,12 +144,12 @@ const Shape& named(const Photo& photo, const std::string& name) {
   throw std::runtime_error("masks.json: no shape named " + name);
 }
 
-struct Match {
+struct MaskMatch {
   std::int32_t label = 0;
   double iou = 0;
 };
 
-Match best_segment(const Segmentation& s, const std::vector<std::uint8_t>& mask) {
+MaskMatch best_segment(const Segmentation& s, const std::vector<std::uint8_t>& mask) {
   std::map<std::int32_t, std::size_t> overlap, size;
   std::size_t inside = 0;
   for (std::size_t p = 0; p < mask.size(); ++p) {
@@ -158,7 +158,7 @@ Match best_segment(const Segmentation& s, const std::vector<std::uint8_t>& mask)
     ++inside;
     if (s.labels[p] > 0) ++overlap[s.labels[p]];
   }
-  Match m;
+  MaskMatch m;
   for (const auto& [label, common] : overlap) {
     const double iou = double(common) / double(inside + size[label] - common);
     if (iou > m.iou) m = {label, iou};
@@ -241,7 +241,7 @@ void check_photo(const Photo& photo) {
   std::vector<std::int32_t> used;
   for (const Shape& object : photo.objects) {
     const auto mask1 = rasterise(object, s1.width, s1.height, 1.0), mask2 = rasterise(object, s2.width, s2.height, 2.0);
-    const Match m1 = best_segment(s1, mask1), m2 = best_segment(s2, mask2);
+    const MaskMatch m1 = best_segment(s1, mask1), m2 = best_segment(s2, mask2);
     EXPECT_GE(m1.iou, 0.8) << object.name << " at 1×";
     EXPECT_GE(m2.iou, 0.8) << object.name << " at 2×";
     EXPECT_EQ(std::count(used.begin(), used.end(), m1.label), 0) << object.name << " shares a segment";
@@ -260,7 +260,7 @@ void check_photo(const Photo& photo) {
   }
   // Objects left out: their IoU printed, for the reasons masks.json gives.
   for (const Shape& object : photo.left_out) {
-    const Match m1 = best_segment(s1, rasterise(object, s1.width, s1.height, 1.0)), m2 = best_segment(s2, rasterise(object, s2.width, s2.height, 2.0));
+    const MaskMatch m1 = best_segment(s1, rasterise(object, s1.width, s1.height, 1.0)), m2 = best_segment(s2, rasterise(object, s2.width, s2.height, 2.0));
     std::cerr << fmt::format("  left out: {}: IoU {:.3f} at 1×, {:.3f} at 2×\n", object.name, m1.iou, m2.iou);
   }
   // Objects that must never share a segment (dark, nearly neutral objects apart: a navy jacket and a black hat):
@@ -338,7 +338,7 @@ Analysed analyse_object(const Photo& photo, const std::string& name) {
     a.analysis = analyzer::analyse_image(r.input, "", {region}, analyzer::AnalyzeOptions{}, std::nullopt, false);
     return a;
   }
-  const Match m = best_segment(s, rasterise(named(photo, name), s.width, s.height, 1.0));
+  const MaskMatch m = best_segment(s, rasterise(named(photo, name), s.width, s.height, 1.0));
   const auto it = std::find_if(r.segmented.regions.begin(), r.segmented.regions.end(), [&](const analyzer::Region& g) { return g.source == "segment" && g.label == m.label; });
   if (it == r.segmented.regions.end()) throw std::runtime_error("no segment for " + name);
   Analysed a{*it, {}};
@@ -499,7 +499,7 @@ TEST(Photographs, ASegmentOfTheLightsColourSaysItMayHoldSeveralObjects) {
         ++checked;
         continue;
       }
-      const Match m = best_segment(s, rasterise(named(photo, white), s.width, s.height, 1.0));
+      const MaskMatch m = best_segment(s, rasterise(named(photo, white), s.width, s.height, 1.0));
       for (std::size_t i = 0; i < a.regions.size(); ++i) {
         if (a.regions[i].source != "segment" || a.regions[i].label != m.label) continue;
         const analyzer::Interpretation& in = a.interpretations[i];
@@ -864,7 +864,7 @@ TEST(LightColour, LightsInViewAreNamedAndNoSurfaceIs) {
     for (const Shape& white : photo.references) {
       EXPECT_TRUE(lights_in(photo, white).empty()) << photo.file << ": the reference " << white.name << " holds a light";
       const Read& r = read(photo);
-      const Match m = best_segment(r.segmented.s, rasterise(white, r.input.image.width, r.input.image.height, 1.0));
+      const MaskMatch m = best_segment(r.segmented.s, rasterise(white, r.input.image.width, r.input.image.height, 1.0));
       for (const analyzer::Region& g : r.segmented.regions) {
         if (g.source != "segment" || g.label != m.label) continue;
         EXPECT_EQ(std::count(il.light_regions.begin(), il.light_regions.end(), g.name), 0)
@@ -908,8 +908,8 @@ TEST(LightColour, TheWholeStillLifeSaysWhatItsHighlightsGive) {
     EXPECT_TRUE(named) << "no light named at the flame near (" << x << ", " << y << ")";
   }
   for (const analyzer::LightInView& l : il.lights) EXPECT_FALSE(photo.references.front().contains(l.x + 0.5, l.y + 0.5)) << l.name;
-  const Match napkin_segment = best_segment(r.segmented.s, rasterise(photo.references.front(), r.input.image.width, r.input.image.height, 1.0));
-  const Match bagel_segment = best_segment(r.segmented.s, rasterise(bagel, r.input.image.width, r.input.image.height, 1.0));
+  const MaskMatch napkin_segment = best_segment(r.segmented.s, rasterise(photo.references.front(), r.input.image.width, r.input.image.height, 1.0));
+  const MaskMatch bagel_segment = best_segment(r.segmented.s, rasterise(bagel, r.input.image.width, r.input.image.height, 1.0));
   std::string napkin_name, bagel_name;
   for (const analyzer::Region& g : r.segmented.regions) {
     if (g.source != "segment") continue;

@@ -16,6 +16,7 @@
 #include "core/scene.h"
 #include "core/spectral_exr.h"
 #include "tests/cli/run_command.h"
+#include "tests/cli/text_files.h"
 #include "tests/core/spectral_exr_fixtures.h"
 
 namespace ct {
@@ -25,9 +26,9 @@ namespace fs = std::filesystem;
 using nlohmann::json;
 using test::run_chromatrace;
 
-const std::string kBox = std::string(CHROMATRACE_SOURCE_DIR) + "/scenes/paper/box.json";
+using test::kPaperBox;
 
-int line_count(const std::string& s) { return static_cast<int>(std::count(s.begin(), s.end(), '\n')); }
+using test::line_count;
 
 void write_text(const fs::path& path, const std::string& text) { std::ofstream(path) << text; }
 
@@ -56,14 +57,14 @@ void expect_bad_input(const std::vector<BadCase>& cases, const fs::path& must_no
 // ---- scene-bands --------------------------------------------------------------------------------------
 
 TEST(SceneBands, SceneGivesBandAveragesOfEveryMaterialAndLightFromCore) {
-  const auto r = run_chromatrace({"scene-bands", kBox, "--bands", "400:700:50", "--json"});
+  const auto r = run_chromatrace({"scene-bands", kPaperBox, "--bands", "400:700:50", "--json"});
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const json report = json::parse(r.out);
   EXPECT_EQ(report["bands"]["count"], 6);
   EXPECT_EQ(report["bands"]["edges_nm"].front(), 400.0);
   EXPECT_EQ(report["bands"]["edges_nm"].back(), 700.0);
 
-  const Scene scene = load_scene(kBox);
+  const Scene scene = load_scene(kPaperBox);
   const Bands bands = Bands::uniform(400, 700, 50);
   EXPECT_EQ(report["spectra"]["yellow"]["bands"].get<std::vector<double>>(),
             band_averages(scene.find_spectrum("yellow")->spectrum, bands));
@@ -79,7 +80,7 @@ TEST(SceneBands, SceneGivesBandAveragesOfEveryMaterialAndLightFromCore) {
   EXPECT_EQ(lamp["radiance"].get<std::vector<double>>(), band_averages(scene.lights[0].emitted_radiance(), bands));
   EXPECT_EQ(report["objects"][5]["material"], "sphere");
 
-  const auto text = run_chromatrace({"scene-bands", kBox});  // the scene's own plan: 380:780:10
+  const auto text = run_chromatrace({"scene-bands", kPaperBox});  // the scene's own plan: 380:780:10
   ASSERT_EQ(text.exit_code, 0) << text.err;
   EXPECT_NE(text.out.find("40 bands over 380-780 nm"), std::string::npos) << text.out;
 }
@@ -110,10 +111,10 @@ TEST(SceneBands, BadInputGetsExitTwoAndOneLineNamingTheField) {
   write_text(dir.file("extra_key.json"), R"({"format": "chromatrace-spectra/1", "spectra": {}, "bands": "1"})");
   expect_bad_input({
       {{"scene-bands", dir.file("missing.json").string()}, "missing.json"},
-      {{"scene-bands", kBox, "--bands", "400:705:10"}, "--bands"},
-      {{"scene-bands", kBox, "--bands", "400:700:10", "--bands-file", dir.file("plan.json").string()}, "--bands-file"},
-      {{"scene-bands", kBox, "--bands-file", dir.file("plan.json").string()}, "plan.json: edges_nm[2]"},
-      {{"scene-bands", kBox, "--bands-file", dir.file("plan_um.json").string()}, "visible range"},
+      {{"scene-bands", kPaperBox, "--bands", "400:705:10"}, "--bands"},
+      {{"scene-bands", kPaperBox, "--bands", "400:700:10", "--bands-file", dir.file("plan.json").string()}, "--bands-file"},
+      {{"scene-bands", kPaperBox, "--bands-file", dir.file("plan.json").string()}, "plan.json: edges_nm[2]"},
+      {{"scene-bands", kPaperBox, "--bands-file", dir.file("plan_um.json").string()}, "visible range"},
       {{"scene-bands", dir.file("bad_source.json").string()}, "spectra.x"},
       {{"scene-bands", dir.file("extra_key.json").string()}, "bands"},
   });
@@ -123,7 +124,7 @@ TEST(SceneBands, BadInputGetsExitTwoAndOneLineNamingTheField) {
 
 TEST(ExportMeshes, WritesTheTracersTrianglesForEveryObjectAndLight) {
   test::TempDir dir;
-  const auto r = run_chromatrace({"export-meshes", kBox, (dir.path() / "meshes").string() + "/", "--json"});
+  const auto r = run_chromatrace({"export-meshes", kPaperBox, (dir.path() / "meshes").string() + "/", "--json"});
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const json index = json::parse(r.out);
   ASSERT_EQ(index["objects"].size(), 7u);
@@ -131,7 +132,7 @@ TEST(ExportMeshes, WritesTheTracersTrianglesForEveryObjectAndLight) {
   EXPECT_EQ(index["lights"][0]["id"], 8);
   EXPECT_EQ(index["objects"][5]["smooth"], true);
 
-  const Scene scene = load_scene(kBox);
+  const Scene scene = load_scene(kPaperBox);
   const std::vector<TriangleMesh> meshes = scene_meshes(scene);
   std::vector<json> entries(index["objects"].begin(), index["objects"].end());
   entries.push_back(index["lights"][0]);
@@ -150,10 +151,10 @@ TEST(ExportMeshes, WritesTheTracersTrianglesForEveryObjectAndLight) {
 // (u, v), so the triangles are the same in space but may index more vertices.
 TEST(ExportMeshes, UvsAreTheTracersCornerCoordinates) {
   test::TempDir dir;
-  const auto r = run_chromatrace({"export-meshes", kBox, dir.path().string(), "--uvs", "--json"});
+  const auto r = run_chromatrace({"export-meshes", kPaperBox, dir.path().string(), "--uvs", "--json"});
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const json index = json::parse(r.out);
-  const Scene scene = load_scene(kBox);
+  const Scene scene = load_scene(kPaperBox);
   const std::vector<TriangleMesh> meshes = scene_meshes(scene);
   for (std::size_t i = 0; i < scene.objects.size(); ++i) {
     const TriangleMesh read = read_ply(dir.path() / index["objects"][i]["file"].get<std::string>());
@@ -181,9 +182,9 @@ TEST(ExportMeshes, BadInputGetsExitTwoAndOneLine) {
   write_text(dir.file("a_file"), "x");
   expect_bad_input({
       {{"export-meshes", dir.file("missing.json").string(), dir.path().string()}, "missing.json"},
-      {{"export-meshes", kBox, dir.file("a_file").string()}, "a_file: exists and is not a directory"},
-      {{"export-meshes", kBox, (dir.path() / "no/such/dir").string()}, "does not exist"},
-      {{"export-meshes", kBox}, "directory"},
+      {{"export-meshes", kPaperBox, dir.file("a_file").string()}, "a_file: exists and is not a directory"},
+      {{"export-meshes", kPaperBox, (dir.path() / "no/such/dir").string()}, "does not exist"},
+      {{"export-meshes", kPaperBox}, "directory"},
   });
 }
 

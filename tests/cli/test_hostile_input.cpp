@@ -33,7 +33,7 @@ using test::read_text;
 using test::run_chromatrace;
 using test::write_text;
 
-const fs::path kMinimal = test::minimal_scene();
+using test::kMinimal;
 
 // chromatrace with a time limit: a command that waits on a special file is killed after `seconds` (exit 124).
 test::CommandResult run_within(int seconds, const std::vector<std::string>& args) {

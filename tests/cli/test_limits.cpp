@@ -22,7 +22,7 @@ using test::line_count;
 using test::run_chromatrace;
 using test::write_text;
 
-const fs::path kMinimal = test::minimal_scene();
+using test::kMinimal;
 
 
 // ---- sizes checked before allocating --------------------------------------------------------------

@@ -24,7 +24,7 @@ using test::read_text;
 using test::run_chromatrace;
 using test::write_text;
 
-const fs::path kMinimal = test::minimal_scene();
+using test::kMinimal;
 
 // chromatrace with these arguments in a child whose files may grow to `kib` KiB, SIGXFSZ ignored.
 test::CommandResult run_with_file_size_limit(int kib, const std::vector<std::string>& args) {

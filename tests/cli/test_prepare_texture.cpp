@@ -20,6 +20,7 @@
 #include "core/texture.h"
 #include "tests/core/image_fixtures.h"
 #include "tests/cli/run_command.h"
+#include "tests/cli/text_files.h"
 
 namespace ct {
 namespace {
@@ -28,7 +29,7 @@ namespace fs = std::filesystem;
 using nlohmann::json;
 using test::run_chromatrace;
 
-int line_count(const std::string& s) { return static_cast<int>(std::count(s.begin(), s.end(), '\n')); }
+using test::line_count;
 
 class PrepareTexture : public ::testing::Test {
  protected:

@@ -13,6 +13,7 @@
 #include "core/file_io.h"
 #include "core/spectral_exr.h"
 #include "tests/cli/run_command.h"
+#include "tests/cli/text_files.h"
 
 namespace ct {
 namespace {
@@ -20,7 +21,7 @@ namespace {
 namespace fs = std::filesystem;
 using test::run_chromatrace;
 
-const std::string kBox = std::string(CHROMATRACE_SOURCE_DIR) + "/scenes/paper/box.json";
+using test::kPaperBox;
 
 class RenderCommand : public ::testing::Test {
  protected:
@@ -33,11 +34,11 @@ class RenderCommand : public ::testing::Test {
   static inline int counter_ = 0;
 };
 
-int line_count(const std::string& s) { return static_cast<int>(std::count(s.begin(), s.end(), '\n')); }
+using test::line_count;
 
 TEST_F(RenderCommand, WritesASpectralExrWithComponentsAndObjectIds) {
   const fs::path out = dir_ / "box.exr";
-  const auto r = run_chromatrace({"render", kBox, "-o", out.string(), "--spp", "2", "--resolution", "32x24",
+  const auto r = run_chromatrace({"render", kPaperBox, "-o", out.string(), "--spp", "2", "--resolution", "32x24",
                                   "--bands", "400:700:20", "--components", "all", "--max-bounces", "3", "--quiet"});
   ASSERT_EQ(r.exit_code, 0) << r.err;
   // --quiet: no progress; all that is said is what the settings leave out (2 paths per pixel), one warning a line.
@@ -66,21 +67,21 @@ TEST_F(RenderCommand, BadInputGetsExitTwoAndOneLineNamingTheField) {
   };
   const std::vector<Case> cases = {
       {{"render", (dir_ / "missing.json").string(), "-o", out.string()}, "missing.json"},
-      {{"render", kBox, "-o", out.string(), "--spp", "0"}, "--spp"},
-      {{"render", kBox, "-o", out.string(), "--max-bounces", "-2"}, "--max-bounces"},
-      {{"render", kBox, "-o", out.string(), "--bands", "380:785:10"}, "--bands"},
-      {{"render", kBox, "-o", out.string(), "--spectral-mode", "rgb"}, "--spectral-mode"},
-      {{"render", kBox, "-o", out.string(), "--components", "paths,colours"}, "--components"},
-      {{"render", kBox, "-o", out.string(), "--resolution", "64"}, "--resolution"},
-      {{"render", kBox, "-o", out.string(), "--time-limit", "-1"}, "--time-limit"},
-      {{"render", kBox, "-o", out.string(), "--threads", "-3"}, "--threads"},
-      {{"render", kBox, "-o", (dir_ / "no/such/dir/out.exr").string(), "--spp", "1", "--resolution", "4x4"}, "out.exr"},
-      {{"render", kBox}, "--output"},
-      {{"render", kBox, "-o", out.string(), "--no-such-option"}, "--no-such-option"},
-      {{"render", kBox, "-o", out.string(), "--seeds", "0"}, "--seeds"},
-      {{"render", kBox, "-o", out.string(), "--seeds", "5", "--spp", "4"}, "--seeds"},
-      {{"render", kBox, "-o", out.string(), "--seeds", "4", "--part", "4"}, "--part"},
-      {{"render", kBox, "-o", out.string(), "--part", "0"}, "--part"},
+      {{"render", kPaperBox, "-o", out.string(), "--spp", "0"}, "--spp"},
+      {{"render", kPaperBox, "-o", out.string(), "--max-bounces", "-2"}, "--max-bounces"},
+      {{"render", kPaperBox, "-o", out.string(), "--bands", "380:785:10"}, "--bands"},
+      {{"render", kPaperBox, "-o", out.string(), "--spectral-mode", "rgb"}, "--spectral-mode"},
+      {{"render", kPaperBox, "-o", out.string(), "--components", "paths,colours"}, "--components"},
+      {{"render", kPaperBox, "-o", out.string(), "--resolution", "64"}, "--resolution"},
+      {{"render", kPaperBox, "-o", out.string(), "--time-limit", "-1"}, "--time-limit"},
+      {{"render", kPaperBox, "-o", out.string(), "--threads", "-3"}, "--threads"},
+      {{"render", kPaperBox, "-o", (dir_ / "no/such/dir/out.exr").string(), "--spp", "1", "--resolution", "4x4"}, "out.exr"},
+      {{"render", kPaperBox}, "--output"},
+      {{"render", kPaperBox, "-o", out.string(), "--no-such-option"}, "--no-such-option"},
+      {{"render", kPaperBox, "-o", out.string(), "--seeds", "0"}, "--seeds"},
+      {{"render", kPaperBox, "-o", out.string(), "--seeds", "5", "--spp", "4"}, "--seeds"},
+      {{"render", kPaperBox, "-o", out.string(), "--seeds", "4", "--part", "4"}, "--part"},
+      {{"render", kPaperBox, "-o", out.string(), "--part", "0"}, "--part"},
   };
   for (const Case& c : cases) {
     const auto r = run_chromatrace(c.args);
@@ -96,7 +97,7 @@ TEST_F(RenderCommand, BadInputGetsExitTwoAndOneLineNamingTheField) {
 // render --seeds K renders K parts and combines them (reference_tracer/seed_split.h): the same bytes as the parts
 // rendered one by one with --part and joined by combine, and no scratch files left beside the output.
 TEST_F(RenderCommand, SeedSplitEqualsItsPartsCombinedAndLeavesOnlyTheOutput) {
-  const std::vector<std::string> split = {kBox, "--spp", "7", "--resolution", "16x12", "--seeds", "3", "--quiet"};
+  const std::vector<std::string> split = {kPaperBox, "--spp", "7", "--resolution", "16x12", "--seeds", "3", "--quiet"};
   const fs::path out = dir_ / "split.exr";
   std::vector<std::string> args = {"render", "-o", out.string()};
   args.insert(args.end(), split.begin(), split.end());

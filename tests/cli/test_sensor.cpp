@@ -11,6 +11,7 @@
 
 #include "core/spectral_exr.h"
 #include "tests/cli/run_command.h"
+#include "tests/cli/text_files.h"
 #include "tests/core/spectral_exr_fixtures.h"
 
 namespace ct {
@@ -19,11 +20,11 @@ namespace {
 namespace fs = std::filesystem;
 using test::run_chromatrace;
 
-const fs::path kD65 = fs::path(CHROMATRACE_TEST_DATA) / "spectral_exr_samples" / "spectral-exr_D65_emissive.exr";
+const fs::path kD65Emissive = fs::path(CHROMATRACE_TEST_DATA) / "spectral_exr_samples" / "spectral-exr_D65_emissive.exr";
 const fs::path kMacbeth =
     fs::path(CHROMATRACE_TEST_DATA) / "spectral_exr_samples" / "spectral-exr_Macbeth_reflective.exr";
 
-int line_count(const std::string& s) { return static_cast<int>(std::count(s.begin(), s.end(), '\n')); }
+using test::line_count;
 
 class SensorCommand : public ::testing::Test {
  protected:
@@ -100,7 +101,7 @@ TEST_F(SensorCommand, BadInputGetsExitTwoAndOneLineNamingTheField) {
       // Found while the pixels stream: after the progress bar's line, unless --quiet.
       {{"sensor", nan.string(), "-o", out.string(), "--quiet"},
        "nan.exr: channel S0.600,000000nm: value nan at pixel (3, 1) is not finite"},
-      {{"sensor", kD65.string(), "-o", out.string(), "--camera", "nikon_d850"},
+      {{"sensor", kD65Emissive.string(), "-o", out.string(), "--camera", "nikon_d850"},
        "spectral-exr_D65_emissive.exr: bands 377.5-827.5 nm reach outside the camera curves of nikon_d850"},
       {{"sensor", in, "-o", out.string(), "--camera", "leica_m"}, "--camera: spectral_response.camera: unknown camera"},
       {{"sensor", in, "-o", out.string(), "--exposure-s", "-1"}, "--exposure-s: exposure.time_s: must be > 0"},

@@ -21,6 +21,7 @@
 #include "core/json_input.h"
 #include "core/series_format.h"
 #include "tests/cli/run_command.h"
+#include "tests/cli/text_files.h"
 #include "tests/core/spectral_exr_fixtures.h"
 #include "tests/core/bad_scenes.h"
 
@@ -37,7 +38,7 @@ class SeriesCommand : public ::testing::Test {
   const fs::path dir_ = temp_.path();
 };
 
-int line_count(const std::string& text) { return static_cast<int>(std::count(text.begin(), text.end(), '\n')); }
+using test::line_count;
 
 Json read_result(const fs::path& dir) { return read_json(dir / "series.json"); }
 

@@ -18,13 +18,14 @@
 #include <nlohmann/json.hpp>
 
 #include "tests/cli/run_command.h"
+#include "tests/cli/text_files.h"
 
 namespace ct {
 namespace {
 
 namespace fs = std::filesystem;
 
-const std::string kMinimal = std::string(CHROMATRACE_TEST_DATA) + "/scenes/minimal.json";
+using test::kMinimal;
 const std::string kScenes = std::string(CHROMATRACE_SOURCE_DIR) + "/scenes";
 
 struct TracedRun {
@@ -95,12 +96,12 @@ TEST(Startup, HelpAndVersionLoadNoImageLibrary) {
 }
 
 TEST(Startup, CheckSceneLoadsNoImageLibrary) {
-  const TracedRun text = run_traced({"check-scene", kMinimal});
+  const TracedRun text = run_traced({"check-scene", kMinimal.string()});
   EXPECT_EQ(text.result.exit_code, 0) << text.err;
-  EXPECT_EQ(text.result.out.rfind(kMinimal + ": valid scene \"minimal\"\n", 0), 0u) << text.result.out;
+  EXPECT_EQ(text.result.out.rfind(kMinimal.string() + ": valid scene \"minimal\"\n", 0), 0u) << text.result.out;
   expect_no_image_library(text, "check-scene");
 
-  const TracedRun json = run_traced({"check-scene", "--json", kMinimal});
+  const TracedRun json = run_traced({"check-scene", "--json", kMinimal.string()});
   ASSERT_EQ(json.result.exit_code, 0) << json.err;
   EXPECT_EQ(nlohmann::json::parse(json.result.out)["scene"]["objects"], 2);
   expect_no_image_library(json, "check-scene --json");
@@ -167,7 +168,7 @@ TEST(Startup, HandedOverCommandsKeepTheirExitCodes) {
   fs::create_directories(dir);
   const std::string out = (dir / "r.exr").string();
   const test::CommandResult render = test::run_chromatrace(
-      {"render", kMinimal, "-o", out, "--resolution", "8x6", "--spp", "1", "--bands", "400:700:100", "--quiet"});
+      {"render", kMinimal.string(), "-o", out, "--resolution", "8x6", "--spp", "1", "--bands", "400:700:100", "--quiet"});
   EXPECT_EQ(render.exit_code, 0) << render.err;  // stderr: the warning that 1 sample is noisy
   const test::CommandResult info = test::run_chromatrace({"info", "--json", out});
   ASSERT_EQ(info.exit_code, 0) << info.err;
@@ -178,10 +179,10 @@ TEST(Startup, HandedOverCommandsKeepTheirExitCodes) {
   const test::CommandResult missing = test::run_chromatrace({"render", "/nonexistent/scene.json", "-o", out});
   EXPECT_EQ(missing.exit_code, 2);
   EXPECT_EQ(missing.err, "chromatrace render: error: /nonexistent/scene.json: cannot open file\n");
-  const test::CommandResult usage = test::run_chromatrace({"render", kMinimal, "--no-such-option"});
+  const test::CommandResult usage = test::run_chromatrace({"render", kMinimal.string(), "--no-such-option"});
   EXPECT_EQ(usage.exit_code, 2);
   EXPECT_EQ(usage.err.rfind("chromatrace render: error: ", 0), 0u) << usage.err;
-  const test::CommandResult not_a_number = test::run_chromatrace({"render", kMinimal, "-o", out, "--spp", "abc"});
+  const test::CommandResult not_a_number = test::run_chromatrace({"render", kMinimal.string(), "-o", out, "--spp", "abc"});
   EXPECT_EQ(not_a_number.exit_code, 2);
   EXPECT_EQ(not_a_number.err.rfind("chromatrace render: error: ", 0), 0u) << not_a_number.err;
   EXPECT_NE(not_a_number.err.find("--spp"), std::string::npos) << not_a_number.err;

@@ -27,7 +27,7 @@ using test::read_text;
 using test::run_chromatrace;
 using test::write_text;
 
-const fs::path kMinimal = test::minimal_scene();
+using test::kMinimal;
 
 // minimal.json with `from` replaced by `to` (which must occur once).
 std::string edited_minimal(const std::string& from, const std::string& to) {

@@ -21,7 +21,9 @@ inline std::string read_text(const std::filesystem::path& path) {
 }
 
 // The smallest valid scene, tests/data/scenes/minimal.json.
-inline std::filesystem::path minimal_scene() { return std::filesystem::path(CHROMATRACE_TEST_DATA) / "scenes" / "minimal.json"; }
+inline const std::filesystem::path kMinimal = std::filesystem::path(CHROMATRACE_TEST_DATA) / "scenes" / "minimal.json";
+// The paper's test box, scenes/paper/box.json.
+inline const std::string kPaperBox = std::string(CHROMATRACE_SOURCE_DIR) + "/scenes/paper/box.json";
 
 inline void write_text(const std::filesystem::path& path, const std::string& text) {
   std::ofstream(path, std::ios::binary) << text;

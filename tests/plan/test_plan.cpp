@@ -23,6 +23,7 @@
 #include "plan/plan.h"
 #include "reference_tracer/render.h"
 #include "tests/cli/run_command.h"
+#include "tests/plan/paper_box.h"
 #include "core/statistics.h"
 
 namespace ct {
@@ -32,7 +33,7 @@ namespace fs = std::filesystem;
 using test::run_chromatrace;
 
 const fs::path kSource = CHROMATRACE_SOURCE_DIR;
-const fs::path kBox = kSource / "scenes/paper/box.json";
+using test::kBox;
 const fs::path kCornell = kSource / "scenes/cornell_box/cornell_box.json";
 
 class Plan : public ::testing::Test {

@@ -27,12 +27,13 @@
 #include "plan/render_check.h"
 #include "reference_tracer/render.h"
 #include "tests/cli/run_command.h"
+#include "tests/plan/paper_box.h"
 
 namespace ct {
 namespace {
 
 namespace fs = std::filesystem;
-const fs::path kBox = fs::path(CHROMATRACE_SOURCE_DIR) / "scenes/paper/box.json";
+using test::kBox;
 constexpr int kSize = 24;  // pixels a side, for the prediction's preview and the measurements alike
 
 // The paper box as a document with absolute paths, at kSize × kSize pixels.
@@ -56,7 +57,7 @@ Json white_box_document() {
   return doc;
 }
 
-Scene scene_of(const Json& doc) { return parse_scene(doc, "box-variant.json", kBox.parent_path()); }
+using test::scene_of;
 
 plan::SettingsPrediction predict(const Scene& scene, int max_bounces, int samples) {
   plan::PlanOptions options;

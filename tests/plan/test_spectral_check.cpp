@@ -19,12 +19,13 @@
 #include "plan/plan.h"
 #include "plan/spectral_check.h"
 #include "tests/cli/run_command.h"
+#include "tests/plan/paper_box.h"
 
 namespace ct {
 namespace {
 
 namespace fs = std::filesystem;
-const fs::path kBox = fs::path(CHROMATRACE_SOURCE_DIR) / "scenes/paper/box.json";
+using test::kBox;
 
 // The paper box with its lamp replaced by a blue LED (peak 450 nm, 10 nm full width at half maximum) or one
 // material's reflectance by a narrow band (a 10 nm wide peak at 600 nm over 0.1).
@@ -40,7 +41,7 @@ Json box_with(bool led, bool narrow_paint) {
   return doc;
 }
 
-Scene scene_of(const Json& doc) { return parse_scene(doc, "box-variant.json", kBox.parent_path()); }
+using test::scene_of;
 
 TEST(SpectralCheck, SmoothSpectraAtTenNanometresGiveNoWarning) {
   const Scene box = load_scene(kBox);

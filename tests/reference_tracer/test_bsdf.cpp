@@ -14,7 +14,6 @@
 namespace ct::rt {
 namespace {
 
-constexpr double kPi = std::numbers::pi;
 
 Vec3 direction_with_cos(double cos_theta, double phi = 0.3) {
   const double s = std::sqrt(1.0 - cos_theta * cos_theta);
@@ -70,8 +69,8 @@ double chi_square_p_value(const Lobe& lobe, const Vec3& wo, std::uint64_t seed) 
     if (!s) continue;
     const int ci = std::min(kCos - 1, static_cast<int>(s->wi.z() * kCos));
     double phi = std::atan2(s->wi.y(), s->wi.x());
-    if (phi < 0) phi += 2 * kPi;
-    const int pi = std::min(kPhi - 1, static_cast<int>(phi / (2 * kPi) * kPhi));
+    if (phi < 0) phi += 2 * std::numbers::pi;
+    const int pi = std::min(kPhi - 1, static_cast<int>(phi / (2 * std::numbers::pi) * kPhi));
     observed[ci * kPhi + pi] += 1.0;
   }
   static constexpr double gx[5] = {-0.9061798459386640, -0.5384693101056831, 0.0, 0.5384693101056831,
@@ -82,7 +81,7 @@ double chi_square_p_value(const Lobe& lobe, const Vec3& wo, std::uint64_t seed) 
   for (int ci = 0; ci < kCos; ++ci)
     for (int pi = 0; pi < kPhi; ++pi) {
       const double c0 = double(ci) / kCos, dc = 1.0 / kCos / kSub;
-      const double p0 = 2 * kPi * pi / kPhi, dp = 2 * kPi / kPhi / kSub;
+      const double p0 = 2 * std::numbers::pi * pi / kPhi, dp = 2 * std::numbers::pi / kPhi / kSub;
       double integral = 0.0;
       for (int a = 0; a < kSub; ++a)
         for (int b = 0; b < kSub; ++b)
@@ -223,7 +222,7 @@ TEST(Ggx, NormalDistributionIsNormalised) {
     double sum = 0.0;
     for (int i = 0; i < n; ++i) {
       const double c = (i + 0.5) / n;
-      sum += 2 * kPi * ggx.D(direction_with_cos(c)) * c / n;
+      sum += 2 * std::numbers::pi * ggx.D(direction_with_cos(c)) * c / n;
     }
     EXPECT_NEAR(sum, 1.0, 1e-4) << alpha;
   }

@@ -32,7 +32,6 @@ namespace {
 
 using nlohmann::json;
 namespace fs = std::filesystem;
-constexpr double kPi = std::numbers::pi;
 
 class EnvironmentTest : public ::testing::Test {
  protected:
@@ -166,9 +165,9 @@ TEST_F(EnvironmentTest, ConstantImageIsTheConstantEnvironment) {
 // here by the midpoint rule over the patch in (φ, cos θ), where dω = dφ d(cos θ).
 double patch_radiance(const Vec3& normal, double rotation_deg, double rho, double radiance) {
   const int n = 400;
-  const double phi0 = 0, phi1 = kPi / 2;  // columns 4..7: u in [4/16, 8/16), φ = π(1 − 2u)
-  const double z0 = std::cos(kPi * 1 / 8), z1 = std::cos(kPi * 3 / 8);
-  const double r = rotation_deg * kPi / 180;
+  const double phi0 = 0, phi1 = std::numbers::pi / 2;  // columns 4..7: u in [4/16, 8/16), φ = π(1 − 2u)
+  const double z0 = std::cos(std::numbers::pi * 1 / 8), z1 = std::cos(std::numbers::pi * 3 / 8);
+  const double r = rotation_deg * std::numbers::pi / 180;
   double sum = 0;
   for (int i = 0; i < n; ++i)
     for (int j = 0; j < n; ++j) {
@@ -176,7 +175,7 @@ double patch_radiance(const Vec3& normal, double rotation_deg, double rho, doubl
       const double s = std::sqrt(1 - z * z);
       sum += std::max(0.0, normal.dot(Vec3(s * std::cos(phi), s * std::sin(phi), z)));
     }
-  return rho / kPi * radiance * sum * (phi1 - phi0) * (z0 - z1) / (n * n);
+  return rho / std::numbers::pi * radiance * sum * (phi1 - phi0) * (z0 - z1) / (n * n);
 }
 
 TEST_F(EnvironmentTest, BrightPatchLightsAPlaneAsTheIntegralSays) {

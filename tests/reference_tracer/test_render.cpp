@@ -30,7 +30,6 @@ namespace ct::rt {
 namespace {
 
 using nlohmann::json;
-constexpr double kPi = std::numbers::pi;
 
 Scene make_scene(const json& doc) { return parse_scene(doc, "test-scene", std::filesystem::temp_directory_path()); }
 
@@ -285,7 +284,7 @@ TEST(GgxMasking, RendersAgreeWhereTheyMustAndDifferWhereTheyMust) {
     doc["objects"] = json::array({{{"name", "plane"}, {"material", "plane"},
                                    {"shape", {{"type", "quad"}, {"corner", {-0.8, -0.8, -0.5}}, {"edge1", {1.6, 0, 0}},
                                               {"edge2", {0, 1.6, 0}}}}}});
-    const double t = view_deg * kPi / 180;
+    const double t = view_deg * std::numbers::pi / 180;
     doc["camera"] = {{"position", {0.9 * std::sin(t), 0, -0.5 + 0.9 * std::cos(t)}}, {"look_at", {0, 0, -0.5}},
                      {"up", {0, 1, 0}}, {"fov_deg", 1}, {"resolution", {4, 4}}};
     doc["render"] = {{"samples", 4096}, {"max_bounces", 1}, {"bands", "500:600:100"}, {"seed", 7}};
@@ -296,7 +295,7 @@ TEST(GgxMasking, RendersAgreeWhereTheyMustAndDifferWhereTheyMust) {
   };
   // ρ(θo) from the lobe's own samples: E[weight].
   const auto albedo = [](double roughness, bool correlated, double view_deg) {
-    const double t = view_deg * kPi / 180;
+    const double t = view_deg * std::numbers::pi / 180;
     return test::directional_albedo(GgxLobe{roughness * roughness, correlated}, Vec3(std::sin(t), 0, std::cos(t)), 400000, 19);
   };
   const auto near = [](const Stats& a, const Stats& b) { return std::abs(a.mean - b.mean) <= kSigmasPerItem * std::hypot(a.se, b.se); };
