@@ -7,12 +7,11 @@
 
 #include <Eigen/Eigenvalues>
 
+#include "core/geometry.h"
 #include "core/statistics.h"
 
 namespace ct::analyzer {
 namespace {
-
-constexpr double kDeg = 180.0 / std::numbers::pi;
 
 struct Slope {
   double kappa = 0, se = 0;  // y = α + κ x
@@ -85,10 +84,10 @@ std::optional<HighlightBranch> highlight_branch(const std::vector<Vec3>& points,
   const double n = static_cast<double>(off_body.size());
   const double from_kappa = all.se / (1 + all.kappa * all.kappa);
   const double from_e = minor / (std::max(major, 1e-300) * std::sqrt(n));
-  b.statistical_deg = std::hypot(from_kappa, from_e) * kDeg;
+  b.statistical_deg = std::hypot(from_kappa, from_e) * kDegreesPerRadian;
   if (lower.ok && upper.ok) {
     const double c = std::clamp(direction_of(lower.kappa, body, e).dot(direction_of(upper.kappa, body, e)), -1.0, 1.0);
-    b.halves_deg = std::acos(c) * kDeg;
+    b.halves_deg = std::acos(c) * kDegreesPerRadian;
   }
   b.uncertainty_deg = std::hypot(b.statistical_deg, b.halves_deg / 2);
   return b;

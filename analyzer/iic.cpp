@@ -9,6 +9,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "core/geometry.h"
 #include "core/principal_axes.h"
 #include "core/random.h"
 #include "core/statistics.h"
@@ -16,7 +17,6 @@
 namespace ct::analyzer {
 namespace {
 
-constexpr double kDeg = 180.0 / std::numbers::pi;
 // The median distance of a two-dimensional normal of unit standard deviation per axis from its centre, √(2 ln 2):
 // chromaticities move in a plane (their components sum to 1), so noise about a point is two-dimensional, and so
 // is a point's noise across a line in RGB.
@@ -26,7 +26,7 @@ double component_sum(const Vec3& v) { return v[0] + v[1] + v[2]; }
 
 // The angle between two directions, in degrees; atan2 keeps its precision at small angles, where acos loses half
 // the digits.
-double angle_deg(const Vec3& a, const Vec3& b) { return std::atan2(a.cross(b).norm(), a.dot(b)) * kDeg; }
+double angle_deg(const Vec3& a, const Vec3& b) { return std::atan2(a.cross(b).norm(), a.dot(b)) * kDegreesPerRadian; }
 
 std::size_t draw(Random& random, std::size_t n) {
   return std::min(n - 1, static_cast<std::size_t>(random.uniform() * static_cast<double>(n)));

@@ -9,6 +9,8 @@
 
 #include <fmt/core.h>
 
+#include "core/geometry.h"
+
 namespace ct::analyzer {
 namespace {
 
@@ -21,8 +23,6 @@ bool holds_a_plane(ShapeClass c) {
   return c == ShapeClass::L || c == ShapeClass::SkewedT || c == ShapeClass::P || c == ShapeClass::Planar ||
          c == ShapeClass::Thickened;
 }
-
-constexpr double kDeg = 180.0 / std::numbers::pi;
 
 // "B once R + G passes 0.031": per channel with a level, the other two channels' sum above which it is clear of black.
 std::string clear_levels_text(const std::array<double, 3>& levels) {
@@ -62,13 +62,13 @@ double mean_direction_se_deg(const std::vector<Vec3>& directions, const std::vec
   for (std::size_t i = 0; i < directions.size(); ++i) {
     w += weights[i];
     propagated += weights[i] * weights[i] * se[i] * se[i];
-    const double a = angular_error_deg(directions[i], mean) / kDeg;
+    const double a = angular_error_deg(directions[i], mean) / kDegreesPerRadian;
     scatter += weights[i] * a * a;
   }
   const double k = static_cast<double>(directions.size());
   const double from_fits = std::sqrt(propagated) / w;
   const double from_scatter = k > 1 ? std::sqrt(scatter / w / k) : 0.0;
-  return std::max(from_fits, from_scatter) * kDeg;
+  return std::max(from_fits, from_scatter) * kDegreesPerRadian;
 }
 
 // The standard error of the planes' intersection, in degrees: a normal tilted by δ moves the least eigenvector of
@@ -99,7 +99,7 @@ double intersection_se_deg(const std::vector<Vec3>& normals, const std::vector<d
   const double nu = k - 2;
   const double from_misfit =
       k > 2 ? std::sqrt(miss / nu) / std::sqrt(lambda2 / k) * std::sqrt(nu * std::expm1(4 / nu)) / 2 : 0.0;
-  return std::max(from_fits, from_misfit) * kDeg;
+  return std::max(from_fits, from_misfit) * kDegreesPerRadian;
 }
 
 }  // namespace
@@ -176,7 +176,7 @@ bool add_highlight_line(const RegionAnalysis& r, const ClusterShape& s, const st
       ++e.lines_left_out;
       return false;
     }
-    e.add_line(b->direction, static_cast<double>(b->samples), b->uncertainty_deg / kDeg, r.name);
+    e.add_line(b->direction, static_cast<double>(b->samples), b->uncertainty_deg / kDegreesPerRadian, r.name);
   } else {
     e.add_line(h.direction, static_cast<double>(h.inliers), line_direction_se(h), r.name);
     e.line_fitted = true;
@@ -205,7 +205,7 @@ Evidence gather_evidence(const std::vector<RegionAnalysis>& regions, const std::
       if (!told_from_body(r, s, notes)) {
         ++e.lines_left_out;
       } else if (!reaches_the_top(s.clipping)) {
-        e.add_line(s.highlight_branch->direction, static_cast<double>(s.highlight_branch->samples), s.highlight_branch->uncertainty_deg / kDeg, r.name);
+        e.add_line(s.highlight_branch->direction, static_cast<double>(s.highlight_branch->samples), s.highlight_branch->uncertainty_deg / kDegreesPerRadian, r.name);
       } else {
         notes.push_back(fmt::format("{}: its highlight branch reaches a clipping level, so it is left out of the highlight-line estimate", r.name));
         ++e.lines_left_out;
@@ -369,7 +369,7 @@ void cross_check(std::size_t plane_count, IlluminantAnalysis& out) {
 // Every light's colour lies within 54.7° of grey (arccos(1/√3), grey to a primary): an estimate whose 2σ reaches
 // that far could be any light's colour, so it says nothing of this one.
 void refuse_if_uninformative(std::optional<IlluminantEstimate>& e) {
-  const double octant_deg = std::acos(1 / std::sqrt(3.0)) * kDeg;
+  const double octant_deg = std::acos(1 / std::sqrt(3.0)) * kDegreesPerRadian;
   if (!e || !e->reliable || !e->uncertainty_deg || 2 * *e->uncertainty_deg < octant_deg) return;
   e->reliable = false;
   e->unreliable_reason = fmt::format("its 2σ ({:.0f}°) reaches past {:.1f}°, the angle from grey to a primary: it could be any "

@@ -10,10 +10,10 @@
 
 #include <fmt/format.h>
 
+#include "core/geometry.h"
+
 namespace ct::analyzer {
 namespace {
-
-constexpr double kDeg = 180.0 / std::numbers::pi;
 
 // The premises a class's process rests on, measured before it is described.
 struct Premises {
@@ -172,7 +172,7 @@ std::optional<Branch> measure_branch(const ClusterShape& s, const IlluminantEsti
     } else {
       const Line& h = s.two_lines->highlight;
       const double spread = (h.t_max - h.t_min) / std::sqrt(12.0);
-      branch_se = spread > 0 ? std::atan2(h.rms, std::sqrt(std::max<double>(1, static_cast<double>(h.inliers))) * spread) * kDeg : 90.0;
+      branch_se = spread > 0 ? std::atan2(h.rms, std::sqrt(std::max<double>(1, static_cast<double>(h.inliers))) * spread) * kDegreesPerRadian : 90.0;
     }
     b.allowed_deg = std::max(criteria.min_line_angle_deg, 2 * std::hypot(branch_se, light.uncertainty_deg.value_or(0.0)));
     if (light.reliable) b.light = *b.light_angle_deg <= *b.allowed_deg;
@@ -326,14 +326,14 @@ BlackReach black_reach(const Line& line, double min_line_angle_deg) {
   const double along = line.point.dot(d);  // the centroid's position along the line, from its closest point to black
   r.miss = (line.point - along * d).norm();
   const double top = along + std::max(line.t_max, line.t_min);  // the brightest end (the direction points brighter)
-  r.angle_deg = std::atan2(r.miss, top) * kDeg;
+  r.angle_deg = std::atan2(r.miss, top) * kDegreesPerRadian;
   // The closest point's standard error: the centroid's (rms / √n across the line) and the tilt's, carried from the
   // centroid to the closest point (a direction's standard error is rms / (√n · the spread along the line)).
   const double n = std::max<double>(1, static_cast<double>(line.inliers));
   const double length = line.t_max - line.t_min;
   const double se = length > 0 ? line.rms / std::sqrt(n) * std::sqrt(1 + 12 * along * along / (length * length))
                                : std::numeric_limits<double>::infinity();
-  r.uncertainty_deg = std::atan2(se, std::hypot(r.miss, top)) * kDeg;
+  r.uncertainty_deg = std::atan2(se, std::hypot(r.miss, top)) * kDegreesPerRadian;
   r.allowed_deg = std::max(min_line_angle_deg, 2 * r.uncertainty_deg);
   // A line known no better than the angle that tells two directions apart cannot say where it passes black.
   r.measured = std::isfinite(se) && r.uncertainty_deg <= min_line_angle_deg;
@@ -476,13 +476,13 @@ Interpretation interpret_region(const RegionAnalysis& region, const Region& pixe
                                               ? std::optional<double>(s.sigma[2] / s.noise_sigma[2]) : std::nullopt;
   const bool thick = thickness && *thickness > criteria.noise_factor;
   if (planar && out.light_colour && !light.reliable) {
-    out.light_off_plane_deg = std::asin(std::min(1.0, std::abs(s.black_plane->normal.normalized().dot(*out.light_colour)))) * kDeg;
+    out.light_off_plane_deg = std::asin(std::min(1.0, std::abs(s.black_plane->normal.normalized().dot(*out.light_colour)))) * kDegreesPerRadian;
     out.findings.push_back({"plane.light_unknown",
                             fmt::format("Its plane through black lies {:.1f}° from the light's colour, which is too uncertain to say "
                                         "whether the plane holds it.", *out.light_off_plane_deg),
                             {}});
   } else if (planar && out.light_colour && thickness) {
-    out.light_off_plane_deg = std::asin(std::min(1.0, std::abs(s.black_plane->normal.normalized().dot(*out.light_colour)))) * kDeg;
+    out.light_off_plane_deg = std::asin(std::min(1.0, std::abs(s.black_plane->normal.normalized().dot(*out.light_colour)))) * kDegreesPerRadian;
     const double allowed = std::max(criteria.min_line_angle_deg, 2 * light.uncertainty_deg.value_or(0.0));
     const bool holds = *out.light_off_plane_deg <= allowed;
     // How far the cluster lies off that plane, in units of its noise across it: the model's plane passes black.

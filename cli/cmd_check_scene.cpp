@@ -27,7 +27,7 @@
 namespace ct::cli {
 namespace {
 
-struct Options {
+struct CheckSceneOptions {
   std::string file, variant, emit, emit_sensor;
   // The render settings to judge instead of the scene's (those a renderer is given on its command line, as the
   // Blender batch passes on its own): the warnings name them by these options.
@@ -50,13 +50,13 @@ const char* fov_axis_name(FovAxis axis) {
   return "";
 }
 
-bool overrides(const Options& o) {
+bool overrides(const CheckSceneOptions& o) {
   return !o.bands.empty() || !o.bands_file.empty() || !o.resolution.empty() || o.samples || o.max_bounces ||
          o.renderer != "tracer";
 }
 
 // The settings the warnings judge: the scene's, with the options' in their place.
-plan::RenderRequest judged_settings(const Scene& scene, const Options& o) {
+plan::RenderRequest judged_settings(const Scene& scene, const CheckSceneOptions& o) {
   plan::RenderRequest request = plan::scene_settings(scene);
   if (o.renderer != "tracer" && o.renderer != "cycles")
     throw InputError(fmt::format("--renderer: must be tracer or cycles, got \"{}\"", o.renderer));
@@ -209,7 +209,7 @@ void print_variant(const Json& v) {
 
 // --emit / --emit-sensor: the variant's resolved scene (paths relative to where it is written) and its sensor
 // settings as a chromatrace-sensor/1 file, so it can be rendered with `render` or the Blender batch by hand.
-void emit_variant(const Options& options, const Series& series) {
+void emit_variant(const CheckSceneOptions& options, const Series& series) {
   const SeriesVariant* variant = &series.variant(options.variant, "--variant");
   std::vector<std::filesystem::path> inputs = series.base_scene.files;
   inputs.push_back(options.file);
@@ -228,7 +228,7 @@ void emit_variant(const Options& options, const Series& series) {
   }
 }
 
-int check(const Options& options) {
+int check(const CheckSceneOptions& options) {
   const Json document = read_json(options.file);
   Json report;
   if (document_format(document) == kSeriesFormat) {
@@ -285,7 +285,7 @@ int check(const Options& options) {
 }  // namespace
 
 Action add_check_scene(CLI::App& app) {
-  auto options = std::make_shared<Options>();
+  auto options = std::make_shared<CheckSceneOptions>();
   CLI::App* command = add_command(app, "check-scene");
   command->add_option("file", options->file, "scene or series JSON file")->required();
   command->add_flag("--json", options->json, "print the summary as JSON");

@@ -24,7 +24,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-struct Options {
+struct ExportMeshesOptions {
   std::string scene, directory;
   bool ascii = false, json = false, quiet = false, uvs = false;
 };
@@ -37,7 +37,7 @@ std::string mesh_file_name(int id, const std::string& name) {
   return fmt::format("{:03d}_{}.ply", id, safe);
 }
 
-int run(const Options& o) {
+int run(const ExportMeshesOptions& o) {
   const Scene scene = load_scene(o.scene);
   const fs::path dir(o.directory);
   check_output_directory(dir, scene.files);
@@ -88,7 +88,7 @@ int run(const Options& o) {
 }  // namespace
 
 Action add_export_meshes(CLI::App& app) {
-  auto o = std::make_shared<Options>();
+  auto o = std::make_shared<ExportMeshesOptions>();
   auto* cmd = add_command(app, "export-meshes");
   cmd->add_option("scene", o->scene, "Scene file (chromatrace-scene/1)")->required();
   cmd->add_option("directory", o->directory, "Output directory (created if missing; its parent must exist)")->required();

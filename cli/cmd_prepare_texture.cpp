@@ -20,7 +20,7 @@
 namespace ct::cli {
 namespace {
 
-struct Options {
+struct PrepareTextureOptions {
   std::string image, bands, bands_file, kind, colour_space = "auto", output;
   int bands_per_render = 3;
   int threads = 0;
@@ -29,7 +29,7 @@ struct Options {
 };
 
 // --check: the image read and judged as a render would, nothing written; its size and capture noise as JSON.
-int check_only(const Options& o, TextureUse use, std::optional<TextureColourSpace> colour_space) {
+int check_only(const PrepareTextureOptions& o, TextureUse use, std::optional<TextureColourSpace> colour_space) {
   const ImageTexture texture = read_image_texture(o.image, o.image, colour_space, use, o.scale);
   const Json summary = {{"image", o.image},
                         {"width", texture.width},
@@ -39,7 +39,7 @@ int check_only(const Options& o, TextureUse use, std::optional<TextureColourSpac
   return 0;
 }
 
-int run(const Options& o) {
+int run(const PrepareTextureOptions& o) {
   if (!o.bands.empty() && !o.bands_file.empty())
     throw InputError("--bands-file: give either --bands or --bands-file, not both");
   if (o.bands.empty() && o.bands_file.empty() && !o.check)
@@ -122,7 +122,7 @@ int run(const Options& o) {
 }  // namespace
 
 Action add_prepare_texture(CLI::App& app) {
-  auto o = std::make_shared<Options>();
+  auto o = std::make_shared<PrepareTextureOptions>();
   auto* cmd = add_command(app, "prepare-texture");
   cmd->add_option("image", o->image, "image texture or HDRI (any format OpenImageIO reads)")->required();
   cmd->add_option("--bands", o->bands, "Band plan lo:hi:width in nm");

@@ -23,7 +23,7 @@
 namespace ct::cli {
 namespace {
 
-struct Options {
+struct SceneBandsOptions {
   std::string file, bands, bands_file;
   bool json = false;
 };
@@ -77,7 +77,7 @@ Json material_entry(const Material& material, const Bands& bands) {
       material.model);
 }
 
-int run(const Options& o) {
+int run(const SceneBandsOptions& o) {
   const std::optional<Bands> given = band_plan_option(o.bands, o.bands_file, "--bands-file");
   const Json document = read_json(o.file);
   const bool spectra_only = document_format(document) == kSpectraFormat;
@@ -145,7 +145,7 @@ int run(const Options& o) {
 }  // namespace
 
 Action add_scene_bands(CLI::App& app) {
-  auto o = std::make_shared<Options>();
+  auto o = std::make_shared<SceneBandsOptions>();
   auto* cmd = add_command(app, "scene-bands");
   cmd->add_option("file", o->file, "scene (chromatrace-scene/1) or spectra list (chromatrace-spectra/1)")->required();
   cmd->add_option("--bands", o->bands, "Band plan lo:hi:width in nm (default: the scene's render.bands, else 380:780:10)");

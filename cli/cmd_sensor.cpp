@@ -21,7 +21,7 @@
 namespace ct::cli {
 namespace {
 
-struct Options {
+struct SensorOptions {
   std::string input, output, config, preset, camera, exposure, outside_curve, cfa, illuminant;
   std::optional<double> exposure_scale, f_number, fov_deg;
   std::optional<int> supersample;
@@ -58,7 +58,7 @@ sensor::ConfigPatch set_patch(const std::string& assignment) {
 
 // The configuration: preset, config file, then each option in a fixed order and --set in the order given;
 // each is checked as it is applied, so an error names the file or option that caused it.
-sensor::SensorConfig configuration(const Options& o) {
+sensor::SensorConfig configuration(const SensorOptions& o) {
   std::vector<sensor::ConfigPatch> patches;
   if (!o.config.empty()) patches.push_back(sensor::read_config_patch(o.config));
   const auto add = [&](const char* option, const std::string& path, Json value) {
@@ -92,7 +92,7 @@ sensor::SensorConfig configuration(const Options& o) {
   return sensor::resolve_config(patches);
 }
 
-int run(const Options& o) {
+int run(const SensorOptions& o) {
   const sensor::SensorConfig config = configuration(o);
   if (o.print_config) {
     fmt::print("{}\n", sensor::config_json(config).dump(2));
@@ -127,7 +127,7 @@ int run(const Options& o) {
 
 Action add_sensor(CLI::App& app) {
   auto* cmd = add_command(app, "sensor");
-  auto o = std::make_shared<Options>();
+  auto o = std::make_shared<SensorOptions>();
   cmd->add_option("input", o->input, "Spectral EXR (emitted radiance, S0 channels; or reflectance with --illuminant)");
   cmd->add_option("-o,--output", o->output,
                   "Output image: .exr (all layers), .tif/.tiff or .png (final image), .dng (the Bayer mosaic)");

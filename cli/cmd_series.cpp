@@ -29,14 +29,14 @@ namespace ct::cli {
 namespace {
 namespace fs = std::filesystem;
 
-struct Options {
+struct SeriesOptions {
   std::string series, output;
   SeriesRenderOptions render;
   int threads = 0;
   bool quiet = false, renders_only = false;
 };
 
-void add_common(CLI::App* cmd, Options& o) {
+void add_common(CLI::App* cmd, SeriesOptions& o) {
   cmd->add_option("-o,--output", o.output, "Output directory (created; its parent must exist)")->required();
   add_series_render_options(cmd, o.render);
   cmd->add_option("--threads", o.threads, "Worker threads (0: all cores)")->check(CLI::NonNegativeNumber);
@@ -90,7 +90,7 @@ void check_inputs_outside(const fs::path& dir, const Series& series, const fs::p
                                        input.string(), w.string()));
 }
 
-int run(const Options& o, const fs::path& series_file) {
+int run(const SeriesOptions& o, const fs::path& series_file) {
   series::RunOptions options = series_run_options(o.render, o.threads, o.quiet);
   options.renders_only = o.renders_only;
   if (o.output.empty()) throw InputError("--output: no directory given");
@@ -124,7 +124,7 @@ int run(const Options& o, const fs::path& series_file) {
 
 Action add_series(CLI::App& app) {
   auto* cmd = add_command(app, "series");
-  auto o = std::make_shared<Options>();
+  auto o = std::make_shared<SeriesOptions>();
   cmd->add_option("series", o->series, "Series file (chromatrace-series/1)")->required();
   add_common(cmd, *o);
   return [o] { return run(*o, o->series); };
@@ -132,10 +132,10 @@ Action add_series(CLI::App& app) {
 
 Action add_paper(CLI::App& app) {
   auto* cmd = add_command(app, "paper");
-  auto o = std::make_shared<Options>();
+  auto o = std::make_shared<SeriesOptions>();
   add_common(cmd, *o);
   return [o] {
-    Options options = *o;
+    SeriesOptions options = *o;
     if (options.render.resolution.empty()) options.render.resolution = "128x128";
     return run(options, shipped_file("scenes/paper/series.json"));
   };

@@ -22,7 +22,7 @@ namespace ct::cli {
 namespace {
 namespace fs = std::filesystem;
 
-struct Options {
+struct StudyCommandOptions {
   std::string scene, output, resolution, camera = "cie1931";
   std::vector<int> bands = {3, 6, 9, 12, 20};
   std::vector<double> fitted = {2, 1, 0.5};
@@ -43,7 +43,7 @@ void check_each(const std::vector<T>& values, const char* option, T least) {
     if (!(v >= least)) throw InputError(fmt::format("{}: every value must be >= {}, got {}", option, least, v));
 }
 
-study::StudyOptions study_options(const Options& o, const Scene& scene) {
+study::StudyOptions study_options(const StudyCommandOptions& o, const Scene& scene) {
   study::StudyOptions s;
   if (!o.resolution.empty()) std::tie(s.width, s.height) = parse_resolution(o.resolution);
   check_each(o.bands, "--bands", 1);
@@ -100,7 +100,7 @@ void print_summary(const study::StudyResult& result, const fs::path& dir) {
 
 Action add_study(CLI::App& app) {
   auto* cmd = add_command(app, "study");
-  auto o = std::make_shared<Options>();
+  auto o = std::make_shared<StudyCommandOptions>();
   cmd->add_option("scene", o->scene, "Scene file (chromatrace-scene/1)")->required();
   cmd->add_option("-o,--output", o->output, "Output directory (created; its parent must exist)")->required();
   cmd->add_option("--resolution", o->resolution, "Image size WxH of every render (default: the scene's)");

@@ -20,7 +20,8 @@
 #include "core/file_io.h"
 
 namespace ct {
-namespace {
+// Not in an anonymous namespace: AtomicExrOutput::File, declared in the header, holds one.
+namespace exr_output_detail {
 
 // An OpenEXR output stream on a file descriptor that remembers its first failure: OpenEXR writes the line
 // offset table from OutputFile's destructor and swallows errors there, so finish() asks the stream instead.
@@ -59,7 +60,9 @@ class DescriptorStream final : public Imf::OStream {
   std::string error_;
 };
 
-}  // namespace
+}  // namespace exr_output_detail
+
+using exr_output_detail::DescriptorStream;
 
 struct AtomicExrOutput::File {
   explicit File(const std::filesystem::path& target) : output(target) {}

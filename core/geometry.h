@@ -10,6 +10,7 @@
 #include <array>
 #include <cstdint>
 #include <limits>
+#include <numbers>
 #include <string>
 #include <variant>
 #include <vector>
@@ -21,6 +22,8 @@ namespace ct {
 
 using Vec3 = Eigen::Vector3d;
 using Vec2 = Eigen::Vector2d;
+
+inline constexpr double kDegreesPerRadian = 180.0 / std::numbers::pi;
 
 struct TriangleMesh {
   std::vector<Vec3> positions;

@@ -9,7 +9,6 @@
 namespace ct::rt {
 namespace {
 
-constexpr double kPi = std::numbers::pi;
 constexpr double kInvPi = 1.0 / std::numbers::pi;
 
 bool same_hemisphere_above(const Vec3& wo, const Vec3& wi) { return wo.z() > 0.0 && wi.z() > 0.0; }
@@ -30,10 +29,10 @@ Vec2 sample_concentric_disk(const Vec2& u) {
   double r, phi;
   if (std::abs(p.x()) > std::abs(p.y())) {
     r = p.x();
-    phi = kPi / 4.0 * (p.y() / p.x());
+    phi = std::numbers::pi / 4.0 * (p.y() / p.x());
   } else {
     r = p.y();
-    phi = kPi / 2.0 - kPi / 4.0 * (p.x() / p.y());
+    phi = std::numbers::pi / 2.0 - std::numbers::pi / 4.0 * (p.x() / p.y());
   }
   return {r * std::cos(phi), r * std::sin(phi)};
 }
@@ -65,7 +64,7 @@ double GgxLobe::D(const Vec3& h) const {
   const double a2 = alpha * alpha;
   const double c2 = h.z() * h.z();
   const double denom = c2 * (a2 - 1.0) + 1.0;
-  return a2 / (kPi * denom * denom);
+  return a2 / (std::numbers::pi * denom * denom);
 }
 
 double GgxLobe::Lambda(const Vec3& w) const {
@@ -102,7 +101,7 @@ std::optional<LobeSample> GgxLobe::sample(const Vec3& wo, const Vec2& u) const {
   const Vec3 t1 = len2 > 0.0 ? Vec3(-vh.y(), vh.x(), 0.0) / std::sqrt(len2) : Vec3(1.0, 0.0, 0.0);
   const Vec3 t2 = vh.cross(t1);
   const double r = std::sqrt(u.x());
-  const double phi = 2.0 * kPi * u.y();
+  const double phi = 2.0 * std::numbers::pi * u.y();
   const double p1 = r * std::cos(phi);
   const double s = 0.5 * (1.0 + vh.z());
   const double p2 = (1.0 - s) * std::sqrt(std::max(0.0, 1.0 - p1 * p1)) + s * r * std::sin(phi);
@@ -122,25 +121,25 @@ double PhongLobe::eval(const Vec3& wo, const Vec3& wi) const {
   if (!same_hemisphere_above(wo, wi)) return 0.0;
   const double c = reflect_about_normal(wo).dot(wi);
   if (c <= 0.0) return 0.0;
-  return (exponent + 2.0) / (2.0 * kPi) * std::pow(c, exponent) * wi.z();
+  return (exponent + 2.0) / (2.0 * std::numbers::pi) * std::pow(c, exponent) * wi.z();
 }
 
 double PhongLobe::pdf(const Vec3& wo, const Vec3& wi) const {
   if (!same_hemisphere_above(wo, wi)) return 0.0;
   const double c = reflect_about_normal(wo).dot(wi);
   if (c <= 0.0) return 0.0;
-  return (exponent + 1.0) / (2.0 * kPi) * std::pow(c, exponent);
+  return (exponent + 1.0) / (2.0 * std::numbers::pi) * std::pow(c, exponent);
 }
 
 std::optional<LobeSample> PhongLobe::sample(const Vec3& wo, const Vec2& u) const {
   if (wo.z() <= 0.0) return std::nullopt;
   const double cos_a = std::pow(u.x(), 1.0 / (exponent + 1.0));
   const double sin_a = std::sqrt(std::max(0.0, 1.0 - cos_a * cos_a));
-  const double phi = 2.0 * kPi * u.y();
+  const double phi = 2.0 * std::numbers::pi * u.y();
   const Frame lobe(reflect_about_normal(wo));
   const Vec3 wi = lobe.to_world(Vec3(sin_a * std::cos(phi), sin_a * std::sin(phi), cos_a));
   if (wi.z() <= 0.0) return std::nullopt;
-  const double p = (exponent + 1.0) / (2.0 * kPi) * std::pow(cos_a, exponent);
+  const double p = (exponent + 1.0) / (2.0 * std::numbers::pi) * std::pow(cos_a, exponent);
   return LobeSample{wi, (exponent + 2.0) / (exponent + 1.0) * wi.z(), p};
 }
 

@@ -13,8 +13,6 @@
 namespace ct::rt {
 namespace {
 
-constexpr double kPi = std::numbers::pi;
-
 // Mean of a spectrum over the visible range, used only to balance sampling decisions (never a result).
 double visible_mean(const PiecewiseLinearSpectrum& s) { return s.average(380.0, 780.0); }
 double visible_mean(const ScaledSigmoid& s) {
@@ -91,10 +89,10 @@ TracerMaterial make_material(const Material& material, TextureSet& textures) {
 }
 
 // Polar angle of the top edge of texel row y (of `height`) in the latitude-longitude image.
-double row_theta(std::size_t y, int height) { return kPi * static_cast<double>(y) / height; }
+double row_theta(std::size_t y, int height) { return std::numbers::pi * static_cast<double>(y) / height; }
 // Solid angle of one texel of row y.
 double texel_solid_angle(std::size_t y, int width, int height) {
-  return 2.0 * kPi / width * (std::cos(row_theta(y, height)) - std::cos(row_theta(y + 1, height)));
+  return 2.0 * std::numbers::pi / width * (std::cos(row_theta(y, height)) - std::cos(row_theta(y + 1, height)));
 }
 
 }  // namespace
@@ -158,7 +156,7 @@ TracerScene::TracerScene(const Scene& scene, int threads) : scene_(scene), meshe
     TracerEnvironment env;
     env.environment = &e;
     env.group = group_index(e.group);
-    const double rotation = e.rotation_deg * kPi / 180.0;
+    const double rotation = e.rotation_deg * std::numbers::pi / 180.0;
     env.cos_rotation = std::cos(rotation);
     env.sin_rotation = std::sin(rotation);
     double integral = 0.0;  // ∫ mean radiance dω
@@ -175,7 +173,7 @@ TracerScene::TracerScene(const Scene& scene, int threads) : scene_(scene), meshe
         for (double& c : env.texel_cdf) c /= integral;
     } else {
       env.spectrum = e.radiance.spectrum.scaled(e.scale);
-      integral = 4.0 * kPi * visible_mean(env.spectrum);
+      integral = 4.0 * std::numbers::pi * visible_mean(env.spectrum);
     }
     // As the power of the disc of the scene's bounding radius that the environment lights: R² · ∫ L dω
     // (in the units of the area lights' mean radiance × area).
@@ -253,9 +251,9 @@ std::optional<LightSample> TracerScene::sample_light(double u1, const Vec2& u2) 
     Vec3 d;  // in the environment's own frame (before its rotation)
     if (env.radiance.texture < 0) {
       // Uniform over the sphere.
-      const double z = 1.0 - 2.0 * u2.x(), r = std::sqrt(std::max(0.0, 1.0 - z * z)), phi = 2.0 * kPi * u2.y();
+      const double z = 1.0 - 2.0 * u2.x(), r = std::sqrt(std::max(0.0, 1.0 - z * z)), phi = 2.0 * std::numbers::pi * u2.y();
       d = Vec3(r * std::cos(phi), r * std::sin(phi), z);
-      out.pdf_solid_angle = select / (4.0 * kPi);
+      out.pdf_solid_angle = select / (4.0 * std::numbers::pi);
     } else {
       const ImageTexture& image = *textures_[static_cast<std::size_t>(env.radiance.texture)].image;
       std::size_t t = static_cast<std::size_t>(std::lower_bound(env.texel_cdf.begin(), env.texel_cdf.end(), v) -
@@ -266,7 +264,7 @@ std::optional<LightSample> TracerScene::sample_light(double u1, const Vec2& u2) 
       const std::size_t w = static_cast<std::size_t>(image.width), x = t % w, y = t / w;
       // Uniform in solid angle within the texel: φ uniform over its columns, cos θ uniform over its rows.
       const double s = (static_cast<double>(x) + u2.x()) / image.width;
-      const double phi = kPi * (1.0 - 2.0 * s);  // Blender: u = ½ − φ / 2π
+      const double phi = std::numbers::pi * (1.0 - 2.0 * s);  // Blender: u = ½ − φ / 2π
       const double z0 = std::cos(row_theta(y, image.height)), z1 = std::cos(row_theta(y + 1, image.height));
       const double z = z0 + u2.y() * (z1 - z0), r = std::sqrt(std::max(0.0, 1.0 - z * z));
       d = Vec3(r * std::cos(phi), r * std::sin(phi), z);
@@ -302,16 +300,16 @@ std::size_t TracerScene::environment_texel(const Vec3& d) const {
   // Into the image's frame (undo the rotation), then Blender's default equirectangular mapping.
   const double x = env.cos_rotation * d.x() + env.sin_rotation * d.y();
   const double y = -env.sin_rotation * d.x() + env.cos_rotation * d.y();
-  const double s = 0.5 - std::atan2(y, x) / (2.0 * kPi);  // in [0, 1]: 0 and 1 are −X
+  const double s = 0.5 - std::atan2(y, x) / (2.0 * std::numbers::pi);  // in [0, 1]: 0 and 1 are −X
   const double theta = std::acos(std::clamp(d.z(), -1.0, 1.0));
   const double column = std::clamp(std::floor(s * image.width), 0.0, image.width - 1.0);
-  const double row = std::clamp(std::floor(theta / kPi * image.height), 0.0, image.height - 1.0);
+  const double row = std::clamp(std::floor(theta / std::numbers::pi * image.height), 0.0, image.height - 1.0);
   return static_cast<std::size_t>(row) * static_cast<std::size_t>(image.width) + static_cast<std::size_t>(column);
 }
 
 double TracerScene::environment_pdf(const Vec3& d) const {
   const TracerEnvironment& env = *environment_;
-  if (env.radiance.texture < 0) return 1.0 / (4.0 * kPi);
+  if (env.radiance.texture < 0) return 1.0 / (4.0 * std::numbers::pi);
   const ImageTexture& image = *textures_[static_cast<std::size_t>(env.radiance.texture)].image;
   const std::size_t t = environment_texel(d);
   const double p_texel = env.texel_cdf[t] - (t == 0 ? 0.0 : env.texel_cdf[t - 1]);

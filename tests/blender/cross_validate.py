@@ -9,7 +9,7 @@
 
 Environment: CHROMATRACE_EXE, BLENDER (the executable), BLENDER_VERSION (its version: the scene's GGX masking is
 Cycles' in that version, tests/blender/scene_for_blender.py), and optionally CROSS_SIZE (32x32), CROSS_BANDS
-(380:780:40), CROSS_SPP (tracer and Cycles samples per pixel), CROSS_KEEP (a folder to keep the files in).
+(400:760:40), CROSS_SPP (tracer and Cycles samples per pixel), CROSS_KEEP (a folder to keep the files in).
 Exit 0 when the assertion holds, 1 otherwise, with the compare verdict on stderr.
 """
 import json
@@ -27,7 +27,7 @@ BLENDER = os.environ.get("BLENDER", "blender")
 BLENDER_VERSION = os.environ.get("BLENDER_VERSION", "3.4")
 SOURCE = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 SIZE = os.environ.get("CROSS_SIZE", "32x32")
-BANDS = os.environ.get("CROSS_BANDS", "380:780:40")
+BANDS = os.environ.get("CROSS_BANDS", "400:760:40")
 SPP = os.environ.get("CROSS_SPP", "2048")
 
 
