@@ -50,6 +50,11 @@ python313() {
   done
   return 1
 }
+# The first (4.5) is installed before the build, which packages the extension with it; the others, and the
+# emva1288 oracle below, download and install while the build compiles (nothing in the build needs them).
+mkdir -p build
+background=()  # "PID LOG" of each install running beside the build
+trap 'for job in "${background[@]}"; do kill "${job%% *}" 2>/dev/null || true; done' EXIT  # a failed build stops them
 for v in "${bpy_versions[@]}"; do
   venv="build/bpy-$v"
   if ! "$venv/bin/python" -c "import importlib.metadata as m, sys; sys.exit(m.version('bpy') != '$v')" 2>/dev/null; then
@@ -59,7 +64,12 @@ for v in "${bpy_versions[@]}"; do
     fi
     rm -rf "$venv"
     "$python" -m venv "$venv"
-    "$venv/bin/pip" install --quiet --disable-pip-version-check "bpy==$v"
+    if [ "$v" = "${bpy_versions[0]}" ]; then
+      "$venv/bin/pip" install --quiet --disable-pip-version-check "bpy==$v"
+    else
+      "$venv/bin/pip" install --quiet --disable-pip-version-check "bpy==$v" >"$venv.log" 2>&1 &
+      background+=("$! $venv.log")
+    fi
   fi
 done
 rm -rf build/bpy-5.0.1  # Blender 5.0, out of support, tested no more
@@ -70,9 +80,20 @@ emva="build/emva1288-venv"
 if ! cmp -s tests/calibrate/emva1288-requirements.txt "$emva/requirements.txt" 2>/dev/null; then
   rm -rf "$emva"
   /usr/bin/python3 -m venv "$emva"
-  "$emva/bin/pip" install --quiet --disable-pip-version-check -r tests/calibrate/emva1288-requirements.txt
-  cp tests/calibrate/emva1288-requirements.txt "$emva/requirements.txt"
+  { "$emva/bin/pip" install --quiet --disable-pip-version-check -r tests/calibrate/emva1288-requirements.txt &&
+      cp tests/calibrate/emva1288-requirements.txt "$emva/requirements.txt"; } >"$emva.log" 2>&1 &
+  background+=("$! $emva.log")
 fi
 
 cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release "-DCHROMATRACE_BPY_VERSIONS=$(IFS=';'; echo "${bpy_versions[*]}")"
 cmake --build build
+
+status=0
+for job in "${background[@]}"; do
+  if ! wait "${job%% *}"; then
+    echo "setup.sh: error: a Python package install failed (${job#* }):" >&2
+    cat "${job#* }" >&2
+    status=1
+  fi
+done
+exit $status

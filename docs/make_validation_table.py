@@ -7,7 +7,7 @@ each takes for the same noise.
 
     CHROMATRACE_EXE=build/cli/chromatrace python3 docs/make_validation_table.py
 
-Environment as tests/blender/cross_validate.py: BLENDER, CROSS_SIZE (32x32), CROSS_BANDS (400:760:40),
+Environment as tests/blender/cross_validate.py: BLENDER, CROSS_SIZE (32x32), CROSS_BANDS (400:760:60),
 CROSS_SPP (2048).
 """
 import json
@@ -23,7 +23,7 @@ EXE = os.environ["CHROMATRACE_EXE"]
 BLENDER = os.environ.get("BLENDER", "blender")
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 SIZE = os.environ.get("CROSS_SIZE", "32x32")
-BANDS = os.environ.get("CROSS_BANDS", "400:760:40")
+BANDS = os.environ.get("CROSS_BANDS", "400:760:60")
 SPP = os.environ.get("CROSS_SPP", "2048")
 SCENES = [("paper box", "scenes/paper/box.json"), ("Cornell box", "scenes/cornell_box/cornell_box.json"),
           ("glossy lights", "scenes/glossy_lights/glossy_lights.json")]

@@ -9,7 +9,7 @@
 
 Environment: CHROMATRACE_EXE, BLENDER (the executable), BLENDER_VERSION (its version: the scene's GGX masking is
 Cycles' in that version, tests/blender/scene_for_blender.py), and optionally CROSS_SIZE (32x32), CROSS_BANDS
-(400:760:40), CROSS_SPP (tracer and Cycles samples per pixel), CROSS_KEEP (a folder to keep the files in).
+(400:760:60), CROSS_SPP (tracer and Cycles samples per pixel), CROSS_KEEP (a folder to keep the files in).
 Exit 0 when the assertion holds, 1 otherwise, with the compare verdict on stderr.
 """
 import json
@@ -27,7 +27,7 @@ BLENDER = os.environ.get("BLENDER", "blender")
 BLENDER_VERSION = os.environ.get("BLENDER_VERSION", "3.4")
 SOURCE = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 SIZE = os.environ.get("CROSS_SIZE", "32x32")
-BANDS = os.environ.get("CROSS_BANDS", "400:760:40")
+BANDS = os.environ.get("CROSS_BANDS", "400:760:60")
 SPP = os.environ.get("CROSS_SPP", "2048")
 
 
@@ -106,6 +106,7 @@ def main():
             # The test has power: on every object of at least 60 interior pixels, the standard error of the
             # total's difference in the brightest band is below the object's tolerance (1 % or 2 %), so a
             # bias of a few per cent would be caught.
+            power = 0.0  # the largest standard error of an object's total as a share of its tolerance
             for o in doc["objects"]:
                 if o["object_id"] < 0 or o["pixels"] < 60:
                     continue
@@ -113,6 +114,7 @@ def main():
                 best = max(cells, key=lambda c: c["mean_b"])
                 se = best["se"] / best["mean_b"]
                 check(se < o["tolerance"], f"{o['object']}: relative standard error {se:.4f} of the total is too large to test")
+                power = max(power, se / o["tolerance"])
             failed = [c for c in doc["cells"] if not c["pass"]]
             check(not failed, f"{len(failed)} cells disagree, e.g. {failed[:3]}")
             # And with the edge pixels: an object's pixels are the same set in both files, so its means agree.
@@ -134,6 +136,7 @@ def main():
                        and (c["mean_b"] != 0 or c["mean_a"] > 0.01 * emitter.get(c["band"], 0.0))]
                 check(not lit, f"emission on pixels of objects that emit none (object, band, Cycles, tracer): {lit[:4]}")
             print(f"agree: {len(doc['cells'])} cells, ΔE00 mean {doc['image']['delta_e00']['mean']:.3f}, "
+                  f"largest standard error of an object's total {power:.2f} of its tolerance, "
                   f"tracer {t_seconds:.1f} s, Cycles {c_seconds:.1f} s")
         elif case == "filter-glossy":
             render_cycles(scene, cycles, work, {"CHROMATRACE_TEST_CYCLES_SETTINGS": "blur_glossy=1,sample_clamp_indirect=10"})

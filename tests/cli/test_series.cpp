@@ -232,9 +232,9 @@ TEST_F(SeriesCommand, PaperPanelsHoldOverSeedsAndSizes) {
       {"2-object-spectra", {}}, {"3-specular", {}}, {"5-two-luminaires", {}}, {"6a-diffuse-global", {}},
       {"6b-dichromatic-global", {}}, {"7a-pixel-area", {}}, {"7c-clipping", {}}, {"7b-gamma", {}},
       {"7d-noise", {}}};  // empty: every expectation
-  // Three seeds over two sizes: two at the default size, the third at a larger one (CI time).
-  for (const auto& [size, seeds] : {std::pair{"128x128", std::vector<std::string>{"1", "2"}},
-                                   std::pair{"192x192", std::vector<std::string>{"3"}}})
+  // Two seeds at two sizes: the default size and a larger one, each with its own seed (CI time).
+  for (const auto& [size, seeds] : {std::pair{"128x128", std::vector<std::string>{"1"}},
+                                   std::pair{"192x192", std::vector<std::string>{"2"}}})
     for (const std::string& seed : seeds) {
       const fs::path out = dir_ / (std::string(size) + "-" + seed);
       std::vector<std::string> args = {"paper", "-o", out.string(), "--resolution", size, "--seed", seed, "--quiet"};
@@ -391,8 +391,10 @@ BlackLine black_line(const CameraPixels& c, int id, int from, int to) {
 // from black whose angle is more than twice their combined spread (two branches, not one thick line).
 TEST_F(SeriesCommand, Figure3cIsVisiblyThickenedByInterreflectionAndForksWhereTwoWallsFeedOneSurface) {
   const std::vector<std::string> lit = {"floor", "back_wall", "left_wall", "right_wall", "sphere", "cylinder"};
-  for (const std::string size : {"64x64", "96x96"})
-    for (const std::string seed : {"1", "2", "3"}) {
+  // Three seeds over two sizes: two at the smaller size, the third at the larger (CI time).
+  for (const auto& [size, seeds] : {std::pair{std::string("64x64"), std::vector<std::string>{"1", "2"}},
+                                   std::pair{std::string("96x96"), std::vector<std::string>{"3"}}})
+    for (const std::string& seed : seeds) {
       const fs::path out = dir_ / (size + "-" + seed);
       const auto r = run_chromatrace({"paper", "-o", out.string(), "--variant", "6a-diffuse-global", "--resolution", size, "--seed", seed, "--quiet"});
       ASSERT_EQ(r.exit_code, 0) << r.err;
@@ -433,8 +435,10 @@ TEST_F(SeriesCommand, Figure3cIsVisiblyThickenedByInterreflectionAndForksWhereTw
 // whatever the seed and the size, the analyzer names interreflection as what bends it, and its direct light alone
 // (the diffuse_direct and bounce.1 layers: no interreflected light) is a straight line.
 TEST_F(SeriesCommand, TheBananaIsCurvedByInterreflectionAndALineWithoutIt) {
-  for (const std::string size : {"64x64", "96x96"})
-    for (const std::string seed : {"1", "2", "3"}) {
+  // Three seeds over two sizes: two at the smaller size, the third at the larger (CI time).
+  for (const auto& [size, seeds] : {std::pair{std::string("64x64"), std::vector<std::string>{"1", "2"}},
+                                   std::pair{std::string("96x96"), std::vector<std::string>{"3"}}})
+    for (const std::string& seed : seeds) {
       const fs::path out = dir_ / (size + "-" + seed);
       const auto r = run_chromatrace({"paper", "-o", out.string(), "--variant", "6c-banana", "--resolution", size, "--seed", seed, "--quiet"});
       ASSERT_EQ(r.exit_code, 0) << r.err;
