@@ -11,14 +11,18 @@ dir=$(realpath -m "$2")
 
 skip() { echo "local_slurm.sh: $*" >&2; exit 77; }
 
+# The three at once (each takes about 2 s to shut down), then what is left after 5 s killed outright.
 stop() {
+  local pids=() daemon pid
   for daemon in slurmd slurmctld munged; do
     [ -f "$dir/$daemon.pid" ] || continue
-    pid=$(cat "$dir/$daemon.pid")
-    kill "$pid" 2>/dev/null
+    pids+=("$(cat "$dir/$daemon.pid")")
+    kill "${pids[-1]}" 2>/dev/null
+    rm -f "$dir/$daemon.pid"
+  done
+  for pid in "${pids[@]}"; do
     for _ in $(seq 50); do kill -0 "$pid" 2>/dev/null || break; sleep 0.1; done
     kill -9 "$pid" 2>/dev/null
-    rm -f "$dir/$daemon.pid"
   done
 }
 
@@ -58,6 +62,8 @@ TaskPlugin=task/none
 JobAcctGatherType=jobacct_gather/none
 AccountingStorageType=accounting_storage/none
 SchedulerType=sched/builtin
+# Start a queued task as soon as a CPU is free: by default Slurm may wait 3 s (batch_sched_delay), most of each test.
+SchedulerParameters=batch_sched_delay=0
 SelectType=select/cons_tres
 SelectTypeParameters=CR_CPU
 ReturnToService=2
