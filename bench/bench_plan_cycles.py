@@ -7,7 +7,7 @@
         [--blender blender [--blender build/tests/blender/blender-4.5 ...]]
 
 Each --blender is run in turn (a Blender binary, or a bpy module behind tests/blender/bpy_blender.py, as the
-build's build/tests/blender/blender-4.5 and blender-5.0 are), the scene's GGX masking set to that Cycles' own
+build's build/tests/blender/blender-4.5, blender-5.2 and blender-5.3 are), the scene's GGX masking set to that Cycles' own
 (separable up to 3.x, height-correlated from 4.0) for its renders and its reference alike.
 
 For the paper box under its own smooth light (CIE D65) and under CIE F11 (three narrow peaks):

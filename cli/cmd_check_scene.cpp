@@ -15,6 +15,7 @@
 #include "cli/app.h"
 #include "cli/command.h"
 #include "cli/options.h"
+#include "core/band_plan.h"
 #include "core/error.h"
 #include "core/file_io.h"
 #include "core/geometry.h"
@@ -70,6 +71,15 @@ plan::RenderRequest judged_settings(const Scene& scene, const CheckSceneOptions&
   if (o.samples) {
     if (*o.samples < 1) throw InputError(fmt::format("--samples: must be at least 1, got {}", *o.samples));
     request.samples = *o.samples, request.samples_name = "--samples";
+  } else if (o.renderer == "cycles" && !o.bands_file.empty()) {
+    // A plan that gives each band group its samples is judged at its fewest, as if every group had them: the noise
+    // of the mix lies below that.
+    const std::vector<int> groups = read_band_plan_file(o.bands_file).cycles_samples;
+    if (!groups.empty()) {
+      request.samples = *std::min_element(groups.begin(), groups.end());
+      request.samples_name = fmt::format("the fewest cycles_samples of {} (every band group at them, an upper bound)",
+                                         o.bands_file);
+    }
   }
   return request;
 }

@@ -97,6 +97,9 @@ int run(const SceneBandsOptions& o) {
   Json report = {{"file", o.file},
                  {"bands", {{"count", bands.size()}, {"edges_nm", bands.edges()}, {"centres_nm", centres}}}};
   if (const BandReconstruction* r = bands.reconstruction()) report["bands"]["reconstruction"] = reconstruction_json(*r);
+  if (!o.bands_file.empty())  // the Cycles samples of each band group, which the Blender add-on renders with
+    if (const std::vector<int> samples = read_band_plan_file(o.bands_file).cycles_samples; !samples.empty())
+      report["bands"]["cycles_samples"] = samples;
   Json spectra_json = Json::object();
   for (const NamedSpectrum& s : spectra) spectra_json[s.name] = spectrum_entry(s.spectrum, bands);
   report["spectra"] = spectra_json;

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "core/band_plan.h"
 
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -10,12 +11,12 @@
 
 namespace ct {
 
-Bands read_band_plan(const std::filesystem::path& file) {
+BandPlanFile read_band_plan_file(const std::filesystem::path& file) {
   const Json document = read_json(file);
   const JsonNode root(document, file.string());
   const std::string format = root["format"].string();
   if (format != "chromatrace-bands/1") root["format"].fail(fmt::format("must be \"chromatrace-bands/1\", got \"{}\"", format));
-  root.expect_object({"format", "edges_nm", "reconstruction"});
+  root.expect_object({"format", "edges_nm", "reconstruction", "cycles_samples"});
   const JsonNode edges_node = root["edges_nm"];
   std::vector<double> edges;
   for (const JsonNode& edge : edges_node.elements()) {
@@ -28,16 +29,27 @@ Bands read_band_plan(const std::filesystem::path& file) {
   if (edges.back() <= 360.0 || edges.front() >= 830.0)
     edges_node.fail(fmt::format("bands [{}, {}] nm do not overlap the visible range 360-830 nm (wavelengths in nm?)",
                                 edges.front(), edges.back()));
-  const Bands bands = Bands::from_edges(std::move(edges), edges_node.location());
-  if (const auto r = root.find("reconstruction")) return read_reconstruction(*r, bands);
-  return bands;
+  BandPlanFile plan{Bands::from_edges(std::move(edges), edges_node.location()), {}};
+  if (const auto r = root.find("reconstruction")) plan.bands = read_reconstruction(*r, plan.bands);
+  if (const auto samples = root.find("cycles_samples")) {
+    const std::vector<JsonNode> groups = samples->elements();
+    const std::size_t wanted = cycles_band_groups(plan.bands.size());
+    if (groups.size() != wanted)
+      samples->fail(fmt::format("{} entries, needs one per Cycles band group of three bands ({} for {} bands)",
+                                groups.size(), wanted, plan.bands.size()));
+    for (const JsonNode& g : groups) plan.cycles_samples.push_back(static_cast<int>(g.integer_in(1, std::numeric_limits<int>::max())));
+  }
+  return plan;
 }
 
-Json band_plan_document(const Bands& bands) {
+Bands read_band_plan(const std::filesystem::path& file) { return read_band_plan_file(file).bands; }
+
+Json band_plan_document(const Bands& bands, const std::vector<int>& cycles_samples) {
   Json j;
   j["format"] = "chromatrace-bands/1";
   j["edges_nm"] = bands.edges();
   if (const BandReconstruction* r = bands.reconstruction()) j["reconstruction"] = reconstruction_json(*r);
+  if (!cycles_samples.empty()) j["cycles_samples"] = cycles_samples;
   return j;
 }
 

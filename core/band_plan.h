@@ -5,22 +5,39 @@
 // spectrum (core/spectrum.h: BandReconstruction; `chromatrace plan` fits it):
 //
 //   {"format": "chromatrace-bands/1", "edges_nm": [380, 400, 420, 440, 450, 460, 480, 520, 600, 780],
-//    "reconstruction": {"lo_nm": 380, "step_nm": 1, "matrix": [[m_00, ..., m_08], ...]}}
+//    "reconstruction": {"lo_nm": 380, "step_nm": 1, "matrix": [[m_00, ..., m_08], ...]},
+//    "cycles_samples": [256, 128, 64]}
 //
 // N + 1 strictly increasing edges give N contiguous bands [edge_i, edge_i+1) that must overlap the visible
 // range 360–830 nm. The reconstruction's matrix has one row per fine band [lo + j·step, lo + (j+1)·step) and one
-// column per band. Errors name the file and the JSON path ("plan.json: edges_nm[3]: ...").
+// column per band. cycles_samples, optional, gives Cycles' samples per pixel for each band group, the bands
+// 3g, 3g + 1, 3g + 2 that one Cycles render carries (⌈N / 3⌉ whole numbers ≥ 1); the Blender add-on renders each
+// group with its own, and the tracer, which carries every band along each path, has no use for them. Errors name
+// the file and the JSON path ("plan.json: edges_nm[3]: ...").
 
+#include <cstddef>
 #include <filesystem>
+#include <vector>
 
 #include "core/json_input.h"
 #include "core/spectrum.h"
 
 namespace ct {
 
-Bands read_band_plan(const std::filesystem::path& file);
-// The chromatrace-bands/1 document of `bands` (with its reconstruction, if any).
-Json band_plan_document(const Bands& bands);
+// What a band-plan file holds: its bands (with their reconstruction) and the Cycles samples of each band group
+// (empty when the file gives none).
+struct BandPlanFile {
+  Bands bands;
+  std::vector<int> cycles_samples;
+};
+BandPlanFile read_band_plan_file(const std::filesystem::path& file);
+Bands read_band_plan(const std::filesystem::path& file);  // the bands alone
+
+// The number of Cycles renders, of three bands each, that `band_count` bands take.
+constexpr std::size_t cycles_band_groups(std::size_t band_count) { return (band_count + 2) / 3; }
+
+// The chromatrace-bands/1 document of `bands` (with its reconstruction, if any, and the groups' samples if given).
+Json band_plan_document(const Bands& bands, const std::vector<int>& cycles_samples = {});
 
 // A reconstruction as JSON ({"lo_nm", "step_nm", "matrix"}), for the band-plan file and the assembly manifest,
 // and back onto `bands` (errors name the node's path).

@@ -17,6 +17,14 @@ def band_groups(band_count, per_render=3):
     return [list(range(first, min(first + per_render, band_count))) for first in range(0, band_count, per_render)]
 
 
+def group_samples(groups, cycles_samples, samples):
+    """Cycles' samples per pixel for each render of `groups`: the band plan's `cycles_samples` (one per band group
+    of three, bands 3g to 3g + 2) where it gives them, the most any of a render's bands asks for; else `samples`."""
+    if not cycles_samples:
+        return [samples] * len(groups)
+    return [max(cycles_samples[b // len(CHANNELS)] for b in group) for group in groups]
+
+
 def channel_of(group, band):
     """The colour channel ("R", "G" or "B") that carries `band` in the render of `group`."""
     return CHANNELS[group.index(band)]

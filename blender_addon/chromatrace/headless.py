@@ -67,6 +67,16 @@ def _empty_startup_scene(bpy):
             collection.remove(item)
 
 
+def _plans_samples(bands_file):
+    """Whether a band-plan file gives Cycles' samples per band group (its other contents `chromatrace` checks)."""
+    try:
+        with open(bands_file) as f:
+            document = json.load(f)
+    except (OSError, ValueError):
+        return False
+    return isinstance(document, dict) and "cycles_samples" in document
+
+
 def _ensure_registered(bpy):
     """Registers the add-on unless Blender already has (an enabled extension or add-on)."""
     if not hasattr(bpy.types.Scene, "chromatrace"):
@@ -98,6 +108,9 @@ def run(argv):
         only_variant=args.bounce_limit, device=args.device)
     if args.bands_file:
         request.bands = None
+        if args.samples is not None and _plans_samples(args.bands_file):
+            raise BadInput(f"--samples: the band plan {args.bands_file} gives each band group its samples "
+                           "(cycles_samples); leave out --samples, or use a plan without them")
     elif args.bands:
         request.bands_file = None
     if args.explain is not None:

@@ -7,7 +7,7 @@ import shutil
 import tempfile
 
 from . import components, node_resolution, node_rules, textures
-from .bands import band_groups
+from .bands import band_groups, group_samples
 from .errors import BadInput
 from .scene_parts import scene_parts
 
@@ -110,6 +110,8 @@ def preflight(scene, request, tool):
     renders = None if refused else len(groups) * len(variants) + (1 if request.object_ids else 0)
     return {"format": "chromatrace-preflight/1", "scene": scene.name,
             "ok": not refused, "renders": renders, "bands": len(edges) - 1, "edges_nm": edges,
-            "bands_per_render": per_render, "band_groups": len(groups), "bounce_limits": len(variants),
+            "bands_per_render": per_render, "band_groups": len(groups),
+            "samples": group_samples(groups, bands["bands"].get("cycles_samples"), request.samples),
+            "bounce_limits": len(variants),
             "render_variants": list(variants),
             "object_id_render": bool(request.object_ids), "owners": owners}

@@ -26,7 +26,7 @@ import bpy
 
 from . import blender_compat, cache, components, cycles_setup, manifest, materials, node_resolution, node_rules
 from . import render_setup, scene_parts
-from .bands import band_groups, describe_band_range
+from .bands import band_groups, describe_band_range, group_samples
 from .cache_description import cache_description
 from .camera_math import camera_description
 from .errors import BadInput
@@ -86,8 +86,11 @@ class SpectralRender:
                                                                           objects, emitters, world)
         total, planned = components.component_plan(request.families, light_groups, request.max_bounces, transmission,
                                                     environment=world["status"] == "lit")
+        groups = band_groups(len(edges) - 1, per_render)
         plan = RenderPlan(view_layer=view_layer, objects=objects, materials=used, inputs=inputs, bands=bands, edges=edges,
-                          groups=band_groups(len(edges) - 1, per_render), replicate=replicate, per_render=per_render,
+                          groups=groups, replicate=replicate, per_render=per_render,
+                          samples=group_samples(groups, bands["bands"].get("cycles_samples"), request.samples),
+                          planned_samples=bool(bands["bands"].get("cycles_samples")),
                           light_groups=light_groups, assignments=assignments, total=total, components=planned,
                           variants=components.render_variants(request.max_bounces, "bounces" in request.families),
                           passes=components.passes_needed(planned),
@@ -153,12 +156,14 @@ class SpectralRender:
                         render_setup.set_colours(journal, plan, group, request.max_bounces)
                         colours_set = True
                     cycles_setup.set_bounces(journal, self.scene, cycles_bounces)
+                    journal.set(self.scene.cycles, "samples", plan.samples[g])
                     if TEST_HOOK is not None:
                         TEST_HOOK("before_render", group=g, variant=variant, rendered=self.rendered)
                     took = self._render_into_cache(journal, final, wanted.get(os.path.basename(final), set()),
                                                    f"render {done + 1}")
                     done += 1
-                    message = f"render {done}/{total} ({describe_band_range(plan.edges, group)}, {variant}): {took}"
+                    message = (f"render {done}/{total} ({describe_band_range(plan.edges, group)}, {variant}"
+                               f"{f', {plan.samples[g]} samples' if plan.planned_samples else ''}): {took}")
                     request.log(message)
                     yield done, total, message
             if only is not None:
@@ -287,7 +292,8 @@ class SpectralRender:
                                      f"{plan.per_render} band(s) per render, max {request.max_bounces} bounces, "
                                      f"on {request.device}"),
             "chromatrace.device": getattr(plan, "device", request.device),
-            "chromatrace.samples": str(request.samples),
+            # One number, or one per band group where the band plan gives each group its own (docs/spectral-exr.md).
+            "chromatrace.samples": ",".join(map(str, plan.samples)) if len(set(plan.samples)) > 1 else str(plan.samples[0]),
             "chromatrace.seed": str(request.seed),
             "chromatrace.scene": source,
             # Blender's colours (RGB lights, worlds, HDRIs, Blackbody nodes) are relative to D65: the preview's white.

@@ -394,6 +394,44 @@ TEST_F(Blender, PlannedBandsCarryTheirReconstructionIntoTheExr) {
   EXPECT_EQ(test::run_chromatrace({"info", "--check", out.string()}).exit_code, 0);
 }
 
+// A band plan that gives each band group its own samples (cycles_samples) is rendered so: each group's render at
+// its samples, said in its progress line, and the header lists them. --samples beside such a plan is refused.
+TEST_F(Blender, PlannedSamplesRenderEachBandGroupWithItsOwn) {
+  const fs::path plan = dir_.file("plan.json"), out = dir_.file("planned.exr");
+  std::ofstream(plan) << R"({"format": "chromatrace-bands/1", "edges_nm": [400, 450, 500, 550, 600, 650, 700],
+                             "cycles_samples": [8, 2]})";
+  const fs::path cache = dir_.file("cache");
+  const CommandResult r = batch({"--scene", box(), "--out", out.string(), "--resolution", "16x16", "--bands-file",
+                                 plan.string(), "--max-bounces", "1", "--components", "none", "--cache-dir",
+                                 cache.string(), "--keep-cache"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const std::vector<std::string> renders = lines_starting(r.err, "chromatrace: render ");
+  ASSERT_EQ(renders.size(), 3u) << r.err;
+  EXPECT_NE(renders[0].find("(400-550 nm, main, 8 samples)"), std::string::npos) << renders[0];
+  EXPECT_NE(renders[1].find("(550-700 nm, main, 2 samples)"), std::string::npos) << renders[1];
+  EXPECT_EQ(SpectralExrReader(out).info().metadata.at("chromatrace.samples"), "8,2");
+  // What Cycles itself says it rendered, in each group's render file (cycles.<view layer>.samples).
+  std::map<std::string, std::string> rendered;
+  for (const auto& entry : fs::recursive_directory_iterator(cache)) {
+    const std::string name = entry.path().filename().string();
+    if (name != "g000_main.exr" && name != "g001_main.exr") continue;
+    auto in = OIIO::ImageInput::open(entry.path().string());
+    ASSERT_TRUE(in) << entry.path();
+    for (const OIIO::ParamValue& p : in->spec().extra_attribs)
+      if (p.name().string().starts_with("cycles.") && p.name().string().ends_with(".samples"))
+        rendered[name] = p.get_string();
+  }
+  EXPECT_EQ(rendered, (std::map<std::string, std::string>{{"g000_main.exr", "8"}, {"g001_main.exr", "2"}}));
+
+  const CommandResult both = batch({"--scene", box(), "--out", dir_.file("both.exr").string(), "--samples", "4",
+                                    "--bands-file", plan.string()});
+  EXPECT_EQ(both.exit_code, 2) << both.err;
+  EXPECT_NE(both.err.find("--samples: the band plan " + plan.string() + " gives each band group its samples"),
+            std::string::npos)
+      << both.err;
+  EXPECT_FALSE(fs::exists(dir_.file("both.exr")));
+}
+
 // What a Cycles render's settings leave out is said before it renders, as `chromatrace render` says it for the
 // tracer (docs/render.md, docs/stability.md): the paper box under CIE F11 (three narrow peaks) with 100 nm bands
 // cannot hold the lamp's own colour, 2 bounces drop light and 4 samples are noisy. The batch prints exactly the

@@ -338,6 +338,22 @@ TEST_F(Plan, SeriesTakesThePlan) {
   EXPECT_EQ(SpectralExrReader(out / reconstructed["file"].get<std::string>()).info().bands, read_band_plan(fitted));
 }
 
+// A band plan may give Cycles' samples for each band group of three (the Blender add-on renders each group with its
+// own); they survive a round trip through the file, one per group: ⌈7 / 3⌉ = 3 for 7 bands.
+TEST_F(Plan, BandPlanFileCarriesTheSamplesOfEachCyclesBandGroup) {
+  EXPECT_EQ(cycles_band_groups(6), 2u);
+  EXPECT_EQ(cycles_band_groups(7), 3u);
+  const Bands bands = Bands::from_edges({400, 440, 480, 520, 560, 600, 640, 700}, "edges");
+  const fs::path file = dir_ / "plan.json";
+  write_file_atomically(file, band_plan_document(bands, {256, 64, 32}).dump());
+  const BandPlanFile read = read_band_plan_file(file);
+  EXPECT_EQ(read.bands, bands);
+  EXPECT_EQ(read.cycles_samples, (std::vector<int>{256, 64, 32}));
+  write_file_atomically(file, band_plan_document(bands).dump());
+  EXPECT_TRUE(read_band_plan_file(file).cycles_samples.empty());
+  EXPECT_FALSE(read_json(file).contains("cycles_samples"));
+}
+
 TEST_F(Plan, BadInputGetsExitTwoAndOneLineNamingTheField) {
   const fs::path bad_scene = dir_ / "bad.json";
   Json doc = read_json(kBox);
@@ -345,6 +361,11 @@ TEST_F(Plan, BadInputGetsExitTwoAndOneLineNamingTheField) {
   write_file_atomically(bad_scene, rebase_scene_paths(doc, kBox.parent_path(), dir_).dump());
   const fs::path bad_plan = dir_ / "bad_plan.json";
   write_file_atomically(bad_plan, R"({"format": "chromatrace-bands/1", "edges_nm": [400, 500, 450]})");
+  const fs::path short_samples = dir_ / "short_samples.json", zero_samples = dir_ / "zero_samples.json";
+  write_file_atomically(short_samples, R"({"format": "chromatrace-bands/1", "edges_nm": [400, 450, 500, 550, 600, 650, 700],
+                                            "cycles_samples": [64]})");
+  write_file_atomically(zero_samples, R"({"format": "chromatrace-bands/1", "edges_nm": [400, 450, 500, 550, 600, 650, 700],
+                                           "cycles_samples": [64, 0]})");
   struct Case {
     std::vector<std::string> args;
     std::string must_mention;
@@ -363,6 +384,9 @@ TEST_F(Plan, BadInputGetsExitTwoAndOneLineNamingTheField) {
        "bad_plan.json: edges_nm[2]"},
       {{"render", kBox.string(), "-o", (dir_ / "x.exr").string(), "--plan", bad_plan.string(), "--bands", "400:700:10"},
        "--plan: give either --bands or --plan"},
+      {{"scene-bands", kBox.string(), "--bands-file", short_samples.string()},
+       "short_samples.json: cycles_samples: 1 entries, needs one per Cycles band group of three bands (2 for 6 bands)"},
+      {{"scene-bands", kBox.string(), "--bands-file", zero_samples.string()}, "zero_samples.json: cycles_samples[1]: must be >= 1"},
   };
   for (const Case& c : cases) {
     const auto r = run_chromatrace(c.args);

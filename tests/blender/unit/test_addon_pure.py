@@ -24,6 +24,14 @@ class Bands(unittest.TestCase):
         with self.assertRaises(ValueError):
             bands.band_groups(3, 4)
 
+    def test_group_samples_follow_the_plans_groups_of_three(self):
+        # No samples in the plan: every render the request's. With them: each render its group's, and a render of
+        # bands from two groups (two bands per render) the more of theirs; one band per render its own group's.
+        self.assertEqual(bands.group_samples(bands.band_groups(7), None, 128), [128, 128, 128])
+        self.assertEqual(bands.group_samples(bands.band_groups(7), [256, 64, 16], 128), [256, 64, 16])
+        self.assertEqual(bands.group_samples(bands.band_groups(7, 2), [256, 64, 16], 128), [256, 256, 64, 16])
+        self.assertEqual(bands.group_samples(bands.band_groups(4, 1), [256, 64], 128), [256, 256, 256, 64])
+
     def test_group_colour_fills_channels_in_order_and_zero_pads(self):
         values = [0.1, 0.2, 0.3, 0.4]
         self.assertEqual(bands.group_colour(values, [0, 1, 2]), (0.1, 0.2, 0.3))
