@@ -240,6 +240,26 @@ TEST(FarmInput, CyclesWithBouncesIsOneTaskPerBandGroupAndBounceLimit) {
   const CommandResult m = test::run_chromatrace({"farm", "cycles", kBox, "-o", masked.string(), "--dry-run", "--ggx-masking", "cycles"});
   ASSERT_EQ(m.exit_code, 0) << m.err;
   EXPECT_NE(read_file(masked / "slurm" / "tasks.sh").find("--ggx-masking cycles"), std::string::npos);
+
+  // A band plan's samples per band group reach the batch, which each task runs: its pre-flight renders each group
+  // with its own, and --samples beside them is refused in the batch's words.
+  const fs::path plan = dir.file("plan.json");
+  write_file_atomically(plan, R"({"format": "chromatrace-bands/1", "edges_nm": [400, 450, 500, 550, 600, 650, 700],
+                                  "cycles_samples": [64, 16]})");
+  const fs::path planned = dir.file("planned");
+  const CommandResult p = test::run_chromatrace({"farm", "cycles", kBox, "-o", planned.string(), "--dry-run",
+                                                 "--bands-file", plan.string()});
+  ASSERT_EQ(p.exit_code, 0) << p.err;
+  EXPECT_NE(p.out.find("--array=0-1 "), std::string::npos) << p.out;
+  EXPECT_EQ(nlohmann::json::parse(read_file(planned / "slurm" / "preflight.json"))["samples"],
+            nlohmann::json::array({64, 16}));
+  const CommandResult both = test::run_chromatrace({"farm", "cycles", kBox, "-o", dir.file("both").string(),
+                                                    "--dry-run", "--bands-file", plan.string(), "--samples", "4"});
+  EXPECT_EQ(both.exit_code, 2) << both.err;
+  EXPECT_NE(both.err.find("--samples: the band plan " + plan.string() + " gives each band group its samples"),
+            std::string::npos)
+      << both.err;
+  EXPECT_FALSE(fs::exists(dir.file("both")));
 }
 
 // Bad input needs no cluster: one line naming the option (or the missing command), exit 2, nothing submitted.
