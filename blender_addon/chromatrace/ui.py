@@ -1,12 +1,35 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
 """Panels: spectral settings in the Render, Material, Light and Object properties."""
 
+import json
+import os
 import textwrap
 
 import bpy
 
 from . import materials, operators
 from .properties import MODEL_ITEMS, analysis_of
+
+
+_PLANNED_SAMPLES = {}  # band-plan file: (its modification time, its cycles_samples or None)
+
+
+def planned_samples(path):
+    """The Cycles samples per band group a band-plan file gives (cycles_samples), or None; read again only when the
+    file changes, since panels are drawn often. What the file holds is checked by `chromatrace` when rendering."""
+    try:
+        mtime = os.path.getmtime(path)
+    except OSError:
+        return None
+    cached = _PLANNED_SAMPLES.get(path)
+    if cached is None or cached[0] != mtime:
+        try:
+            with open(path) as f:
+                samples = json.load(f).get("cycles_samples")
+        except (OSError, ValueError, AttributeError):
+            samples = None
+        cached = _PLANNED_SAMPLES[path] = (mtime, samples if isinstance(samples, list) and samples else None)
+    return cached[1]
 
 
 class _Panel:
@@ -43,7 +66,12 @@ class CHROMATRACE_PT_render(_Panel, bpy.types.Panel):
         else:
             col.prop(s, "bands_file")
         col = layout.column(heading="Sampling")
-        col.prop(s, "samples")
+        planned = planned_samples(bpy.path.abspath(s.bands_file)) if s.band_plan == "FILE" and s.bands_file else None
+        row = col.row()
+        row.enabled = not planned  # the plan's samples are rendered, not these
+        row.prop(s, "samples")
+        if planned:
+            col.label(text=f"Samples per band group, from the plan: {', '.join(map(str, planned))}")
         col.prop(s, "max_bounces")
         col.prop(s, "seed")
         col.prop(s, "pixel_filter")

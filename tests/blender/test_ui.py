@@ -7,6 +7,7 @@ synchronously, as it does in background mode); choosing a material model builds 
 unregisters and registers again cleanly.
 """
 
+import json
 import os
 import shutil
 import sys
@@ -91,6 +92,17 @@ if holder.layout.drawn != ["chromatrace.render_spectral", "chromatrace.analyze_r
     failures.append(f"the Render tab's first panel draws {holder.layout.drawn}")
 scene.chromatrace.band_plan = "FILE"
 draw(ui.CHROMATRACE_PT_render, context)
+# A plan that gives each band group its samples: the panel says they are the plan's.
+with tempfile.TemporaryDirectory() as plan_dir:
+    plan_file = os.path.join(plan_dir, "plan.json")
+    with open(plan_file, "w") as f:
+        json.dump({"format": "chromatrace-bands/1", "edges_nm": [400, 450, 500, 550, 600, 650, 700],
+                   "cycles_samples": [256, 64]}, f)
+    scene.chromatrace.bands_file = plan_file
+    said = [d[1] for d in draw(ui.CHROMATRACE_PT_render, context) if isinstance(d, tuple)]
+    if "Samples per band group, from the plan: 256, 64" not in said:
+        failures.append(f"the panel does not say the plan gives the samples: {said}")
+    scene.chromatrace.bands_file = ""
 scene.chromatrace.band_plan = "RANGE"
 for kind in ("RGB", "LIBRARY", "CONSTANT", "CSV", "ILLUMINANT", "BLACKBODY", "SAMPLES", "NAMED"):
     material.chromatrace.reflectance.kind = kind
