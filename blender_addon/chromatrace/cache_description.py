@@ -80,7 +80,9 @@ def cache_description(scene, request, plan, resolution):
         "inputs": [[i.label, i.role, key, scale] for i, key, scale, _owner in plan.inputs],
         "averages": {k: v["bands"] for k, v in plan.bands["spectra"].items()},
         "textures": {k: v["hash"] for k, v in plan.textures.items()},
-        "samples": plan.samples, "seed": request.seed, "max_bounces": request.max_bounces,
+        # A plan's samples per band group; otherwise the one number, as before (caches made earlier stay valid).
+        "samples": plan.samples if plan.planned_samples else request.samples,
+        "seed": request.seed, "max_bounces": request.max_bounces,
         "device": request.device, "variants": plan.variants, "point_filter": request.point_filter,
         "resolution": resolution,
         "passes": sorted(plan.passes), "light_groups": plan.assignments, "ids": plan.ids,
