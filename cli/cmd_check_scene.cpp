@@ -15,7 +15,6 @@
 #include "cli/app.h"
 #include "cli/command.h"
 #include "cli/options.h"
-#include "core/band_plan.h"
 #include "core/error.h"
 #include "core/file_io.h"
 #include "core/geometry.h"
@@ -63,7 +62,8 @@ plan::RenderRequest judged_settings(const Scene& scene, const CheckSceneOptions&
     throw InputError(fmt::format("--renderer: must be tracer or cycles, got \"{}\"", o.renderer));
   // Cycles renders band averages only: its band plan is judged in the bands mode, and no fix names the other.
   if (o.renderer == "cycles") request.mode = SpectralMode::Bands, request.continuous_available = false;
-  if (const auto bands = band_plan_option(o.bands, o.bands_file, "--bands-file")) request.bands = *bands;
+  const std::optional<BandPlanFile> plan = band_plan_file_option(o.bands, o.bands_file, "--bands-file");
+  if (plan) request.bands = plan->bands;
   if (o.max_bounces) {
     if (*o.max_bounces < 0) throw InputError(fmt::format("--max-bounces: must be >= 0, got {}", *o.max_bounces));
     request.max_bounces = *o.max_bounces, request.bounces_name = "--max-bounces";
@@ -71,15 +71,13 @@ plan::RenderRequest judged_settings(const Scene& scene, const CheckSceneOptions&
   if (o.samples) {
     if (*o.samples < 1) throw InputError(fmt::format("--samples: must be at least 1, got {}", *o.samples));
     request.samples = *o.samples, request.samples_name = "--samples";
-  } else if (o.renderer == "cycles" && !o.bands_file.empty()) {
+  } else if (o.renderer == "cycles" && plan && !plan->cycles_samples.empty()) {
     // A plan that gives each band group its samples is judged at its fewest, as if every group had them: the noise
     // of the mix lies below that.
-    const std::vector<int> groups = read_band_plan_file(o.bands_file).cycles_samples;
-    if (!groups.empty()) {
-      request.samples = *std::min_element(groups.begin(), groups.end());
-      request.samples_name = fmt::format("the fewest cycles_samples of {} (every band group at them, an upper bound)",
-                                         o.bands_file);
-    }
+    const std::vector<int>& groups = plan->cycles_samples;
+    request.samples = *std::min_element(groups.begin(), groups.end());
+    request.samples_name = fmt::format("the fewest cycles_samples of {} (every band group at them, an upper bound)",
+                                       o.bands_file);
   }
   return request;
 }

@@ -78,7 +78,7 @@ Json material_entry(const Material& material, const Bands& bands) {
 }
 
 int run(const SceneBandsOptions& o) {
-  const std::optional<Bands> given = band_plan_option(o.bands, o.bands_file, "--bands-file");
+  const std::optional<BandPlanFile> given = band_plan_file_option(o.bands, o.bands_file, "--bands-file");
   const Json document = read_json(o.file);
   const bool spectra_only = document_format(document) == kSpectraFormat;
   std::optional<Scene> scene;
@@ -90,16 +90,15 @@ int run(const SceneBandsOptions& o) {
     spectra = scene->spectra;
     refuse_textures_and_environment(*scene);
   }
-  const Bands bands = given.value_or(scene ? scene->render.bands : RenderSettings{}.bands);
+  const Bands bands = given ? given->bands : scene ? scene->render.bands : RenderSettings{}.bands;
 
   std::vector<double> centres;
   for (std::size_t i = 0; i < bands.size(); ++i) centres.push_back(bands.centre(i));
   Json report = {{"file", o.file},
                  {"bands", {{"count", bands.size()}, {"edges_nm", bands.edges()}, {"centres_nm", centres}}}};
   if (const BandReconstruction* r = bands.reconstruction()) report["bands"]["reconstruction"] = reconstruction_json(*r);
-  if (!o.bands_file.empty())  // the Cycles samples of each band group, which the Blender add-on renders with
-    if (const std::vector<int> samples = read_band_plan_file(o.bands_file).cycles_samples; !samples.empty())
-      report["bands"]["cycles_samples"] = samples;
+  if (given && !given->cycles_samples.empty())  // the Cycles samples of each band group, which the add-on renders with
+    report["bands"]["cycles_samples"] = given->cycles_samples;
   Json spectra_json = Json::object();
   for (const NamedSpectrum& s : spectra) spectra_json[s.name] = spectrum_entry(s.spectrum, bands);
   report["spectra"] = spectra_json;

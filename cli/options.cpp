@@ -30,11 +30,17 @@ std::pair<int, int> parse_resolution(const std::string& text, std::string_view o
   return {static_cast<int>(size[0]), static_cast<int>(size[1])};
 }
 
-std::optional<Bands> band_plan_option(const std::string& bands, const std::string& file, std::string_view file_option) {
+std::optional<BandPlanFile> band_plan_file_option(const std::string& bands, const std::string& file,
+                                                  std::string_view file_option) {
   if (!bands.empty() && !file.empty())
     throw InputError(fmt::format("{}: give either --bands or {}, not both", file_option, file_option));
-  if (!bands.empty()) return Bands::parse(bands, "--bands");
-  if (!file.empty()) return read_band_plan(file);
+  if (!bands.empty()) return BandPlanFile{Bands::parse(bands, "--bands"), {}};
+  if (!file.empty()) return read_band_plan_file(file);
+  return std::nullopt;
+}
+
+std::optional<Bands> band_plan_option(const std::string& bands, const std::string& file, std::string_view file_option) {
+  if (auto plan = band_plan_file_option(bands, file, file_option)) return std::move(plan->bands);
   return std::nullopt;
 }
 

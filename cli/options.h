@@ -8,6 +8,7 @@
 #include <string_view>
 #include <utility>
 
+#include "core/band_plan.h"
 #include "core/spectrum.h"
 
 namespace ct::cli {
@@ -16,7 +17,10 @@ namespace ct::cli {
 std::pair<int, int> parse_resolution(const std::string& text, std::string_view option = "--resolution");
 
 // The band plan given by `--bands lo:hi:width` or by a band-plan file (the option `file_option`, e.g. --plan), at
-// most one of them; nullopt when neither is given.
+// most one of them; nullopt when neither is given. The file's form also carries what else the file gives (Cycles'
+// samples per band group; none for --bands).
+std::optional<BandPlanFile> band_plan_file_option(const std::string& bands, const std::string& file,
+                                                  std::string_view file_option);
 std::optional<Bands> band_plan_option(const std::string& bands, const std::string& file, std::string_view file_option);
 
 // The `chromatrace` command as the commands it starts must call it: the front executable the full program was

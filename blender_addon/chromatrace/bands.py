@@ -5,6 +5,8 @@ Pure Python (no bpy). Band edges and band averages come from the `chromatrace` c
 this module only decides how the bands are packed into renders.
 """
 
+import json
+
 CHANNELS = ("R", "G", "B")
 
 
@@ -15,6 +17,17 @@ def band_groups(band_count, per_render=3):
     if band_count < 1:
         raise ValueError(f"band_count must be at least 1, got {band_count}")
     return [list(range(first, min(first + per_render, band_count))) for first in range(0, band_count, per_render)]
+
+
+def planned_samples(bands_file):
+    """The Cycles samples per band group a band-plan file gives (its "cycles_samples"), or None when it gives none or
+    cannot be read; whether the rest of the file is sound, `chromatrace` says when it reads it."""
+    try:
+        with open(bands_file) as f:
+            samples = json.load(f).get("cycles_samples")
+    except (OSError, ValueError, AttributeError):
+        return None
+    return samples if isinstance(samples, list) and samples else None
 
 
 def group_samples(groups, cycles_samples, samples):

@@ -67,16 +67,6 @@ def _empty_startup_scene(bpy):
             collection.remove(item)
 
 
-def _plans_samples(bands_file):
-    """Whether a band-plan file gives Cycles' samples per band group (its other contents `chromatrace` checks)."""
-    try:
-        with open(bands_file) as f:
-            document = json.load(f)
-    except (OSError, ValueError):
-        return False
-    return isinstance(document, dict) and "cycles_samples" in document
-
-
 def _ensure_registered(bpy):
     """Registers the add-on unless Blender already has (an enabled extension or add-on)."""
     if not hasattr(bpy.types.Scene, "chromatrace"):
@@ -87,7 +77,7 @@ def _ensure_registered(bpy):
 def run(argv):
     args = parse_batch_args(argv)
     import bpy
-    from . import scene_import, spectral_render, tool
+    from . import bands, scene_import, spectral_render, tool
 
     _ensure_registered(bpy)
     log = (lambda message: None) if args.quiet else _log
@@ -108,7 +98,7 @@ def run(argv):
         only_variant=args.bounce_limit, device=args.device)
     if args.bands_file:
         request.bands = None
-        if args.samples is not None and _plans_samples(args.bands_file):
+        if args.samples is not None and bands.planned_samples(args.bands_file):
             raise BadInput(f"--samples: the band plan {args.bands_file} gives each band group its samples "
                            "(cycles_samples); leave out --samples, or use a plan without them")
     elif args.bands:

@@ -1,13 +1,12 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
 """Panels: spectral settings in the Render, Material, Light and Object properties."""
 
-import json
 import os
 import textwrap
 
 import bpy
 
-from . import materials, operators
+from . import bands, materials, operators
 from .properties import MODEL_ITEMS, analysis_of
 
 
@@ -15,20 +14,14 @@ _PLANNED_SAMPLES = {}  # band-plan file: (its modification time, its cycles_samp
 
 
 def planned_samples(path):
-    """The Cycles samples per band group a band-plan file gives (cycles_samples), or None; read again only when the
-    file changes, since panels are drawn often. What the file holds is checked by `chromatrace` when rendering."""
+    """bands.planned_samples of a band-plan file, read again only when the file changes: panels are drawn often."""
     try:
         mtime = os.path.getmtime(path)
     except OSError:
         return None
     cached = _PLANNED_SAMPLES.get(path)
     if cached is None or cached[0] != mtime:
-        try:
-            with open(path) as f:
-                samples = json.load(f).get("cycles_samples")
-        except (OSError, ValueError, AttributeError):
-            samples = None
-        cached = _PLANNED_SAMPLES[path] = (mtime, samples if isinstance(samples, list) and samples else None)
+        cached = _PLANNED_SAMPLES[path] = (mtime, bands.planned_samples(path))
     return cached[1]
 
 

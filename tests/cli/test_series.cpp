@@ -222,6 +222,10 @@ TEST_F(SeriesCommand, CyclesRendersAVariantThroughRealBlender) {
   EXPECT_GE(by_renderer["cycles"]["regions"].size(), 8u);  // the image and every object in view
 }
 
+// The renders of a finding checked over seeds and sizes at small sizes: three seeds, two at 64 × 64 and the third at
+// 96 × 96 (CI time).
+const std::vector<std::pair<std::string, std::string>> kSmallRuns = {{"64x64", "1"}, {"64x64", "2"}, {"96x96", "3"}};
+
 // The paper's structures must stay found whatever the seed and the size (a finding of one render is no finding):
 // Figures 3a, 3b (the sphere's L or T, the cylinder's P), 3c, 3d (thickened by the interreflection, bent by the
 // highlight: the box's finding where the paper sees a banana, scenes/paper/README.md), 4b (the red wall's mixed
@@ -233,24 +237,22 @@ TEST_F(SeriesCommand, PaperPanelsHoldOverSeedsAndSizes) {
       {"6b-dichromatic-global", {}}, {"7a-pixel-area", {}}, {"7c-clipping", {}}, {"7b-gamma", {}},
       {"7d-noise", {}}};  // empty: every expectation
   // Two seeds at two sizes: the default size and a larger one, each with its own seed (CI time).
-  for (const auto& [size, seeds] : {std::pair{"128x128", std::vector<std::string>{"1"}},
-                                   std::pair{"192x192", std::vector<std::string>{"2"}}})
-    for (const std::string& seed : seeds) {
-      const fs::path out = dir_ / (std::string(size) + "-" + seed);
-      std::vector<std::string> args = {"paper", "-o", out.string(), "--resolution", size, "--seed", seed, "--quiet"};
-      for (const auto& [variant, targets] : checked) args.insert(args.end(), {"--variant", variant});
-      const auto r = run_chromatrace(args);
-      ASSERT_EQ(r.exit_code, 0) << r.err;
-      const Json result = read_result(out);
-      for (const Json& v : result["variants"]) {
-        const std::vector<std::string>& targets = checked.at(v["name"].get<std::string>());
-        for (const Json& e : v["expect"]) {
-          const std::string target = e["target"].get<std::string>();
-          if (!targets.empty() && std::find(targets.begin(), targets.end(), target) == targets.end()) continue;
-          EXPECT_TRUE(e["ok"].get<bool>()) << size << " seed " << seed << ", " << v["name"] << ": " << e.dump();
-        }
+  for (const auto& [size, seed] : {std::pair<std::string, std::string>{"128x128", "1"}, {"192x192", "2"}}) {
+    const fs::path out = dir_ / (size + "-" + seed);
+    std::vector<std::string> args = {"paper", "-o", out.string(), "--resolution", size, "--seed", seed, "--quiet"};
+    for (const auto& [variant, targets] : checked) args.insert(args.end(), {"--variant", variant});
+    const auto r = run_chromatrace(args);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const Json result = read_result(out);
+    for (const Json& v : result["variants"]) {
+      const std::vector<std::string>& targets = checked.at(v["name"].get<std::string>());
+      for (const Json& e : v["expect"]) {
+        const std::string target = e["target"].get<std::string>();
+        if (!targets.empty() && std::find(targets.begin(), targets.end(), target) == targets.end()) continue;
+        EXPECT_TRUE(e["ok"].get<bool>()) << size << " seed " << seed << ", " << v["name"] << ": " << e.dump();
       }
     }
+  }
 }
 
 // A camera image's R, G, B, pixel after pixel.
@@ -391,73 +393,67 @@ BlackLine black_line(const CameraPixels& c, int id, int from, int to) {
 // from black whose angle is more than twice their combined spread (two branches, not one thick line).
 TEST_F(SeriesCommand, Figure3cIsVisiblyThickenedByInterreflectionAndForksWhereTwoWallsFeedOneSurface) {
   const std::vector<std::string> lit = {"floor", "back_wall", "left_wall", "right_wall", "sphere", "cylinder"};
-  // Three seeds over two sizes: two at the smaller size, the third at the larger (CI time).
-  for (const auto& [size, seeds] : {std::pair{std::string("64x64"), std::vector<std::string>{"1", "2"}},
-                                   std::pair{std::string("96x96"), std::vector<std::string>{"3"}}})
-    for (const std::string& seed : seeds) {
-      const fs::path out = dir_ / (size + "-" + seed);
-      const auto r = run_chromatrace({"paper", "-o", out.string(), "--variant", "6a-diffuse-global", "--resolution", size, "--seed", seed, "--quiet"});
-      ASSERT_EQ(r.exit_code, 0) << r.err;
-      const Json v = read_result(out)["variants"][0];
-      for (const Json& e : v["expect"]) EXPECT_TRUE(e["ok"].get<bool>()) << size << " seed " << seed << ": " << e.dump();
+  for (const auto& [size, seed] : kSmallRuns) {
+    const fs::path out = dir_ / (size + "-" + seed);
+    const auto r = run_chromatrace({"paper", "-o", out.string(), "--variant", "6a-diffuse-global", "--resolution", size, "--seed", seed, "--quiet"});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const Json v = read_result(out)["variants"][0];
+    for (const Json& e : v["expect"]) EXPECT_TRUE(e["ok"].get<bool>()) << size << " seed " << seed << ": " << e.dump();
 
-      const CameraPixels camera = camera_pixels(out / "6a-diffuse-global" / "camera.exr");
-      const double bin = figure_bin(camera);
-      int thick = 0;
-      std::string widths;
-      const Json analysis = read_json(out / "6a-diffuse-global" / "analysis" / "analysis.json");
-      for (const Json& region : analysis["regions"])
-        for (const std::string& name : lit)
-          if (region["name"].get<std::string>().ends_with("(" + name + ")")) {
-            const double sigma2 = region["shape"]["sigma"][1].get<double>(), noise2 = region["shape"]["noise_sigma"][1].get<double>();
-            thick += sigma2 > bin && sigma2 > analyzer::ShapeCriteria{}.noise_factor * noise2 ? 1 : 0;
-            widths += fmt::format(" {} {:.2f} bin ({:.1f} x noise)", name, sigma2 / bin, sigma2 / noise2);
-          }
-      EXPECT_GE(2 * thick, static_cast<int>(lit.size())) << size << " seed " << seed << ":" << widths;
+    const CameraPixels camera = camera_pixels(out / "6a-diffuse-global" / "camera.exr");
+    const double bin = figure_bin(camera);
+    int thick = 0;
+    std::string widths;
+    const Json analysis = read_json(out / "6a-diffuse-global" / "analysis" / "analysis.json");
+    for (const Json& region : analysis["regions"])
+      for (const std::string& name : lit)
+        if (region["name"].get<std::string>().ends_with("(" + name + ")")) {
+          const double sigma2 = region["shape"]["sigma"][1].get<double>(), noise2 = region["shape"]["noise_sigma"][1].get<double>();
+          thick += sigma2 > bin && sigma2 > analyzer::ShapeCriteria{}.noise_factor * noise2 ? 1 : 0;
+          widths += fmt::format(" {} {:.2f} bin ({:.1f} x noise)", name, sigma2 / bin, sigma2 / noise2);
+        }
+    EXPECT_GE(2 * thick, static_cast<int>(lit.size())) << size << " seed " << seed << ":" << widths;
 
-      int back = 0, red = 0, green = 0;
-      for (const auto& [id, name] : camera.names) {
-        if (name == "back_wall") back = id;
-        if (name == "left_wall") red = id;
-        if (name == "right_wall") green = id;
-      }
-      ASSERT_TRUE(back && red && green);
-      const BlackLine near_red = black_line(camera, back, 0, camera.width / 3);
-      const BlackLine near_green = black_line(camera, back, camera.width - camera.width / 3, camera.width);
-      const double angle = std::acos(std::clamp(std::abs(near_red.direction.dot(near_green.direction)), 0.0, 1.0));
-      EXPECT_GT(angle, 2 * std::hypot(near_red.spread_rad, near_green.spread_rad))
-          << size << " seed " << seed << ": fork " << angle * 180 / M_PI << " deg, branches " << near_red.spread_rad * 180 / M_PI << " and "
-          << near_green.spread_rad * 180 / M_PI << " deg thick";
+    int back = 0, red = 0, green = 0;
+    for (const auto& [id, name] : camera.names) {
+      if (name == "back_wall") back = id;
+      if (name == "left_wall") red = id;
+      if (name == "right_wall") green = id;
     }
+    ASSERT_TRUE(back && red && green);
+    const BlackLine near_red = black_line(camera, back, 0, camera.width / 3);
+    const BlackLine near_green = black_line(camera, back, camera.width - camera.width / 3, camera.width);
+    const double angle = std::acos(std::clamp(std::abs(near_red.direction.dot(near_green.direction)), 0.0, 1.0));
+    EXPECT_GT(angle, 2 * std::hypot(near_red.spread_rad, near_green.spread_rad))
+        << size << " seed " << seed << ": fork " << angle * 180 / M_PI << " deg, branches " << near_red.spread_rad * 180 / M_PI << " and "
+        << near_green.spread_rad * 180 / M_PI << " deg thick";
+  }
 }
 
 // The banana built for the paper's mechanism (6c-banana: a tube of one paint lit from one end): its wall is curved
 // whatever the seed and the size, the analyzer names interreflection as what bends it, and its direct light alone
 // (the diffuse_direct and bounce.1 layers: no interreflected light) is a straight line.
 TEST_F(SeriesCommand, TheBananaIsCurvedByInterreflectionAndALineWithoutIt) {
-  // Three seeds over two sizes: two at the smaller size, the third at the larger (CI time).
-  for (const auto& [size, seeds] : {std::pair{std::string("64x64"), std::vector<std::string>{"1", "2"}},
-                                   std::pair{std::string("96x96"), std::vector<std::string>{"3"}}})
-    for (const std::string& seed : seeds) {
-      const fs::path out = dir_ / (size + "-" + seed);
-      const auto r = run_chromatrace({"paper", "-o", out.string(), "--variant", "6c-banana", "--resolution", size, "--seed", seed, "--quiet"});
-      ASSERT_EQ(r.exit_code, 0) << r.err;
-      const Json v = read_result(out)["variants"][0];  // a copy: the result read is a temporary
-      for (const Json& e : v["expect"]) EXPECT_TRUE(e["ok"].get<bool>()) << size << " seed " << seed << ": " << e.dump();
-      const fs::path camera = out / "6c-banana" / "camera.exr";
-      for (const std::string layer : {"diffuse_direct", "bounce.1"}) {
-        const fs::path analysis = out / ("direct-" + layer);
-        ASSERT_EQ(run_chromatrace({"analyze", camera.string(), "--layer", layer, "-o", analysis.string(), "--no-plots", "--no-report", "-q"}).exit_code, 0);
-        const Json regions = read_json(analysis / "analysis.json")["regions"];
-        int found = 0;
-        for (const Json& region : regions)
-          if (region["name"] == "object 1 (tube)") {
-            ++found;
-            EXPECT_EQ(region["shape"]["class"], "linear") << size << " seed " << seed << ", " << layer << ": " << region["shape"]["reason"];
-          }
-        EXPECT_EQ(found, 1) << size << " seed " << seed << ", " << layer;
-      }
+  for (const auto& [size, seed] : kSmallRuns) {
+    const fs::path out = dir_ / (size + "-" + seed);
+    const auto r = run_chromatrace({"paper", "-o", out.string(), "--variant", "6c-banana", "--resolution", size, "--seed", seed, "--quiet"});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const Json v = read_result(out)["variants"][0];  // a copy: the result read is a temporary
+    for (const Json& e : v["expect"]) EXPECT_TRUE(e["ok"].get<bool>()) << size << " seed " << seed << ": " << e.dump();
+    const fs::path camera = out / "6c-banana" / "camera.exr";
+    for (const std::string layer : {"diffuse_direct", "bounce.1"}) {
+      const fs::path analysis = out / ("direct-" + layer);
+      ASSERT_EQ(run_chromatrace({"analyze", camera.string(), "--layer", layer, "-o", analysis.string(), "--no-plots", "--no-report", "-q"}).exit_code, 0);
+      const Json regions = read_json(analysis / "analysis.json")["regions"];
+      int found = 0;
+      for (const Json& region : regions)
+        if (region["name"] == "object 1 (tube)") {
+          ++found;
+          EXPECT_EQ(region["shape"]["class"], "linear") << size << " seed " << seed << ", " << layer << ": " << region["shape"]["reason"];
+        }
+      EXPECT_EQ(found, 1) << size << " seed " << seed << ", " << layer;
     }
+  }
 }
 
 TEST_F(SeriesCommand, EmitWritesAVariantThatRendersOnItsOwn) {
