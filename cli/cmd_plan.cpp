@@ -1,9 +1,11 @@
 // SPDX-License-Identifier: Apache-2.0
 // chromatrace plan SCENE.json -o PLAN.json: the fewest bands and bounces for a colour-error target (docs/plan.md).
+#include <cmath>
 #include <filesystem>
 #include <string>
 
 #include <fmt/core.h>
+#include <fmt/ranges.h>
 
 #include "cli/app.h"
 #include "cli/command.h"
@@ -35,6 +37,11 @@ Action add_plan(CLI::App& app) {
                 "Cost Cycles renders for separate bounce components (one render per bounce order)");
   cmd->add_flag("!--no-reconstruction", o->plan.reconstruction,
                 "Read band values as a step function instead of fitting a reconstruction to the scene's spectra");
+  cmd->add_option("--cycles-noise-ratio", o->plan.cycles_noise_ratio,
+                  "Cycles' Monte Carlo noise over the tracer's at equal samples (default: measured over the test "
+                  "scenes, the prediction stated over their range)");
+  cmd->add_option("--reference-spp", o->plan.reference_samples,
+                  "Also predict the mean ΔE00 compare measures against a tracer reference of this many paths per pixel");
   cmd->add_option("--threads", o->plan.threads, "Worker threads (0: all cores)")->capture_default_str();
   cmd->add_flag("-q,--quiet", o->quiet, "No summary on stderr");
 
@@ -46,6 +53,10 @@ Action add_plan(CLI::App& app) {
       throw InputError(fmt::format("--preview-size: must be >= 1, got {}", o->plan.preview_size));
     if (o->plan.preview_samples < 1)
       throw InputError(fmt::format("--preview-spp: must be >= 1, got {}", o->plan.preview_samples));
+    if (o->plan.cycles_noise_ratio < 0 || !std::isfinite(o->plan.cycles_noise_ratio))
+      throw InputError(fmt::format("--cycles-noise-ratio: must be > 0, got {:g}", o->plan.cycles_noise_ratio));
+    if (o->plan.reference_samples < 0)
+      throw InputError(fmt::format("--reference-spp: must be >= 1, got {}", o->plan.reference_samples));
     const Scene scene = load_scene(o->scene);
     // Before the preview render: neither output may be an input (the scene, its meshes and tables) or the other.
     for (const std::string* out : {&o->output, &o->report})
@@ -56,11 +67,20 @@ Action add_plan(CLI::App& app) {
     if (!o->output.empty()) write_file_atomically(o->output, plan::bands_document(p).dump(2) + "\n");
     if (!o->report.empty()) write_file_atomically(o->report, report.dump(2) + "\n");
     fmt::print("{}\n", report.dump(2));
-    if (!o->quiet)
-      fmt::print(stderr, "{}: {} bands, max bounces {}, predicted mean ΔE00 {:.2f} (target {:g}{}); Cycles renders {} "
-                         "(scene's settings: {})\n",
-                 o->scene, p.bands.size(), p.max_bounces, p.predicted_mean, o->plan.target_de00,
+    if (!o->quiet) {
+      std::string cycles;
+      if (!p.cycles_samples.empty())
+        cycles = fmt::format("; Cycles samples per band group {}, with their noise {:.2f}{}", fmt::join(p.cycles_samples, ", "),
+                             p.cycles_predicted_mean,
+                             p.cycles_predicted_low < p.cycles_predicted_high
+                                 ? fmt::format(" ({:.2f}-{:.2f} over Cycles' noise on the test scenes)",
+                                               p.cycles_predicted_low, p.cycles_predicted_high)
+                                 : std::string());
+      fmt::print(stderr, "{}: {} bands, max bounces {}, predicted mean ΔE00 {:.2f} from them{} (target {:g}{}); Cycles "
+                         "renders {} (scene's settings: {})\n",
+                 o->scene, p.bands.size(), p.max_bounces, p.predicted_mean, cycles, o->plan.target_de00,
                  p.target_met ? "" : ", NOT met", p.cycles_renders, p.scene_cycles_renders);
+    }
     return 0;
   };
 }

@@ -76,6 +76,10 @@ class Model {
   }
   std::pair<double, double> evaluate(const std::vector<int>& edges, int max_bounces, bool reconstruct,
                                      BandReconstruction* fitted) const;
+  // Mean ΔE00 of the preview's noise (a realisation of one render's) in those of the bands `edges` (grid indices)
+  // that `carry` marks, the others noiseless, the band values read as the plan reads them, on exact colours: their
+  // part in the noise's colour error.
+  double band_noise(const std::vector<int>& edges, int max_bounces, const std::vector<bool>& carry) const;
   bool reconstructs() const { return reconstruct_; }
   std::pair<double, double> evaluate_exact(int max_bounces) const;  // exact spectra, truncated bounces
 
@@ -101,7 +105,22 @@ class Model {
   void set_white(const Preview& preview, const std::vector<bool>& near_light);
   void measure_preview_noise(const Preview& preview);
 
-  std::pair<double, double> score(const Templates& templates, int max_bounces) const;
+  // Templates of a band plan (tristimulus values at unit luminance, [id][k][lobe]) and the weights that turn its
+  // band values into tristimulus values ([channel][band]; with a fitted reconstruction, through it).
+  struct BandedTemplates {
+    Templates templates;
+    std::array<std::vector<double>, 3> weights;
+  };
+  BandedTemplates banded_templates(const std::vector<int>& edges, int max_bounces, bool reconstruct,
+                                   BandReconstruction* fitted) const;
+  // Tristimulus noise per preview pixel: the realisation of one preview render's noise averaged into the bands
+  // `edges` (grid indices), each band's times its scale, through `weights` (in the preview's units).
+  std::vector<Vec3d> noise_tristimulus(const std::vector<int>& edges, const std::array<std::vector<double>, 3>& weights,
+                                       const std::vector<double>& band_scale) const;
+  // Mean and 95th percentile over the preview's pixels of ΔE00 against the exact colours, `noise` (per preview
+  // pixel) added to the tested colours.
+  std::pair<double, double> score(const Templates& templates, int max_bounces,
+                                  const std::vector<Vec3d>* noise = nullptr) const;
   std::optional<BandReconstruction> fit_reconstruction(const TemplateSpectra& banded, const std::vector<int>& edges,
                                                        int max_bounces) const;
 
@@ -119,6 +138,11 @@ class Model {
   bool reconstruct_ = false;
   std::vector<Pixel> pixels_;
   std::vector<Vec3d> lab_exact_;
+  // A realisation of one preview render's noise in the totals, [pixel][preview band] ((a − b)/√2 of two renders
+  // with different seeds), and the preview's band edges.
+  std::vector<float> noise_;
+  std::vector<double> preview_edges_nm_;
+  double preview_units_ = 1;  // the preview's weights over the observer's integrals
   Vec3d white_{};
   std::vector<int> grid_edges_;
   double hit_fraction_ = 0, mean_albedo_ = 0, preview_noise_ = 0;
@@ -320,11 +344,12 @@ void Model::set_white(const Preview& preview, const std::vector<bool>& near_ligh
 
 // Noise: a second preview with the next seed. The two differ by noise alone, of twice the variance of either;
 // while noise is small against the colour, ΔE00 grows in proportion to its standard deviation, so one render's
-// noise is the mean ΔE00 between the two / √2 and falls as 1/√(paths per pixel).
+// noise is the mean ΔE00 between the two / √2 and falls as 1/√(paths per pixel). (a − b)/√2 is kept as a
+// realisation of one render's noise, for the share of each band in it.
 void Model::measure_preview_noise(const Preview& preview) {
   rt::RenderOptions options = preview.options;
-  options.seed = preview.scene.render.seed + 1;
   options.components = rt::ComponentSelection::parse("none");
+  options.seed = preview.scene.render.seed + 1;
   const rt::RenderedImage second = rt::render(preview.scene, options);
   const std::size_t N = preview.pixels();
   std::vector<Vec3d> a(N), b(N);
@@ -334,9 +359,44 @@ void Model::measure_preview_noise(const Preview& preview) {
   }
   preview_noise_ = N ? delta_e_between(a, b, white_).mean / std::sqrt(2.0) : 0.0;
   preview_samples_ = preview.image.samples;
+  const std::vector<float>&la = preview.image.layers[0], &lb = second.layers[0];
+  noise_.resize(la.size());
+  for (std::size_t i = 0; i < la.size(); ++i) noise_[i] = static_cast<float>((double{la[i]} - lb[i]) / std::sqrt(2.0));
+  preview_edges_nm_ = preview.image.bands.edges();
+  // The preview's weights are the observer's integrals over its bands times a constant (the camera model's units,
+  // sensor_sim/spectral_response.h); the preview's bands cover the grid.
+  const double observer = Grid::integral(obs_[1], 0, grid_.hi - grid_.lo);
+  const double preview_sum = std::accumulate(preview.weights[1].begin(), preview.weights[1].end(), 0.0);
+  preview_units_ = observer > 0 ? preview_sum / observer : 1.0;
 }
 
-std::pair<double, double> Model::score(const Templates& templates, int max_bounces) const {
+std::vector<Vec3d> Model::noise_tristimulus(const std::vector<int>& edges,
+                                            const std::array<std::vector<double>, 3>& weights,
+                                            const std::vector<double>& band_scale) const {
+  const std::size_t nbp = preview_edges_nm_.size() - 1, nb = edges.size() - 1;
+  const std::vector<float>& noise = noise_;
+  const std::size_t N = nbp ? noise.size() / nbp : 0;
+  // A band's value is the mean over its range: the preview bands' values weighted by their overlap with it.
+  std::vector<std::vector<double>> overlap(nb, std::vector<double>(nbp, 0.0));
+  for (std::size_t b = 0; b < nb; ++b) {
+    const double lo = grid_.lo + edges[b], hi = grid_.lo + edges[b + 1];
+    for (std::size_t j = 0; j < nbp; ++j) {
+      const double o = std::min(hi, preview_edges_nm_[j + 1]) - std::max(lo, preview_edges_nm_[j]);
+      if (o > 0) overlap[b][j] = o / (hi - lo) * band_scale[b];
+    }
+  }
+  std::vector<Vec3d> out(N, Vec3d{});
+  for (std::size_t p = 0; p < N; ++p)
+    for (std::size_t b = 0; b < nb; ++b) {
+      double v = 0;
+      for (std::size_t j = 0; j < nbp; ++j) v += overlap[b][j] * noise[p * nbp + j];
+      for (int c = 0; c < 3; ++c) out[p][c] += weights[c][b] * v;
+    }
+  return out;
+}
+
+std::pair<double, double> Model::score(const Templates& templates, int max_bounces,
+                                        const std::vector<Vec3d>* noise) const {
   std::vector<double> de(pixels_.size());
   for (std::size_t p = 0; p < pixels_.size(); ++p) {
     const Pixel& px = pixels_[p];
@@ -344,6 +404,8 @@ std::pair<double, double> Model::score(const Templates& templates, int max_bounc
     for (int k = 0; k <= std::min(max_bounces, kmax_); ++k)
       for (int lobe = 0; lobe < 2; ++lobe)
         for (int c = 0; c < 3; ++c) x[c] += px.y[k][lobe] * templates[px.id][k][lobe][c];
+    if (noise)
+      for (int c = 0; c < 3; ++c) x[c] += (*noise)[px.index][c];
     de[p] = delta_e_2000(lab_exact_[p], xyz_to_lab(x, white_));
   }
   const double sum = std::accumulate(de.begin(), de.end(), 0.0);
@@ -424,6 +486,22 @@ std::optional<BandReconstruction> Model::fit_reconstruction(const TemplateSpectr
 
 std::pair<double, double> Model::evaluate(const std::vector<int>& edges, int max_bounces, bool reconstruct,
                                           BandReconstruction* fitted) const {
+  return score(banded_templates(edges, max_bounces, reconstruct, fitted).templates, std::min(max_bounces, kmax_));
+}
+
+double Model::band_noise(const std::vector<int>& edges, int max_bounces, const std::vector<bool>& carry) const {
+  const BandedTemplates b = banded_templates(edges, max_bounces, reconstruct_, nullptr);
+  std::array<std::vector<double>, 3> weights = b.weights;  // in the preview's units, as the colours are
+  for (auto& w : weights)
+    for (double& x : w) x *= preview_units_;
+  std::vector<double> scale(carry.size());
+  for (std::size_t i = 0; i < carry.size(); ++i) scale[i] = carry[i] ? 1.0 : 0.0;
+  const std::vector<Vec3d> noise = noise_tristimulus(edges, weights, scale);
+  return score(exact_, kmax_, &noise).first;
+}
+
+Model::BandedTemplates Model::banded_templates(const std::vector<int>& edges, int max_bounces, bool reconstruct,
+                                               BandReconstruction* fitted) const {
   const std::size_t nb = edges.size() - 1;
   const int K = std::min(max_bounces, kmax_);
   auto averages = [&](const Sampled& f) {
@@ -477,7 +555,7 @@ std::pair<double, double> Model::evaluate(const std::vector<int>& edges, int max
         if (y > 0) x = {x[0] / y, x[1] / y, x[2] / y};
         else x = {0.0, 0.0, 0.0};
       }
-  return score(t, K);
+  return {std::move(t), banded.weight};
 }
 
 // Coordinate descent over the candidate positions of each inner edge (indices into grid_edges): each edge in
@@ -554,6 +632,55 @@ double noise_at(const Model& model, int samples) {
 // The paths per pixel at which the noise alone is predicted at the target.
 int samples_for(const Model& model, double target) {
   return std::max(1, static_cast<int>(std::ceil(model.preview_samples() * std::pow(model.preview_noise() / target, 2))));
+}
+
+// Cycles' samples per band group for the bands `edges` (grid indices) at the bounce limit K, whose bands and
+// bounces alone are predicted at `bands_error`. Cycles' noise is `ratio` times the tracer's at equal samples, and
+// the tracer's falls as 1/√samples from the preview's (noise_at). A group's share f_g of the noise's variance is
+// its part in the preview's noise, e_g² / Σ e² (Model::band_noise), so that with N_g samples a group the noise is
+// ratio · noise_at(1) · √(Σ f_g / N_g); it adds to the bands' error as the square root of the sum of squares (on the
+// paper box the measured error of Cycles at 256 and at 210 samples a group was 0.92 and 1.00 against a predicted
+// 0.93 and 1.02, docs/plan.md). The fewest samples in all for the target have N_g ∝ √f_g (the same cost per sample
+// in every group); no group gets less than a quarter of the most (the plan's observer is not the only camera its
+// render will meet). Empty when the bands and bounces alone miss the target.
+struct CyclesNoise {
+  std::vector<double> share;  // f_g
+  double ratio = 1, at_one = 0;  // Cycles over the tracer; the tracer's noise at 1 sample
+  double at(const std::vector<int>& samples) const {
+    double v = 0;
+    for (std::size_t g = 0; g < share.size(); ++g) v += share[g] / samples[g];
+    return ratio * at_one * std::sqrt(v);
+  }
+};
+CyclesNoise cycles_noise(const Model& model, const std::vector<int>& edges, int max_bounces, double ratio) {
+  const std::size_t nb = edges.size() - 1, groups = (nb + 2) / 3;
+  CyclesNoise n;
+  n.ratio = ratio;
+  n.at_one = noise_at(model, 1);
+  n.share.resize(groups);
+  for (std::size_t g = 0; g < groups; ++g) {
+    std::vector<bool> carry(nb, false);
+    for (std::size_t b = 3 * g; b < std::min(nb, 3 * g + 3); ++b) carry[b] = true;
+    n.share[g] = std::pow(model.band_noise(edges, max_bounces, carry), 2);
+  }
+  const double sum = std::accumulate(n.share.begin(), n.share.end(), 0.0);
+  for (double& f : n.share) f = sum > 0 ? f / sum : 1.0 / static_cast<double>(groups);
+  return n;
+}
+std::vector<int> cycles_samples_for(const CyclesNoise& noise, double bands_error, double target) {
+  if (!(bands_error < target)) return {};
+  const double budget = std::sqrt(target * target - bands_error * bands_error);
+  std::vector<double> w(noise.share.size());
+  for (std::size_t g = 0; g < w.size(); ++g) w[g] = std::sqrt(noise.share[g]);
+  const double top = *std::max_element(w.begin(), w.end());
+  for (double& x : w) x = std::max(x, 0.25 * top);
+  // N_g = k·w_g with ratio² · at_one² · Σ f_g / (k·w_g) = budget².
+  double v = 0;
+  for (std::size_t g = 0; g < w.size(); ++g) v += noise.share[g] / w[g];
+  const double k = std::pow(noise.ratio * noise.at_one / budget, 2) * v;
+  std::vector<int> samples(w.size());
+  for (std::size_t g = 0; g < w.size(); ++g) samples[g] = std::max(1, static_cast<int>(std::ceil(k * w[g] - 1e-9)));
+  return samples;
 }
 
 // The luminance fraction that arrives after more than k events, k = 0 .. the model's depth − 1, over the preview;
@@ -640,6 +767,13 @@ Plan make_plan(const Scene& scene, const PlanOptions& options) {
   std::vector<std::size_t> previous{0, cells};
   std::vector<std::size_t> best_idx;
   double best_value = std::numeric_limits<double>::infinity();
+  // For Cycles the counts after the first taken are weighed too, while their samples in all fall: more bands leave
+  // the noise more of the target, at a render per three of them.
+  const bool cycles = options.renderer == Renderer::Cycles;
+  const double ratio = options.cycles_noise_ratio > 0 ? options.cycles_noise_ratio : kCyclesNoiseRatio;
+  auto total = [](const std::vector<int>& n) { return std::accumulate(n.begin(), n.end(), 0L); };
+  bool chosen = false;
+  std::vector<int> chosen_samples;
   for (std::size_t n = step; n <= max_bands; n += step) {
     std::vector<std::size_t> uniform(n + 1);
     for (std::size_t i = 0; i <= n; ++i) uniform[i] = (i * cells + n / 2) / n;
@@ -651,18 +785,18 @@ Plan make_plan(const Scene& scene, const PlanOptions& options) {
       a_val = b_val;
     }
     previous = a_idx;
-    best_idx = a_idx;
-    best_value = a_val;
     BandTrial trial;
     trial.bands = static_cast<int>(a_idx.size() - 1);
     trial.predicted_mean = a_val;
-    for (std::size_t i : a_idx) trial.edges_nm.push_back(model.lo() + cand[i]);
+    std::vector<int> trial_edges;
+    for (std::size_t i : a_idx) {
+      trial.edges_nm.push_back(model.lo() + cand[i]);
+      trial_edges.push_back(cand[i]);
+    }
     // A count that meets the target is taken unless the warnings before a render (check-scene, render) would
     // name its bands: the mean over the image can hide one surface whose colour the bands cannot hold.
     bool taken = false;
     if (a_val <= options.target_de00) {
-      std::vector<int> trial_edges;
-      for (std::size_t i : a_idx) trial_edges.push_back(cand[i]);
       BandReconstruction r;
       model.evaluate(trial_edges, plan.max_bounces, model.reconstructs(), &r);
       Bands b = Bands::from_edges(trial.edges_nm, "plan");
@@ -672,9 +806,33 @@ Plan make_plan(const Scene& scene, const PlanOptions& options) {
       else trial.refused = warnings.front().message;
     }
     plan.trials.push_back(trial);
-    if (taken) break;
+    if (!chosen) {
+      best_idx = a_idx;
+      best_value = a_val;
+    }
+    if (!taken) {
+      if (chosen) break;
+      continue;
+    }
+    if (!cycles) {
+      chosen = true;
+      break;
+    }
+    const std::vector<int> samples = cycles_samples_for(cycles_noise(model, trial_edges, plan.max_bounces, ratio), a_val,
+                                                        options.target_de00);
+    plan.trials.back().cycles_samples = samples;
+    const bool cheaper = !samples.empty() && (chosen_samples.empty() || total(samples) < total(chosen_samples));
+    if (!chosen || cheaper) {
+      best_idx = a_idx;
+      best_value = a_val;
+      chosen_samples = samples;
+    }
+    // Stop at the first count that costs more than the one before it (or, with none feasible yet, keep looking).
+    if (chosen && !cheaper && !chosen_samples.empty()) break;
+    chosen = true;
   }
-  plan.target_met = !plan.trials.empty() && best_value <= options.target_de00 && plan.trials.back().refused.empty();
+  plan.cycles_samples = chosen_samples;
+  plan.target_met = chosen && best_value <= options.target_de00 && (!cycles || !plan.cycles_samples.empty());
   std::vector<int> edges;
   std::vector<double> edges_nm;
   for (std::size_t i : best_idx) {
@@ -687,6 +845,27 @@ Plan make_plan(const Scene& scene, const PlanOptions& options) {
       model.evaluate(edges, plan.max_bounces, model.reconstructs(), &reconstruction);
   if (reconstruction.fine > 0) plan.bands = plan.bands.with_reconstruction(std::move(reconstruction), "plan");
   plan.predicted_band_only = model.evaluate(edges, kmax).first;
+  if (cycles && !plan.cycles_samples.empty()) {
+    CyclesNoise noise = cycles_noise(model, edges, plan.max_bounces, ratio);
+    const auto& n = plan.cycles_samples;
+    auto with = [&](double noise_de00) { return std::hypot(plan.predicted_mean, noise_de00); };
+    plan.cycles_noise_ratio = ratio;
+    plan.cycles_noise_only = noise.at(n);
+    plan.cycles_predicted_mean = with(plan.cycles_noise_only);
+    plan.cycles_predicted_low = plan.cycles_predicted_high = plan.cycles_predicted_mean;
+    if (!(options.cycles_noise_ratio > 0)) {
+      noise.ratio = kCyclesNoiseRatioLow;
+      plan.cycles_predicted_low = with(noise.at(n));
+      noise.ratio = kCyclesNoiseRatioHigh;
+      plan.cycles_predicted_high = with(noise.at(n));
+    }
+    if (options.reference_samples > 0) {
+      const double reference = noise_at(model, options.reference_samples);
+      plan.cycles_predicted_against_reference = std::hypot(plan.cycles_predicted_mean, reference);
+      plan.cycles_against_reference_low = std::hypot(plan.cycles_predicted_low, reference);
+      plan.cycles_against_reference_high = std::hypot(plan.cycles_predicted_high, reference);
+    }
+  }
   {
     std::vector<int> scene_edges;
     for (double e : scene.render.bands.edges()) scene_edges.push_back(static_cast<int>(std::lround(e)) - model.lo());
@@ -749,7 +928,7 @@ SettingsPrediction predict_settings(const Scene& scene, int max_bounces, int sam
   return p;
 }
 
-Json bands_document(const Plan& plan) { return band_plan_document(plan.bands); }
+Json bands_document(const Plan& plan) { return band_plan_document(plan.bands, plan.cycles_samples); }
 
 Json report_document(const Plan& plan, const Scene& scene, const PlanOptions& options) {
   Json j;
@@ -769,6 +948,7 @@ Json report_document(const Plan& plan, const Scene& scene, const PlanOptions& op
   s["max_bounces"] = plan.max_bounces;
   s["samples"] = plan.samples;
   s["samples_from"] = "tracer paths per pixel for a mean ΔE00 of Monte Carlo noise at the target, at the preview's pixel size";
+  if (!plan.cycles_samples.empty()) s["cycles_samples"] = plan.cycles_samples;
   j["settings"] = s;
   Json p;
   p["mean_de00"] = plan.predicted_mean;
@@ -780,10 +960,29 @@ Json report_document(const Plan& plan, const Scene& scene, const PlanOptions& op
   p["noise_mean_de00_at_planned_samples"] = plan.noise_at_samples;
   p["noise_mean_de00_at_scene_samples"] = plan.noise_at_scene_samples;
   p["energy_after_bounces"] = plan.energy_after;
+  if (!plan.cycles_samples.empty()) {
+    Json c{{"samples_per_band_group", plan.cycles_samples},
+           {"mean_de00", plan.cycles_predicted_mean},
+           {"mean_de00_range", {plan.cycles_predicted_low, plan.cycles_predicted_high}},
+           {"noise_only_mean_de00", plan.cycles_noise_only},
+           {"noise_ratio_to_tracer", plan.cycles_noise_ratio},
+           {"noise_ratio_from", options.cycles_noise_ratio > 0 ? "--cycles-noise-ratio"
+                                                               : "the median over the test scenes; the range over them"}};
+    if (options.reference_samples > 0)
+      c["against_tracer_reference"] = Json{
+          {"samples", options.reference_samples},
+          {"mean_de00", plan.cycles_predicted_against_reference},
+          {"mean_de00_range", {plan.cycles_against_reference_low, plan.cycles_against_reference_high}}};
+    p["cycles"] = c;
+  }
   Json trials = Json::array();
-  for (const BandTrial& t : plan.trials)
-    trials.push_back(Json{{"bands", t.bands}, {"mean_de00", t.predicted_mean}, {"edges_nm", t.edges_nm},
-                          {"refused", t.refused.empty() ? Json() : Json(t.refused)}});
+  for (const BandTrial& t : plan.trials) {
+    Json trial{{"bands", t.bands}, {"mean_de00", t.predicted_mean}, {"edges_nm", t.edges_nm},
+               {"refused", t.refused.empty() ? Json() : Json(t.refused)}};
+    if (options.renderer == Renderer::Cycles && t.refused.empty() && t.predicted_mean <= options.target_de00)
+      trial["cycles_samples"] = t.cycles_samples.empty() ? Json() : Json(t.cycles_samples);
+    trials.push_back(trial);
+  }
   p["band_counts_tried"] = trials;
   j["prediction"] = p;
   Json c;

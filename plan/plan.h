@@ -49,7 +49,19 @@ struct PlanOptions {
   // Fit a reconstruction of the bands' values (core/spectrum.h: BandReconstruction) to the scene's spectra and
   // plan with it; not when the scene has image textures, whose spectra the model does not hold.
   bool reconstruction = true;
+  // Cycles: its Monte Carlo noise against the tracer's at equal samples per pixel (the ratio of one render's mean
+  // ΔE00 of noise). 0: kCyclesNoiseRatio, the median over the test scenes, the prediction stated over their range.
+  double cycles_noise_ratio = 0;
+  // Also predict the mean ΔE00 that comparing the Cycles render with a tracer reference of this many paths per
+  // pixel measures (its noise counts too); 0: not.
+  int reference_samples = 0;
 };
+
+// Cycles' Monte Carlo noise against the tracer's at equal samples per pixel: the mean ΔE00 between two renders with
+// different seeds, Cycles over the tracer, 64×64 pixels, 64 samples, 6 bands of 50 nm, Blender 3.4: the paper box
+// 0.75, the Cornell box 0.77, the textured scene under an HDRI 0.60, the glossy lights 1.07 (docs/plan.md).
+constexpr double kCyclesNoiseRatio = 0.76;
+constexpr double kCyclesNoiseRatioLow = 0.60, kCyclesNoiseRatioHigh = 1.07;
 
 struct BandTrial {
   int bands = 0;
@@ -58,6 +70,7 @@ struct BandTrial {
   // Why a count that met the target was not taken: the first warning check_band_plan (check-scene, render) gives
   // for those bands, e.g. one material lit by one light off by more than 2 (the mean hides one surface).
   std::string refused;
+  std::vector<int> cycles_samples;  // Cycles, a count taken: its samples per band group (empty: none meet the target)
 };
 
 struct Plan {
@@ -76,6 +89,16 @@ struct Plan {
   double scene_bands_predicted_mean = 0;  // the scene's own band plan, for comparison
   std::vector<BandTrial> trials;          // every band count tried, fewest first
   std::vector<double> energy_after;       // luminance fraction beyond k bounces, k = 0 .. scene max - 1
+  // Cycles: samples per pixel of each band group (three bands a render), chosen with the bands: the fewest in all
+  // for which the bands, the bounce limit and Monte Carlo noise together are predicted at the target, shared
+  // between the groups by their part in the noise's colour error (docs/plan.md).
+  std::vector<int> cycles_samples;
+  double cycles_noise_ratio = 0;                  // the ratio the prediction used
+  double cycles_predicted_mean = 0;               // mean ΔE00 of bands, bounces and noise at cycles_samples
+  double cycles_predicted_low = 0, cycles_predicted_high = 0;  // the same over the ratio's range
+  double cycles_noise_only = 0;                   // the noise alone at cycles_samples (exact spectra)
+  // With PlanOptions::reference_samples: what compare measures against such a reference, and its range.
+  double cycles_predicted_against_reference = 0, cycles_against_reference_low = 0, cycles_against_reference_high = 0;
   // Cost.
   int cycles_band_groups = 0;    // ceil(bands / 3)
   int cycles_bounce_variants = 1;

@@ -432,6 +432,54 @@ TEST_F(Blender, PlannedSamplesRenderEachBandGroupWithItsOwn) {
   EXPECT_FALSE(fs::exists(dir_.file("both.exr")));
 }
 
+// plan for Cycles gives each band group its samples with the bands, predicting the mean ΔE00 of bands, bounces and
+// Cycles' noise together, stated over the range of Cycles' noise against the tracer's measured on the test scenes
+// (docs/plan.md). Here Cycles renders the plan (its bands, bounce limit and samples per group) of the paper box and
+// the Cornell box, each with two seeds, and compare measures the render against a tracer reference of 5 nm bands at
+// the scene's bounce limit; its noise counts in what compare measures, and the plan predicts that too
+// (--reference-spp). The measured error must lie in the stated range, and every seed's within 0.1 of the others'.
+TEST_F(Blender, JointPlanPredictsTheMeasuredErrorOfCycles) {
+  constexpr int kSize = 48, kReferenceSpp = 2048;
+  const std::string res = fmt::format("{}x{}", kSize, kSize);
+  for (const std::string& scene : {box(), kSource + "/scenes/cornell_box/cornell_box.json"}) {
+    SCOPED_TRACE(scene);
+    const std::string name = scene == box() ? "paper_box" : "cornell_box";
+    const fs::path plan = dir_.file(name + "-plan.json"), report = dir_.file(name + "-report.json");
+    const fs::path reference = dir_.file(name + "-reference.exr");
+    const CommandResult p = test::run_chromatrace({"plan", scene, "--edge-step", "5", "--target-de00", "1",
+                                                   "--reference-spp", std::to_string(kReferenceSpp), "-o",
+                                                   plan.string(), "--report", report.string(), "--quiet"});
+    ASSERT_EQ(p.exit_code, 0) << p.err;
+    const json r = read_json(report);
+    ASSERT_TRUE(r["target_met"].get<bool>());
+    const json& predicted = r["prediction"]["cycles"]["against_tracer_reference"];
+    const double lo = predicted["mean_de00_range"][0].get<double>(), hi = predicted["mean_de00_range"][1].get<double>();
+    const CommandResult t = test::run_chromatrace(
+        {"render", scene, "-o", reference.string(), "--resolution", res, "--bands", "380:780:5", "--spp",
+         std::to_string(kReferenceSpp), "--seed", "7", "--quiet"});
+    ASSERT_EQ(t.exit_code, 0) << t.err;
+    std::vector<double> measured;
+    for (int seed : {1, 2}) {
+      const fs::path out = dir_.file(fmt::format("{}-{}.exr", name, seed)), cmp = dir_.file(fmt::format("{}-cmp{}", name, seed));
+      const CommandResult c = batch({"--scene", scene, "--out", out.string(), "--resolution", res, "--bands-file",
+                                     plan.string(), "--max-bounces", std::to_string(r["settings"]["max_bounces"].get<int>()),
+                                     "--components", "none", "--seed", std::to_string(seed)},
+                                    fmt::format("cache-{}-{}", name, seed));
+      ASSERT_EQ(c.exit_code, 0) << c.err;
+      const CommandResult m = test::run_chromatrace({"compare", out.string(), reference.string(), "-o", cmp.string(),
+                                                     "--colour", "own", "--quiet"});
+      ASSERT_EQ(m.exit_code, 0) << m.err;
+      measured.push_back(read_json(cmp / "compare.json")["image"]["delta_e00"]["mean"].get<double>());
+      std::fprintf(stderr, "%s, seed %d, samples per group %s: measured mean dE00 %.3f, predicted %.3f (%.3f-%.3f)\n",
+                   name.c_str(), seed, r["settings"]["cycles_samples"].dump().c_str(), measured.back(),
+                   predicted["mean_de00"].get<double>(), lo, hi);
+      EXPECT_GE(measured.back(), lo);
+      EXPECT_LE(measured.back(), hi);
+    }
+    EXPECT_NEAR(measured[0], measured[1], 0.1);
+  }
+}
+
 // What a Cycles render's settings leave out is said before it renders, as `chromatrace render` says it for the
 // tracer (docs/render.md, docs/stability.md): the paper box under CIE F11 (three narrow peaks) with 100 nm bands
 // cannot hold the lamp's own colour, 2 bounces drop light and 4 samples are noisy. The batch prints exactly the

@@ -354,6 +354,64 @@ TEST_F(Plan, BandPlanFileCarriesTheSamplesOfEachCyclesBandGroup) {
   EXPECT_FALSE(read_json(file).contains("cycles_samples"));
 }
 
+// For Cycles, plan gives samples to each band group of three with the bands: Cycles' noise `ratio` × the tracer's
+// at equal samples, f_g a group's share of its variance, adds to the bands' and bounces' error B in quadrature, so
+// the fewest samples in all for the target T have N_g = k·√f_g (no group under a quarter of the most) with
+// ratio² · noise(1)² · Σ f_g / N_g = T² − B². Known answers of that law: the predicted error is the target (each
+// N_g rounded up: at most it, within 1 %); samples scale with ratio² and with
+// 1 / (T² − B²); every group gets at least a quarter of the most; the band file carries them; the tracer gets none.
+TEST_F(Plan, CyclesSamplesPerBandGroupMeetTheTargetWithTheBands) {
+  const fs::path bands = dir_ / "plan.json";
+  auto plan = [&](std::vector<std::string> extra) {
+    std::vector<std::string> args = {"plan", kBox.string(), "--threads", "2", "--quiet", "--edge-step", "5"};
+    args.insert(args.end(), extra.begin(), extra.end());
+    const auto r = run_chromatrace(args);
+    EXPECT_EQ(r.exit_code, 0) << r.err;
+    return parse_json(r.out, "stdout");
+  };
+  const Json one = plan({"-o", bands.string(), "--cycles-noise-ratio", "1"});
+  const Json& c = one["prediction"]["cycles"];
+  const auto n = c["samples_per_band_group"].get<std::vector<int>>();
+  ASSERT_EQ(n.size(), (one["settings"]["band_count"].get<std::size_t>() + 2) / 3);
+  EXPECT_EQ(one["settings"]["cycles_samples"].get<std::vector<int>>(), n);
+  EXPECT_EQ(read_band_plan_file(bands).cycles_samples, n);
+  EXPECT_TRUE(one["target_met"].get<bool>());
+  const double bands_error = one["prediction"]["mean_de00"].get<double>(), noise = c["noise_only_mean_de00"].get<double>();
+  EXPECT_NEAR(c["mean_de00"].get<double>(), std::hypot(bands_error, noise), 1e-9);
+  EXPECT_LE(c["mean_de00"].get<double>(), 1.0);
+  EXPECT_GT(c["mean_de00"].get<double>(), 0.99);  // rounding up a few hundred samples moves it by well under 1 %
+  const int most = *std::max_element(n.begin(), n.end());
+  for (int g : n) EXPECT_GE(4 * g, most);
+  EXPECT_EQ(c["noise_ratio_to_tracer"].get<double>(), 1.0);
+  EXPECT_EQ(c["mean_de00_range"][0], c["mean_de00"]);  // a given ratio: no range
+  // Twice the noise: four times the samples (each within the rounding of one sample per group).
+  const auto twice = plan({"--cycles-noise-ratio", "2"})["prediction"]["cycles"]["samples_per_band_group"].get<std::vector<int>>();
+  ASSERT_EQ(twice.size(), n.size());
+  for (std::size_t g = 0; g < n.size(); ++g) EXPECT_NEAR(twice[g], 4.0 * n[g], 4.0) << g;
+  // A looser target: the noise's budget T² − B² grows, the samples fall by its ratio (same bands and bounces).
+  const Json loose = plan({"--cycles-noise-ratio", "1", "--target-de00", "1.5"});
+  ASSERT_EQ(loose["settings"]["bands"], one["settings"]["bands"]);
+  const double b2 = loose["prediction"]["mean_de00"].get<double>();
+  const auto fewer = loose["prediction"]["cycles"]["samples_per_band_group"].get<std::vector<int>>();
+  const double scale = (1.0 - bands_error * bands_error) / (1.5 * 1.5 - b2 * b2);
+  for (std::size_t g = 0; g < n.size(); ++g) EXPECT_NEAR(fewer[g], scale * n[g], 1.0) << g;
+  // The default ratio is the measured median, stated over the measured range; against a reference of N paths its
+  // noise adds in quadrature too.
+  const Json median = plan({"--reference-spp", "4096"});
+  const Json& m = median["prediction"]["cycles"];
+  EXPECT_EQ(m["noise_ratio_to_tracer"].get<double>(), plan::kCyclesNoiseRatio);
+  EXPECT_LT(m["mean_de00_range"][0].get<double>(), m["mean_de00"].get<double>());
+  EXPECT_GT(m["mean_de00_range"][1].get<double>(), m["mean_de00"].get<double>());
+  const double reference_noise = median["prediction"]["noise_mean_de00_at_scene_samples"].get<double>() *
+                                 std::sqrt(median["scene_settings"]["samples"].get<double>() / 4096);
+  EXPECT_NEAR(m["against_tracer_reference"]["mean_de00"].get<double>(),
+              std::hypot(m["mean_de00"].get<double>(), reference_noise), 1e-9);
+  // The tracer traces every band on each path: no groups, no samples of Cycles.
+  const Json tracer = plan({"--renderer", "tracer", "-o", bands.string()});
+  EXPECT_FALSE(tracer["prediction"].contains("cycles"));
+  EXPECT_TRUE(read_band_plan_file(bands).cycles_samples.empty());
+}
+
 TEST_F(Plan, BadInputGetsExitTwoAndOneLineNamingTheField) {
   const fs::path bad_scene = dir_ / "bad.json";
   Json doc = read_json(kBox);
@@ -376,6 +434,8 @@ TEST_F(Plan, BadInputGetsExitTwoAndOneLineNamingTheField) {
       {{"plan", kBox.string(), "--target-de00", "0"}, "--target-de00"},
       {{"plan", kBox.string(), "--renderer", "eevee"}, "--renderer"},
       {{"plan", kBox.string(), "--camera", "nokia_3310"}, "--camera"},
+      {{"plan", kBox.string(), "--cycles-noise-ratio", "-1"}, "--cycles-noise-ratio: must be > 0"},
+      {{"plan", kBox.string(), "--reference-spp", "-5"}, "--reference-spp: must be >= 1"},
       {{"plan", kBox.string(), "-o", (dir_ / "no/such/dir/plan.json").string()}, "does not exist"},
       {{"render", kBox.string(), "-o", (dir_ / "x.exr").string(), "--plan", bad_plan.string()},
        "bad_plan.json: edges_nm[2]"},
