@@ -61,7 +61,7 @@ plan::RenderRequest judged_settings(const Scene& scene, const CheckSceneOptions&
   if (o.renderer != "tracer" && o.renderer != "cycles")
     throw InputError(fmt::format("--renderer: must be tracer or cycles, got \"{}\"", o.renderer));
   // Cycles renders band averages only: its band plan is judged in the bands mode, and no fix names the other.
-  if (o.renderer == "cycles") request.mode = SpectralMode::Bands, request.continuous_available = false;
+  if (o.renderer == "cycles") request.mode = SpectralMode::Bands, request.continuous_available = false, request.cycles = true;
   const std::optional<BandPlanFile> plan = band_plan_file_option(o.bands, o.bands_file, "--bands-file");
   if (plan) request.bands = plan->bands;
   if (o.max_bounces) {
@@ -72,12 +72,10 @@ plan::RenderRequest judged_settings(const Scene& scene, const CheckSceneOptions&
     if (*o.samples < 1) throw InputError(fmt::format("--samples: must be at least 1, got {}", *o.samples));
     request.samples = *o.samples, request.samples_name = "--samples";
   } else if (o.renderer == "cycles" && plan && !plan->cycles_samples.empty()) {
-    // A plan that gives each band group its samples is judged at its fewest, as if every group had them: the noise
-    // of the mix lies below that.
-    const std::vector<int>& groups = plan->cycles_samples;
-    request.samples = *std::min_element(groups.begin(), groups.end());
-    request.samples_name = fmt::format("the fewest cycles_samples of {} (every band group at them, an upper bound)",
-                                       o.bands_file);
+    // A plan that gives each band group its samples: each group's noise falls with its own.
+    request.cycles_samples = plan->cycles_samples;
+    request.samples = *std::min_element(request.cycles_samples.begin(), request.cycles_samples.end());
+    request.samples_name = fmt::format("cycles_samples of {}", o.bands_file);
   }
   return request;
 }

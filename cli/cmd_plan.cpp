@@ -3,6 +3,7 @@
 #include <cmath>
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include <fmt/core.h>
 #include <fmt/ranges.h>
@@ -12,6 +13,7 @@
 #include "core/error.h"
 #include "core/file_io.h"
 #include "core/scene.h"
+#include "core/spectral_exr.h"
 #include "plan/plan.h"
 
 namespace ct::cli {
@@ -20,6 +22,7 @@ Action add_plan(CLI::App& app) {
   auto* cmd = add_command(app, "plan");
   struct Options {
     std::string scene, output, report, renderer = "cycles";
+    std::vector<std::string> pilots;
     plan::PlanOptions plan;
     bool quiet = false;
   };
@@ -40,6 +43,10 @@ Action add_plan(CLI::App& app) {
   cmd->add_option("--cycles-noise-ratio", o->plan.cycles_noise_ratio,
                   "Cycles' Monte Carlo noise over the tracer's at equal samples (default: measured over the test "
                   "scenes, the prediction stated over their range)");
+  cmd->add_option("--cycles-pilot", o->pilots,
+                  "Two Cycles renders of the scene with different seeds (same samples, bands and size): Cycles' noise "
+                  "against the tracer's measured on them")
+      ->expected(2);
   cmd->add_option("--reference-spp", o->plan.reference_samples,
                   "Also predict the mean ΔE00 compare measures against a tracer reference of this many paths per pixel");
   cmd->add_option("--threads", o->plan.threads, "Worker threads (0: all cores)")->capture_default_str();
@@ -58,10 +65,28 @@ Action add_plan(CLI::App& app) {
     if (o->plan.reference_samples < 0)
       throw InputError(fmt::format("--reference-spp: must be >= 1, got {}", o->plan.reference_samples));
     const Scene scene = load_scene(o->scene);
-    // Before the preview render: neither output may be an input (the scene, its meshes and tables) or the other.
+    // Before the preview render: neither output may be an input (the scene, its meshes and tables, the pilots) or
+    // the other.
+    std::vector<std::filesystem::path> inputs = scene.files;
+    inputs.insert(inputs.end(), o->pilots.begin(), o->pilots.end());
     for (const std::string* out : {&o->output, &o->report})
-      if (!out->empty()) check_output_file(*out, scene.files);
+      if (!out->empty()) check_output_file(*out, inputs);
     check_distinct_outputs({o->output, o->report});
+    if (!o->pilots.empty()) {
+      if (o->plan.cycles_noise_ratio > 0)
+        throw InputError("--cycles-pilot: give either --cycles-pilot or --cycles-noise-ratio");
+      if (o->plan.renderer != plan::Renderer::Cycles)
+        throw InputError("--cycles-pilot: Cycles' noise is for --renderer cycles");
+      const plan::NoiseRatio r = plan::measure_cycles_noise(scene, o->pilots[0], o->pilots[1], o->plan.camera, o->plan.threads);
+      o->plan.cycles_noise_ratio = r.ratio;
+      o->plan.cycles_noise_ratio_range = {std::max(0.0, r.ratio - 2 * r.se), r.ratio + 2 * r.se};
+      o->plan.cycles_group_shares = r.group_shares;
+      o->plan.cycles_group_shares_edges_nm = SpectralExrReader(o->pilots[0]).info().bands.edges();
+      o->plan.cycles_noise_ratio_from = fmt::format(
+          "Cycles pilots {} and {} ({} samples): mean ΔE00 {:.3f} between them against the tracer's {:.3f}, ratio ± "
+          "2 standard errors",
+          o->pilots[0], o->pilots[1], r.samples, r.cycles, r.tracer);
+    }
     const plan::Plan p = plan::make_plan(scene, o->plan);
     const Json report = plan::report_document(p, scene, o->plan);
     if (!o->output.empty()) write_file_atomically(o->output, plan::bands_document(p).dump(2) + "\n");

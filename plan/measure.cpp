@@ -13,6 +13,7 @@
 #include "core/spectral_exr.h"
 #include "core/render_delta_e.h"
 #include "plan/plan.h"
+#include "reference_tracer/render.h"
 #include "sensor_sim/spectral_response.h"
 
 namespace ct::plan {
@@ -47,6 +48,144 @@ Measurement measure_delta_e(const std::filesystem::path& test, const std::filesy
   const Vec3d white = white_point(
       xw, near_emitters(ids, iw.width, iw.height, [&](std::int32_t id) { return id >= first_light; }), policy);
   return delta_e_between(xa, xb, white);
+}
+
+namespace {
+
+// The mean ΔE00 between two renders' tristimulus values under the white of the first (measure_delta_e's policy),
+// and its standard error over the pixels.
+std::pair<double, double> mean_difference(const std::vector<Vec3d>& a, const std::vector<Vec3d>& b,
+                                          const std::vector<std::int32_t>& ids, int width, int height,
+                                          const Scene& scene, const Bands& bands, const sensor::CameraCurves& curves) {
+  const auto first_light = static_cast<std::int32_t>(scene.objects.size()) + 1;
+  const PiecewiseLinearSpectrum light = scene_light_spectrum(scene);
+  WhitePolicy policy;
+  for (int c = 0; c < 3; ++c)
+    policy.light[c] = integral_of_product(light, curves.curves[c], bands.min_wavelength(), bands.max_wavelength());
+  const std::vector<bool> near = near_emitters(ids, width, height, [&](std::int32_t id) { return id >= first_light; });
+  const Vec3d white = white_point(a, near, policy);
+  // ΔE00 in its linear regime: between m − ε·d/2 and m + ε·d/2 (m the pair's mean, d their difference), over ε.
+  // The mean ΔE00 of a large difference grows more slowly than the difference (CIELAB's cube root, ΔE00's
+  // compression of chroma), so a pilot's few samples would understate the noisier renderer's part; linearised,
+  // it scales as the noise's standard deviation at any number of samples.
+  constexpr double kEpsilon = 1e-3;
+  std::vector<double> de;
+  for (std::size_t p = 0; p < a.size(); ++p) {
+    Vec3d lo{}, hi{};
+    for (int c = 0; c < 3; ++c) {
+      const double m = 0.5 * (a[p][c] + b[p][c]), d = b[p][c] - a[p][c];
+      lo[c] = m - 0.5 * kEpsilon * d;
+      hi[c] = m + 0.5 * kEpsilon * d;
+    }
+    de.push_back(delta_e_2000(xyz_to_lab(lo, white), xyz_to_lab(hi, white)) / kEpsilon);
+  }
+  const double n = static_cast<double>(de.size());
+  const double mean = n > 0 ? std::accumulate(de.begin(), de.end(), 0.0) / n : 0.0;
+  double var = 0;
+  for (double x : de) var += (x - mean) * (x - mean);
+  return {mean, n > 1 ? std::sqrt(var / (n - 1) / n) : 0.0};
+}
+
+int integer_metadata(const SpectralExrInfo& info, const std::string& key) {
+  const auto it = info.metadata.find(key);
+  if (it == info.metadata.end()) throw InputError(fmt::format("{}: {}: missing", info.file, key));
+  std::size_t used = 0;
+  int v = 0;
+  try {
+    v = std::stoi(it->second, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  if (used != it->second.size() || v < 1)
+    throw InputError(fmt::format("{}: {}: \"{}\" is not one number of samples (a pilot renders every band group alike)",
+                                 info.file, key, it->second));
+  return v;
+}
+
+}  // namespace
+
+NoiseRatio measure_cycles_noise(const Scene& scene, const std::filesystem::path& a, const std::filesystem::path& b,
+                                const std::string& camera, int threads) {
+  const sensor::CameraCurves curves = sensor::camera_curves(camera, {"r", "g", "b"}, "--camera");
+  SpectralExrReader ra(a), rb(b);
+  const SpectralExrInfo &ia = ra.info(), &ib = rb.info();
+  for (const SpectralExrInfo* info : {&ia, &ib}) {
+    const auto renderer = info->metadata.find("chromatrace.renderer");
+    if (renderer == info->metadata.end() || !renderer->second.starts_with("Cycles"))
+      throw InputError(fmt::format("{}: chromatrace.renderer: not a Cycles render (\"{}\"); a pilot is rendered by "
+                                   "Cycles through the Blender add-on",
+                                   info->file, renderer == info->metadata.end() ? "" : renderer->second));
+  }
+  if (ib.width != ia.width || ib.height != ia.height)
+    throw InputError(fmt::format("{}: {}x{} pixels but {} has {}x{}", ib.file, ib.width, ib.height, ia.file, ia.width,
+                                 ia.height));
+  if (!(ib.bands == ia.bands)) throw InputError(fmt::format("{}: other bands than {}", ib.file, ia.file));
+  NoiseRatio out;
+  out.samples = integer_metadata(ia, "chromatrace.samples");
+  if (integer_metadata(ib, "chromatrace.samples") != out.samples)
+    throw InputError(fmt::format("{}: chromatrace.samples: {} but {} has {}", ib.file, ib.metadata.at("chromatrace.samples"),
+                                 ia.file, out.samples));
+  if (ia.metadata.count("chromatrace.seed") && ib.metadata.count("chromatrace.seed") &&
+      ia.metadata.at("chromatrace.seed") == ib.metadata.at("chromatrace.seed"))
+    throw InputError(fmt::format("{}: chromatrace.seed: {} is also the seed of {} (the same samples twice: no noise to "
+                                 "measure)", ib.file, ib.metadata.at("chromatrace.seed"), ia.file));
+  const std::size_t pixels = static_cast<std::size_t>(ia.width) * static_cast<std::size_t>(ia.height);
+  const std::vector<float> va = ra.read_layer(ia.total()), vb = rb.read_layer(ib.total());
+  auto tristimuli = [&](const std::vector<float>& v) { return sensor::camera_tristimulus(v, ia.bands, curves, pixels); };
+  std::vector<std::int32_t> ids(pixels, 0);
+  if (ia.has_object_ids) ra.read_object_ids(0, ia.height, ids);
+  const std::vector<Vec3d> xa = tristimuli(va);
+  const auto [cycles, cycles_se] = mean_difference(xa, tristimuli(vb), ids, ia.width, ia.height, scene, ia.bands, curves);
+  // Each group's part, and each pair's: the first pilot with those groups' bands taken from the second.
+  const std::size_t nb = ia.bands.size(), groups = (nb + 2) / 3;
+  auto swapped = [&](std::size_t g, std::size_t h) {
+    std::vector<float> hybrid = va;
+    for (std::size_t p = 0; p < pixels; ++p)
+      for (std::size_t b = 0; b < nb; ++b)
+        if (b / 3 == g || b / 3 == h) hybrid[p * nb + b] = vb[p * nb + b];
+    const double e = mean_difference(xa, tristimuli(hybrid), ids, ia.width, ia.height, scene, ia.bands, curves).first;
+    return e * e;
+  };
+  std::vector<double> single(groups);
+  for (std::size_t g = 0; g < groups; ++g) single[g] = swapped(g, g);
+  out.group_shares.assign(groups * groups, 0.0);
+  double sum = 0;
+  for (std::size_t g = 0; g < groups; ++g)
+    for (std::size_t h = 0; h < groups; ++h) {
+      double& d = out.group_shares[g * groups + h];
+      d = g == h ? single[g] : h < g ? out.group_shares[h * groups + g] : 0.5 * (swapped(g, h) - single[g] - single[h]);
+      sum += d;
+    }
+  for (double& d : out.group_shares) d = sum > 0 ? d / sum : 0.0;
+  // The tracer alike: the pilots' size, bands and samples.
+  Scene s = scene;
+  s.camera.width = ia.width;
+  s.camera.height = ia.height;
+  rt::RenderOptions o;
+  o.samples = out.samples;
+  o.bands = ia.bands;
+  o.mode = SpectralMode::Bands;
+  o.components = rt::ComponentSelection::parse("none");
+  o.threads = threads;
+  o.progress = false;
+  std::array<std::vector<Vec3d>, 2> tracer;
+  std::vector<std::int32_t> tracer_ids;
+  for (std::uint64_t seed : {1, 2}) {
+    o.seed = seed;
+    const rt::RenderedImage image = rt::render(s, o);
+    tracer[seed - 1] = sensor::camera_tristimulus(image.layers[0], ia.bands, curves, pixels);
+    tracer_ids = image.object_ids;
+  }
+  const auto [traced, traced_se] =
+      mean_difference(tracer[0], tracer[1], tracer_ids, ia.width, ia.height, scene, ia.bands, curves);
+  if (!(traced > 0))
+    throw InputError(fmt::format("{}: the tracer's renders of {} at its size and samples show no noise to compare with",
+                                 ia.file, scene.source));
+  out.cycles = cycles;
+  out.tracer = traced;
+  out.ratio = cycles / traced;
+  out.se = out.ratio * std::hypot(cycles_se / std::max(cycles, 1e-300), traced_se / traced);
+  return out;
 }
 
 }  // namespace ct::plan

@@ -635,49 +635,90 @@ int samples_for(const Model& model, double target) {
 }
 
 // Cycles' samples per band group for the bands `edges` (grid indices) at the bounce limit K, whose bands and
-// bounces alone are predicted at `bands_error`. Cycles' noise is `ratio` times the tracer's at equal samples, and
-// the tracer's falls as 1/√samples from the preview's (noise_at). A group's share f_g of the noise's variance is
-// its part in the preview's noise, e_g² / Σ e² (Model::band_noise), so that with N_g samples a group the noise is
-// ratio · noise_at(1) · √(Σ f_g / N_g); it adds to the bands' error as the square root of the sum of squares (on the
-// paper box the measured error of Cycles at 256 and at 210 samples a group was 0.92 and 1.00 against a predicted
-// 0.93 and 1.02, docs/plan.md). The fewest samples in all for the target have N_g ∝ √f_g (the same cost per sample
-// in every group); no group gets less than a quarter of the most (the plan's observer is not the only camera its
-// render will meet). Empty when the bands and bounces alone miss the target.
+// bounces alone are predicted at `bands_error`. Cycles' noise is `ratio` times the tracer's at equal samples, and the
+// tracer's falls as 1/√samples from the preview's (noise_at). How it is shared between the groups is a G × G matrix
+// s (summing to 1): s_gg a group's own part, s_gh (g ≠ h) the part of two groups' correlated noise (Cycles traces
+// the same paths for every group with the same seed, so their noise is correlated over the samples they share). With
+// N_g samples a group the noise is ratio · noise_at(1) · √(Σ_gh s_gh / max(N_g, N_h)) (two groups share the samples of
+// the fewer: their covariance falls with the more), and it adds to the bands' error as the square root of the sum of
+// squares. Measured on two Cycles pilots (measure_cycles_noise) s has all its terms; else plan's model gives the
+// diagonal alone, each group's part in the preview's noise (Model::band_noise). On the paper box under D65 the
+// pilots measure the two groups at 0.63 and 0.37 with a pair term of nearly nothing, and Cycles at 256 and at 210
+// samples a group measured 0.92 and 1.00 against a predicted 0.93 and 1.02 (docs/plan.md). The samples are the
+// fewest in all for the target: a search over the groups' proportions (each a quarter of the most or more: the
+// plan's observer is not the only camera its render will meet), the scale then set by the budget. Empty when the
+// bands and bounces alone miss the target.
 struct CyclesNoise {
-  std::vector<double> share;  // f_g
+  std::size_t groups = 0;
+  std::vector<double> share;  // s, G × G row by row
+  bool measured = false;      // from Cycles' pilots, else from plan's model (diagonal)
   double ratio = 1, at_one = 0;  // Cycles over the tracer; the tracer's noise at 1 sample
-  double at(const std::vector<int>& samples) const {
+  // Σ_gh s_gh / max(n_g, n_h): the noise's variance at samples n in units of (ratio · at_one)².
+  template <typename T>
+  double variance(const std::vector<T>& n) const {
     double v = 0;
-    for (std::size_t g = 0; g < share.size(); ++g) v += share[g] / samples[g];
-    return ratio * at_one * std::sqrt(v);
+    for (std::size_t g = 0; g < groups; ++g)
+      for (std::size_t h = 0; h < groups; ++h)
+        v += share[g * groups + h] / static_cast<double>(std::max(n[g], n[h]));
+    return v;
   }
+  double at(const std::vector<int>& samples) const { return ratio * at_one * std::sqrt(std::max(0.0, variance(samples))); }
 };
-CyclesNoise cycles_noise(const Model& model, const std::vector<int>& edges, int max_bounces, double ratio) {
+CyclesNoise cycles_noise(const Model& model, const std::vector<int>& edges, int max_bounces, double ratio,
+                         const PlanOptions& options) {
   const std::size_t nb = edges.size() - 1, groups = (nb + 2) / 3;
   CyclesNoise n;
+  n.groups = groups;
   n.ratio = ratio;
   n.at_one = noise_at(model, 1);
-  n.share.resize(groups);
+  // Shares measured on Cycles' pilots of these very bands.
+  bool measured = options.cycles_group_shares.size() == groups * groups &&
+                  options.cycles_group_shares_edges_nm.size() == nb + 1;
+  for (std::size_t i = 0; measured && i <= nb; ++i)
+    measured = std::abs(options.cycles_group_shares_edges_nm[i] - (model.lo() + edges[i])) < 1e-6;
+  if (measured) {
+    n.share = options.cycles_group_shares;
+    n.measured = true;
+    return n;
+  }
+  n.share.assign(groups * groups, 0.0);
+  double sum = 0;
   for (std::size_t g = 0; g < groups; ++g) {
     std::vector<bool> carry(nb, false);
     for (std::size_t b = 3 * g; b < std::min(nb, 3 * g + 3); ++b) carry[b] = true;
-    n.share[g] = std::pow(model.band_noise(edges, max_bounces, carry), 2);
+    sum += n.share[g * groups + g] = std::pow(model.band_noise(edges, max_bounces, carry), 2);
   }
-  const double sum = std::accumulate(n.share.begin(), n.share.end(), 0.0);
-  for (double& f : n.share) f = sum > 0 ? f / sum : 1.0 / static_cast<double>(groups);
+  for (std::size_t g = 0; g < groups; ++g)
+    n.share[g * groups + g] = sum > 0 ? n.share[g * groups + g] / sum : 1.0 / static_cast<double>(groups);
   return n;
 }
 std::vector<int> cycles_samples_for(const CyclesNoise& noise, double bands_error, double target) {
   if (!(bands_error < target)) return {};
   const double budget = std::sqrt(target * target - bands_error * bands_error);
-  std::vector<double> w(noise.share.size());
-  for (std::size_t g = 0; g < w.size(); ++g) w[g] = std::sqrt(noise.share[g]);
-  const double top = *std::max_element(w.begin(), w.end());
-  for (double& x : w) x = std::max(x, 0.25 * top);
-  // N_g = k·w_g with ratio² · at_one² · Σ f_g / (k·w_g) = budget².
-  double v = 0;
-  for (std::size_t g = 0; g < w.size(); ++g) v += noise.share[g] / w[g];
-  const double k = std::pow(noise.ratio * noise.at_one / budget, 2) * v;
+  // Proportions w (N_g = k·w_g): k = (ratio · at_one / budget)² · variance(w) meets the budget, at a cost of k·Σw.
+  auto cost = [&](const std::vector<double>& w) {
+    return noise.variance(w) * std::accumulate(w.begin(), w.end(), 0.0);
+  };
+  std::vector<double> w(noise.groups, 1.0);
+  double best = cost(w);
+  for (double step : {1.25, 1.1, 1.03, 1.01}) {
+    for (bool improved = true; improved;) {
+      improved = false;
+      for (std::size_t g = 0; g < w.size(); ++g)
+        for (double f : {step, 1 / step}) {
+          std::vector<double> t = w;
+          t[g] *= f;
+          const double top = *std::max_element(t.begin(), t.end());
+          if (*std::min_element(t.begin(), t.end()) < 0.25 * top - 1e-12) continue;
+          if (const double c = cost(t); c < best - 1e-12) {
+            best = c;
+            w = t;
+            improved = true;
+          }
+        }
+    }
+  }
+  const double k = std::pow(noise.ratio * noise.at_one / budget, 2) * noise.variance(w);
   std::vector<int> samples(w.size());
   for (std::size_t g = 0; g < w.size(); ++g) samples[g] = std::max(1, static_cast<int>(std::ceil(k * w[g] - 1e-9)));
   return samples;
@@ -818,7 +859,7 @@ Plan make_plan(const Scene& scene, const PlanOptions& options) {
       chosen = true;
       break;
     }
-    const std::vector<int> samples = cycles_samples_for(cycles_noise(model, trial_edges, plan.max_bounces, ratio), a_val,
+    const std::vector<int> samples = cycles_samples_for(cycles_noise(model, trial_edges, plan.max_bounces, ratio, options), a_val,
                                                         options.target_de00);
     plan.trials.back().cycles_samples = samples;
     const bool cheaper = !samples.empty() && (chosen_samples.empty() || total(samples) < total(chosen_samples));
@@ -846,19 +887,24 @@ Plan make_plan(const Scene& scene, const PlanOptions& options) {
   if (reconstruction.fine > 0) plan.bands = plan.bands.with_reconstruction(std::move(reconstruction), "plan");
   plan.predicted_band_only = model.evaluate(edges, kmax).first;
   if (cycles && !plan.cycles_samples.empty()) {
-    CyclesNoise noise = cycles_noise(model, edges, plan.max_bounces, ratio);
+    CyclesNoise noise = cycles_noise(model, edges, plan.max_bounces, ratio, options);
     const auto& n = plan.cycles_samples;
     auto with = [&](double noise_de00) { return std::hypot(plan.predicted_mean, noise_de00); };
     plan.cycles_noise_ratio = ratio;
+    plan.tracer_noise_at_one = noise.at_one;
+    for (std::size_t g = 0; g < noise.groups; ++g) plan.cycles_noise_shares.push_back(noise.share[g * noise.groups + g]);
+    if (noise.measured) plan.cycles_noise_pair_shares = noise.share;
+    plan.cycles_noise_shares_measured = noise.measured;
     plan.cycles_noise_only = noise.at(n);
     plan.cycles_predicted_mean = with(plan.cycles_noise_only);
-    plan.cycles_predicted_low = plan.cycles_predicted_high = plan.cycles_predicted_mean;
-    if (!(options.cycles_noise_ratio > 0)) {
-      noise.ratio = kCyclesNoiseRatioLow;
-      plan.cycles_predicted_low = with(noise.at(n));
-      noise.ratio = kCyclesNoiseRatioHigh;
-      plan.cycles_predicted_high = with(noise.at(n));
-    }
+    // The range: the ratio's (measured on the pilots, or over the test scenes), and the noise model's own accuracy.
+    std::array<double, 2> range = options.cycles_noise_ratio_range;
+    if (!(options.cycles_noise_ratio > 0)) range = {kCyclesNoiseRatioLow, kCyclesNoiseRatioHigh};
+    if (!(range[1] > 0)) range = {ratio, ratio};
+    noise.ratio = range[0] / (1 + kCyclesNoiseModelAccuracy);
+    plan.cycles_predicted_low = with(noise.at(n));
+    noise.ratio = range[1] * (1 + kCyclesNoiseModelAccuracy);
+    plan.cycles_predicted_high = with(noise.at(n));
     if (options.reference_samples > 0) {
       const double reference = noise_at(model, options.reference_samples);
       plan.cycles_predicted_against_reference = std::hypot(plan.cycles_predicted_mean, reference);
@@ -966,8 +1012,14 @@ Json report_document(const Plan& plan, const Scene& scene, const PlanOptions& op
            {"mean_de00_range", {plan.cycles_predicted_low, plan.cycles_predicted_high}},
            {"noise_only_mean_de00", plan.cycles_noise_only},
            {"noise_ratio_to_tracer", plan.cycles_noise_ratio},
-           {"noise_ratio_from", options.cycles_noise_ratio > 0 ? "--cycles-noise-ratio"
-                                                               : "the median over the test scenes; the range over them"}};
+           {"tracer_noise_at_one_sample", plan.tracer_noise_at_one},
+           {"noise_share_per_band_group", plan.cycles_noise_shares},
+           {"noise_shares_between_band_groups", plan.cycles_noise_pair_shares},
+           {"noise_shares_from", plan.cycles_noise_shares_measured ? "the Cycles pilots" : "plan's model of the preview's noise"},
+           {"noise_ratio_from", options.cycles_noise_ratio > 0
+                                    ? (options.cycles_noise_ratio_from.empty() ? std::string("--cycles-noise-ratio")
+                                                                               : options.cycles_noise_ratio_from)
+                                    : std::string("the median over the test scenes; the range over them")}};
     if (options.reference_samples > 0)
       c["against_tracer_reference"] = Json{
           {"samples", options.reference_samples},

@@ -50,8 +50,14 @@ struct PlanOptions {
   // plan with it; not when the scene has image textures, whose spectra the model does not hold.
   bool reconstruction = true;
   // Cycles: its Monte Carlo noise against the tracer's at equal samples per pixel (the ratio of one render's mean
-  // ΔE00 of noise). 0: kCyclesNoiseRatio, the median over the test scenes, the prediction stated over their range.
+  // ΔE00 of noise), the range the prediction is stated over and where the ratio comes from. 0: kCyclesNoiseRatio,
+  // the median over the test scenes, stated over their range.
   double cycles_noise_ratio = 0;
+  std::array<double, 2> cycles_noise_ratio_range{0, 0};
+  std::string cycles_noise_ratio_from;
+  // How Cycles' noise is shared between band groups and pairs of them as measured (NoiseRatio::group_shares), for
+  // the bands it was measured with (edges in nm); other bands take the shares of plan's model (no pairs).
+  std::vector<double> cycles_group_shares, cycles_group_shares_edges_nm;
   // Also predict the mean ΔE00 that comparing the Cycles render with a tracer reference of this many paths per
   // pixel measures (its noise counts too); 0: not.
   int reference_samples = 0;
@@ -62,6 +68,12 @@ struct PlanOptions {
 // 0.75, the Cornell box 0.77, the textured scene under an HDRI 0.60, the glossy lights 1.07 (docs/plan.md).
 constexpr double kCyclesNoiseRatio = 0.76;
 constexpr double kCyclesNoiseRatioLow = 0.60, kCyclesNoiseRatioHigh = 1.07;
+// How far the predicted noise of a Cycles render may be off with its ratio known, as a factor (1 + this) either way.
+// Cycles renders of the paper box and the Cornell box at the samples a plan with pilots gave them (Blender 3.4 and
+// 5.3, two seeds each, 48 × 48 pixels) had noise from 22 % under (the Cornell box: its pilots, at 64 samples, put
+// Cycles at 0.85 of the tracer, its renders at 500 samples nearer 0.67) to 14 % over their prediction
+// (docs/plan.md).
+constexpr double kCyclesNoiseModelAccuracy = 0.4;
 
 struct BandTrial {
   int bands = 0;
@@ -94,6 +106,10 @@ struct Plan {
   // between the groups by their part in the noise's colour error (docs/plan.md).
   std::vector<int> cycles_samples;
   double cycles_noise_ratio = 0;                  // the ratio the prediction used
+  double tracer_noise_at_one = 0;                 // the tracer's noise (mean ΔE00) at one path per pixel
+  std::vector<double> cycles_noise_shares;        // each band group's share of the noise's variance (diagonal)
+  bool cycles_noise_shares_measured = false;      // on Cycles' pilots, else by plan's model
+  std::vector<double> cycles_noise_pair_shares;   // measured: G × G with the pairs' terms (NoiseRatio)
   double cycles_predicted_mean = 0;               // mean ΔE00 of bands, bounces and noise at cycles_samples
   double cycles_predicted_low = 0, cycles_predicted_high = 0;  // the same over the ratio's range
   double cycles_noise_only = 0;                   // the noise alone at cycles_samples (exact spectra)
@@ -132,6 +148,24 @@ Json report_document(const Plan& plan, const Scene& scene, const PlanOptions& op
 // The light spectrum the plan adapts to: the scene's lights weighted by mean radiance × area (and a
 // uniform environment by 4π·R², R the scene's bounding radius), as a 1 nm table.
 PiecewiseLinearSpectrum scene_light_spectrum(const Scene& scene);
+
+// Cycles' Monte Carlo noise against the tracer's, measured on the scene itself: two Cycles renders of it (pilots,
+// e.g. at the plan's preview size) with different seeds and the same samples, bands and size; the tracer renders it
+// twice alike (its seeds 1 and 2, the scene's bounce limit) and the ratio is that of the mean ΔE00 between the two
+// of each (measure_delta_e's statistic, under the white of the first of each pair), its standard error from their
+// pixels'.
+struct NoiseRatio {
+  double ratio = 0, se = 0;
+  double cycles = 0, tracer = 0;  // mean ΔE00 between the two renders of each
+  int samples = 0;
+  // How Cycles' noise is shared between the band groups (three bands a render) and between pairs of them, whose
+  // noise is correlated where they share paths (the same seed): G × G, row by row, summing to 1. Diagonal: e_g², e_g
+  // the mean ΔE00 between the first pilot and the first with group g's bands from the second; off the diagonal,
+  // (e_gh² − e_g² − e_h²) / 2 with both groups' bands from the second.
+  std::vector<double> group_shares;
+};
+NoiseRatio measure_cycles_noise(const Scene& scene, const std::filesystem::path& a, const std::filesystem::path& b,
+                                const std::string& camera = "cie1931", int threads = 0);
 
 using Measurement = RenderDeltaE;
 // ΔE00 (core/render_delta_e.h) between the totals of two spectral EXR renders of `scene` (same size; any band

@@ -1,7 +1,10 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "plan/render_check.h"
 
+#include <cmath>
+
 #include <fmt/core.h>
+#include <fmt/ranges.h>
 
 #include "plan/plan.h"
 #include "plan/spectral_check.h"
@@ -34,11 +37,30 @@ std::vector<std::string> render_warnings(const Scene& scene, const RenderRequest
         settings.bounces_name, settings.max_bounces, 100 * p.share_beyond, settings.max_bounces,
         settings.max_bounces == 1 ? "" : "s", p.bounce_de00,
         p.bounces_for_target, target_de00));
-  if (p.noise_de00 > target_de00)
+  if (settings.cycles) {
+    // The tracer's noise at one sample, Cycles' share of it, and the groups' samples (each group's noise the same
+    // share of the whole, as plan's model has them but for its weights).
+    const double at_one = p.noise_de00 * std::sqrt(static_cast<double>(settings.samples));
+    double inverse = 1.0 / settings.samples;
+    if (!settings.cycles_samples.empty()) {
+      inverse = 0;
+      for (int n : settings.cycles_samples) inverse += 1.0 / n / static_cast<double>(settings.cycles_samples.size());
+    }
+    const double noise = kCyclesNoiseRatio * at_one * std::sqrt(inverse);
+    if (noise > target_de00)
+      out.push_back(fmt::format(
+          "{} {} gives Cycles Monte Carlo noise of a predicted mean ΔE00 of {:.3g} ({:g} × the tracer's, the median "
+          "over the test scenes); use {} samples for {:g} (chromatrace plan)",
+          settings.samples_name, settings.cycles_samples.empty() ? fmt::format("{}", settings.samples)
+                                                                 : fmt::format("{}", fmt::join(settings.cycles_samples, ", ")),
+          noise, kCyclesNoiseRatio,
+          static_cast<int>(std::ceil(std::pow(kCyclesNoiseRatio * at_one / target_de00, 2))), target_de00));
+  } else if (p.noise_de00 > target_de00) {
     out.push_back(fmt::format(
         "{} {} gives Monte Carlo noise of a predicted mean ΔE00 of {:.3g} (the tracer in bands mode); use {} "
         "samples for {:g} (chromatrace plan)",
         settings.samples_name, settings.samples, p.noise_de00, p.samples_for_target, target_de00));
+  }
   return out;
 }
 

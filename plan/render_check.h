@@ -23,6 +23,10 @@ struct RenderRequest {
   // The renderer has the continuous spectral mode (the tracer; Cycles renders bands only): the band warnings'
   // fixes name it only then.
   bool continuous_available = true;
+  // Cycles renders it: its noise is kCyclesNoiseRatio × the tracer's (plan/plan.h), each band group's falling with
+  // its own samples where `cycles_samples` gives them (one per group of three bands; else `samples` for every one).
+  bool cycles = false;
+  std::vector<int> cycles_samples;
   int threads = 0;
 };
 

@@ -32,6 +32,12 @@ def _parser():
     p.add_argument("--samples", type=int, help="samples per pixel (default: the scene's)")
     p.add_argument("--bands", help="band plan lo:hi:width in nm (default: the scene's)")
     p.add_argument("--bands-file", help="band plan file (chromatrace-bands/1)")
+    p.add_argument("--plan", type=float, metavar="DE00",
+                   help="plan bands, bounce limit and each band group's samples for this mean ΔE00 (chromatrace plan, "
+                        "with Cycles' noise measured on two small pilot renders) and render with them")
+    p.add_argument("--plan-edge-step", type=float, metavar="NM",
+                   help="with --plan: band edges on multiples of NM nm (chromatrace plan --edge-step; 5 lets compare "
+                        "hold the render against a reference of 5 nm bands)")
     p.add_argument("--max-bounces", type=int, help="scattering events per path: 0 emitters, 1 direct, >= 2 global")
     p.add_argument("--components", help="component families: paths, lights, bounces, all, none (default: the scene's)")
     p.add_argument("--resolution", help="image size WxH, overriding the camera's")
@@ -95,6 +101,16 @@ def parse_batch_args(argv):
         raise BadInput("--band-group: renders a band group, --explain renders nothing; give one of them")
     if args.bounce_limit is not None and args.band_group is None:
         raise BadInput("--bounce-limit: needs --band-group (the group whose render it is)")
+    if args.plan is not None:
+        if not args.plan > 0:
+            raise BadInput(f"--plan: the mean ΔE00 to plan for must be > 0, got {args.plan:g}")
+        for option, value in (("--bands", args.bands), ("--bands-file", args.bands_file), ("--samples", args.samples),
+                              ("--max-bounces", args.max_bounces), ("--band-group", args.band_group),
+                              ("--explain", args.explain)):
+            if value is not None:
+                raise BadInput(f"{option}: --plan chooses the bands, bounce limit and samples; give one of them")
+    if args.plan_edge_step is not None and args.plan is None:
+        raise BadInput("--plan-edge-step: needs --plan (the plan whose band edges it places)")
     if args.bands and args.bands_file:
         raise BadInput("--bands-file: give either --bands or --bands-file, not both")
     if args.bands_file and not os.path.isfile(args.bands_file):

@@ -77,7 +77,7 @@ def _ensure_registered(bpy):
 def run(argv):
     args = parse_batch_args(argv)
     import bpy
-    from . import bands, scene_import, spectral_render, tool
+    from . import planning, scene_import, tool
 
     _ensure_registered(bpy)
     log = (lambda message: None) if args.quiet else _log
@@ -89,6 +89,52 @@ def run(argv):
     else:
         bpy.ops.wm.open_mainfile(filepath=os.path.abspath(args.blend))
     scene = bpy.context.scene
+    work, planned = None, None
+    try:
+        if args.plan is not None:
+            work = planning.planning_folder()
+            planned = _plan(args, scene, chromatrace_tool, work, log)
+            args.bands_file, args.max_bounces = planned.bands_file, planned.max_bounces
+        _render(args, bpy, scene, chromatrace_tool, log, planned)
+    finally:
+        if work:
+            planning.remove_folder(work)
+
+
+def _plan(args, scene, chromatrace_tool, work, log):
+    """batch.py --plan: the plan (planning.py) of the scene file, or of the open scene written as one, with pilots
+    rendered by this Cycles."""
+    from . import planning, scene_export, spectral_render
+    scene_file = args.scene
+    if not scene_file:
+        scene_file = os.path.join(work, "scene.json")
+        try:
+            scene_export.export_scene(scene, scene_file, chromatrace_tool, log=lambda message: None)
+        except BadInput as e:
+            raise BadInput(f"--plan: the scene could not be written as a scene file to plan: {e}") from None
+    base = spectral_render.Request.from_scene(scene, resolution=args.resolution, device=args.device,
+                                              on_mixing_nodes=args.on_mixing_nodes, on_world=args.on_world)
+
+    def render_pilot(bands_file, seed, output):
+        pilot = spectral_render.Request(**vars(base))
+        pilot.bands, pilot.bands_file, pilot.samples, pilot.seed = None, bands_file, planning.PILOT_SAMPLES, seed
+        pilot.families, pilot.object_ids = set(), True
+        pilot.resolution = planning.pilot_resolution(*base.resolution_of(scene))
+        pilot.output, pilot.cache_root, pilot.keep_cache = output, os.path.join(work, "cache"), False
+        pilot.log = lambda message: None
+        spectral_render.SpectralRender(scene, pilot, chromatrace_tool).run()
+
+    log(f"planning for a mean ΔE00 of {args.plan:g}: chromatrace plan, then two pilot renders of "
+        f"{'x'.join(map(str, planning.pilot_resolution(*base.resolution_of(scene))))} at {planning.PILOT_SAMPLES} "
+        "samples for Cycles' noise")
+    with _stdout_silenced(args.quiet):
+        planned = planning.plan_render(scene_file, args.plan, work, render_pilot, chromatrace_tool, args.plan_edge_step)
+    log(planned.summary())
+    return planned
+
+
+def _render(args, bpy, scene, chromatrace_tool, log, planned):
+    from . import bands, spectral_render
     request = spectral_render.Request.from_scene(
         scene, output=os.path.abspath(args.out) if args.out else None, samples=args.samples,
         max_bounces=args.max_bounces, seed=args.seed, bands=args.bands, bands_file=args.bands_file,
@@ -96,6 +142,8 @@ def run(argv):
         keep_cache=args.keep_cache or None, log=log, on_mixing_nodes=args.on_mixing_nodes,
         bands_per_render=args.bands_per_render, on_world=args.on_world, only_group=args.band_group,
         only_variant=args.bounce_limit, device=args.device)
+    if planned:
+        request.plan_header = planned.header()
     if args.bands_file:
         request.bands = None
         if args.samples is not None and bands.planned_samples(args.bands_file):

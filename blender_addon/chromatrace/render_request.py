@@ -45,6 +45,7 @@ class Request:
         self.keep_cache = False
         self.only_group = None  # render only this band group into the cache, no ids, no assembly (batch --band-group)
         self.only_variant = None  # with only_group: only this render variant (bounce limit) of it (--bounce-limit)
+        self.plan_header = None  # batch --plan: what the output's header keeps of the plan (chromatrace.plan)
         self.log = _stderr_log
         for key, value in values.items():
             if not hasattr(self, key):

@@ -287,6 +287,8 @@ class SpectralRender:
         attributes = {}
         if plan.world["status"] == "omitted":
             attributes["chromatrace.warning"] = node_resolution.world_warning(plan.world)
+        if request.plan_header:
+            attributes["chromatrace.plan"] = request.plan_header
         return attributes | {
             "chromatrace.renderer": (f"Cycles (Blender {bpy.app.version_string}) via the chromatrace add-on: "
                                      f"{plan.per_render} band(s) per render, max {request.max_bounces} bounces, "

@@ -66,6 +66,16 @@ class Tool:
             args += ["--bands-file", bands_file]
         return self.run(*args, json_output=True)
 
+    def plan(self, scene_file, target, output, report, pilots=None, edge_step=None):
+        """`chromatrace plan` for Cycles: the band-plan file and the report; with two pilot renders, Cycles' noise
+        measured on them."""
+        args = ["plan", scene_file, "--target-de00", repr(float(target)), "-o", output, "--report", report, "--quiet"]
+        if edge_step:
+            args += ["--edge-step", repr(float(edge_step))]
+        if pilots:
+            args += ["--cycles-pilot", *pilots]
+        return self.run(*args)
+
     def check_scene(self, scene_file):
         return self.run("check-scene", scene_file, "--json", json_output=True)
 

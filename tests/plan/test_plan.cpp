@@ -383,7 +383,11 @@ TEST_F(Plan, CyclesSamplesPerBandGroupMeetTheTargetWithTheBands) {
   const int most = *std::max_element(n.begin(), n.end());
   for (int g : n) EXPECT_GE(4 * g, most);
   EXPECT_EQ(c["noise_ratio_to_tracer"].get<double>(), 1.0);
-  EXPECT_EQ(c["mean_de00_range"][0], c["mean_de00"]);  // a given ratio: no range
+  // A given ratio: the range is the noise model's own accuracy alone.
+  EXPECT_NEAR(c["mean_de00_range"][0].get<double>(),
+              std::hypot(bands_error, noise / (1 + plan::kCyclesNoiseModelAccuracy)), 1e-9);
+  EXPECT_NEAR(c["mean_de00_range"][1].get<double>(),
+              std::hypot(bands_error, noise * (1 + plan::kCyclesNoiseModelAccuracy)), 1e-9);
   // Twice the noise: four times the samples (each within the rounding of one sample per group).
   const auto twice = plan({"--cycles-noise-ratio", "2"})["prediction"]["cycles"]["samples_per_band_group"].get<std::vector<int>>();
   ASSERT_EQ(twice.size(), n.size());

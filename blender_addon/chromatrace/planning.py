@@ -1,0 +1,105 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""A spectral render planned for a colour-error target (batch.py --plan; docs/plan.md, "Cycles' samples"):
+
+1. `chromatrace plan` on the scene as a scene file (the batch's --scene, or the open scene written as the panel's
+   Export writes it): the fewest bands and bounces, from the tracer's preview.
+2. Two pilot renders by this Cycles with those bands, at the plan's preview size and PILOT_SAMPLES, seeds 1 and 2,
+   no components: Cycles' Monte Carlo noise on this scene and this Blender.
+3. `chromatrace plan --cycles-pilot` again: the same bands and bounces, and each band group's samples for the
+   target with Cycles' noise as the pilots measured it. The render then takes that plan.
+
+The pilots cost little (PILOT_SAMPLES at 32 pixels on the longer side: under a thousandth of a 256-sample render
+at 1024 pixels) and are made in a folder of their own, removed after.
+"""
+
+import json
+import os
+import shutil
+import tempfile
+
+from .errors import BadInput
+
+PILOT_SIZE = 32  # pixels on the longer side: plan's preview size
+PILOT_SAMPLES = 64
+PILOT_SEEDS = (1, 2)
+
+
+def pilot_resolution(width, height):
+    """The pilots' size: the render's aspect with PILOT_SIZE pixels on the longer side."""
+    if width >= height:
+        return [PILOT_SIZE, max(1, round(height * PILOT_SIZE / width))]
+    return [max(1, round(width * PILOT_SIZE / height)), PILOT_SIZE]
+
+
+class Planned:
+    """The outcome: the band-plan file the render takes (bands, reconstruction, samples per band group), the plan's
+    report (`chromatrace plan --report`), and one line saying what it predicts."""
+
+    def __init__(self, bands_file, report):
+        self.bands_file = bands_file
+        self.report = report
+
+    @property
+    def max_bounces(self):
+        return self.report["settings"]["max_bounces"]
+
+    @property
+    def samples(self):
+        return self.report["settings"]["cycles_samples"]
+
+    def summary(self):
+        cycles = self.report["prediction"]["cycles"]
+        low, high = cycles["mean_de00_range"]
+        return (f"plan for a mean ΔE00 of {self.report['target_de00']:g}: {self.report['settings']['band_count']} bands, "
+                f"max {self.max_bounces} bounces, samples per band group {', '.join(map(str, self.samples))}; "
+                f"predicted mean ΔE00 {cycles['mean_de00']:.2f} ({low:.2f}-{high:.2f}), Cycles' noise "
+                f"{cycles['noise_ratio_to_tracer']:.2f} × the tracer's on the pilots")
+
+    def header(self):
+        """What the output's header keeps of the plan (chromatrace.plan)."""
+        cycles = self.report["prediction"]["cycles"]
+        return json.dumps({"target_de00": self.report["target_de00"], "camera": self.report["camera"],
+                           "max_bounces": self.max_bounces, "cycles_samples": self.samples,
+                           "predicted_mean_de00": cycles["mean_de00"], "predicted_range": cycles["mean_de00_range"],
+                           "noise_ratio_to_tracer": cycles["noise_ratio_to_tracer"],
+                           "tracer_noise_at_one_sample": cycles["tracer_noise_at_one_sample"]})
+
+
+def plan_render(scene_file, target, work_dir, render_pilot, tool, edge_step=None):
+    """Plans the render of `scene_file` for a mean ΔE00 of `target` into `work_dir`. `render_pilot(bands_file, seed,
+    output)` renders a pilot with this Cycles (the caller's scene, at the pilots' size and samples, no components).
+    Returns a Planned; BadInput when no plan reaches the target."""
+    first, first_report = os.path.join(work_dir, "plan-bands.json"), os.path.join(work_dir, "plan-bands-report.json")
+    tool.plan(scene_file, target, first, first_report, edge_step=edge_step)
+    with open(first_report) as f:
+        report = json.load(f)
+    if not report["target_met"]:
+        raise BadInput(f"--plan: no plan reaches a mean ΔE00 of {target:g} on {scene_file}: "
+                       + "; ".join(report["notes"] or ["the bands and bounces alone miss it"]))
+    # The pilots render every group alike: the plan's bands without its samples.
+    with open(first) as f:
+        bands = json.load(f)
+    bands.pop("cycles_samples", None)
+    pilot_bands = os.path.join(work_dir, "pilot-bands.json")
+    with open(pilot_bands, "w") as f:
+        json.dump(bands, f)
+    pilots = []
+    for seed in PILOT_SEEDS:
+        pilots.append(os.path.join(work_dir, f"pilot-{seed}.exr"))
+        render_pilot(pilot_bands, seed, pilots[-1])
+    final, final_report = os.path.join(work_dir, "plan.json"), os.path.join(work_dir, "plan-report.json")
+    tool.plan(scene_file, target, final, final_report, pilots=pilots, edge_step=edge_step)
+    with open(final_report) as f:
+        report = json.load(f)
+    if not report["target_met"] or "cycles" not in report["prediction"]:
+        raise BadInput(f"--plan: no plan reaches a mean ΔE00 of {target:g} on {scene_file} with this Cycles' noise: "
+                       + "; ".join(report["notes"] or ["the bands and bounces alone miss it"]))
+    return Planned(final, report)
+
+
+def planning_folder():
+    return tempfile.mkdtemp(prefix="chromatrace-plan-")
+
+
+def remove_folder(path):
+    shutil.rmtree(path, ignore_errors=True)
