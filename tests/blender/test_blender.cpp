@@ -216,6 +216,11 @@ TEST_F(Blender, BadInputExitsTwoWithOneErrorLineNamingTheField) {
       {{"--scene", box(), "--out", dir_.file("no/dir/out.exr").string()}, "--out"},
       // A GPU backend this Blender does not have (Cycles has Metal only on macOS) is refused by name.
       {{"--scene", box(), "--out", out, "--device", "METAL", "--resolution", "8x8", "--samples", "1"}, "--device"},
+      // --plan chooses the bands, bounce limit and samples itself.
+      {{"--scene", box(), "--out", out, "--plan", "0"}, "--plan: the mean ΔE00 to plan for must be > 0"},
+      {{"--scene", box(), "--out", out, "--plan", "1", "--samples", "64"}, "--samples: --plan chooses"},
+      {{"--scene", box(), "--out", out, "--plan", "1", "--bands", "400:700:50"}, "--bands: --plan chooses"},
+      {{"--scene", box(), "--out", out, "--plan-edge-step", "5"}, "--plan-edge-step: needs --plan"},
   };
   for (const Case& c : cases) {
     const CommandResult r = batch(c.args);

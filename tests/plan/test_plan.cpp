@@ -428,6 +428,10 @@ TEST_F(Plan, BadInputGetsExitTwoAndOneLineNamingTheField) {
                                             "cycles_samples": [64]})");
   write_file_atomically(zero_samples, R"({"format": "chromatrace-bands/1", "edges_nm": [400, 450, 500, 550, 600, 650, 700],
                                            "cycles_samples": [64, 0]})");
+  // Two tracer renders are not Cycles pilots.
+  const fs::path tracer_a = dir_ / "a.exr", tracer_b = dir_ / "b.exr";
+  for (const fs::path& f : {tracer_a, tracer_b})
+    ASSERT_EQ(run_chromatrace({"render", kBox.string(), "-o", f.string(), "--resolution", "4x4", "--spp", "1", "-q"}).exit_code, 0);
   struct Case {
     std::vector<std::string> args;
     std::string must_mention;
@@ -440,6 +444,13 @@ TEST_F(Plan, BadInputGetsExitTwoAndOneLineNamingTheField) {
       {{"plan", kBox.string(), "--camera", "nokia_3310"}, "--camera"},
       {{"plan", kBox.string(), "--cycles-noise-ratio", "-1"}, "--cycles-noise-ratio: must be > 0"},
       {{"plan", kBox.string(), "--reference-spp", "-5"}, "--reference-spp: must be >= 1"},
+      {{"plan", kBox.string(), "--cycles-pilot", tracer_a.string(), tracer_b.string()},
+       "a.exr: chromatrace.renderer: not a Cycles render"},
+      {{"plan", kBox.string(), "--cycles-pilot", tracer_a.string(), tracer_b.string(), "--cycles-noise-ratio", "0.8"},
+       "--cycles-pilot: give either --cycles-pilot or --cycles-noise-ratio"},
+      {{"plan", kBox.string(), "--cycles-pilot", tracer_a.string(), tracer_b.string(), "--renderer", "tracer"},
+       "--cycles-pilot: Cycles' noise is for --renderer cycles"},
+      {{"plan", kBox.string(), "--cycles-pilot", tracer_a.string()}, "--cycles-pilot"},
       {{"plan", kBox.string(), "-o", (dir_ / "no/such/dir/plan.json").string()}, "does not exist"},
       {{"render", kBox.string(), "-o", (dir_ / "x.exr").string(), "--plan", bad_plan.string()},
        "bad_plan.json: edges_nm[2]"},
