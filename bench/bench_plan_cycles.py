@@ -1,9 +1,9 @@
 #!/usr/bin/env python3
 # SPDX-License-Identifier: Apache-2.0
-"""Benchmark: a spectral Cycles render planned by `chromatrace plan` against one plain RGB Cycles render.
+"""Benchmark: a spectral Cycles render planned for a colour-error target against one plain RGB Cycles render.
 
     CHROMATRACE_EXE=build/cli/chromatrace python3 bench/bench_plan_cycles.py [--resolution 96] [--samples 256]
-        [--reference-spp 2048] [--light d65|f11|both] [--no-reconstruction]
+        [--reference-spp 8192] [--target 1] [--light d65|f11|both]
         [--blender blender [--blender build/tests/blender/blender-4.5 ...]]
 
 Each --blender is run in turn (a Blender binary, or a bpy module behind tests/blender/bpy_blender.py, as the
@@ -12,23 +12,28 @@ build's build/tests/blender/blender-4.5, blender-5.2 and blender-5.3 are), the s
 
 For the paper box under its own smooth light (CIE D65) and under CIE F11 (three narrow peaks):
 
-1. `chromatrace plan --renderer cycles --edge-step 5 --target-de00 1`: the fewest bands (in whole groups of three)
-   and bounces for a mean ΔE00 of 1; edges on multiples of 5 nm, so the plan nests in the 5 nm reference.
-2. The planned spectral render: the add-on's batch (blender_addon/batch.py) with the plan's bands and bounce
-   limit, path-type components only, at --samples. Its cost is the CPU seconds of its Cycles renders (band
-   groups and the one-sample object-id render), from the batch's own progress lines.
-3. One plain RGB Cycles render of the same imported scene, same samples and resolution, the scene's bounce limit,
-   in a Blender started the same way (bench_blender.py's PLAIN): what a user renders without chromatrace.
-4. The planned render's error: `chromatrace compare` of it against a reference-tracer render with 5 nm bands, the
-   scene's bounce limit and --reference-spp paths per pixel; its image-level mean ΔE00 (CIE 1931 observer) holds
-   the plan's band and bounce error and both renders' noise.
+1. The planned spectral render: the add-on's batch (blender_addon/batch.py) with --plan TARGET --plan-edge-step 5
+   (chromatrace plan, two pilot renders for Cycles' noise, plan again: bands, bounce limit and each band group's
+   samples), path-type components. Its cost: the CPU seconds of its Cycles renders (band groups and the one-sample
+   object-id render) from the batch's progress lines, and apart the planning's (the batch's "planning:" line: the
+   two runs of chromatrace plan and the pilots), which does not grow with the image.
+2. One plain RGB Cycles render of the same imported scene, --samples per pixel and the same resolution, the scene's
+   bounce limit, in a Blender started the same way (bench_blender.py's PLAIN): what a user renders without
+   chromatrace.
+3. The planned render's error: `chromatrace compare` of it against a reference-tracer render with 5 nm bands, the
+   scene's bounce limit and --reference-spp paths per pixel (one per light and masking, shared by the Blenders): the
+   image's mean ΔE00 (CIE 1931 observer) and the worst object's. The reference's own noise is in what compare
+   measures; the plan's prediction against it (the header's chromatrace.plan: its prediction, and the tracer's noise
+   at one sample over √(reference paths), in quadrature) is printed beside it.
 
-Prints, per light, the CPU ratio planned spectral / plain RGB and the measured mean ΔE00. Not a test: the machine
-is shared, so read the figures as ratios from one run.
+Prints, per Blender and light, the CPU ratio planned spectral / plain RGB with and without the planning, the
+predicted and measured mean ΔE00 and the worst object's. Not a test: the machine is shared, so read the figures as
+ratios from one run.
 """
 
 import argparse
 import json
+import math
 import os
 import re
 import subprocess
@@ -80,89 +85,105 @@ def run(cmd, **kw):
     return r
 
 
-def bench(light, args, work, blender_exe, version):
+def header_plan(exe, exr):
+    info = json.loads(run([exe, "info", exr, "--json"]).stdout)
+    return json.loads(info["metadata"]["chromatrace.plan"])
+
+
+def bench(light, args, work, blender_exe, version, references):
     exe = os.environ["CHROMATRACE_EXE"]
     masking = "height-correlated" if int(version.split(".")[0]) >= 4 else "separable"
-    work = os.path.join(work, version)
-    os.makedirs(work, exist_ok=True)
     scene = scene_for(light, work, masking)
     res = f"{args.resolution}x{args.resolution}"
-    plan_file, report_file = os.path.join(work, f"{light}-plan.json"), os.path.join(work, f"{light}-report.json")
-    run([exe, "plan", scene, "--renderer", "cycles", "--edge-step", "5", "--target-de00", "1", "-o", plan_file,
-         "--report", report_file, "-q"] + (["--no-reconstruction"] if args.no_reconstruction else []))
-    with open(report_file) as f:
-        report = json.load(f)
-    bounces = report["settings"]["max_bounces"]
-    bands = report["settings"]["band_count"]
-    scene_bounces = report["scene_settings"]["max_bounces"]
+    with open(scene) as f:
+        scene_bounces = json.load(f)["render"]["max_bounces"]
 
-    reference = os.path.join(work, f"{light}-reference.exr")
-    start, start_cpu = time.monotonic(), _children_cpu()
-    run([exe, "render", scene, "-o", reference, "--resolution", res, "--bands", "380:780:5", "--spp",
-         str(args.reference_spp), "--max-bounces", str(scene_bounces), "--seed", "7", "-q"])
-    reference_cpu = _children_cpu() - start_cpu
+    # The reference, once per light and masking.
+    reference = os.path.join(work, f"{light}-{masking}-reference.exr")
+    if reference not in references:
+        start_cpu = _children_cpu()
+        run([exe, "render", scene, "-o", reference, "--resolution", res, "--bands", "380:780:5", "--spp",
+             str(args.reference_spp), "--max-bounces", str(scene_bounces), "--seed", "7", "-q"])
+        references[reference] = _children_cpu() - start_cpu
 
+    out_dir = os.path.join(work, version)
+    os.makedirs(out_dir, exist_ok=True)
     blender = [blender_exe, "--background", "--factory-startup"]
-    spectral_exr = os.path.join(work, f"{light}-cycles.exr")
+    spectral_exr = os.path.join(out_dir, f"{light}-cycles.exr")
     spectral = run(blender + ["--python", os.path.join(ROOT, "blender_addon", "batch.py"), "--", "--scene", scene,
-                              "--out", spectral_exr, "--resolution", res, "--samples", str(args.samples),
-                              "--bands-file", plan_file, "--max-bounces", str(bounces), "--components", "paths",
-                              "--cache-dir", os.path.join(work, f"{light}-cache")],
+                              "--out", spectral_exr, "--resolution", res, "--plan", repr(args.target),
+                              "--plan-edge-step", "5", "--components", "paths",
+                              "--cache-dir", os.path.join(out_dir, f"{light}-cache")],
                    env=dict(os.environ, CHROMATRACE_EXE=exe))
     timings = re.findall(r"chromatrace: render \d+/\d+ \(([^)]*)\): ([0-9.]+) s, ([0-9.]+) s CPU", spectral.stderr)
-    if not timings:
-        sys.exit("no render timings in the batch's output:\n" + spectral.stderr[-800:])
+    planning = re.search(r"chromatrace: planning: ([0-9.]+) s, ([0-9.]+) s CPU", spectral.stderr)
+    said = re.search(r"chromatrace: (plan for a mean .*)", spectral.stderr)
+    if not timings or not planning or not said:
+        sys.exit("no render or planning timings in the batch's output:\n" + spectral.stderr[-1200:])
     spectral_cpu = sum(float(cpu) for _what, _wall, cpu in timings)
-    groups = [(what, float(cpu)) for what, _wall, cpu in timings]
+    planning_cpu = float(planning.group(2))
+    plan = header_plan(exe, spectral_exr)
+    reference_noise = plan["tracer_noise_at_one_sample"] / args.reference_spp ** 0.5
+    predicted = math.hypot(plan["predicted_mean_de00"], reference_noise)
+    low, high = (math.hypot(x, reference_noise) for x in plan["predicted_range"])
 
     plain = run(blender + ["--python-expr", PLAIN.format(root=ROOT, box=scene, samples=args.samples,
-                                                          res=args.resolution, out=os.path.join(work, "rgb.exr"))])
+                                                          res=args.resolution, out=os.path.join(out_dir, "rgb.exr"))])
     found = re.search(r"PLAIN_RENDER_SECONDS ([0-9.]+) ([0-9.]+)", plain.stdout)
     if not found:
         sys.exit("plain RGB render printed no timing:\n" + plain.stdout[-400:] + plain.stderr[-800:])
     plain_cpu = float(found.group(2))
 
-    compare_dir = os.path.join(work, f"{light}-compare")
+    compare_dir = os.path.join(out_dir, f"{light}-compare")
     run([exe, "compare", spectral_exr, reference, "-o", compare_dir, "--colour", "own", "-q"])
     with open(os.path.join(compare_dir, "compare.json")) as f:
         compared = json.load(f)
     mean_de = compared["image"]["delta_e00"]["mean"]
+    worst_de, worst = max((o["delta_e00_mean"], o["object"]) for o in compared["objects"]
+                          if o["object_id"] >= 0 and "delta_e00_mean" in o)
 
-    print(f"\nBlender {version}, {light.upper()}: plan {bands} bands (edges {report['settings']['bands']['edges_nm']}), "
-          f"{bounces} bounces (scene: {scene_bounces}); predicted mean dE00 {report['prediction']['mean_de00']:.2f}")
-    for what, cpu in groups:
-        print(f"  Cycles render ({what}): {cpu:.2f} s CPU")
-    print(f"  planned spectral, all Cycles renders: {spectral_cpu:.2f} s CPU")
-    print(f"  plain RGB Cycles render:              {plain_cpu:.2f} s CPU")
-    print(f"  ratio planned spectral / plain RGB:   {spectral_cpu / plain_cpu:.2f}x CPU")
-    print(f"  measured mean dE00 against the 5 nm reference ({args.reference_spp} spp, "
-          f"{reference_cpu:.1f} s CPU): {mean_de:.2f}")
-    return spectral_cpu / plain_cpu, mean_de
+    print(f"\nBlender {version}, {light.upper()}: {said.group(1)}")
+    for what, _wall, cpu in timings:
+        print(f"  Cycles render ({what}): {float(cpu):.2f} s CPU")
+    print(f"  planned spectral, all Cycles renders: {spectral_cpu:.2f} s CPU; planning (plan twice, pilots): "
+          f"{planning_cpu:.2f} s CPU")
+    print(f"  plain RGB Cycles render ({args.samples} samples): {plain_cpu:.2f} s CPU")
+    print(f"  ratio planned spectral / plain RGB: {spectral_cpu / plain_cpu:.2f}x CPU "
+          f"({(spectral_cpu + planning_cpu) / plain_cpu:.2f}x with the planning)")
+    print(f"  mean dE00 against the 5 nm reference ({args.reference_spp} paths per pixel, "
+          f"{references[reference]:.0f} s CPU): measured {mean_de:.2f}, predicted {predicted:.2f} "
+          f"({low:.2f}-{high:.2f}); without the reference's noise predicted {plan['predicted_mean_de00']:.2f}; "
+          f"worst object {worst} {worst_de:.2f}")
+    return dict(ratio=spectral_cpu / plain_cpu, with_planning=(spectral_cpu + planning_cpu) / plain_cpu,
+                measured=mean_de, predicted=predicted, low=low, high=high, worst=f"{worst_de:.2f} ({worst})",
+                samples=",".join(map(str, plan["cycles_samples"])))
 
 
 def main():
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--resolution", type=int, default=96)
-    p.add_argument("--samples", type=int, default=256)
-    p.add_argument("--reference-spp", type=int, default=2048)
+    p.add_argument("--samples", type=int, default=256, help="the plain render's samples per pixel")
+    p.add_argument("--reference-spp", type=int, default=8192)
+    p.add_argument("--target", type=float, default=1.0, help="the plan's mean dE00")
     p.add_argument("--light", choices=("d65", "f11", "both"), default="both")
     p.add_argument("--blender", action="append", help="a Blender (repeatable; default: blender)")
-    p.add_argument("--no-reconstruction", action="store_true",
-                   help="plan's edges alone, its band values read as a step function (plan --no-reconstruction)")
     args = p.parse_args()
     if not os.environ.get("CHROMATRACE_EXE"):
         sys.exit("set CHROMATRACE_EXE to the chromatrace executable (e.g. build/cli/chromatrace)")
-    print(f"paper box, {args.resolution}x{args.resolution}, {args.samples} samples, {os.cpu_count()} cores, "
-          f"load average {os.getloadavg()[0]:.1f}")
+    print(f"paper box, {args.resolution}x{args.resolution}, plain render {args.samples} samples, plan for a mean dE00 "
+          f"of {args.target:g}, {os.cpu_count()} cores, load average {os.getloadavg()[0]:.1f}")
     with tempfile.TemporaryDirectory(prefix="chromatrace-bench-plan-") as work:
-        results = []
+        results, references = [], {}
         for blender_exe in args.blender or ["blender"]:
             version = blender_version(blender_exe)
             for light in (("d65", "f11") if args.light == "both" else (args.light,)):
-                results.append((version, light, *bench(light, args, work, blender_exe, version)))
-        print("\nBlender  light  CPU planned spectral / plain RGB  measured mean dE00")
-        for version, light, ratio, mean_de in results:
-            print(f"{version:8s} {light.upper():5s}  {ratio:5.2f}x{'':27s}{mean_de:.2f}")
+                results.append((version, light, bench(light, args, work, blender_exe, version, references)))
+        print(f"\nload average at the end {os.getloadavg()[0]:.1f}")
+        print("\nBlender  light  samples per group  CPU / plain  with planning  mean dE00 measured  predicted (range)"
+              "      worst object")
+        for version, light, r in results:
+            print(f"{version:8s} {light.upper():5s}  {r['samples']:17s}  {r['ratio']:10.2f}x  {r['with_planning']:12.2f}x"
+                  f"  {r['measured']:17.2f}  {r['predicted']:.2f} ({r['low']:.2f}-{r['high']:.2f})  {r['worst']}")
 
 
 if __name__ == "__main__":

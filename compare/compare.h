@@ -86,6 +86,8 @@ struct Comparison {
   std::string camera;
   std::vector<double> delta_e;  // per pixel, [y][x]
   double delta_e_mean = 0, delta_e_p95 = 0, delta_e_max = 0;
+  // Mean ΔE00 over each object's pixels (its id in both renders), by object id.
+  std::map<std::int32_t, double> delta_e_by_object;
   // Linear sRGB previews of A, B (row-major RGB), scaled so the reference white is 1.
   std::vector<float> rgb_a, rgb_b;
 };

@@ -91,7 +91,13 @@ json to_json(const Comparison& c) {
     if (!std::isfinite(az)) o["max_abs_z"] = nullptr;
     else if (!o["max_abs_z"].is_null() && az > o["max_abs_z"].get<double>()) o["max_abs_z"] = az;
   }
-  for (std::int32_t id : order) objects.push_back(by_id[id]);
+  for (std::int32_t id : order) {
+    json& o = by_id[id];
+    if (id < 0) o["delta_e00_mean"] = c.delta_e_mean;
+    else if (const auto found = c.delta_e_by_object.find(id); found != c.delta_e_by_object.end())
+      o["delta_e00_mean"] = found->second;
+    objects.push_back(o);
+  }
   return {{"format", "chromatrace-compare/1"},
           {"a", side_json(c.a)},
           {"b", side_json(c.b)},

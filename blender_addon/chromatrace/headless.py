@@ -17,9 +17,11 @@ defaults).
 import contextlib
 import json
 import os
+import resource
 import shutil
 import signal
 import sys
+import time
 import traceback
 
 from .batch_args import parse_batch_args
@@ -127,10 +129,19 @@ def _plan(args, scene, chromatrace_tool, work, log):
     log(f"planning for a mean ΔE00 of {args.plan:g}: chromatrace plan, then two pilot renders of "
         f"{'x'.join(map(str, planning.pilot_resolution(*base.resolution_of(scene))))} at {planning.PILOT_SAMPLES} "
         "samples for Cycles' noise")
+    start, start_cpu = time.monotonic(), _cpu_seconds()
     with _stdout_silenced(args.quiet):
         planned = planning.plan_render(scene_file, args.plan, work, render_pilot, chromatrace_tool, args.plan_edge_step)
     log(planned.summary())
+    # The planning's cost beside the renders' (their progress lines): this process's CPU (the pilots' Cycles
+    # renders) and its finished children's (chromatrace plan, twice).
+    log(f"planning: {time.monotonic() - start:.2f} s, {_cpu_seconds() - start_cpu:.2f} s CPU")
     return planned
+
+
+def _cpu_seconds():
+    own, children = resource.getrusage(resource.RUSAGE_SELF), resource.getrusage(resource.RUSAGE_CHILDREN)
+    return own.ru_utime + own.ru_stime + children.ru_utime + children.ru_stime
 
 
 def _render(args, bpy, scene, chromatrace_tool, log, planned):

@@ -279,6 +279,13 @@ TEST_F(Compare, IdenticalRendersHaveZeroDeltaE) {
   const json d2 = result("out2");
   EXPECT_GT(d2["image"]["delta_e00"]["p95"].get<double>(), 0.3);
   EXPECT_LT(d2["image"]["delta_e00"]["max"].get<double>(), 10.0);
+  // Each object's mean ΔE00 over its pixels: none on the wall, the ball's above the image's (which the wall dilutes).
+  std::map<std::string, double> by_object;
+  for (const json& o : d2["objects"]) by_object[o["object"].get<std::string>()] = o["delta_e00_mean"].get<double>();
+  EXPECT_EQ(by_object.at("wall"), 0.0);
+  EXPECT_EQ(by_object.at("(image)"), d2["image"]["delta_e00"]["mean"].get<double>());
+  EXPECT_GT(by_object.at("ball"), by_object.at("(image)"));
+  EXPECT_GT(by_object.at("(image)"), 0.0);
 }
 
 // Noiseless renders whose ball differs by 0.5 %, inside its 2 % tolerance: its cells have no standard error, so

@@ -11,7 +11,7 @@ import unittest
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "..", "..", "blender_addon"))
 
 from chromatrace import bands, batch_args, cache, camera_math, components, defaults, floats, manifest, node_rules, ply, spectra  # noqa: E402
-from chromatrace import cameras, scene_parts, tool  # noqa: E402
+from chromatrace import cameras, planning, scene_parts, tool  # noqa: E402
 from types import SimpleNamespace  # noqa: E402
 from chromatrace.errors import BadInput  # noqa: E402
 from chromatrace.journal import Journal  # noqa: E402
@@ -262,12 +262,41 @@ class BatchArgs(unittest.TestCase):
             (["--scene", self.scene, "--out", self.out, "--band-group", "x"], "--band-group"),
             (["--scene", self.scene, "--explain", "--band-group", "0"], "--band-group"),
             (["--scene", self.scene, "--out", self.out, "--bounce-limit", "k1"], "--bounce-limit"),
+            (["--scene", self.scene, "--out", self.out, "--plan", "-1"], "--plan"),
+            (["--scene", self.scene, "--out", self.out, "--plan", "1", "--samples", "8"], "--samples"),
+            (["--scene", self.scene, "--out", self.out, "--plan", "1", "--bands-file", self.scene], "--bands-file"),
+            (["--scene", self.scene, "--out", self.out, "--plan", "1", "--max-bounces", "3"], "--max-bounces"),
+            (["--scene", self.scene, "--out", self.out, "--plan", "1", "--band-group", "0"], "--band-group"),
+            (["--scene", self.scene, "--plan", "1", "--explain"], "--explain"),
+            (["--scene", self.scene, "--out", self.out, "--plan-edge-step", "5"], "--plan-edge-step"),
         ]
         for argv, option in cases:
             with self.assertRaises(BadInput, msg=argv) as caught:
                 batch_args.parse_batch_args(argv)
             self.assertIn(option, str(caught.exception))
             self.assertNotIn("\n", str(caught.exception))
+
+
+class Planning(unittest.TestCase):
+    def test_pilots_keep_the_renders_aspect_at_32_pixels_on_the_longer_side(self):
+        self.assertEqual(planning.pilot_resolution(1920, 1080), [32, 18])
+        self.assertEqual(planning.pilot_resolution(1080, 1920), [18, 32])
+        self.assertEqual(planning.pilot_resolution(64, 64), [32, 32])
+        self.assertEqual(planning.pilot_resolution(4000, 10), [32, 1])
+
+    def test_the_plan_said_and_kept_in_the_header(self):
+        report = {"target_de00": 1.0, "camera": "cie1931",
+                  "settings": {"band_count": 6, "max_bounces": 5, "cycles_samples": [212, 186]},
+                  "prediction": {"cycles": {"mean_de00": 0.998, "mean_de00_range": [0.79, 1.28],
+                                            "noise_ratio_to_tracer": 0.746, "tracer_noise_at_one_sample": 18.1}}}
+        planned = planning.Planned("plan.json", report)
+        self.assertEqual(planned.summary(), "plan for a mean ΔE00 of 1: 6 bands, max 5 bounces, samples per band "
+                                            "group 212, 186; predicted mean ΔE00 1.00 (0.79-1.28), Cycles' noise "
+                                            "0.75 × the tracer's on the pilots")
+        header = json.loads(planned.header())
+        self.assertEqual(header["cycles_samples"], [212, 186])
+        self.assertEqual(header["predicted_range"], [0.79, 1.28])
+        self.assertEqual(header["tracer_noise_at_one_sample"], 18.1)
 
 
 class Ply(unittest.TestCase):
