@@ -109,6 +109,12 @@ def _plan(args, scene, chromatrace_tool, work, log):
     from . import planning, scene_export, spectral_render
     scene_file = args.scene
     if not scene_file:
+        # The plan's model reads a scene file; Blender's own light objects (and the colours of its nodes) have none.
+        lamps = sorted(ob.name for ob in scene.objects if ob.type == "LIGHT" and not ob.hide_render)
+        if lamps:
+            raise BadInput(f"--plan: {args.blend}: Blender light objects ({', '.join(lamps)}) cannot be planned yet "
+                           "(chromatrace plan reads a scene file, whose lights are emitting quads or spheres); give a "
+                           "band plan (--bands-file, from chromatrace plan on a scene file) or --bands instead")
         scene_file = os.path.join(work, "scene.json")
         try:
             scene_export.export_scene(scene, scene_file, chromatrace_tool, log=lambda message: None)

@@ -707,6 +707,18 @@ TEST_F(Blender, BlendFileRendersAndIsNeverWritten) {
   EXPECT_EQ(test::read_bytes(blend), before);
   EXPECT_EQ(fs::last_write_time(blend), mtime);
   EXPECT_FALSE(fs::exists(dir_.file("box.blend1")));
+  // --plan on a .blend plans the scene as Export writes it (its emitting quads and chromatrace materials), and still
+  // leaves the file as it was; the output's header keeps the plan.
+  const fs::path planned = dir_.file("planned.exr");
+  const CommandResult p = batch({"--blend", blend.string(), "--out", planned.string(), "--resolution", "16x16",
+                                 "--plan", "2", "--components", "none"}, "cache-planned");
+  ASSERT_EQ(p.exit_code, 0) << p.err;
+  const json plan = json::parse(SpectralExrReader(planned).info().metadata.at("chromatrace.plan"));
+  EXPECT_EQ(plan["target_de00"].get<double>(), 2.0);
+  EXPECT_LE(plan["predicted_mean_de00"].get<double>(), 2.0);
+  EXPECT_EQ(SpectralExrReader(planned).info().bands.size(), 3 * plan["cycles_samples"].size());
+  EXPECT_EQ(test::read_bytes(blend), before);
+  EXPECT_EQ(fs::last_write_time(blend), mtime);
 }
 
 
@@ -1041,6 +1053,16 @@ TEST_F(ArtistScene, BlackbodyLightBandShapeIsPlancksLaw) {
   for (const double kelvin : {3000.0, 6500.0}) {
     const std::string k = std::to_string(static_cast<int>(kelvin));
     const fs::path blend = make({"blackbody", k}, "blackbody" + k + ".blend");
+    if (kelvin == 3000.0) {
+      // Blender's own lights have no scene file for the plan to read: --plan refuses by name, rendering nothing.
+      const CommandResult refused = batch({"--blend", blend.string(), "--out", dir_.file("planned.exr").string(),
+                                           "--plan", "1"});
+      EXPECT_EQ(refused.exit_code, 2) << refused.err;
+      EXPECT_NE(refused.err.find("--plan: " + blend.string() + ": Blender light objects (Area) cannot be planned yet"),
+                std::string::npos)
+          << refused.err;
+      EXPECT_FALSE(fs::exists(dir_.file("planned.exr")));
+    }
     const json plan = explain(blend);
     const json& area = *owner(plan, "light", "Area");
     EXPECT_EQ(area["status"], "exact") << plan.dump(1);
