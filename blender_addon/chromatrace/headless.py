@@ -104,40 +104,26 @@ def run(argv):
 
 
 def _plan(args, scene, chromatrace_tool, work, log):
-    """batch.py --plan: the plan (planning.py) of the scene file, or of the open scene written as one, with pilots
+    """batch.py --plan: the plan (plan_scene.py) of the scene file, or of the open scene written as one, with pilots
     rendered by this Cycles."""
-    from . import planning, scene_export, spectral_render
-    scene_file = args.scene
-    if not scene_file:
-        # The plan's model reads a scene file; Blender's own light objects (and the colours of its nodes) have none.
-        lamps = sorted(ob.name for ob in scene.objects if ob.type == "LIGHT" and not ob.hide_render)
-        if lamps:
-            raise BadInput(f"--plan: {args.blend}: Blender light objects ({', '.join(lamps)}) cannot be planned yet "
-                           "(chromatrace plan reads a scene file, whose lights are emitting quads or spheres); give a "
-                           "band plan (--bands-file, from chromatrace plan on a scene file) or --bands instead")
-        scene_file = os.path.join(work, "scene.json")
-        try:
-            scene_export.export_scene(scene, scene_file, chromatrace_tool, log=lambda message: None)
-        except BadInput as e:
-            raise BadInput(f"--plan: the scene could not be written as a scene file to plan: {e}") from None
-    base = spectral_render.Request.from_scene(scene, resolution=args.resolution, device=args.device,
-                                              on_mixing_nodes=args.on_mixing_nodes, on_world=args.on_world)
-
-    def render_pilot(bands_file, seed, output):
-        pilot = spectral_render.Request(**vars(base))
-        pilot.bands, pilot.bands_file, pilot.samples, pilot.seed = None, bands_file, planning.PILOT_SAMPLES, seed
-        pilot.families, pilot.object_ids = set(), True
-        pilot.resolution = planning.pilot_resolution(*base.resolution_of(scene))
-        pilot.output, pilot.cache_root, pilot.keep_cache = output, os.path.join(work, "cache"), False
-        pilot.log = lambda message: None
-        spectral_render.SpectralRender(scene, pilot, chromatrace_tool).run()
-
+    from . import plan_scene, planning, spectral_render
+    request = dict(resolution=args.resolution, device=args.device, on_mixing_nodes=args.on_mixing_nodes,
+                   on_world=args.on_world)
+    pilot_size = plan_scene.pilot_resolution(scene, spectral_render.Request.from_scene(
+        scene, **{k: v for k, v in request.items() if v is not None}))
     log(f"planning for a mean ΔE00 of {args.plan:g}: chromatrace plan, then two pilot renders of "
-        f"{'x'.join(map(str, planning.pilot_resolution(*base.resolution_of(scene))))} at {planning.PILOT_SAMPLES} "
+        f"{'x'.join(map(str, pilot_size))} at {planning.PILOT_SAMPLES} "
         "samples for Cycles' noise")
     start, start_cpu = time.monotonic(), _cpu_seconds()
     with _stdout_silenced(args.quiet):
-        planned = planning.plan_render(scene_file, args.plan, work, render_pilot, chromatrace_tool, args.plan_edge_step)
+        try:
+            planned = plan_scene.plan_open_scene(scene, chromatrace_tool, args.plan, work, scene_file=args.scene,
+                                                 edge_step=args.plan_edge_step, **request)
+        except BadInput as e:
+            message = str(e)
+            if not message.startswith("--plan"):
+                message = f"--plan: {args.blend or args.scene}: {message}"
+            raise BadInput(message) from None
     log(planned.summary())
     # The planning's cost beside the renders' (their progress lines): this process's CPU (the pilots' Cycles
     # renders) and its finished children's (chromatrace plan, twice).

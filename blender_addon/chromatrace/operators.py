@@ -397,10 +397,43 @@ PRESETS = {
     "PAPER": ("The paper's settings", "40 bands of 10 nm over 380-780 nm (14 Cycles renders), 256 samples, "
               "8 bounces, as scenes/paper/box.json", {"band_plan": "RANGE", "bands_lo": 380.0, "bands_hi": 780.0,
                                                       "bands_width": 10.0, "samples": 256, "max_bounces": 8}),
-    "FINAL": ("Final", "31 bands of 10 nm over 400-710 nm (11 Cycles renders), 1024 samples, 12 bounces",
-              {"band_plan": "RANGE", "bands_lo": 400.0, "bands_hi": 710.0, "bands_width": 10.0, "samples": 1024,
-               "max_bounces": 12}),
+    "FINAL": ("Final", "Planned for a mean ΔE00 of 1: the fewest bands, bounces and samples per band group that the "
+              "plan predicts there (Plan, with the target set to 1)", {"plan_target": 1.0}),
 }
+
+
+class CHROMATRACE_OT_plan(bpy.types.Operator):
+    """Plan the bands, bounces and each band group's samples for the target mean ΔE00: chromatrace plan on the scene
+    as Export writes it, with two small pilot renders that measure this Cycles' noise; the plan is kept in the
+    render cache and becomes the scene's band plan"""
+
+    bl_idname = "chromatrace.plan"
+    bl_label = "Plan"
+    bl_options = {"REGISTER", "UNDO"}
+
+    def execute(self, context):
+        from . import plan_scene, planning
+        scene = context.scene
+        s = scene.chromatrace
+        work = planning.planning_folder()
+        try:
+            planned = plan_scene.plan_open_scene(scene, _tool(context), s.plan_target, work)
+            kept = plan_scene.keep(planned, bpy.path.abspath(s.cache_dir) if s.cache_dir else None,
+                                   s.scene_name or scene.name)
+        except (BadInput, RuntimeError) as e:
+            self.report({"ERROR"}, f"Plan: {panel_words(str(e))}")
+            return {"CANCELLED"}
+        finally:
+            planning.remove_folder(work)
+        s.band_plan = "FILE"
+        s.bands_file = kept
+        s.max_bounces = planned.max_bounces
+        s.plan_summary = (f"{planned.report['settings']['band_count']} bands in {len(planned.samples)} Cycles renders, "
+                          f"max {planned.max_bounces} bounces; predicted mean ΔE00 "
+                          f"{planned.report['prediction']['cycles']['mean_de00']:.2f} "
+                          f"({'-'.join(f'{x:.2f}' for x in planned.report['prediction']['cycles']['mean_de00_range'])})")
+        self.report({"INFO"}, planned.summary())
+        return {"FINISHED"}
 
 
 class CHROMATRACE_OT_apply_preset(bpy.types.Operator):
@@ -415,6 +448,8 @@ class CHROMATRACE_OT_apply_preset(bpy.types.Operator):
         s = context.scene.chromatrace
         for key, value in PRESETS[self.preset][2].items():
             setattr(s, key, value)
+        if self.preset == "FINAL":
+            return bpy.ops.chromatrace.plan()
         return {"FINISHED"}
 
 
@@ -460,7 +495,7 @@ def _menu_export(self, context):
 
 
 _classes = (CHROMATRACE_OT_render_escape, CHROMATRACE_OT_render_spectral, CHROMATRACE_OT_analyze_render, CHROMATRACE_OT_preflight, CHROMATRACE_OT_import_scene, CHROMATRACE_OT_export_scene,
-            CHROMATRACE_OT_build_material, CHROMATRACE_OT_set_model, CHROMATRACE_OT_apply_preset, CHROMATRACE_OT_spectrum_add, CHROMATRACE_OT_spectrum_remove)
+            CHROMATRACE_OT_build_material, CHROMATRACE_OT_set_model, CHROMATRACE_OT_plan, CHROMATRACE_OT_apply_preset, CHROMATRACE_OT_spectrum_add, CHROMATRACE_OT_spectrum_remove)
 
 
 def register():

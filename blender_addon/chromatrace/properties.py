@@ -240,6 +240,9 @@ class CHROMATRACE_PG_scene(bpy.types.PropertyGroup):
                                 description="The camera whose spectral response sees the render when it is analysed")
     cache_dir: StringProperty(name="Cache", subtype="DIR_PATH",
                               description="Band groups already rendered, for resuming (empty: the user cache)")
+    plan_target: FloatProperty(name="Target ΔE00", min=0.05, soft_max=5.0, default=1.0, precision=2,
+                               description="The mean colour error (CIEDE2000) Plan aims the bands, bounces and samples at")
+    plan_summary: StringProperty(description="What the last Plan chose and predicts")
     scene_name: StringProperty(name="Name")
     description: StringProperty(name="Description")
     source_file: StringProperty(description="The scene file this scene was imported from")

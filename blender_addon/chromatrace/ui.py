@@ -50,6 +50,11 @@ class CHROMATRACE_PT_render(_Panel, bpy.types.Panel):
             box = layout.box()
             box.prop(analysis, "sensor", text="")
             box.prop(analysis, "analyze", text="")
+        col = layout.column(heading="Plan")
+        col.prop(s, "plan_target")
+        col.operator("chromatrace.plan", icon="SORTTIME")
+        if s.plan_summary and s.band_plan == "FILE":
+            col.label(text=s.plan_summary)
         col = layout.column(heading="Bands")
         col.prop(s, "band_plan")
         if s.band_plan == "RANGE":

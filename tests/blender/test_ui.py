@@ -211,7 +211,7 @@ if not os.path.isfile(os.path.join(work, "ui.preview.png")):
 from chromatrace.operators import RENDER_WARNINGS  # noqa: E402
 said = RENDER_WARNINGS.get(scene.name, [])
 if (not any(w.startswith("render.max_bounces 2 leaves") for w in said)
-        or not any(w.startswith("render.samples 2 gives Monte Carlo noise") for w in said)
+        or not any(w.startswith("render.samples 2 gives Cycles Monte Carlo noise") for w in said)
         or not any("bands of 100 nm give its" in w and "chromatrace plan" in w for w in said)
         or any("--spectral-mode" in w for w in said)):
     failures.append(f"Render Spectral did not say what its settings leave out: {said}")
@@ -248,6 +248,48 @@ if os.path.isfile(os.path.join(os.path.dirname(report), "analysis.json")):
             failures.append("the analysis of the render found no regions")
 else:
     failures.append("Analyze Histogram wrote no analysis.json")
+# Plan: the bands, bounces and each band group's samples for the target, from the scene as Export writes it and two
+# small pilots of this Cycles; the plan is kept in the render cache (plans/<scene name>.json and its report) and
+# becomes the scene's band plan, its bounce limit the scene's, and the panel says what it predicts (Samples greyed
+# out under the plan's). The Final preset plans for a mean ΔE00 of 1.
+from chromatrace import bands as band_plans  # noqa: E402
+s.plan_target = 2.0
+# The default file's point light is a Blender light, which the plan's scene file cannot hold: refused by name.
+lamps = [ob for ob in scene.objects if ob.type == "LIGHT" and not ob.hide_render]
+try:
+    bpy.ops.chromatrace.plan()
+    failures.append(f"Plan did not refuse a scene with Blender lights ({[ob.name for ob in lamps]})")
+except RuntimeError as e:
+    if not lamps or f"Blender light objects ({lamps[0].name})" not in str(e):
+        failures.append(f"Plan's refusal does not name the Blender light: {e}")
+for ob in lamps:
+    ob.hide_render = True
+if bpy.ops.chromatrace.plan() != {"FINISHED"}:
+    failures.append("Plan did not finish")
+kept = os.path.join(work, "cache", "plans", f"{s.scene_name}.json")
+report_file = os.path.join(work, "cache", "plans", f"{s.scene_name}.report.json")
+if (s.band_plan, bpy.path.abspath(s.bands_file)) != ("FILE", kept) or not os.path.isfile(report_file):
+    failures.append(f"Plan did not keep its plan in the cache and set it: {s.band_plan} {s.bands_file}")
+else:
+    with open(report_file) as f:
+        planned_report = json.load(f)
+    planned = band_plans.planned_samples(kept)
+    if (planned_report["target_de00"] != 2.0 or not planned
+            or planned != planned_report["prediction"]["cycles"]["samples_per_band_group"]
+            or s.max_bounces != planned_report["settings"]["max_bounces"]
+            or not s.plan_summary.startswith(f"{planned_report['settings']['band_count']} bands in {len(planned)} Cycles renders")):
+        failures.append(f"Plan set other settings than its report: {s.plan_summary}, {planned}, {s.max_bounces}")
+    drawn = draw(ui.CHROMATRACE_PT_render, Context(scene=scene, window_manager=bpy.context.window_manager))
+    if ("label", s.plan_summary) not in drawn or not any(isinstance(d, tuple) and d[1].startswith("Samples per band group, from the plan") for d in drawn):
+        failures.append(f"the render panel does not show the plan: {drawn}")
+    if bpy.ops.chromatrace.apply_preset(preset="FINAL") != {"FINISHED"}:
+        failures.append("the Final preset did not plan")
+    with open(report_file) as f:
+        if json.load(f)["target_de00"] != 1.0 or s.plan_target != 1.0:
+            failures.append("the Final preset did not plan for a mean ΔE00 of 1")
+s.band_plan, s.samples, s.max_bounces = "RANGE", 2, 2
+for ob in lamps:
+    ob.hide_render = False
 # A sky texture cannot be a spectrum: with World light: Omit the render goes on without it and says so.
 sky_world = bpy.data.worlds.new("Sky")
 sky_world.use_nodes = True

@@ -1,0 +1,58 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""The open scene planned for a colour-error target with this Blender (planning.py's steps): the scene as a scene
+file — the batch's --scene, or the open scene written as Export writes it — and the pilots rendered by this Cycles.
+batch.py --plan and the Render panel's Plan button both come here."""
+
+import os
+import shutil
+
+from . import cache, planning, scene_export, spectral_render
+from .errors import BadInput
+
+
+def plan_open_scene(scene, tool, target, work, scene_file=None, edge_step=None, **request):
+    """Planned (planning.py) for `scene`. `request`: the render's Request settings the pilots keep (resolution,
+    device, on_mixing_nodes, on_world). BadInput when the scene cannot be planned."""
+    if not scene_file:
+        # The plan's model reads a scene file; Blender's own light objects (and the colours of its nodes) have none.
+        lamps = sorted(ob.name for ob in scene.objects if ob.type == "LIGHT" and not ob.hide_render)
+        if lamps:
+            raise BadInput(f"Blender light objects ({', '.join(lamps)}) cannot be planned yet (chromatrace plan reads "
+                           "a scene file, whose lights are emitting quads or spheres); give a band plan made by "
+                           "chromatrace plan on a scene file instead")
+        scene_file = os.path.join(work, "scene.json")
+        try:
+            scene_export.export_scene(scene, scene_file, tool, log=lambda message: None)
+        except BadInput as e:
+            raise BadInput(f"the scene could not be written as a scene file to plan: {e}") from None
+    base = spectral_render.Request.from_scene(scene, **{k: v for k, v in request.items() if v is not None})
+
+    def render_pilot(bands_file, seed, output):
+        pilot = spectral_render.Request(**vars(base))
+        pilot.bands, pilot.bands_file, pilot.samples, pilot.seed = None, bands_file, planning.PILOT_SAMPLES, seed
+        pilot.families, pilot.object_ids = set(), True
+        pilot.resolution = pilot_resolution(scene, base)
+        pilot.output, pilot.cache_root, pilot.keep_cache = output, os.path.join(work, "cache"), False
+        pilot.log = lambda message: None
+        spectral_render.SpectralRender(scene, pilot, tool).run()
+
+    return planning.plan_render(scene_file, target, work, render_pilot, tool, edge_step)
+
+
+def pilot_resolution(scene, request):
+    return planning.pilot_resolution(*request.resolution_of(scene))
+
+
+def keep(planned, cache_root, name):
+    """The plan (band file and report) kept in the render cache's plans/ folder under the scene's name, where the
+    scene's band plan then points; returns the band file's path."""
+    folder = os.path.join(cache_root or cache.default_root(), "plans")
+    os.makedirs(folder, exist_ok=True)
+    safe = "".join(c if c.isalnum() or c in "-_." else "_" for c in name) or "scene"
+    bands_file = os.path.join(folder, f"{safe}.json")
+    for source, target in ((planned.bands_file, bands_file),
+                           (os.path.join(os.path.dirname(planned.bands_file), "plan-report.json"),
+                            os.path.join(folder, f"{safe}.report.json"))):
+        shutil.copyfile(source, target + ".partial")
+        os.replace(target + ".partial", target)
+    return bands_file
