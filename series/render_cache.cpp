@@ -62,6 +62,7 @@ Json render_inputs(const Scene& scene, const RunOptions& options) {
           {"components", options.components}};
   // The reconstruction changes no pixel's band values, but the file carries it and every colour made of them.
   if (const BandReconstruction* r = bands.reconstruction()) inputs["reconstruction"] = reconstruction_json(*r);
+  if (!options.cycles_samples.empty()) inputs["cycles_samples"] = options.cycles_samples;
   // Another Blender is another Cycles (its GGX masking, its sampling): the executable, and its size and time, so
   // that one upgraded in place renders again too.
   if (options.renderer == Renderer::Cycles) inputs["blender"] = executable_identity(options.blender);

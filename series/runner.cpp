@@ -84,13 +84,14 @@ void render_with_cycles(const Scene& scene, const fs::path& scene_file, const fs
   batch.option("--scene", scene_file.string())
       .option("--ggx-masking", "cycles")
       .option("--out", out.string())
-      .option("--samples", std::to_string(options.spp.value_or(scene.render.samples)))
       .option("--seed", std::to_string(options.seed.value_or(scene.render.seed)))
       .option("--components", options.components)
       .option("--cache-dir", (dir / "renders" / "cycles-cache").string());
   if (options.width || options.height)
     batch.option("--resolution", fmt::format("{}x{}", options.width.value_or(scene.camera.width),
                                              options.height.value_or(scene.camera.height)));
+  if (options.cycles_samples.empty())  // else the band file gives each group its own
+    batch.option("--samples", std::to_string(options.spp.value_or(scene.render.samples)));
   batch.option("--max-bounces", options.max_bounces);
   if (options.bands) batch.option("--bands-file", options.bands_file.string());
   if (!options.progress) batch.flag("--quiet");

@@ -42,6 +42,9 @@ struct RunOptions {
   std::optional<int> max_bounces;      // override the scenes' render.max_bounces
   std::optional<Bands> bands;          // override the scenes' band plan: a chromatrace-bands/1 file's bands
   std::filesystem::path bands_file;    // that file (handed to the Blender batch as --bands-file), absolute
+  // Cycles: the band file gives each band group of three its samples (its cycles_samples), which the batch renders
+  // instead of `spp`; part of the render's cache key.
+  std::vector<int> cycles_samples;
   std::string components = "paths,lights";
   int threads = 0;
   bool progress = true;

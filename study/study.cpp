@@ -9,6 +9,7 @@
 
 #include <fmt/core.h>
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "core/band_plan.h"
 #include "core/error.h"
@@ -62,7 +63,7 @@ int cycles_renders(const Bands& bands) { return static_cast<int>((bands.size() +
 
 bool same_settings(const Setting& a, const Setting& b) {
   return a.renderer == b.renderer && a.bands == b.bands && a.samples == b.samples && a.max_bounces == b.max_bounces &&
-         a.mode == b.mode;
+         a.mode == b.mode && a.cycles_samples == b.cycles_samples;
 }
 
 
@@ -224,11 +225,17 @@ std::vector<Setting> make_settings(const Scene& scene, const StudyOptions& optio
       po.renderer = renderer == series::Renderer::Cycles ? plan::Renderer::Cycles : plan::Renderer::Tracer;
       po.threads = options.threads;
       const plan::Plan p = plan::make_plan(scene, po);
-      vary("planned", fmt::format("{} bands, {} bounces, {} samples", p.bands.size(), p.max_bounces, p.samples), "1",
-           [&](Setting& s) {
+      // Cycles: each band group with the samples the plan gives it, chosen with the bands (docs/plan.md).
+      const bool groups = renderer == series::Renderer::Cycles && !p.cycles_samples.empty();
+      vary("planned",
+           groups ? fmt::format("{} bands, {} bounces, samples per band group {}", p.bands.size(), p.max_bounces,
+                                fmt::join(p.cycles_samples, ", "))
+                  : fmt::format("{} bands, {} bounces, {} samples", p.bands.size(), p.max_bounces, p.samples),
+           "1", [&](Setting& s) {
              s.bands = p.bands;
              s.max_bounces = p.max_bounces;
-             s.samples = p.samples;
+             s.samples = groups ? *std::max_element(p.cycles_samples.begin(), p.cycles_samples.end()) : p.samples;
+             if (groups) s.cycles_samples = p.cycles_samples;
            });
     }
   }
@@ -290,7 +297,8 @@ StudyResult run_study(const fs::path& scene_file, const fs::path& dir, const Stu
     ro.max_bounces = s.max_bounces;
     ro.bands = s.bands;
     ro.bands_file = fs::absolute(dir / "plans" / (s.name + ".json"));
-    write_file_atomically(ro.bands_file, band_plan_document(s.bands).dump(2) + "\n");
+    ro.cycles_samples = s.cycles_samples;
+    write_file_atomically(ro.bands_file, band_plan_document(s.bands, s.cycles_samples).dump(2) + "\n");
     ro.components = kComponents;
     ro.threads = options.threads;
     ro.progress = options.progress;
@@ -399,16 +407,18 @@ StudyResult run_study(const fs::path& scene_file, const fs::path& dir, const Stu
 
 Json result_json(const StudyResult& result) {
   auto setting_json = [](const Setting& s) {
-    return Json{{"name", s.name},
-                {"knob", s.knob},
-                {"value", s.value},
-                {"renderer", renderer_label(s.renderer)},
-                {"bands", s.bands.edges()},
-                {"band_count", s.bands.size()},
-                {"reconstruction", s.bands.reconstruction() != nullptr},
-                {"samples", s.samples},
-                {"max_bounces", s.max_bounces},
-                {"spectral_mode", s.mode}};
+    Json j{{"name", s.name},
+           {"knob", s.knob},
+           {"value", s.value},
+           {"renderer", renderer_label(s.renderer)},
+           {"bands", s.bands.edges()},
+           {"band_count", s.bands.size()},
+           {"reconstruction", s.bands.reconstruction() != nullptr},
+           {"samples", s.samples},
+           {"max_bounces", s.max_bounces},
+           {"spectral_mode", s.mode}};
+    if (!s.cycles_samples.empty()) j["cycles_samples"] = s.cycles_samples;
+    return j;
   };
   auto optional = [](const std::optional<double>& v) { return v ? Json(*v) : Json(); };
   Json settings = Json::array();

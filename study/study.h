@@ -63,6 +63,7 @@ struct Setting {
   series::Renderer renderer = series::Renderer::Tracer;
   Bands bands;
   int samples = 0, max_bounces = 0;
+  std::vector<int> cycles_samples;  // Cycles, planned: each band group's samples (then `samples` is the most of them)
   std::string mode = "bands";
 };
 

@@ -390,10 +390,16 @@ TEST_F(Blender, PlannedBandsCarryTheirReconstructionIntoTheExr) {
   const fs::path plan = dir_.file("plan.json"), out = dir_.file("planned.exr");
   const CommandResult p = test::run_chromatrace({"plan", box(), "--edge-step", "5", "-o", plan.string(), "--quiet"});
   ASSERT_EQ(p.exit_code, 0) << p.err;
-  const CommandResult r = batch({"--scene", box(), "--out", out.string(), "--resolution", "16x16", "--samples", "2",
+  // The plan gives each band group its samples (cycles_samples), which the render takes.
+  const CommandResult r = batch({"--scene", box(), "--out", out.string(), "--resolution", "16x16",
                                  "--bands-file", plan.string(), "--max-bounces", "1", "--components", "none"});
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const Bands planned = read_band_plan(plan);
+  const std::vector<int> samples = read_band_plan_file(plan).cycles_samples;
+  ASSERT_FALSE(samples.empty());
+  EXPECT_EQ(SpectralExrReader(out).info().metadata.at("chromatrace.samples"),
+            std::set<int>(samples.begin(), samples.end()).size() == 1 ? std::to_string(samples[0])
+                                                                      : fmt::format("{}", fmt::join(samples, ",")));
   ASSERT_NE(planned.reconstruction(), nullptr);
   EXPECT_EQ(SpectralExrReader(out).info().bands, planned);
   EXPECT_EQ(test::run_chromatrace({"info", "--check", out.string()}).exit_code, 0);

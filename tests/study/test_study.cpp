@@ -6,6 +6,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -16,6 +17,7 @@
 
 #include "core/json_input.h"
 #include "study/charts.h"
+#include "plan/plan.h"
 #include "study/study.h"
 #include "tests/cli/run_command.h"
 #include "core/statistics.h"
@@ -137,6 +139,37 @@ TEST(Study, PaperBoxAtCiSize) {
     check_pareto(study);
   }
   fs::remove_all(dir);
+}
+
+// The planned setting is plan's for its renderer: for Cycles its band groups each take the samples plan gives them
+// (its cycles_samples, which the band file then carries); the tracer's takes plan's paths per pixel.
+TEST(Study, PlannedCyclesSettingTakesEachBandGroupsSamples) {
+  const Scene scene = load_scene(kBox);
+  study::StudyOptions options;
+  options.renderers = {series::Renderer::Tracer, series::Renderer::Cycles};
+  options.threads = 2;
+  const std::vector<study::Setting> settings = study::make_settings(scene, options);
+  plan::PlanOptions po;
+  po.threads = 2;
+  const plan::Plan cycles = plan::make_plan(scene, po);
+  po.renderer = plan::Renderer::Tracer;
+  const plan::Plan tracer = plan::make_plan(scene, po);
+  int found = 0;
+  for (const study::Setting& s : settings) {
+    if (s.knob != "planned") continue;
+    ++found;
+    if (s.renderer == series::Renderer::Cycles) {
+      ASSERT_FALSE(cycles.cycles_samples.empty());
+      EXPECT_EQ(s.cycles_samples, cycles.cycles_samples);
+      EXPECT_EQ(s.samples, *std::max_element(cycles.cycles_samples.begin(), cycles.cycles_samples.end()));
+      EXPECT_NE(s.value.find("samples per band group"), std::string::npos) << s.value;
+      EXPECT_EQ(s.bands, cycles.bands);
+    } else {
+      EXPECT_TRUE(s.cycles_samples.empty());
+      EXPECT_EQ(s.samples, tracer.samples);
+    }
+  }
+  EXPECT_EQ(found, 2);
 }
 
 TEST(StudyPareto, MarksExactlyTheUndominated) {
