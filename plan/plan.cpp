@@ -643,8 +643,8 @@ int samples_for(const Model& model, double target) {
 // the fewer: their covariance falls with the more), and it adds to the bands' error as the square root of the sum of
 // squares. Measured on two Cycles pilots (measure_cycles_noise) s has all its terms; else plan's model gives the
 // diagonal alone, each group's part in the preview's noise (Model::band_noise). On the paper box under D65 the
-// pilots measure the two groups at 0.63 and 0.37 with a pair term of nearly nothing, and Cycles at 256 and at 210
-// samples a group measured 0.92 and 1.00 against a predicted 0.93 and 1.02 (docs/plan.md). The samples are the
+// pilots measure the two groups' own parts at 0.80 and 0.44 of the whole and their pair term at −0.12 (twice:
+// noise common to every band moves lightness more than hue), which favours an even split (docs/plan.md). The samples are the
 // fewest in all for the target: a search over the groups' proportions (each a quarter of the most or more: the
 // plan's observer is not the only camera its render will meet), the scale then set by the budget. Empty when the
 // bands and bounces alone miss the target.
