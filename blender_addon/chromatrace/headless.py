@@ -125,6 +125,8 @@ def _plan(args, scene, chromatrace_tool, work, log):
                 message = f"--plan: {args.blend or args.scene}: {message}"
             raise BadInput(message) from None
     log(planned.summary())
+    for note in planned.notes:
+        _log(f"warning: the plan: {note}")  # also with --quiet: the prediction is less certain for it
     # The planning's cost beside the renders' (their progress lines): this process's CPU (the pilots' Cycles
     # renders) and its finished children's (chromatrace plan, twice).
     log(f"planning: {time.monotonic() - start:.2f} s, {_cpu_seconds() - start_cpu:.2f} s CPU")

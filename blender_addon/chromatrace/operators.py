@@ -433,6 +433,8 @@ class CHROMATRACE_OT_plan(bpy.types.Operator):
                           f"{planned.report['prediction']['cycles']['mean_de00']:.2f} "
                           f"({'-'.join(f'{x:.2f}' for x in planned.report['prediction']['cycles']['mean_de00_range'])})")
         self.report({"INFO"}, planned.summary())
+        for note in planned.notes:
+            self.report({"WARNING"}, f"Plan: {note}")
         return {"FINISHED"}
 
 

@@ -47,6 +47,12 @@ class Planned:
     def samples(self):
         return self.report["settings"]["cycles_samples"]
 
+    @property
+    def notes(self):
+        """What the plan's model could not hold (an image texture modelled as a flat reflectance, a camera whose
+        curves end early, ...): said beside the prediction, which they make less certain."""
+        return list(self.report.get("notes", []))
+
     def summary(self):
         cycles = self.report["prediction"]["cycles"]
         low, high = cycles["mean_de00_range"]

@@ -493,6 +493,15 @@ TEST_F(Blender, PlannedRenderMeetsThePredictedError) {
     }
     EXPECT_NEAR(measured[0], measured[1], 0.1);
   }
+  // What the plan's model cannot hold is said beside its prediction, which it makes less certain: an image texture
+  // is modelled as a flat reflectance (also with --quiet).
+  const fs::path textured = dir_.file("textured.exr");
+  const CommandResult t = batch({"--scene", kSource + "/scenes/textured/textured.json", "--out", textured.string(),
+                                 "--resolution", "16x16", "--plan", "2", "--components", "none", "--ggx-masking",
+                                 "cycles", "--quiet"},
+                                "cache-textured");
+  ASSERT_EQ(t.exit_code, 0) << t.err;
+  EXPECT_NE(t.err.find("chromatrace: warning: the plan: materials.floor is an image texture"), std::string::npos) << t.err;
 }
 
 // What a Cycles render's settings leave out is said before it renders, as `chromatrace render` says it for the

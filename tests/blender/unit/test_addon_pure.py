@@ -293,6 +293,9 @@ class Planning(unittest.TestCase):
         self.assertEqual(planned.summary(), "plan for a mean ΔE00 of 1: 6 bands, max 5 bounces, samples per band "
                                             "group 212, 186; predicted mean ΔE00 1.00 (0.79-1.28), Cycles' noise "
                                             "0.75 × the tracer's on the pilots")
+        self.assertEqual(planned.notes, [])
+        self.assertEqual(planning.Planned("plan.json", dict(report, notes=["materials.floor is an image texture"])).notes,
+                         ["materials.floor is an image texture"])
         header = json.loads(planned.header())
         self.assertEqual(header["cycles_samples"], [212, 186])
         self.assertEqual(header["predicted_range"], [0.79, 1.28])
