@@ -52,18 +52,21 @@ Measurement measure_delta_e(const std::filesystem::path& test, const std::filesy
 
 namespace {
 
-// The mean ΔE00 between two renders' tristimulus values under the white of the first (measure_delta_e's policy),
-// and its standard error over the pixels.
-std::pair<double, double> mean_difference(const std::vector<Vec3d>& a, const std::vector<Vec3d>& b,
-                                          const std::vector<std::int32_t>& ids, int width, int height,
-                                          const Scene& scene, const Bands& bands, const sensor::CameraCurves& curves) {
+// The white a render's pixels are compared under (measure_delta_e's policy): the scene's light at the level of
+// `level`'s surfaces, those on or next to an emitter left out.
+Vec3d white_of(const std::vector<Vec3d>& level, const std::vector<std::int32_t>& ids, int width, int height,
+               const Scene& scene, const Bands& bands, const sensor::CameraCurves& curves) {
   const auto first_light = static_cast<std::int32_t>(scene.objects.size()) + 1;
   const PiecewiseLinearSpectrum light = scene_light_spectrum(scene);
   WhitePolicy policy;
   for (int c = 0; c < 3; ++c)
     policy.light[c] = integral_of_product(light, curves.curves[c], bands.min_wavelength(), bands.max_wavelength());
-  const std::vector<bool> near = near_emitters(ids, width, height, [&](std::int32_t id) { return id >= first_light; });
-  const Vec3d white = white_point(a, near, policy);
+  return white_point(level, near_emitters(ids, width, height, [&](std::int32_t id) { return id >= first_light; }),
+                     policy);
+}
+
+// The mean ΔE00 between two renders' tristimulus values under `white`, and its standard error over the pixels.
+std::pair<double, double> mean_difference(const std::vector<Vec3d>& a, const std::vector<Vec3d>& b, const Vec3d& white) {
   // ΔE00 in its linear regime: between m − ε·d/2 and m + ε·d/2 (m the pair's mean, d their difference), over ε.
   // The mean ΔE00 of a large difference grows more slowly than the difference (CIELAB's cube root, ΔE00's
   // compression of chroma), so a pilot's few samples would understate the noisier renderer's part; linearised,
@@ -121,6 +124,7 @@ NoiseRatio measure_cycles_noise(const Scene& scene, const std::filesystem::path&
                                  ia.height));
   if (!(ib.bands == ia.bands)) throw InputError(fmt::format("{}: other bands than {}", ib.file, ia.file));
   NoiseRatio out;
+  out.edges_nm = ia.bands.edges();
   out.samples = integer_metadata(ia, "chromatrace.samples");
   if (integer_metadata(ib, "chromatrace.samples") != out.samples)
     throw InputError(fmt::format("{}: chromatrace.samples: {} but {} has {}", ib.file, ib.metadata.at("chromatrace.samples"),
@@ -135,7 +139,8 @@ NoiseRatio measure_cycles_noise(const Scene& scene, const std::filesystem::path&
   std::vector<std::int32_t> ids(pixels, 0);
   if (ia.has_object_ids) ra.read_object_ids(0, ia.height, ids);
   const std::vector<Vec3d> xa = tristimuli(va);
-  const auto [cycles, cycles_se] = mean_difference(xa, tristimuli(vb), ids, ia.width, ia.height, scene, ia.bands, curves);
+  const Vec3d cycles_white = white_of(xa, ids, ia.width, ia.height, scene, ia.bands, curves);
+  const auto [cycles, cycles_se] = mean_difference(xa, tristimuli(vb), cycles_white);
   // Each group's part, and each pair's: the first pilot with those groups' bands taken from the second.
   const std::size_t nb = ia.bands.size(), groups = (nb + 2) / 3;
   auto swapped = [&](std::size_t g, std::size_t h) {
@@ -143,7 +148,7 @@ NoiseRatio measure_cycles_noise(const Scene& scene, const std::filesystem::path&
     for (std::size_t p = 0; p < pixels; ++p)
       for (std::size_t b = 0; b < nb; ++b)
         if (b / 3 == g || b / 3 == h) hybrid[p * nb + b] = vb[p * nb + b];
-    const double e = mean_difference(xa, tristimuli(hybrid), ids, ia.width, ia.height, scene, ia.bands, curves).first;
+    const double e = mean_difference(xa, tristimuli(hybrid), cycles_white).first;
     return e * e;
   };
   std::vector<double> single(groups);
@@ -177,7 +182,7 @@ NoiseRatio measure_cycles_noise(const Scene& scene, const std::filesystem::path&
     tracer_ids = image.object_ids;
   }
   const auto [traced, traced_se] =
-      mean_difference(tracer[0], tracer[1], tracer_ids, ia.width, ia.height, scene, ia.bands, curves);
+      mean_difference(tracer[0], tracer[1], white_of(tracer[0], tracer_ids, ia.width, ia.height, scene, ia.bands, curves));
   if (!(traced > 0))
     throw InputError(fmt::format("{}: the tracer's renders of {} at its size and samples show no noise to compare with",
                                  ia.file, scene.source));

@@ -163,6 +163,7 @@ struct NoiseRatio {
   // the mean ΔE00 between the first pilot and the first with group g's bands from the second; off the diagonal,
   // (e_gh² − e_g² − e_h²) / 2 with both groups' bands from the second.
   std::vector<double> group_shares;
+  std::vector<double> edges_nm;  // the pilots' band edges, which the shares are of
 };
 NoiseRatio measure_cycles_noise(const Scene& scene, const std::filesystem::path& a, const std::filesystem::path& b,
                                 const std::string& camera = "cie1931", int threads = 0);
