@@ -194,9 +194,20 @@ Lanes PathTracer::lane_values(const PiecewiseLinearSpectrum& s, const Chunk* chu
 
 std::pair<double, double> PathTracer::film_position(int x, int y, std::uint64_t stream) const {
   if (!settings_.box_filter) return {x + 0.5, y + 0.5};
-  // The pixel position uses its own stream so it does not shift the path's random numbers.
-  Random rng(settings_.seed ^ 0x5DEECE66Dull, stream);
-  return {x + rng.uniform(), y + rng.uniform()};
+  // Stratified over the pixel, as Cycles' sample pattern is: sample s is the s-th point of Roberts' R2
+  // sequence (a low-discrepancy sequence every prefix of which covers the pixel evenly), shifted by a random
+  // offset of the pixel's own (Cranley-Patterson rotation), so the estimate stays unbiased and pixels do not
+  // share a pattern. Independent uniform positions would leave a pixel that straddles an edge with the
+  // variance of a coin toss per path. The offset has its own stream so it does not shift the path's random
+  // numbers.
+  constexpr double kR2x = 0.75487766624669276;  // 1/g and 1/g², g the plastic number (1.3247...)
+  constexpr double kR2y = 0.56984029099805327;
+  const std::uint64_t pixel = stream >> 32, sample = stream & 0xFFFFFFFFull;
+  Random rng(settings_.seed ^ 0x5DEECE66Dull, pixel);
+  const double ox = rng.uniform(), oy = rng.uniform();
+  const auto fraction = [](double v) { return v - std::floor(v); };
+  const double s = static_cast<double>(sample);
+  return {x + fraction(ox + s * kR2x), y + fraction(oy + s * kR2y)};
 }
 
 int PathTracer::object_id_at(int x, int y) const {

@@ -73,7 +73,8 @@ class PathTracer {
   // Traces one path through image point (px, py) (pixels from the top-left) and adds its contributions
   // to `pixel`. `stream` identifies the path for the random-number generator.
   void trace(double px, double py, std::uint64_t stream, PixelAccumulator& pixel) const;
-  // The film position of sample `stream` in pixel (x, y): the centre, or uniform over the pixel (box).
+  // The film position of sample `stream` ((pixel index << 32) | sample index) in pixel (x, y): the centre,
+  // or stratified over the pixel (box; integrator.cpp).
   std::pair<double, double> film_position(int x, int y, std::uint64_t stream) const;
   // Object id seen through the centre of pixel (x, y); 0 for the background.
   int object_id_at(int x, int y) const;
