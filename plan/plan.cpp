@@ -2,6 +2,7 @@
 #include "plan/plan.h"
 
 #include <algorithm>
+#include <functional>
 #include <cmath>
 #include <limits>
 #include <numeric>
@@ -123,6 +124,13 @@ class Model {
                                   const std::vector<Vec3d>* noise = nullptr) const;
   std::optional<BandReconstruction> fit_reconstruction(const TemplateSpectra& banded, const std::vector<int>& edges,
                                                        int max_bounces) const;
+  // Appends to `t` (tristimulus values, not yet at unit luminance) the templates of the textured surfaces' colours, in
+  // a basis: `spectra` the surfaces' template spectra, `in_basis` a spectrum's values in it, `weight` its observer
+  // weights. A colour sees its surface's irradiance: its diffuse spectrum is the surface's times R_c / R_o (0 where
+  // R_o is); its emission and glossy lobe are the surface's.
+  void add_colour_templates(Templates& t, const TemplateSpectra& spectra,
+                            const std::function<std::vector<double>(const Sampled&)>& in_basis,
+                            const std::array<std::vector<double>, 3>& weight) const;
 
   Grid grid_;
   int kmax_ = 0;
@@ -137,6 +145,18 @@ class Model {
   std::vector<std::vector<std::array<double, 2>>> share_;  // [id][k][lobe]: Σ over pixels of the luminance share
   bool reconstruct_ = false;
   std::vector<Pixel> pixels_;
+  // What each pixel is scored as (per pixel; lab_exact_ their exact colours): itself, or on a textured surface one of
+  // the texture's colours (Surface::colours; set_white), with the pixel's luminance of each (bounce order, lobe)
+  // times the colour's over the surface's.
+  struct Sample {
+    std::size_t id;  // template id: a surface's, or one of its colours' (after the surfaces)
+    std::vector<std::array<double, 2>> y;  // [k][lobe]
+  };
+  std::vector<Sample> samples_;
+  // Template ids of the textured surfaces' colours: per surface id, its colours' (empty: one spectrum); per colour,
+  // its surface.
+  std::vector<std::vector<std::size_t>> colour_ids_;
+  std::vector<std::size_t> colour_surface_;
   std::vector<Vec3d> lab_exact_;
   // A realisation of one preview render's noise in the totals, [pixel][preview band] ((a − b)/√2 of two renders
   // with different seeds), and the preview's band edges.
@@ -230,8 +250,17 @@ void Model::set_exact_templates() {
   exact.mean_albedo = albedo_.v;
   if (has_environment_) exact.environment = environment_.v;
   exact_ = bounce_templates(exact, transfer_, kmax_, &exact_spectra_);
-  exact_y_.assign(ids, std::vector<std::array<double, 2>>(static_cast<std::size_t>(kmax_) + 1, {0.0, 0.0}));
+  colour_ids_.assign(ids, {});
+  colour_surface_.clear();
   for (std::size_t id = 0; id < ids; ++id)
+    for (std::size_t c = 0; c < surfaces_[id].colours.size(); ++c) {
+      colour_ids_[id].push_back(ids + colour_surface_.size());
+      colour_surface_.push_back(id);
+    }
+  add_colour_templates(exact_, exact_spectra_, [](const Sampled& f) { return f.v; }, exact.weight);
+  const std::size_t all = exact_.size();
+  exact_y_.assign(all, std::vector<std::array<double, 2>>(static_cast<std::size_t>(kmax_) + 1, {0.0, 0.0}));
+  for (std::size_t id = 0; id < all; ++id)
     for (int k = 0; k <= kmax_; ++k)
       for (int lobe = 0; lobe < 2; ++lobe) {
         Vec3d& x = exact_[id][k][lobe];
@@ -239,6 +268,29 @@ void Model::set_exact_templates() {
         if (x[1] > 0) x = {x[0] / x[1], 1.0, x[2] / x[1]};
         else x = {0.0, 0.0, 0.0};
       }
+}
+
+void Model::add_colour_templates(Templates& t, const TemplateSpectra& spectra,
+                                 const std::function<std::vector<double>(const Sampled&)>& in_basis,
+                                 const std::array<std::vector<double>, 3>& weight) const {
+  const std::size_t ids = surfaces_.size();
+  for (std::size_t id = 0; id < ids; ++id) {
+    if (colour_ids_[id].empty()) continue;
+    const std::vector<double> base = in_basis(surfaces_[id].diffuse);
+    for (const auto& [share, spectrum] : surfaces_[id].colours) {
+      const std::vector<double> r = in_basis(spectrum);
+      std::vector<std::array<Vec3d, 2>> x = t[id];
+      for (std::size_t k = 1; k < x.size(); ++k) {
+        const std::vector<double>& f = spectra[id][k][0];
+        Vec3d v{};
+        for (int c = 0; c < 3; ++c)
+          for (std::size_t i = 0; i < f.size(); ++i)
+            if (base[i] > 0) v[c] += f[i] * r[i] / base[i] * weight[c][i];
+        x[k][0] = v;
+      }
+      t.push_back(std::move(x));
+    }
+  }
 }
 
 // The preview: the scene at options.preview_size pixels on its longer side, to the model's depth, every component.
@@ -324,22 +376,47 @@ void Model::read_preview(const Preview& preview, const std::vector<bool>& near_l
 // The exact colours of the preview's pixels and the white (core/render_delta_e.h: the scene's light at the level of
 // the exact image, unlit pixels black, lights and their neighbours left out).
 void Model::set_white(const Preview& preview, const std::vector<bool>& near_light) {
-  std::vector<Vec3d> xyz(pixels_.size());
+  samples_.clear();
+  std::vector<std::size_t> seen(surfaces_.size(), 0);  // pixels of each surface so far
+  for (const Pixel& px : pixels_) {
+    const auto id = static_cast<std::size_t>(px.id);
+    if (colour_ids_[id].empty()) {
+      samples_.push_back({id, px.y});
+    } else {
+      // The n-th pixel of a textured surface shows the colour whose interval of the cumulative shares holds
+      // frac(½ + n/φ): a low-discrepancy walk, so that every colour gets its share of the surface's pixels, spread
+      // over them, at the cost of one sample a pixel.
+      const double u = std::fmod(0.5 + static_cast<double>(seen[id]++) * 0.6180339887498949, 1.0);
+      const auto& colours = surfaces_[id].colours;
+      std::size_t c = 0;
+      for (double sum = colours[0].first; c + 1 < colours.size() && sum <= u; sum += colours[++c].first) {
+      }
+      const std::size_t cid = colour_ids_[id][c];
+      Sample sample{cid, px.y};
+      for (int k = 0; k <= kmax_; ++k)
+        for (int lobe = 0; lobe < 2; ++lobe) {
+          const double base = exact_y_[id][k][lobe];
+          sample.y[k][lobe] *= base > 0 ? exact_y_[cid][k][lobe] / base : 0.0;
+        }
+      samples_.push_back(std::move(sample));
+    }
+  }
+  std::vector<Vec3d> xyz(samples_.size());
   std::vector<Vec3d> level(preview.pixels(), Vec3d{});
   for (std::size_t p = 0; p < pixels_.size(); ++p) {
-    const Pixel& px = pixels_[p];
+    const Sample& s = samples_[p];
     Vec3d x{};
     for (int k = 0; k <= kmax_; ++k)
       for (int lobe = 0; lobe < 2; ++lobe)
-        for (int c = 0; c < 3; ++c) x[c] += px.y[k][lobe] * exact_[px.id][k][lobe][c];
+        for (int c = 0; c < 3; ++c) x[c] += s.y[k][lobe] * exact_[s.id][k][lobe][c];
     xyz[p] = x;
-    level[px.index] = x;
+    level[pixels_[p].index] = x;
   }
   WhitePolicy policy;
   policy.light = tristimulus(light_.v, obs_);
   white_ = white_point(level, near_light, policy);
-  lab_exact_.resize(pixels_.size());
-  for (std::size_t p = 0; p < pixels_.size(); ++p) lab_exact_[p] = xyz_to_lab(xyz[p], white_);
+  lab_exact_.resize(samples_.size());
+  for (std::size_t p = 0; p < samples_.size(); ++p) lab_exact_[p] = xyz_to_lab(xyz[p], white_);
 }
 
 // Noise: a second preview with the next seed. The two differ by noise alone, of twice the variance of either;
@@ -399,13 +476,13 @@ std::pair<double, double> Model::score(const Templates& templates, int max_bounc
                                         const std::vector<Vec3d>* noise) const {
   std::vector<double> de(pixels_.size());
   for (std::size_t p = 0; p < pixels_.size(); ++p) {
-    const Pixel& px = pixels_[p];
+    const Sample& s = samples_[p];
     Vec3d x{};
     for (int k = 0; k <= std::min(max_bounces, kmax_); ++k)
       for (int lobe = 0; lobe < 2; ++lobe)
-        for (int c = 0; c < 3; ++c) x[c] += px.y[k][lobe] * templates[px.id][k][lobe][c];
+        for (int c = 0; c < 3; ++c) x[c] += s.y[k][lobe] * templates[s.id][k][lobe][c];
     if (noise)
-      for (int c = 0; c < 3; ++c) x[c] += (*noise)[px.index][c];
+      for (int c = 0; c < 3; ++c) x[c] += (*noise)[pixels_[p].index][c];
     de[p] = delta_e_2000(lab_exact_[p], xyz_to_lab(x, white_));
   }
   const double sum = std::accumulate(de.begin(), de.end(), 0.0);
@@ -524,7 +601,7 @@ Model::BandedTemplates Model::banded_templates(const std::vector<int>& edges, in
   banded.mean_albedo = averages(albedo_);
   if (has_environment_) banded.environment = averages(environment_);
   TemplateSpectra spectra;
-  auto t = bounce_templates(banded, transfer_, K, reconstruct ? &spectra : nullptr);
+  auto t = bounce_templates(banded, transfer_, K, reconstruct || !colour_surface_.empty() ? &spectra : nullptr);
   const std::optional<BandReconstruction> fit = reconstruct ? fit_reconstruction(spectra, edges, K) : std::nullopt;
   if (fit) {
     // The observer's weights of the reconstructed spectrum (band_weights with 1 nm fine bands), and the templates
@@ -547,6 +624,7 @@ Model::BandedTemplates Model::banded_templates(const std::vector<int>& edges, in
           }
     if (fitted) *fitted = r;  // else it stays empty (fine = 0): read as a step function
   }
+  add_colour_templates(t, spectra, averages, banded.weight);
   for (std::size_t id = 0; id < t.size(); ++id)
     for (int k = 0; k <= K; ++k)
       for (int lobe = 0; lobe < 2; ++lobe) {
@@ -759,23 +837,21 @@ PiecewiseLinearSpectrum scene_light_spectrum(const Scene& scene) {
   const std::vector<TriangleMesh> meshes = scene_meshes(scene);
   bool any = false;
   for (std::size_t i = 0; i < scene.lights.size(); ++i) {
-    const Light& light = scene.lights[i];
-    if (light.radiance.texture) continue;
-    const double area = surface_area(meshes[scene.objects.size() + i]);
-    const PiecewiseLinearSpectrum e = light.emitted_radiance();
-    for (std::size_t j = 0; j < nm.size(); ++j) v[j] += area * e(nm[j]);
+    const TriangleMesh& mesh = meshes[scene.objects.size() + i];
+    const PiecewiseLinearSpectrum e = emitted_mean_radiance(scene.lights[i], mesh);
+    for (std::size_t j = 0; j < nm.size(); ++j) v[j] += surface_area(mesh) * e(nm[j]);
     any = true;
   }
-  if (scene.environment && !scene.environment->radiance.texture) {
+  if (scene.environment) {
     Bounds all;
     for (const TriangleMesh& m : meshes)
       for (const Vec3& p : m.positions) all.extend(p);
     const double radius = all.empty() ? 1.0 : std::max(1e-6, 0.5 * (all.hi - all.lo).norm());
-    const PiecewiseLinearSpectrum e = scene.environment->radiance.spectrum.scaled(scene.environment->scale);
+    const PiecewiseLinearSpectrum e = mean_environment_radiance(*scene.environment);
     for (std::size_t j = 0; j < nm.size(); ++j) v[j] += 4 * M_PI * radius * radius * e(nm[j]);
     any = true;
   }
-  if (!any) std::fill(v.begin(), v.end(), 1.0);  // textured light only: equal energy
+  if (!any) std::fill(v.begin(), v.end(), 1.0);  // no light at all: equal energy
   const double peak = *std::max_element(v.begin(), v.end());
   if (peak > 0)
     for (double& x : v) x /= peak;

@@ -145,8 +145,9 @@ SettingsPrediction predict_settings(const Scene& scene, int max_bounces, int sam
 Json bands_document(const Plan& plan);
 Json report_document(const Plan& plan, const Scene& scene, const PlanOptions& options);
 
-// The light spectrum the plan adapts to: the scene's lights weighted by mean radiance × area (and a
-// uniform environment by 4π·R², R the scene's bounding radius), as a 1 nm table.
+// The light spectrum the plan adapts to: the scene's lights weighted by mean radiance × area (and the
+// environment's mean radiance by 4π·R², R the scene's bounding radius; a textured light or environment as its
+// texels' mean spectrum, plan/radiosity.h), as a 1 nm table.
 PiecewiseLinearSpectrum scene_light_spectrum(const Scene& scene);
 
 // Cycles' Monte Carlo noise against the tracer's, measured on the scene itself: two Cycles renders of it (pilots,

@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <map>
+#include <numeric>
 
 #include <fmt/core.h>
 
@@ -11,6 +13,10 @@
 #include "reference_tracer/accel.h"
 
 namespace ct::plan {
+
+// How many colours a textured surface is seen as (texture_colours): each multiplies its pixels' cost in the plan's
+// every evaluation.
+constexpr std::size_t kTextureColours = 16;
 
 Transfer transfer_factors(const Scene& scene, const std::vector<TriangleMesh>& meshes, int samples) {
   std::vector<const TriangleMesh*> ptrs;
@@ -76,19 +82,198 @@ Transfer transfer_factors(const Scene& scene, const std::vector<TriangleMesh>& m
 }
 
 
+namespace {
+
+// A texture's texels pooled by colour (reflectances on a grid of 1/64 per channel; radiances by chromaticity,
+// rgb / max, on that grid, their magnitudes summed): within a pool the spectra differ by less than the sigmoid's
+// change over 1/64 of a channel.
+struct Pool {
+  double weight = 0, magnitude = 0;
+  std::array<double, 3> colour{};  // the weighted mean (of rgb, or rgb / max for a radiance)
+};
+
+std::vector<Pool> texel_pools(const ImageTexture& texture, const std::vector<double>& weight, double& total) {
+  constexpr int kLevels = 64;
+  const bool radiance = texture.use == TextureUse::Radiance;
+  std::map<std::uint32_t, Pool> pools;  // ordered: sums over it do not depend on hashing
+  total = 0;
+  for (std::size_t t = 0; t < texture.texel_count(); ++t) {
+    const double w = t < weight.size() ? weight[t] : 0.0;
+    if (!(w > 0)) continue;
+    total += w;
+    std::array<double, 3> c = texture.texel(t);
+    const double m = std::max({c[0], c[1], c[2]});
+    if (!(m > 0)) continue;  // black: no light, and a zero reflectance
+    if (radiance)
+      for (double& x : c) x /= m;
+    std::uint32_t key = 0;
+    for (double x : c) key = key * (kLevels + 1) + static_cast<std::uint32_t>(std::lround(std::clamp(x, 0.0, 1.0) * kLevels));
+    Pool& pool = pools[key];
+    pool.weight += w;
+    pool.magnitude += w * (radiance ? m : 1.0);
+    for (int i = 0; i < 3; ++i) pool.colour[i] += w * c[i];
+  }
+  std::vector<Pool> out;
+  for (auto& [key, pool] : pools) {
+    for (double& x : pool.colour) x /= pool.weight;
+    out.push_back(pool);
+  }
+  return out;
+}
+
+// Σ magnitude · spectrum of the pools `members`, on the 1 nm grid 360–830 nm.
+std::vector<double> pooled_spectrum(const ImageTexture& texture, const std::vector<Pool>& pools,
+                                    const std::vector<std::size_t>& members) {
+  std::vector<double> v(471, 0.0);
+  for (const std::size_t m : members) {
+    const ScaledSigmoid s = texel_spectrum(pools[m].colour, texture.use);
+    for (std::size_t j = 0; j < v.size(); ++j) v[j] += pools[m].magnitude * s(360.0 + static_cast<double>(j));
+  }
+  return v;
+}
+
+PiecewiseLinearSpectrum on_grid(std::vector<double> v, double factor) {
+  std::vector<double> nm(v.size());
+  for (std::size_t j = 0; j < v.size(); ++j) nm[j] = 360.0 + static_cast<double>(j), v[j] *= factor;
+  return PiecewiseLinearSpectrum(nm, v);
+}
+
+}  // namespace
+
+PiecewiseLinearSpectrum mean_texture_spectrum(const ImageTexture& texture, const std::vector<double>& weight) {
+  double total = 0;
+  const std::vector<Pool> pools = texel_pools(texture, weight, total);
+  std::vector<std::size_t> all(pools.size());
+  std::iota(all.begin(), all.end(), std::size_t{0});
+  return on_grid(pooled_spectrum(texture, pools, all), total > 0 ? texture.scale / total : 0.0);
+}
+
+std::vector<TextureColour> texture_colours(const ImageTexture& texture, const std::vector<double>& weight,
+                                           std::size_t count) {
+  double total = 0;
+  const std::vector<Pool> pools = texel_pools(texture, weight, total);
+  if (pools.empty() || !(total > 0)) return {};
+  // Weighted k-means over the pools' colours, seeded deterministically: the heaviest pool, then each time the pool
+  // farthest from every centre so far (weighted by its share), then ten rounds of assignment and update.
+  const std::size_t k = std::min(count, pools.size());
+  auto distance2 = [](const std::array<double, 3>& a, const std::array<double, 3>& b) {
+    return (a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) + (a[2] - b[2]) * (a[2] - b[2]);
+  };
+  std::vector<std::array<double, 3>> centre;
+  std::size_t first = 0;
+  for (std::size_t i = 1; i < pools.size(); ++i)
+    if (pools[i].weight > pools[first].weight) first = i;
+  centre.push_back(pools[first].colour);
+  std::vector<double> nearest(pools.size(), std::numeric_limits<double>::infinity());
+  while (centre.size() < k) {
+    std::size_t far = 0;
+    double best = -1;
+    for (std::size_t i = 0; i < pools.size(); ++i) {
+      nearest[i] = std::min(nearest[i], distance2(pools[i].colour, centre.back()));
+      if (pools[i].weight * nearest[i] > best) best = pools[i].weight * nearest[i], far = i;
+    }
+    centre.push_back(pools[far].colour);
+  }
+  std::vector<std::size_t> cluster(pools.size(), 0);
+  for (int round = 0; round < 10; ++round) {
+    for (std::size_t i = 0; i < pools.size(); ++i)
+      for (std::size_t c = 1; c < k; ++c)
+        if (distance2(pools[i].colour, centre[c]) < distance2(pools[i].colour, centre[cluster[i]])) cluster[i] = c;
+    std::vector<std::array<double, 4>> sum(k, {0.0, 0.0, 0.0, 0.0});
+    for (std::size_t i = 0; i < pools.size(); ++i) {
+      for (int j = 0; j < 3; ++j) sum[cluster[i]][j] += pools[i].weight * pools[i].colour[j];
+      sum[cluster[i]][3] += pools[i].weight;
+    }
+    for (std::size_t c = 0; c < k; ++c)
+      if (sum[c][3] > 0) centre[c] = {sum[c][0] / sum[c][3], sum[c][1] / sum[c][3], sum[c][2] / sum[c][3]};
+  }
+  std::vector<TextureColour> out;
+  for (std::size_t c = 0; c < k; ++c) {
+    std::vector<std::size_t> members;
+    double w = 0;
+    for (std::size_t i = 0; i < pools.size(); ++i)
+      if (cluster[i] == c) members.push_back(i), w += pools[i].weight;
+    if (members.empty()) continue;
+    out.push_back({w / total, on_grid(pooled_spectrum(texture, pools, members), texture.scale / w)});
+  }
+  double seen = 0;
+  for (const Pool& p : pools) seen += p.weight;
+  if (seen < total) out.push_back({(total - seen) / total, on_grid(std::vector<double>(471, 0.0), 0.0)});  // black
+  return out;
+}
+
+std::vector<std::array<Vec2, 3>> light_corner_uvs(const Light& light) {
+  return std::visit([](const auto& shape) { return corner_uvs(Shape(shape)); }, light.shape);
+}
+
+std::vector<double> surface_texel_weights(const TriangleMesh& mesh, const std::vector<std::array<Vec2, 3>>& uvs,
+                                          const ImageTexture& texture) {
+  constexpr int kPoints = 16384;  // a texel's share to ±1/(2·√16384) ≈ 0.4 % of the surface at most
+  std::vector<double> weight(texture.texel_count(), 0.0);
+  std::vector<double> cdf;
+  double area = 0;
+  for (std::size_t tri = 0; tri < mesh.triangles.size(); ++tri) cdf.push_back(area += triangle_area(mesh, tri));
+  if (uvs.size() != mesh.triangles.size() || !(area > 0)) {
+    std::fill(weight.begin(), weight.end(), 1.0);
+    return weight;
+  }
+  Random rng(0x74657865ull, 0);
+  for (int i = 0; i < kPoints; ++i) {
+    const double pick = rng.uniform() * area;
+    const std::size_t tri = std::min<std::size_t>(
+        static_cast<std::size_t>(std::upper_bound(cdf.begin(), cdf.end(), pick) - cdf.begin()), cdf.size() - 1);
+    double a = rng.uniform(), b = rng.uniform();
+    if (a + b > 1) a = 1 - a, b = 1 - b;
+    const auto& c = uvs[tri];
+    const Vec2 uv = (1 - a - b) * c[0] + a * c[1] + b * c[2];
+    weight[texture.texel_at(uv.x(), uv.y())] += 1;
+  }
+  return weight;
+}
+
+std::vector<double> environment_texel_weights(const ImageTexture& texture) {
+  std::vector<double> weight(texture.texel_count());
+  for (int y = 0; y < texture.height; ++y) {
+    const double w = std::sin(M_PI * (y + 0.5) / texture.height);
+    std::fill_n(weight.begin() + static_cast<std::ptrdiff_t>(y) * texture.width, texture.width, w);
+  }
+  return weight;
+}
+
+PiecewiseLinearSpectrum emitted_mean_radiance(const Light& light, const TriangleMesh& mesh) {
+  if (!light.radiance.texture) return light.emitted_radiance();
+  const ImageTexture& t = *light.radiance.texture;
+  return mean_texture_spectrum(t, surface_texel_weights(mesh, light_corner_uvs(light), t)).scaled(light.scale);
+}
+
+PiecewiseLinearSpectrum mean_environment_radiance(const Environment& environment) {
+  if (!environment.radiance.texture) return environment.radiance.spectrum.scaled(environment.scale);
+  const ImageTexture& t = *environment.radiance.texture;
+  return mean_texture_spectrum(t, environment_texel_weights(t)).scaled(environment.scale);
+}
+
 SceneSurfaces scene_surfaces(const Scene& scene, const std::vector<TriangleMesh>& meshes, const Grid& grid,
                              const Sampled& light, bool reconstruction, std::vector<std::string>& notes) {
   SceneSurfaces out;
-  auto spectrum_of = [&](const SpectrumRef& ref, const std::string& what) -> Sampled {
+  auto sampled = [&](const PiecewiseLinearSpectrum& s) { return grid.sample([&](double nm) { return s(nm); }); };
+  std::vector<std::pair<double, Sampled>> colours;  // the last texture's (spectrum_of)
+  auto spectrum_of = [&](const SpectrumRef& ref, const std::string& what, const TriangleMesh& mesh,
+                         const std::vector<std::array<Vec2, 3>>& uvs) -> Sampled {
+    colours.clear();
     if (ref.texture) {
       if (reconstruction && !out.textured)
-        notes.push_back(fmt::format("{} is an image texture, whose spectra the model does not hold: no reconstruction "
-                                    "is fitted (the bands' values are read as a step function)", what));
+        notes.push_back(fmt::format("{} is an image texture, whose texels' spectra the model does not hold: no "
+                                    "reconstruction is fitted (the bands' values are read as a step function)", what));
       out.textured = true;
-      notes.push_back(fmt::format("{} is an image texture: modelled as a flat reflectance of 0.5", what));
-      return grid.constant(0.5);
+      notes.push_back(fmt::format("{} is an image texture: modelled as its texels' mean spectrum over the surface, "
+                                  "seen as up to {} colours", what, kTextureColours));
+      const std::vector<double> weight = surface_texel_weights(mesh, uvs, *ref.texture);
+      colours.clear();
+      for (const TextureColour& c : texture_colours(*ref.texture, weight, kTextureColours))
+        colours.emplace_back(c.share, sampled(c.spectrum));
+      return sampled(mean_texture_spectrum(*ref.texture, weight));
     }
-    return grid.sample([&](double nm) { return ref.spectrum(nm); });
+    return sampled(ref.spectrum);
   };
   const Sampled zero = grid.constant(0.0);
   const Sampled one = grid.constant(1.0);
@@ -96,10 +281,13 @@ SceneSurfaces scene_surfaces(const Scene& scene, const std::vector<TriangleMesh>
   std::vector<double> albedo(grid.n(), 0.0);
   double area_sum = 0;
   std::vector<Surface>& surfaces = out.surfaces;
-  surfaces.assign(static_cast<std::size_t>(scene.id_count()) + 1, Surface{zero, zero, zero, zero, false});
-  auto add_material = [&](std::size_t id, const Material& m, double area) {
+  surfaces.assign(static_cast<std::size_t>(scene.id_count()) + 1, Surface{zero, zero, zero, zero, false, {}});
+  auto add_material = [&](std::size_t id, const Material& m, const TriangleMesh& mesh,
+                          const std::vector<std::array<Vec2, 3>>& uvs) {
+    const double area = surface_area(mesh);
     Surface& s = surfaces[id];
-    s.diffuse = spectrum_of(m.reflectance_spectrum(), fmt::format("materials.{}", m.name));
+    s.diffuse = spectrum_of(m.reflectance_spectrum(), fmt::format("materials.{}", m.name), mesh, uvs);
+    s.colours = colours;
     double ks = 0;
     bool mirror = false;
     if (auto* d = std::get_if<DichromaticMaterial>(&m.model)) {
@@ -119,19 +307,16 @@ SceneSurfaces scene_surfaces(const Scene& scene, const std::vector<TriangleMesh>
     area_sum += area;
   };
   for (std::size_t o = 0; o < scene.objects.size(); ++o)
-    add_material(o + 1, scene.materials[scene.objects[o].material], surface_area(meshes[o]));
+    add_material(o + 1, scene.materials[scene.objects[o].material], meshes[o], corner_uvs(scene.objects[o].shape));
   for (std::size_t l = 0; l < scene.lights.size(); ++l) {
     const std::size_t id = scene.objects.size() + l + 1;
     const Light& light_l = scene.lights[l];
-    if (light_l.material) add_material(id, scene.materials[*light_l.material], surface_area(meshes[id - 1]));
+    if (light_l.material) add_material(id, scene.materials[*light_l.material], meshes[id - 1], light_corner_uvs(light_l));
     surfaces[id].emitter = true;
-    if (light_l.radiance.texture) {
-      notes.push_back(fmt::format("lights[{}].radiance is an image texture: modelled as the scene's light", l));
-      surfaces[id].emission = light;
-    } else {
-      const PiecewiseLinearSpectrum e = light_l.emitted_radiance();
-      surfaces[id].emission = grid.sample([&](double nm) { return e(nm); });
-    }
+    if (light_l.radiance.texture)
+      notes.push_back(fmt::format("lights[{}].radiance is an image texture: modelled as its texels' mean spectrum "
+                                  "over the light", l));
+    surfaces[id].emission = sampled(emitted_mean_radiance(light_l, meshes[id - 1]));
   }
   out.mean_albedo.v = albedo;
   for (double& a : out.mean_albedo.v) a /= std::max(area_sum, 1e-300);
@@ -142,13 +327,10 @@ SceneSurfaces scene_surfaces(const Scene& scene, const std::vector<TriangleMesh>
   surfaces[0].glossy = out.mean_albedo;
   if (scene.environment) {
     out.has_environment = true;
-    if (scene.environment->radiance.texture) {
-      notes.push_back("environment.radiance is an image texture: modelled as the scene's light spectrum");
-      out.environment = light;
-    } else {
-      const PiecewiseLinearSpectrum e = scene.environment->radiance.spectrum.scaled(scene.environment->scale);
-      out.environment = grid.sample([&](double nm) { return e(nm); });
-    }
+    if (scene.environment->radiance.texture)
+      notes.push_back("environment.radiance is an image texture: modelled as its texels' mean spectrum over the "
+                      "sphere of directions");
+    out.environment = sampled(mean_environment_radiance(*scene.environment));
     surfaces[0].emission = out.environment;
   }
   return out;

@@ -22,6 +22,8 @@
 #include "core/colour.h"
 #include "core/geometry.h"
 #include "core/scene.h"
+#include "core/spectrum.h"
+#include "core/texture.h"
 #include "plan/spectral_grid.h"
 
 namespace ct::plan {
@@ -41,14 +43,51 @@ struct Surface {
   Sampled glossy;    // what a glossy bounce multiplies by
   Sampled albedo;    // what the surface sends on (diffuse + specular)
   bool emitter = false;
+  // An image texture's colours (texture_colours: their shares sum to 1, the shares times the spectra to `diffuse`),
+  // what a camera sees of the surface; empty for a surface of one spectrum.
+  std::vector<std::pair<double, Sampled>> colours;
 };
+
+// The mean spectrum of an image texture where it is seen, its texels upsampled as the renderers upsample them
+// (core/texture.h), the texture's scale included: `weight` per texel (its share of a surface's area or of the
+// sphere of directions). Texels are pooled by colour first (reflectances on a grid of 1/64 per channel; radiances
+// by chromaticity, rgb / max, on that grid, their magnitudes summed), each pool's mean colour upsampled once: within
+// a pool the spectra differ by less than the sigmoid's change over 1/64 of a channel. 1 nm samples over 360–830 nm.
+PiecewiseLinearSpectrum mean_texture_spectrum(const ImageTexture& texture, const std::vector<double>& weight);
+// A texture's colours: its texels (by `weight`, as for mean_texture_spectrum) in at most `count` clusters of similar
+// colour (weighted k-means in linear RGB), each with its share of the weight and its texels' mean spectrum (the
+// texture's scale included). The shares times the spectra sum to mean_texture_spectrum; empty for a texture that
+// is black wherever it is seen.
+struct TextureColour {
+  double share;
+  PiecewiseLinearSpectrum spectrum;
+};
+std::vector<TextureColour> texture_colours(const ImageTexture& texture, const std::vector<double>& weight,
+                                           std::size_t count);
+
+// Each texel's share of the area of `mesh`, whose triangles' corners have the (u, v) `uvs` (core/geometry.h,
+// corner_uvs): area-uniform points from a seeded stream, each looked up at its (u, v). Even shares when there are
+// no (u, v).
+std::vector<double> surface_texel_weights(const TriangleMesh& mesh, const std::vector<std::array<Vec2, 3>>& uvs,
+                                          const ImageTexture& texture);
+// corner_uvs of a light's shape.
+std::vector<std::array<Vec2, 3>> light_corner_uvs(const Light& light);
+// Each texel's share of the sphere of directions, for an equirectangular environment: a row's texels at polar angle
+// θ cover solid angle ∝ sin θ.
+std::vector<double> environment_texel_weights(const ImageTexture& texture);
+
+// A light's emitted radiance (× its scale), a textured one's as its texels' mean over `mesh`, the light's shape.
+PiecewiseLinearSpectrum emitted_mean_radiance(const Light& light, const TriangleMesh& mesh);
+// The environment's radiance (× its scale), a textured one's as its texels' mean over the sphere of directions.
+PiecewiseLinearSpectrum mean_environment_radiance(const Environment& environment);
 
 // The scene's surfaces by id (0: the background, which sends the environment's or the scene's light and
 // reflects the mean albedo), with the scene's light spectrum (`light`: scene_light_spectrum on the grid), the
-// area-weighted mean albedo, and the environment (empty when the scene has none). Image textures are modelled
-// as a flat reflectance of 0.5 or, on an emitter, as the scene's light, each with a note; `textured` is set
-// when a material is an image texture (whose spectra no reconstruction can be fitted to: with `reconstruction`,
-// a note says so).
+// area-weighted mean albedo, and the environment (empty when the scene has none). An image texture is modelled
+// as its texels' mean spectrum over the surface, or over the sphere of directions for the environment
+// (mean_texture_spectrum), with a note: the spread of its colours about that mean is not modelled. `textured` is
+// set when a material is an image texture (whose texels' spectra no reconstruction is fitted to: with
+// `reconstruction`, a note says so).
 struct SceneSurfaces {
   std::vector<Surface> surfaces;
   Sampled mean_albedo, environment;

@@ -49,7 +49,7 @@ class Planned:
 
     @property
     def notes(self):
-        """What the plan's model could not hold (an image texture modelled as a flat reflectance, a camera whose
+        """What the plan's model could not hold (an image texture seen as a few colours, a camera whose
         curves end early, ...): said beside the prediction, which they make less certain."""
         return list(self.report.get("notes", []))
 

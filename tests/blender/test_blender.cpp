@@ -494,7 +494,7 @@ TEST_F(Blender, PlannedRenderMeetsThePredictedError) {
     EXPECT_NEAR(measured[0], measured[1], 0.1);
   }
   // What the plan's model cannot hold is said beside its prediction, which it makes less certain: an image texture
-  // is modelled as a flat reflectance (also with --quiet).
+  // is seen as a few colours (also with --quiet).
   const fs::path textured = dir_.file("textured.exr");
   const CommandResult t = batch({"--scene", kSource + "/scenes/textured/textured.json", "--out", textured.string(),
                                  "--resolution", "16x16", "--plan", "2", "--components", "none", "--ggx-masking",

@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: Apache-2.0
 // plan/radiosity.h on known answers: the transfer factors of a closed cube (they sum to 1, and each is the
 // analytic form factor between two of its faces), a small patch under a rectangle (the analytic view factor the
-// tracer's tests use), and the bounce recursion on a hand-made transfer.
+// tracer's tests use), the bounce recursion on a hand-made transfer, and image textures as their texels' mean
+// spectrum (each texel's exact share of a surface or of the sphere of directions).
 #include <cmath>
 #include <numbers>
 
@@ -10,6 +11,7 @@
 #include "tests/common/view_factor.h"
 #include "core/scene.h"
 #include "core/statistics.h"
+#include "core/texture.h"
 #include "plan/radiosity.h"
 
 namespace ct::plan {
@@ -117,6 +119,94 @@ TEST(Radiosity, BounceTemplatesFollowTheRecursion) {
   EXPECT_DOUBLE_EQ(diffuse_y(0, 2), 0.32);
   EXPECT_EQ(x[1][1][1][1], 0.0);
   EXPECT_DOUBLE_EQ(spectra[2][2][0][0], 0.03);
+}
+
+ImageTexture texture_of(int width, int height, std::vector<float> rgb, TextureUse use, double scale = 1.0) {
+  ImageTexture t;
+  t.width = width;
+  t.height = height;
+  t.rgb = std::move(rgb);
+  t.use = use;
+  t.scale = scale;
+  return t;
+}
+
+// The mean of a texture whose colours fall in different pools is the weighted mean of the texels' own spectra (the
+// renderers' upsampling), the texture's scale included; a radiance's texels are relative to D65 and may exceed 1.
+TEST(TextureMean, IsTheWeightedMeanOfTheTexelsSpectra) {
+  for (const TextureUse use : {TextureUse::Reflectance, TextureUse::Radiance}) {
+    const float k = use == TextureUse::Radiance ? 3.0f : 1.0f;
+    const ImageTexture t = texture_of(3, 1, {0.8f * k, 0.05f * k, 0.05f * k, 0.05f, 0.1f, 0.8f, 0.3f, 0.3f, 0.3f},
+                                      use, 0.5);
+    const std::vector<double> weight = {1.0, 3.0, 0.0};  // the grey texel covers nothing
+    const PiecewiseLinearSpectrum mean = mean_texture_spectrum(t, weight);
+    for (double nm = 380; nm <= 780; nm += 10) {
+      const double expected = 0.5 * (1.0 * texel_spectrum(t.texel(0), use)(nm) + 3.0 * texel_spectrum(t.texel(1), use)(nm)) / 4.0;
+      EXPECT_NEAR(mean(nm), expected, 1e-9 * std::max(1.0, expected)) << nm;
+    }
+  }
+}
+
+// A quad's texels each cover their share of its area (2 × 2 texels: a quarter each) and a sphere's rows of texels
+// the zone between their polar angles, (cos θa − cos θb)/2 of its area (tessellated finely, so that the flat
+// triangles' area differs from the sphere's by well under the sampling error). Tolerance: three binomial standard
+// errors of the 16384 points, plus 0.2 % for the tessellation.
+TEST(TextureMean, SurfaceTexelsWeighByTheAreaTheyCover) {
+  const Scene scene = scene_of(Json::array({quad("q", {0, 0, 0}, {2, 0, 0}, {0, 1, 0}),
+                                            {{"name", "s"}, {"material", "grey"},
+                                             {"shape", {{"type", "sphere"}, {"center", {0, 0, 3}}, {"radius", 1},
+                                                        {"segments", 128}, {"rings", 64}}}}}),
+                               Json::array());
+  const std::vector<TriangleMesh> meshes = scene_meshes(scene);
+  const double n = 16384;
+  const ImageTexture square = texture_of(2, 2, std::vector<float>(12, 0.5f), TextureUse::Reflectance);
+  std::vector<double> w = surface_texel_weights(meshes[0], corner_uvs(scene.objects[0].shape), square);
+  for (double x : w) EXPECT_NEAR(x / n, 0.25, 3 * std::sqrt(0.25 * 0.75 / n)) << "quad";
+  const ImageTexture rows = texture_of(1, 4, std::vector<float>(12, 0.5f), TextureUse::Reflectance);
+  w = surface_texel_weights(meshes[1], corner_uvs(scene.objects[1].shape), rows);
+  for (int y = 0; y < 4; ++y) {
+    const double a = std::numbers::pi * y / 4, b = std::numbers::pi * (y + 1) / 4;  // row 0 at the north pole
+    const double share = (std::cos(a) - std::cos(b)) / 2;
+    EXPECT_NEAR(w[y] / n, share, 3 * std::sqrt(share * (1 - share) / n) + 0.002) << "sphere row " << y;
+  }
+}
+
+// An equirectangular environment's rows of equal height: each row's share of the sphere of directions is exactly
+// (cos θa − cos θb)/2, which the sine at the row's middle gives once normalised (2 sin(m) sin(h/2) ∝ sin m).
+TEST(TextureMean, EnvironmentTexelsWeighByTheirSolidAngle) {
+  const ImageTexture sky = texture_of(3, 6, std::vector<float>(54, 1.0f), TextureUse::Radiance);
+  const std::vector<double> w = environment_texel_weights(sky);
+  double total = 0;
+  for (double x : w) total += x;
+  for (int y = 0; y < 6; ++y) {
+    const double a = std::numbers::pi * y / 6, b = std::numbers::pi * (y + 1) / 6;
+    for (int x = 0; x < 3; ++x) EXPECT_NEAR(w[y * 3 + x] / total, (std::cos(a) - std::cos(b)) / 2 / 3, 1e-12);
+  }
+}
+
+// A texture of one colour is that colour's spectrum: a surface with it, a light with it and an environment with it
+// are modelled exactly as with the {"rgb"} source of that colour (a reflectance as the sigmoid, an emitter as the
+// sigmoid times D65's white), so the plan sees a one-colour texture as it sees the colour.
+TEST(TextureMean, OneColourTextureIsThatColoursSpectrum) {
+  const std::vector<float> texels = {0.7f, 0.4f, 0.1f, 0.7f, 0.4f, 0.1f};
+  const std::array<double, 3> as_float = {double(0.7f), double(0.4f), double(0.1f)};
+  Scene scene = scene_of(Json::array({quad("q", {0, 0, 0}, {1, 0, 0}, {0, 1, 0})}), Json::array());
+  auto& lambert = std::get<LambertMaterial>(scene.materials[scene.objects[0].material].model);
+  lambert.reflectance.texture = std::make_shared<ImageTexture>(texture_of(2, 1, texels, TextureUse::Reflectance));
+  scene.environment->radiance.texture = std::make_shared<ImageTexture>(texture_of(1, 2, texels, TextureUse::Radiance, 2.0));
+  scene.environment->scale = 1.5;
+  const Grid grid{400, 700};
+  std::vector<std::string> notes;
+  const SceneSurfaces s = scene_surfaces(scene, scene_meshes(scene), grid, grid.constant(1.0), false, notes);
+  const ScaledSigmoid reflectance = texel_spectrum(as_float, TextureUse::Reflectance);
+  const ScaledSigmoid emitted = texel_spectrum(as_float, TextureUse::Radiance);
+  for (std::size_t i = 0; i < grid.n(); ++i) {
+    const double nm = grid.lo + static_cast<double>(i);
+    EXPECT_NEAR(s.surfaces[1].diffuse.v[i], reflectance(nm), 1e-9) << nm;
+    EXPECT_NEAR(s.environment.v[i], 3.0 * emitted(nm), 1e-9 * std::max(1.0, emitted(nm))) << nm;
+  }
+  EXPECT_TRUE(s.textured);
+  EXPECT_FALSE(notes.empty());
 }
 
 }  // namespace
