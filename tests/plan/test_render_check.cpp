@@ -230,7 +230,7 @@ TEST(RenderCheck, CheckSceneAndRenderSayItAndPlansSettingsAreSilent) {
   EXPECT_NE(part.err.find("warning: --spp 4 gives"), std::string::npos) << part.err;
 
   // For Cycles the noise is kCyclesNoiseRatio × the tracer's, and with samples per band group each group's falls
-  // with its own: the tracer's noise at one sample n₁ = noise(4)·√4, then 0.76·n₁·√(mean of 1/N_g).
+  // with its own: the tracer's noise at one sample n₁ = noise(4)·√4, then kCyclesNoiseRatio·n₁·√(mean of 1/N_g).
   const double at_one = p.noise_de00 * 2.0;
   const fs::path groups = dir / "groups.json";
   write_file_atomically(groups, R"({"format": "chromatrace-bands/1", "edges_nm": [380, 430, 480, 530, 580, 630, 780],
@@ -240,8 +240,9 @@ TEST(RenderCheck, CheckSceneAndRenderSayItAndPlansSettingsAreSilent) {
   EXPECT_EQ(cycles.exit_code, 0) << cycles.err;
   EXPECT_NE(cycles.out.find(fmt::format(
                 "warning    cycles_samples of {} 4, 16 gives Cycles Monte Carlo noise of a predicted mean ΔE00 of {:.3g} "
-                "(0.76 × the tracer's, the median over the test scenes); use {} samples for 1",
+                "({:g} × the tracer's, the median over the test scenes); use {} samples for 1",
                 groups.string(), plan::kCyclesNoiseRatio * at_one * std::sqrt((1.0 / 4 + 1.0 / 16) / 2),
+                plan::kCyclesNoiseRatio,
                 static_cast<int>(std::ceil(std::pow(plan::kCyclesNoiseRatio * at_one, 2))))),
             std::string::npos)
       << cycles.out;
