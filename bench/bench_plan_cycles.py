@@ -3,14 +3,20 @@
 """Benchmark: a spectral Cycles render planned for a colour-error target against one plain RGB Cycles render.
 
     CHROMATRACE_EXE=build/cli/chromatrace python3 bench/bench_plan_cycles.py [--resolution 96] [--samples 256]
-        [--reference-spp 8192] [--target 1] [--light d65|f11|both]
+        [--reference-spp 8192] [--target 1] [--light d65|f11|both] [--scene box|textured|both]
         [--blender blender [--blender build/tests/blender/blender-4.5 ...]]
 
 Each --blender is run in turn (a Blender binary, or a bpy module behind tests/blender/bpy_blender.py, as the
 build's build/tests/blender/blender-4.5, blender-5.2 and blender-5.3 are), the scene's GGX masking set to that Cycles' own
 (separable up to 3.x, height-correlated from 4.0) for its renders and its reference alike.
 
-For the paper box under its own smooth light (CIE D65) and under CIE F11 (three narrow peaks):
+For two scenes, each under a smooth light (D65) and under CIE F11 (three narrow peaks):
+
+- the paper box (scenes/paper/box.json) under its own lamp (CIE D65), and with the lamp's spectrum F11;
+- the textured scene (scenes/textured/textured.json: image textures, a glossy ball, an HDRI sky, whose RGB texels
+  are relative to D65), and the same scene under a uniform F11 sky of the HDRI's mean luminance.
+
+For each:
 
 1. The planned spectral render: the add-on's batch (blender_addon/batch.py) with --plan TARGET --plan-edge-step 5
    (chromatrace plan, two pilot renders for Cycles' noise, plan again: bands, bounce limit and each band group's
@@ -44,7 +50,9 @@ import time
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from bench_blender import PLAIN, ROOT, _children_cpu  # noqa: E402
 
-BOX = os.path.join(ROOT, "scenes", "paper", "box.json")
+SCENES = {"box": os.path.join(ROOT, "scenes", "paper", "box.json"),
+          "textured": os.path.join(ROOT, "scenes", "textured", "textured.json")}
+DATA = os.path.join(ROOT, "core", "data")
 
 
 def absolute_paths(node, base):
@@ -63,16 +71,42 @@ def blender_version(blender):
     return re.search(r"BLENDER_VERSION (\S+)", r.stdout).group(1)
 
 
-def scene_for(light, work, masking):
-    with open(BOX) as f:
-        doc = absolute_paths(json.load(f), os.path.dirname(BOX))
-    if light == "f11":
+def read_csv(path):
+    with open(path) as f:
+        rows = [line.strip().split(",") for line in f if line.strip()][1:]
+    return {float(r[0]): [float(x) for x in r[1:]] for r in rows}
+
+
+def f11_luminance():
+    """CIE F11's luminance (the CIE 1931 ȳ) relative to the flat spectrum 1's, on F11's 5 nm table."""
+    f11, cmf = read_csv(os.path.join(DATA, "illuminants", "F11.csv")), read_csv(os.path.join(DATA, "cie1931_2deg_1nm.csv"))
+    y = {nm: v[1] for nm, v in cmf.items()}
+    common = [nm for nm in f11 if nm in y]
+    return sum(f11[nm][0] * y[nm] for nm in common) / sum(y[nm] for nm in common)
+
+
+def texture_mean_luminance(path):
+    """The mean Rec. 709 luminance of an image's texels (oiiotool --stats)."""
+    stats = run(["oiiotool", "--stats", path]).stdout
+    r, g, b = (float(x) for x in re.search(r"Stats Avg: (\S+) (\S+) (\S+)", stats).groups())
+    return 0.2126 * r + 0.7152 * g + 0.0722 * b
+
+
+def scene_for(scene_name, light, work, masking):
+    source = SCENES[scene_name]
+    with open(source) as f:
+        doc = absolute_paths(json.load(f), os.path.dirname(source))
+    if light == "f11" and scene_name == "box":
         doc["spectra"]["lamp"] = {"illuminant": "F11"}
-        doc["name"] = "box-f11"
+    elif light == "f11":  # the HDRI's place taken by a uniform F11 sky of its mean luminance
+        sky = doc["environment"]["radiance"]["texture"]
+        doc["environment"] = {"radiance": {"illuminant": "F11"},
+                              "scale": round(texture_mean_luminance(sky) / f11_luminance(), 6)}
+    doc["name"] = f"{scene_name}-{light}"
     for material in doc["materials"].values():
         if material.get("type") == "dichromatic" and material.get("lobe", "ggx") == "ggx":
             material["masking"] = masking
-    path = os.path.join(work, f"box-{light}-{masking}.json")
+    path = os.path.join(work, f"{scene_name}-{light}-{masking}.json")
     with open(path, "w") as f:
         json.dump(doc, f, indent=1)
     return path
@@ -90,16 +124,17 @@ def header_plan(exe, exr):
     return json.loads(info["metadata"]["chromatrace.plan"])
 
 
-def bench(light, args, work, blender_exe, version, references):
+def bench(scene_name, light, args, work, blender_exe, version, references):
     exe = os.environ["CHROMATRACE_EXE"]
     masking = "height-correlated" if int(version.split(".")[0]) >= 4 else "separable"
-    scene = scene_for(light, work, masking)
+    scene = scene_for(scene_name, light, work, masking)
+    case = f"{scene_name}-{light}"
     res = f"{args.resolution}x{args.resolution}"
     with open(scene) as f:
         scene_bounces = json.load(f)["render"]["max_bounces"]
 
-    # The reference, once per light and masking.
-    reference = os.path.join(work, f"{light}-{masking}-reference.exr")
+    # The reference, once per scene, light and masking.
+    reference = os.path.join(work, f"{case}-{masking}-reference.exr")
     if reference not in references:
         start_cpu = _children_cpu()
         run([exe, "render", scene, "-o", reference, "--resolution", res, "--bands", "380:780:5", "--spp",
@@ -109,11 +144,11 @@ def bench(light, args, work, blender_exe, version, references):
     out_dir = os.path.join(work, version)
     os.makedirs(out_dir, exist_ok=True)
     blender = [blender_exe, "--background", "--factory-startup"]
-    spectral_exr = os.path.join(out_dir, f"{light}-cycles.exr")
+    spectral_exr = os.path.join(out_dir, f"{case}-cycles.exr")
     spectral = run(blender + ["--python", os.path.join(ROOT, "blender_addon", "batch.py"), "--", "--scene", scene,
                               "--out", spectral_exr, "--resolution", res, "--plan", repr(args.target),
                               "--plan-edge-step", "5", "--components", "paths",
-                              "--cache-dir", os.path.join(out_dir, f"{light}-cache")],
+                              "--cache-dir", os.path.join(out_dir, f"{case}-cache")],
                    env=dict(os.environ, CHROMATRACE_EXE=exe))
     timings = re.findall(r"chromatrace: render \d+/\d+ \(([^)]*)\): ([0-9.]+) s, ([0-9.]+) s CPU", spectral.stderr)
     planning = re.search(r"chromatrace: planning: ([0-9.]+) s, ([0-9.]+) s CPU", spectral.stderr)
@@ -126,15 +161,19 @@ def bench(light, args, work, blender_exe, version, references):
     reference_noise = plan["tracer_noise_at_one_sample"] / args.reference_spp ** 0.5
     predicted = math.hypot(plan["predicted_mean_de00"], reference_noise)
     low, high = (math.hypot(x, reference_noise) for x in plan["predicted_range"])
+    worst_plan = plan.get("worst_object")
+    worst_predicted = (f"{math.hypot(worst_plan['mean_de00'], reference_noise * worst_plan['noise_to_image_noise']):.2f} "
+                       f"({worst_plan['name']})") if worst_plan else "-"
 
     plain = run(blender + ["--python-expr", PLAIN.format(root=ROOT, box=scene, samples=args.samples,
-                                                          res=args.resolution, out=os.path.join(out_dir, "rgb.exr"))])
+                                                          res=args.resolution,
+                                                          out=os.path.join(out_dir, f"{case}-rgb.exr"))])
     found = re.search(r"PLAIN_RENDER_SECONDS ([0-9.]+) ([0-9.]+)", plain.stdout)
     if not found:
         sys.exit("plain RGB render printed no timing:\n" + plain.stdout[-400:] + plain.stderr[-800:])
     plain_cpu = float(found.group(2))
 
-    compare_dir = os.path.join(out_dir, f"{light}-compare")
+    compare_dir = os.path.join(out_dir, f"{case}-compare")
     run([exe, "compare", spectral_exr, reference, "-o", compare_dir, "--colour", "own", "-q"])
     with open(os.path.join(compare_dir, "compare.json")) as f:
         compared = json.load(f)
@@ -142,7 +181,7 @@ def bench(light, args, work, blender_exe, version, references):
     worst_de, worst = max((o["delta_e00_mean"], o["object"]) for o in compared["objects"]
                           if o["object_id"] >= 0 and "delta_e00_mean" in o)
 
-    print(f"\nBlender {version}, {light.upper()}: {said.group(1)}")
+    print(f"\nBlender {version}, {scene_name}, {light.upper()}: {said.group(1)}")
     for what, _wall, cpu in timings:
         print(f"  Cycles render ({what}): {float(cpu):.2f} s CPU")
     print(f"  planned spectral, all Cycles renders: {spectral_cpu:.2f} s CPU; planning (plan twice, pilots): "
@@ -153,9 +192,10 @@ def bench(light, args, work, blender_exe, version, references):
     print(f"  mean dE00 against the 5 nm reference ({args.reference_spp} paths per pixel, "
           f"{references[reference]:.0f} s CPU): measured {mean_de:.2f}, predicted {predicted:.2f} "
           f"({low:.2f}-{high:.2f}); without the reference's noise predicted {plan['predicted_mean_de00']:.2f}; "
-          f"worst object {worst} {worst_de:.2f}")
+          f"worst object {worst} {worst_de:.2f}, predicted {worst_predicted}")
     return dict(ratio=spectral_cpu / plain_cpu, with_planning=(spectral_cpu + planning_cpu) / plain_cpu,
                 measured=mean_de, predicted=predicted, low=low, high=high, worst=f"{worst_de:.2f} ({worst})",
+                worst_predicted=worst_predicted,
                 samples=",".join(map(str, plan["cycles_samples"])))
 
 
@@ -166,24 +206,28 @@ def main():
     p.add_argument("--reference-spp", type=int, default=8192)
     p.add_argument("--target", type=float, default=1.0, help="the plan's mean dE00")
     p.add_argument("--light", choices=("d65", "f11", "both"), default="both")
+    p.add_argument("--scene", choices=("box", "textured", "both"), default="both")
     p.add_argument("--blender", action="append", help="a Blender (repeatable; default: blender)")
     args = p.parse_args()
     if not os.environ.get("CHROMATRACE_EXE"):
         sys.exit("set CHROMATRACE_EXE to the chromatrace executable (e.g. build/cli/chromatrace)")
-    print(f"paper box, {args.resolution}x{args.resolution}, plain render {args.samples} samples, plan for a mean dE00 "
+    print(f"{args.resolution}x{args.resolution}, plain render {args.samples} samples, plan for a mean dE00 "
           f"of {args.target:g}, {os.cpu_count()} cores, load average {os.getloadavg()[0]:.1f}")
     with tempfile.TemporaryDirectory(prefix="chromatrace-bench-plan-") as work:
         results, references = [], {}
         for blender_exe in args.blender or ["blender"]:
             version = blender_version(blender_exe)
-            for light in (("d65", "f11") if args.light == "both" else (args.light,)):
-                results.append((version, light, bench(light, args, work, blender_exe, version, references)))
+            for scene_name in (("box", "textured") if args.scene == "both" else (args.scene,)):
+                for light in (("d65", "f11") if args.light == "both" else (args.light,)):
+                    results.append((version, scene_name, light,
+                                    bench(scene_name, light, args, work, blender_exe, version, references)))
         print(f"\nload average at the end {os.getloadavg()[0]:.1f}")
-        print("\nBlender  light  samples per group  CPU / plain  with planning  mean dE00 measured  predicted (range)"
-              "      worst object")
-        for version, light, r in results:
-            print(f"{version:8s} {light.upper():5s}  {r['samples']:17s}  {r['ratio']:10.2f}x  {r['with_planning']:12.2f}x"
-                  f"  {r['measured']:17.2f}  {r['predicted']:.2f} ({r['low']:.2f}-{r['high']:.2f})  {r['worst']}")
+        print("\nBlender  scene     light  samples per group  CPU / plain  with planning  mean dE00 measured  "
+              "predicted (range)      worst object measured, predicted")
+        for version, scene_name, light, r in results:
+            print(f"{version:8s} {scene_name:9s} {light.upper():5s}  {r['samples']:17s}  {r['ratio']:10.2f}x  "
+                  f"{r['with_planning']:12.2f}x"
+                  f"  {r['measured']:17.2f}  {r['predicted']:.2f} ({r['low']:.2f}-{r['high']:.2f})  {r['worst']}, {r['worst_predicted']}")
 
 
 if __name__ == "__main__":

@@ -48,6 +48,9 @@ Action add_plan(CLI::App& app) {
       ->expected(2);
   cmd->add_option("--reference-spp", o->plan.reference_samples,
                   "Also predict the mean ΔE00 compare measures against a tracer reference of this many paths per pixel");
+  cmd->add_option("--object-target-de00", o->plan.object_target_de00,
+                  "Cycles: the mean ΔE00 no object may be predicted above; the samples grow until none is (default: twice "
+                  "--target-de00)");
   cmd->add_option("--threads", o->plan.threads, "Worker threads (0: all cores)")->capture_default_str();
   cmd->add_flag("-q,--quiet", o->quiet, "No summary on stderr");
 
@@ -61,6 +64,8 @@ Action add_plan(CLI::App& app) {
       throw InputError(fmt::format("--preview-spp: must be >= 1, got {}", o->plan.preview_samples));
     if (o->plan.cycles_noise_ratio < 0 || !std::isfinite(o->plan.cycles_noise_ratio))
       throw InputError(fmt::format("--cycles-noise-ratio: must be > 0, got {:g}", o->plan.cycles_noise_ratio));
+    if (o->plan.object_target_de00 < 0 || !std::isfinite(o->plan.object_target_de00))
+      throw InputError(fmt::format("--object-target-de00: must be > 0, got {:g}", o->plan.object_target_de00));
     if (o->plan.reference_samples < 0)
       throw InputError(fmt::format("--reference-spp: must be >= 1, got {}", o->plan.reference_samples));
     const Scene scene = load_scene(o->scene);

@@ -83,6 +83,13 @@ class Model {
   double band_noise(const std::vector<int>& edges, int max_bounces, const std::vector<bool>& carry) const;
   bool reconstructs() const { return reconstruct_; }
   std::pair<double, double> evaluate_exact(int max_bounces) const;  // exact spectra, truncated bounces
+  // Per surface id: the mean ΔE00 over its pixels of the preview of a plan's bands and bounce limit, as evaluate's
+  // (0 for an id with no lit pixel).
+  std::vector<double> evaluate_by_id(const std::vector<int>& edges, int max_bounces) const;
+  // Per surface id: one preview's noise as mean ΔE00 over its lit pixels (as preview_noise() over the image), and
+  // how many lit pixels it has in the preview.
+  const std::vector<double>& preview_noise_by_id() const { return preview_noise_by_id_; }
+  const std::vector<std::size_t>& pixels_by_id() const { return pixels_by_id_; }
 
   const std::vector<int>& grid_edges() const { return grid_edges_; }  // candidate edge positions (grid indices)
   int lo() const { return grid_.lo; }
@@ -121,7 +128,7 @@ class Model {
   // Mean and 95th percentile over the preview's pixels of ΔE00 against the exact colours, `noise` (per preview
   // pixel) added to the tested colours.
   std::pair<double, double> score(const Templates& templates, int max_bounces,
-                                  const std::vector<Vec3d>* noise = nullptr) const;
+                                  const std::vector<Vec3d>* noise = nullptr, std::vector<double>* by_id = nullptr) const;
   std::optional<BandReconstruction> fit_reconstruction(const TemplateSpectra& banded, const std::vector<int>& edges,
                                                        int max_bounces) const;
   // Appends to `t` (tristimulus values, not yet at unit luminance) the templates of the textured surfaces' colours, in
@@ -166,6 +173,8 @@ class Model {
   Vec3d white_{};
   std::vector<int> grid_edges_;
   double hit_fraction_ = 0, mean_albedo_ = 0, preview_noise_ = 0;
+  std::vector<double> preview_noise_by_id_;
+  std::vector<std::size_t> pixels_by_id_;
   int preview_samples_ = 0;
   std::size_t pixel_count_ = 0;
 };
@@ -435,6 +444,14 @@ void Model::measure_preview_noise(const Preview& preview) {
     b[p] = preview.colour(second.layers[0], p);
   }
   preview_noise_ = N ? delta_e_between(a, b, white_).mean / std::sqrt(2.0) : 0.0;
+  preview_noise_by_id_.assign(surfaces_.size(), 0.0);
+  pixels_by_id_.assign(surfaces_.size(), 0);
+  for (const Pixel& px : pixels_) {
+    preview_noise_by_id_[px.id] += delta_e_2000(xyz_to_lab(a[px.index], white_), xyz_to_lab(b[px.index], white_));
+    ++pixels_by_id_[px.id];
+  }
+  for (std::size_t id = 0; id < surfaces_.size(); ++id)
+    if (pixels_by_id_[id]) preview_noise_by_id_[id] /= std::sqrt(2.0) * static_cast<double>(pixels_by_id_[id]);
   preview_samples_ = preview.image.samples;
   const std::vector<float>&la = preview.image.layers[0], &lb = second.layers[0];
   noise_.resize(la.size());
@@ -473,7 +490,7 @@ std::vector<Vec3d> Model::noise_tristimulus(const std::vector<int>& edges,
 }
 
 std::pair<double, double> Model::score(const Templates& templates, int max_bounces,
-                                        const std::vector<Vec3d>* noise) const {
+                                        const std::vector<Vec3d>* noise, std::vector<double>* by_id) const {
   std::vector<double> de(pixels_.size());
   for (std::size_t p = 0; p < pixels_.size(); ++p) {
     const Sample& s = samples_[p];
@@ -485,12 +502,26 @@ std::pair<double, double> Model::score(const Templates& templates, int max_bounc
       for (int c = 0; c < 3; ++c) x[c] += (*noise)[pixels_[p].index][c];
     de[p] = delta_e_2000(lab_exact_[p], xyz_to_lab(x, white_));
   }
+  if (by_id) {
+    by_id->assign(surfaces_.size(), 0.0);
+    std::vector<std::size_t> count(surfaces_.size(), 0);
+    for (std::size_t p = 0; p < pixels_.size(); ++p) (*by_id)[pixels_[p].id] += de[p], ++count[pixels_[p].id];
+    for (std::size_t id = 0; id < count.size(); ++id)
+      if (count[id]) (*by_id)[id] /= static_cast<double>(count[id]);
+  }
   const double sum = std::accumulate(de.begin(), de.end(), 0.0);
   de.resize(pixel_count_, 0.0);  // unlit pixels: no error
   return {pixel_count_ ? sum / static_cast<double>(pixel_count_) : 0.0, quantile(de, 0.95)};
 }
 
 std::pair<double, double> Model::evaluate_exact(int max_bounces) const { return score(exact_, max_bounces); }
+
+std::vector<double> Model::evaluate_by_id(const std::vector<int>& edges, int max_bounces) const {
+  std::vector<double> by_id;
+  score(banded_templates(edges, max_bounces, reconstruct_, nullptr).templates, std::min(max_bounces, kmax_), nullptr,
+        &by_id);
+  return by_id;
+}
 
 // The reconstruction that best turns the band values of the model's templates into their exact spectra: 1 nm
 // fine bands over the model's grid, the matrix R minimising Σ_t w_t·|a_t − R·b_t|² over the templates t up to the
@@ -828,6 +859,44 @@ int bounces_for(const Model& model, double target) {
   return kmax;
 }
 
+// Each surface seen by at least kObjectPixels lit pixels of the preview (fewer hold too little of its noise to
+// judge): its bands' and bounces' error (its pixels' mean ΔE00), and its noise as its share of the image's (its
+// pixels' noise in the preview over the image's) at the planned samples, in quadrature. Where one is predicted
+// above the object limit, every group's samples grow by the same factor until none is (the noise falls as
+// 1/√samples); a surface whose bands and bounces alone exceed it is said in a note.
+constexpr std::size_t kObjectPixels = 16;
+void limit_objects(Plan& plan, const Scene& scene, const Model& model, const std::vector<int>& edges,
+                   const CyclesNoise& noise, const PlanOptions& options) {
+  const double limit = options.object_target_de00 > 0 ? options.object_target_de00 : 2 * options.target_de00;
+  plan.object_target_de00 = limit;
+  const std::vector<double> bands = model.evaluate_by_id(edges, plan.max_bounces);
+  const std::vector<double>& noise_by_id = model.preview_noise_by_id();
+  auto name = [&](std::size_t id) {
+    return id <= scene.objects.size() ? scene.objects[id - 1].name : scene.lights[id - scene.objects.size() - 1].name;
+  };
+  const double image_noise = model.preview_noise();
+  double factor = 1;  // on the samples
+  std::vector<std::pair<std::size_t, double>> judged;  // id, its noise at the planned samples
+  for (std::size_t id = 1; id < bands.size(); ++id) {
+    if (model.pixels_by_id()[id] < kObjectPixels || !(image_noise > 0)) continue;
+    const double own = noise.at(plan.cycles_samples) * noise_by_id[id] / image_noise;
+    judged.emplace_back(id, own);
+    if (bands[id] >= limit) {
+      plan.notes.push_back(fmt::format("{}: its bands and bounces alone are predicted at a mean ΔE00 of {:.2f}, above "
+                                       "the object limit {:g}", name(id), bands[id], limit));
+      continue;
+    }
+    factor = std::max(factor, std::pow(own / std::sqrt(limit * limit - bands[id] * bands[id]), 2));
+  }
+  if (factor > 1 + 1e-9) {
+    for (int& n : plan.cycles_samples) n = static_cast<int>(std::ceil(n * factor - 1e-9));
+    plan.object_samples_factor = factor;
+  }
+  for (const auto& [id, own] : judged)
+    plan.objects.push_back({name(id), static_cast<int>(id), model.pixels_by_id()[id], bands[id],
+                            std::hypot(bands[id], own / std::sqrt(factor)), noise_by_id[id] / image_noise});
+}
+
 }  // namespace
 
 PiecewiseLinearSpectrum scene_light_spectrum(const Scene& scene) {
@@ -964,6 +1033,7 @@ Plan make_plan(const Scene& scene, const PlanOptions& options) {
   plan.predicted_band_only = model.evaluate(edges, kmax).first;
   if (cycles && !plan.cycles_samples.empty()) {
     CyclesNoise noise = cycles_noise(model, edges, plan.max_bounces, ratio, options);
+    limit_objects(plan, scene, model, edges, noise, options);
     const auto& n = plan.cycles_samples;
     auto with = [&](double noise_de00) { return std::hypot(plan.predicted_mean, noise_de00); };
     plan.cycles_noise_ratio = ratio;
@@ -1101,6 +1171,19 @@ Json report_document(const Plan& plan, const Scene& scene, const PlanOptions& op
           {"samples", options.reference_samples},
           {"mean_de00", plan.cycles_predicted_against_reference},
           {"mean_de00_range", {plan.cycles_against_reference_low, plan.cycles_against_reference_high}}};
+    c["object_limit_mean_de00"] = plan.object_target_de00;
+    c["samples_raised_for_objects"] = plan.object_samples_factor;
+    Json objects = Json::array();
+    for (const Plan::ObjectPrediction& o : plan.objects) {
+      Json j{{"name", o.name}, {"object_id", o.id}, {"preview_pixels", o.preview_pixels},
+             {"bands_only_mean_de00", o.bands_only}, {"mean_de00", o.predicted_mean},
+             {"noise_to_image_noise", o.noise_scale}};
+      if (options.reference_samples > 0)
+        j["against_tracer_reference_mean_de00"] =
+            std::hypot(o.predicted_mean, plan.tracer_noise_at_one * o.noise_scale / std::sqrt(options.reference_samples));
+      objects.push_back(j);
+    }
+    c["objects"] = objects;
     p["cycles"] = c;
   }
   Json trials = Json::array();

@@ -61,6 +61,9 @@ struct PlanOptions {
   // Also predict the mean ΔE00 that comparing the Cycles render with a tracer reference of this many paths per
   // pixel measures (its noise counts too); 0: not.
   int reference_samples = 0;
+  // Cycles: the mean ΔE00 no object of the preview may be predicted above (its bands, bounces and noise); the samples
+  // grow until none is. 0: twice target_de00.
+  double object_target_de00 = 0;
 };
 
 // Cycles' Monte Carlo noise against the tracer's at equal samples per pixel: the mean ΔE00 between two renders with
@@ -114,6 +117,17 @@ struct Plan {
   double cycles_predicted_mean = 0;               // mean ΔE00 of bands, bounces and noise at cycles_samples
   double cycles_predicted_low = 0, cycles_predicted_high = 0;  // the same over the ratio's range
   double cycles_noise_only = 0;                   // the noise alone at cycles_samples (exact spectra)
+  // Each object the preview sees enough of (limit_objects in plan.cpp): its predicted mean ΔE00 at cycles_samples,
+  // and the factor by which the samples grew so that none exceeds object_target_de00 (1: the mean's samples did).
+  struct ObjectPrediction {
+    std::string name;
+    int id = 0;
+    std::size_t preview_pixels = 0;
+    double bands_only = 0, predicted_mean = 0;
+    double noise_scale = 1;  // its pixels' noise over the image's, in the preview
+  };
+  std::vector<ObjectPrediction> objects;
+  double object_target_de00 = 0, object_samples_factor = 1;
   // With PlanOptions::reference_samples: what compare measures against such a reference, and its range.
   double cycles_predicted_against_reference = 0, cycles_against_reference_low = 0, cycles_against_reference_high = 0;
   // Cost.

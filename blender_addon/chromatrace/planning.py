@@ -59,7 +59,20 @@ class Planned:
         return (f"plan for a mean ΔE00 of {self.report['target_de00']:g}: {self.report['settings']['band_count']} bands, "
                 f"max {self.max_bounces} bounces, samples per band group {', '.join(map(str, self.samples))}; "
                 f"predicted mean ΔE00 {cycles['mean_de00']:.2f} ({low:.2f}-{high:.2f}), Cycles' noise "
-                f"{cycles['noise_ratio_to_tracer']:.2f} × the tracer's on the pilots")
+                f"{cycles['noise_ratio_to_tracer']:.2f} × the tracer's on the pilots{self._worst_object()}")
+
+    def worst_object(self):
+        """The object predicted worst (plan's prediction.cycles.objects), or None."""
+        objects = self.report["prediction"]["cycles"].get("objects") or []
+        return max(objects, key=lambda o: o["mean_de00"]) if objects else None
+
+    def _worst_object(self):
+        worst, cycles = self.worst_object(), self.report["prediction"]["cycles"]
+        if worst is None:
+            return ""
+        raised = cycles.get("samples_raised_for_objects", 1)
+        return (f"; worst object {worst['name']} {worst['mean_de00']:.2f} (objects held to "
+                f"{cycles['object_limit_mean_de00']:g}" + (f", samples × {raised:.2f} for it)" if raised > 1 else ")"))
 
     def header(self):
         """What the output's header keeps of the plan (chromatrace.plan)."""
@@ -68,7 +81,8 @@ class Planned:
                            "max_bounces": self.max_bounces, "cycles_samples": self.samples,
                            "predicted_mean_de00": cycles["mean_de00"], "predicted_range": cycles["mean_de00_range"],
                            "noise_ratio_to_tracer": cycles["noise_ratio_to_tracer"],
-                           "tracer_noise_at_one_sample": cycles["tracer_noise_at_one_sample"]})
+                           "tracer_noise_at_one_sample": cycles["tracer_noise_at_one_sample"],
+                           "worst_object": self.worst_object()})
 
 
 def plan_render(scene_file, target, work_dir, render_pilot, tool, edge_step=None):

@@ -25,6 +25,7 @@
 #include "core/scene.h"
 #include "core/series_format.h"
 #include "core/spectral_exr.h"
+#include "plan/plan.h"
 #include "tests/cli/run_command.h"
 #include "tests/cli/text_files.h"
 #include "tests/common/view_factor.h"
@@ -485,11 +486,27 @@ TEST_F(Blender, PlannedRenderMeetsThePredictedError) {
       const CommandResult m = test::run_chromatrace({"compare", out.string(), reference.string(), "-o", cmp.string(),
                                                      "--colour", "own", "--quiet"});
       ASSERT_EQ(m.exit_code, 0) << m.err;
-      measured.push_back(read_json(cmp / "compare.json")["image"]["delta_e00"]["mean"].get<double>());
+      const json compared = read_json(cmp / "compare.json");
+      measured.push_back(compared["image"]["delta_e00"]["mean"].get<double>());
       std::fprintf(stderr, "%s, seed %d, %s: measured mean dE00 %.3f against the reference, predicted %.3f (%.3f-%.3f)\n",
                    name.c_str(), seed, said[0].c_str(), measured.back(), predicted, lo, hi);
       EXPECT_GE(measured.back(), lo);
       EXPECT_LE(measured.back(), hi);
+      // No object above the object limit (2): the worst measured is at most the worst predicted with its noise taken
+      // to the noise model's accuracy (and the reference's noise on that object).
+      double worst_measured = 0;
+      for (const json& o : compared["objects"])
+        if (o["object_id"].get<int>() > 0 && o.contains("delta_e00_mean"))
+          worst_measured = std::max(worst_measured, o["delta_e00_mean"].get<double>());
+      const json& worst = plan["worst_object"];
+      const double b = worst["bands_only_mean_de00"].get<double>(), own = worst["mean_de00"].get<double>();
+      const double worst_hi = std::hypot(b, std::sqrt(std::max(0.0, own * own - b * b)) * (1 + plan::kCyclesNoiseModelAccuracy),
+                                         reference_noise * worst["noise_to_image_noise"].get<double>());
+      std::fprintf(stderr, "  worst object measured %.3f; predicted %s %.3f (against the reference %.3f), at most %.3f\n",
+                   worst_measured, worst["name"].get<std::string>().c_str(), own,
+                   std::hypot(own, reference_noise * worst["noise_to_image_noise"].get<double>()), worst_hi);
+      EXPECT_LE(own, 2.0 + 1e-9);
+      EXPECT_LE(worst_measured, worst_hi);
     }
     EXPECT_NEAR(measured[0], measured[1], 0.1);
   }

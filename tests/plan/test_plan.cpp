@@ -156,6 +156,43 @@ TEST_F(Plan, PredictsTheMeasuredErrorOnTheTexturedScene) {
   EXPECT_GE(o.plan.predicted_mean, o.measured / 1.5);
 }
 
+// No object may be predicted above the object limit (twice the target unless given): on the paper box the ceiling,
+// lit by interreflection alone, has 2.4 times the image's noise, so the samples the mean needs leave it above 2, and
+// every group's grow by the one factor that brings it to 2 (within the rounding of a sample). Each object's
+// prediction is its bands' and bounces' error and its share of the noise in quadrature; its noise scales as the
+// image's.
+TEST_F(Plan, ObjectsAreHeldToTheirLimit) {
+  auto plan = [&](std::vector<std::string> extra) {
+    std::vector<std::string> args = {"plan", kBox.string(), "--threads", "2", "--quiet", "--edge-step", "5",
+                                     "--cycles-noise-ratio", "0.8"};
+    args.insert(args.end(), extra.begin(), extra.end());
+    const auto r = run_chromatrace(args);
+    EXPECT_EQ(r.exit_code, 0) << r.err;
+    return parse_json(r.out, "stdout");
+  };
+  const Json free = plan({"--object-target-de00", "100"})["prediction"]["cycles"];
+  const Json held = plan({})["prediction"]["cycles"];
+  EXPECT_EQ(held["object_limit_mean_de00"].get<double>(), 2.0);
+  EXPECT_EQ(free["samples_raised_for_objects"].get<double>(), 1.0);
+  const double factor = held["samples_raised_for_objects"].get<double>();
+  EXPECT_GT(factor, 1.0);
+  const auto n = free["samples_per_band_group"].get<std::vector<int>>(), m = held["samples_per_band_group"].get<std::vector<int>>();
+  ASSERT_EQ(n.size(), m.size());
+  for (std::size_t g = 0; g < n.size(); ++g) EXPECT_NEAR(m[g], factor * n[g], 1.0) << g;
+  double worst = 0;
+  std::string worst_name;
+  for (const Json& o : held["objects"]) {
+    const double own = o["mean_de00"].get<double>(), bands = o["bands_only_mean_de00"].get<double>();
+    const double noise = held["noise_only_mean_de00"].get<double>() * o["noise_to_image_noise"].get<double>();
+    EXPECT_NEAR(own * own, bands * bands + noise * noise, 0.02 * own * own) << o["name"];  // noise at rounded samples
+    EXPECT_LE(own, 2.0 + 1e-9) << o["name"];
+    if (own > worst) worst = own, worst_name = o["name"];
+  }
+  EXPECT_EQ(worst_name, "ceiling");
+  EXPECT_NEAR(worst, 2.0, 0.01);
+  EXPECT_LT(held["mean_de00"].get<double>(), free["mean_de00"].get<double>());
+}
+
 // The planned samples: two renders at that many paths per pixel and independent seeds differ by a mean ΔE00 of
 // √2 × the noise of one; the noise of one must be the target within a factor 1.5 (the preview at the
 // measurement's pixel size, as the prediction assumes).
@@ -391,7 +428,12 @@ TEST_F(Plan, CyclesSamplesPerBandGroupMeetTheTargetWithTheBands) {
     EXPECT_EQ(r.exit_code, 0) << r.err;
     return parse_json(r.out, "stdout");
   };
-  const Json one = plan({"-o", bands.string(), "--cycles-noise-ratio", "1"});
+  // The law of the mean alone first: no object limit to meet (test ObjectsAreHeldToTheirLimit below).
+  auto mean_plan = [&](std::vector<std::string> extra) {
+    extra.insert(extra.end(), {"--object-target-de00", "100"});
+    return plan(extra);
+  };
+  const Json one = mean_plan({"-o", bands.string(), "--cycles-noise-ratio", "1"});
   const Json& c = one["prediction"]["cycles"];
   const auto n = c["samples_per_band_group"].get<std::vector<int>>();
   ASSERT_EQ(n.size(), (one["settings"]["band_count"].get<std::size_t>() + 2) / 3);
@@ -411,11 +453,11 @@ TEST_F(Plan, CyclesSamplesPerBandGroupMeetTheTargetWithTheBands) {
   EXPECT_NEAR(c["mean_de00_range"][1].get<double>(),
               std::hypot(bands_error, noise * (1 + plan::kCyclesNoiseModelAccuracy)), 1e-9);
   // Twice the noise: four times the samples (each within the rounding of one sample per group).
-  const auto twice = plan({"--cycles-noise-ratio", "2"})["prediction"]["cycles"]["samples_per_band_group"].get<std::vector<int>>();
+  const auto twice = mean_plan({"--cycles-noise-ratio", "2"})["prediction"]["cycles"]["samples_per_band_group"].get<std::vector<int>>();
   ASSERT_EQ(twice.size(), n.size());
   for (std::size_t g = 0; g < n.size(); ++g) EXPECT_NEAR(twice[g], 4.0 * n[g], 4.0) << g;
   // A looser target: the noise's budget T² − B² grows, the samples fall by its ratio (same bands and bounces).
-  const Json loose = plan({"--cycles-noise-ratio", "1", "--target-de00", "1.5"});
+  const Json loose = mean_plan({"--cycles-noise-ratio", "1", "--target-de00", "1.5"});
   ASSERT_EQ(loose["settings"]["bands"], one["settings"]["bands"]);
   const double b2 = loose["prediction"]["mean_de00"].get<double>();
   const auto fewer = loose["prediction"]["cycles"]["samples_per_band_group"].get<std::vector<int>>();
@@ -423,7 +465,7 @@ TEST_F(Plan, CyclesSamplesPerBandGroupMeetTheTargetWithTheBands) {
   for (std::size_t g = 0; g < n.size(); ++g) EXPECT_NEAR(fewer[g], scale * n[g], 1.0) << g;
   // The default ratio is the measured median, stated over the measured range; against a reference of N paths its
   // noise adds in quadrature too.
-  const Json median = plan({"--reference-spp", "4096"});
+  const Json median = mean_plan({"--reference-spp", "4096"});
   const Json& m = median["prediction"]["cycles"];
   EXPECT_EQ(m["noise_ratio_to_tracer"].get<double>(), plan::kCyclesNoiseRatio);
   EXPECT_LT(m["mean_de00_range"][0].get<double>(), m["mean_de00"].get<double>());
