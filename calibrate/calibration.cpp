@@ -31,10 +31,13 @@ Json channel_json(const ChannelCalibration& c) {
   return {{"channel", c.channel},
           {"gain_dn_per_e", estimate_json(c.gain_dn_per_e)},
           {"dark_noise_e", estimate_json(c.dark_noise_e)},
+          {"dark_noise_is_upper_limit", c.dark_noise_upper_limit},
           {"saturation_capacity_e", estimate_json(c.saturation_capacity_e)},
           {"saturation_mean_dn", c.saturation_mean_dn},
           {"clip_level_e", c.clip_level_e ? estimate_json(*c.clip_level_e) : Json(nullptr)},
           {"dark_current_e_per_s", estimate_json(c.dark_current_e_per_s)},
+          {"dark_current_from_variance_e_per_s",
+           c.dark_current_from_variance_e_per_s ? estimate_json(*c.dark_current_from_variance_e_per_s) : Json(nullptr)},
           {"black_level_dn", estimate_json(c.black_level_dn)},
           {"dsnu_e", nonuniformity_json(c.dsnu_e)},
           {"prnu", nonuniformity_json(c.prnu)},
@@ -43,6 +46,12 @@ Json channel_json(const ChannelCalibration& c) {
           {"quantum_efficiency", c.quantum_efficiency ? estimate_json(*c.quantum_efficiency) : Json(nullptr)},
           {"points", points},
           {"notes", c.notes}};
+}
+
+bool dark_current_from_variance(const ChannelCalibration& c) {
+  if (!c.dark_current_from_variance_e_per_s) return false;
+  const Estimate &m = c.dark_current_e_per_s, &v = *c.dark_current_from_variance_e_per_s;
+  return std::abs(v.value - m.value) > 3 * std::hypot(v.standard_error, m.standard_error);
 }
 
 // The mean of the three channels' values.
@@ -55,35 +64,52 @@ double channel_mean(const std::array<ChannelCalibration, 3>& channels, Get get) 
 
 }  // namespace
 
+double simulated_dark_current(const ChannelCalibration& c) {
+  return dark_current_from_variance(c) ? c.dark_current_from_variance_e_per_s->value : c.dark_current_e_per_s.value;
+}
+
 Calibration calibrate(const CalibrationInput& input) {
   if (input.flats.empty()) throw InputError("--flat: no flat frames");
   if (input.darks.empty()) throw InputError("--dark: no dark frames");
   if (input.photons_per_s && !(*input.photons_per_s > 0 && std::isfinite(*input.photons_per_s)))
     throw InputError(fmt::format("--photons-per-s: must be a positive number, got {}", *input.photons_per_s));
 
+  // Every frame, then the odd one out named against the most common camera and size (the first frame may be the odd
+  // one: naming it as the norm would point at a good file).
+  std::vector<std::pair<int, Frame>> frames;  // kind (0 flat, 1 dark), frame
+  for (int kind = 0; kind < 2; ++kind)
+    for (const auto& file : kind == 0 ? input.flats : input.darks) frames.emplace_back(kind, read_frame(file));
+  auto most_common = [&](auto key) {
+    std::map<decltype(key(frames[0].second)), std::size_t> count;
+    for (const auto& [kind, f] : frames) ++count[key(f)];
+    return std::max_element(count.begin(), count.end(), [](const auto& a, const auto& b) { return a.second < b.second; })->first;
+  };
+  const std::string sensor = most_common([](const Frame& f) { return f.sensor; });
+  const auto size = most_common([](const Frame& f) { return std::pair{f.channels[0].width, f.channels[0].height}; });
+  const auto norm = [&](auto matches) {
+    return std::find_if(frames.begin(), frames.end(), [&](const auto& kf) { return matches(kf.second); })->second.file;
+  };
+  for (const auto& [kind, f] : frames) {
+    const Plane& p = f.channels[0];
+    if (f.sensor != sensor)
+      throw InputError(fmt::format("{}: {}, but {} is {}: every frame must come from the same camera and mosaic", f.file,
+                                   f.sensor, norm([&](const Frame& g) { return g.sensor == sensor; }), sensor));
+    if (std::pair{p.width, p.height} != size)
+      throw InputError(fmt::format("{}: {} x {} values per channel, but {} has {} x {}: every frame must come from the same "
+                                   "sensor area",
+                                   f.file, p.width, p.height,
+                                   norm([&](const Frame& g) { return std::pair{g.channels[0].width, g.channels[0].height} == size; }),
+                                   size.first, size.second));
+  }
+
   // Frames by exposure time.
   std::map<double, std::array<std::vector<Frame>, 2>> by_time;  // [0] flats, [1] darks
-  int width = -1, height = -1;
-  std::string first, sensor;
   std::optional<int> bits;
-  for (int kind = 0; kind < 2; ++kind)
-    for (const auto& file : kind == 0 ? input.flats : input.darks) {
-      Frame f = read_frame(file);
-      const Plane& p = f.channels[0];
-      if (width < 0) {
-        width = p.width, height = p.height, first = f.file, sensor = f.sensor;
-      } else if (f.sensor != sensor) {
-        throw InputError(fmt::format("{}: {}, but {} is {}: every frame must come from the same camera and mosaic", f.file,
-                                     f.sensor, first, sensor));
-      } else if (p.width != width || p.height != height) {
-        throw InputError(fmt::format("{}: {} x {} values per channel, but {} has {} x {}: every frame must come from the same "
-                                     "sensor area",
-                                     f.file, p.width, p.height, first, width, height));
-      }
-      if (f.adc_bits && *f.adc_bits > 0) bits = f.adc_bits;
-      else if (!bits && f.white_level_dn) bits = static_cast<int>(std::ceil(std::log2(*f.white_level_dn + 1)));
-      by_time[f.exposure_s][static_cast<std::size_t>(kind)].push_back(std::move(f));
-    }
+  for (auto& [kind, f] : frames) {
+    if (f.adc_bits && *f.adc_bits > 0) bits = f.adc_bits;
+    else if (!bits && f.white_level_dn) bits = static_cast<int>(std::ceil(std::log2(*f.white_level_dn + 1)));
+    by_time[f.exposure_s][static_cast<std::size_t>(kind)].push_back(std::move(f));
+  }
   if (by_time.size() < 2)
     throw InputError(fmt::format("--flat: every frame has the exposure time {} s; the photon transfer needs a series of exposures",
                                  by_time.begin()->first));
@@ -124,6 +150,14 @@ Calibration calibrate(const CalibrationInput& input) {
     }
     try {
       result.channels[c] = calibrate_channel(kChannelNames[c], steps);
+      ChannelCalibration& cc = result.channels[c];
+      if (dark_current_from_variance(cc))
+        cc.notes.push_back(fmt::format(
+            "the dark current from the dark frames' variance, {:.4g} ± {:.2g} e⁻/s, is not the dark mean's, {:.4g} ± {:.2g} "
+            "e⁻/s (a camera that subtracts its dark offset on chip keeps the mean flat): the sensor settings take the "
+            "variance's, the dark electrons' shot noise",
+            cc.dark_current_from_variance_e_per_s->value, cc.dark_current_from_variance_e_per_s->standard_error,
+            cc.dark_current_e_per_s.value, cc.dark_current_e_per_s.standard_error));
     } catch (const InputError& e) {
       throw InputError(fmt::format("--flat: {}", e.what()));
     }
@@ -133,7 +167,7 @@ Calibration calibrate(const CalibrationInput& input) {
   Json noise = {{"enabled", true},
                 {"shot", true},
                 {"read_e", channel_mean(ch, [](const auto& c) { return c.dark_noise_e.value; })},
-                {"dark_current_e_per_s", std::max(0.0, channel_mean(ch, [](const auto& c) { return c.dark_current_e_per_s.value; }))},
+                {"dark_current_e_per_s", std::max(0.0, channel_mean(ch, [](const auto& c) { return simulated_dark_current(c); }))},
                 {"dsnu_e", channel_mean(ch, [](const auto& c) { return c.dsnu_e.pixel.value; })},
                 {"dsnu_row_e", channel_mean(ch, [](const auto& c) { return c.dsnu_e.row.value; })},
                 {"dsnu_column_e", channel_mean(ch, [](const auto& c) { return c.dsnu_e.column.value; })},
@@ -143,11 +177,24 @@ Calibration calibrate(const CalibrationInput& input) {
   Json adc = {{"enabled", true},
               {"gain_dn_per_e", channel_mean(ch, [](const auto& c) { return c.gain_dn_per_e.value; })},
               {"black_level_dn", channel_mean(ch, [](const auto& c) { return c.black_level_dn.value; })}};
-  if (bits) adc["bits"] = *bits;
+  std::string bits_from = "the frames' own";
+  if (!bits) {
+    // A TIFF or EXR says no ADC depth: the largest value any frame holds (the top code where frames clip) sets it,
+    // so that the simulated camera clips where this one does rather than at 16 bits.
+    double largest = 0;
+    for (const auto& [t, sets] : by_time)
+      for (const auto& set : sets)
+        for (const Frame& f : set)
+          for (const Plane& p : f.channels)
+            for (double v : p.values) largest = std::max(largest, v);
+    bits = std::max(1, static_cast<int>(std::ceil(std::log2(std::floor(largest) + 1))));
+    bits_from = fmt::format("from the largest value in the frames, {:g} DN", largest);
+  }
+  adc["bits"] = *bits;
   result.sensor = {{"format", "chromatrace-sensor/1"},
                    {"description", fmt::format("Calibrated with chromatrace calibrate (EMVA 1288 Linear) from {} flat and {} dark frames "
-                                               "at {} exposure times; the mean of the R, G and B channels",
-                                               result.flats, result.darks, result.exposures)},
+                                               "at {} exposure times; the mean of the R, G and B channels; adc.bits {}",
+                                               result.flats, result.darks, result.exposures, bits_from)},
                    {"noise", noise},
                    {"full_well", {{"enabled", true}, {"electrons", channel_mean(ch, [](const auto& c) {
                                    return c.clip_level_e ? c.clip_level_e->value : c.saturation_capacity_e.value;
@@ -161,7 +208,7 @@ Calibration calibrate(const CalibrationInput& input) {
                    {"darks", result.darks},
                    {"exposures", result.exposures},
                    {"photons_per_s", input.photons_per_s ? Json(*input.photons_per_s) : Json(nullptr)},
-                   {"frame_size", {width, height}},
+                   {"frame_size", {size.first, size.second}},
                    {"channels", channels},
                    {"sensor", result.sensor}};
   return result;

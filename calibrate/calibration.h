@@ -32,4 +32,9 @@ struct Calibration {
 // saturation.
 Calibration calibrate(const CalibrationInput& input);
 
+// The dark current the sensor settings take for a channel: the dark mean's estimate, unless the dark variance's
+// disagrees with it by more than three standard errors (a camera that subtracts its dark offset on chip keeps the
+// mean flat while the dark electrons' shot noise grows); then the variance's, the noise the histograms show.
+double simulated_dark_current(const ChannelCalibration& c);
+
 }  // namespace ct::calibrate

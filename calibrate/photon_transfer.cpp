@@ -14,6 +14,8 @@ namespace ct::calibrate {
 namespace {
 
 constexpr double kQuantisationVariance = 1.0 / 12.0;  // σ_q², DN²
+// Below this dark variance (DN²) EMVA 1288 gives only an upper limit of the temporal dark noise.
+constexpr double kQuantisationLimit = 0.24;
 constexpr double kGainFitTop = 0.7;                    // the gain is fitted up to this share of saturation
 constexpr double kLinearityLow = 0.05, kLinearityHigh = 0.95;
 
@@ -230,15 +232,25 @@ ChannelCalibration calibrate_channel(const std::string& channel, const std::vect
     c.dark_current_e_per_s = {dm.slope / K, std::hypot(dm.slope_se / K, dm.slope / K * rK)};
     c.black_level_dn = {dm.intercept, dm.intercept_se};
     const LineFit dv = fit_line(times, dark_variances, false);
+    const double K2 = K * K;
+    c.dark_current_from_variance_e_per_s = Estimate{dv.slope / K2, std::hypot(dv.slope_se / K2, dv.slope / K2 * 2 * rK)};
     dark_variance_0 = dv.intercept;
     dark_variance_0_se = std::max(dv.intercept_se, variance_se(dark[0].variance, n) / std::sqrt(double(steps.size())));
   } else {
     c.black_level_dn = {dark[0].mean, std::sqrt(dark[0].variance / double(n))};
     c.notes.push_back("every dark frame has one exposure time: no dark current measured");
   }
-  const double read_variance = std::max(0.0, dark_variance_0 - kQuantisationVariance);
-  const double sigma_d = std::sqrt(read_variance) / K;
-  c.dark_noise_e = {sigma_d, sigma_d * std::hypot(read_variance > 0 ? dark_variance_0_se / (2 * read_variance) : 0.0, rK)};
+  if (dark_variance_0 < kQuantisationLimit) {
+    c.dark_noise_upper_limit = true;
+    c.dark_noise_e = {std::sqrt(kQuantisationLimit - kQuantisationVariance) / K, 0.0};
+    c.notes.push_back(fmt::format("the dark frames' temporal variance, {:.3g} DN², is below 0.24 DN²: quantisation hides "
+                                  "the temporal dark noise, whose upper limit √(0.24 − 1/12)/K is given (EMVA 1288)",
+                                  dark_variance_0));
+  } else {
+    const double read_variance = dark_variance_0 - kQuantisationVariance;
+    const double sigma_d = std::sqrt(read_variance) / K;
+    c.dark_noise_e = {sigma_d, sigma_d * std::hypot(dark_variance_0_se / (2 * read_variance), rK)};
+  }
 
   // DSNU at the shortest exposure, PRNU at the flat level nearest half of saturation. A spread √v from a variance v
   // with standard error se has the standard error se / (2√v), or, where v is not above its error, is bounded by √se.

@@ -10,8 +10,10 @@
 //   - the overall system gain K: the slope of σ_y² − σ_y.dark² against μ_y − μ_y.dark, a line through the origin
 //     fitted from the darkest flat up to 70 % of saturation;
 //   - saturation: the flat level at which σ_y² is largest; the saturation capacity μ_e.sat = (μ_y − μ_y.dark)/K there;
-//   - the temporal dark noise σ_d = √(σ_y.dark² − σ_q²)/K at the shortest exposure, σ_q² = 1/12 DN²;
-//   - the dark current: the slope of μ_y.dark against t, over K (e⁻/s);
+//   - the temporal dark noise σ_d = √(σ_y.dark² − σ_q²)/K at the shortest exposure, σ_q² = 1/12 DN²; where
+//     σ_y.dark² < 0.24 DN² quantisation hides it, and the upper limit √(0.24 − 1/12)/K = 0.40/K is given instead;
+//   - the dark current, both ways the standard gives: the slope of μ_y.dark against t over K, and the slope of
+//     σ_y.dark² against t over K² (its shot noise; what a camera that subtracts its dark offset on chip shows) (e⁻/s);
 //   - DSNU and PRNU: the spatial variance of the mean of the frames less the temporal variance left in it
 //     (σ²/L for L frames), split into row, column and pixel parts as Release 4.0 does (the variance of the row
 //     means and of the column means, each less what the pixel part leaves in a mean); DSNU = s_y.dark/K (e⁻),
@@ -73,6 +75,12 @@ struct ChannelCalibration {
   // where the brightest pixels of a frame start to clip. Absent when no exposure clips every pixel.
   std::optional<Estimate> clip_level_e;
   Estimate dark_current_e_per_s;    // from μ_y.dark against t
+  // The dark current from σ²_y.dark against t (slope / K²: the dark electrons' shot noise), which a camera that
+  // subtracts its dark offset on chip still shows; absent with one exposure time.
+  std::optional<Estimate> dark_current_from_variance_e_per_s;
+  // σ²_y.dark below 0.24 DN²: quantisation hides the temporal dark noise, and dark_noise_e is EMVA 1288's upper
+  // limit √(0.24 − 1/12)/K, not a measurement.
+  bool dark_noise_upper_limit = false;
   Estimate black_level_dn;          // μ_y.dark extrapolated to t = 0
   Nonuniformity dsnu_e;             // DSNU, e⁻
   Nonuniformity prnu;               // PRNU, a fraction

@@ -225,10 +225,15 @@ td,th{border-bottom:1px solid #ddd;padding:4px 10px;text-align:right}th:first-ch
     html += "</tr>";
   };
   row("system gain K (DN/e⁻)", [](const auto& c) { return cell(c.gain_dn_per_e); });
-  row("temporal dark noise σd (e⁻)", [](const auto& c) { return cell(c.dark_noise_e); });
+  row("temporal dark noise σd (e⁻)", [](const auto& c) {
+    return c.dark_noise_upper_limit ? fmt::format("≤ {:.3g} (quantisation)", c.dark_noise_e.value) : cell(c.dark_noise_e);
+  });
   row("saturation capacity μe.sat (e⁻)", [](const auto& c) { return cell(c.saturation_capacity_e); });
   row("clip level (e⁻)", [](const auto& c) { return c.clip_level_e ? cell(*c.clip_level_e) : std::string("—"); });
-  row("dark current (e⁻/s)", [](const auto& c) { return cell(c.dark_current_e_per_s); });
+  row("dark current from the dark mean (e⁻/s)", [](const auto& c) { return cell(c.dark_current_e_per_s); });
+  row("dark current from the dark variance (e⁻/s)", [](const auto& c) {
+    return c.dark_current_from_variance_e_per_s ? cell(*c.dark_current_from_variance_e_per_s) : std::string("—");
+  });
   row("black level (DN)", [](const auto& c) { return cell(c.black_level_dn); });
   row("DSNU (e⁻): total", [](const auto& c) { return cell(c.dsnu_e.total); });
   row("&nbsp;&nbsp;row / column / pixel", [](const auto& c) {

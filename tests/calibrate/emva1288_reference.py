@@ -23,6 +23,7 @@ def main(descriptor):
         "sigma_d": r.sigma_d,
         "u_e_sat": r.u_e_sat,
         "dark_current_mean": r.u_I_mean,
+        "dark_current_var": r.u_I_var,
         "DSNU": r.DSNU1288,
         "DSNU_row": r.DSNU1288_row,
         "DSNU_col": r.DSNU1288_col,
