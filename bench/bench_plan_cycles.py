@@ -14,7 +14,8 @@ For two scenes, each under a smooth light (D65) and under CIE F11 (three narrow 
 
 - the paper box (scenes/paper/box.json) under its own lamp (CIE D65), and with the lamp's spectrum F11;
 - the textured scene (scenes/textured/textured.json: image textures, a glossy ball, an HDRI sky, whose RGB texels
-  are relative to D65), and the same scene under a uniform F11 sky of the HDRI's mean luminance.
+  are relative to D65), and the same scene lit instead by an F11 panel overhead (a 6 m square 3 m up, of the HDRI's
+  mean luminance; Blender's world takes no measured spectrum).
 
 For each:
 
@@ -98,10 +99,12 @@ def scene_for(scene_name, light, work, masking):
         doc = absolute_paths(json.load(f), os.path.dirname(source))
     if light == "f11" and scene_name == "box":
         doc["spectra"]["lamp"] = {"illuminant": "F11"}
-    elif light == "f11":  # the HDRI's place taken by a uniform F11 sky of its mean luminance
-        sky = doc["environment"]["radiance"]["texture"]
-        doc["environment"] = {"radiance": {"illuminant": "F11"},
-                              "scale": round(texture_mean_luminance(sky) / f11_luminance(), 6)}
+    elif light == "f11":  # the HDRI's place taken by a 6 m square F11 panel 3 m up of the HDRI's mean luminance
+        sky = doc.pop("environment")["radiance"]["texture"]
+        doc["lights"] = [{"name": "panel_f11", "shape": {"type": "quad", "corner": [-3, -3, 3], "edge1": [0, 6, 0],
+                                                          "edge2": [6, 0, 0]},
+                          "radiance": {"illuminant": "F11"},
+                          "scale": round(texture_mean_luminance(sky) / f11_luminance(), 6)}]
     doc["name"] = f"{scene_name}-{light}"
     for material in doc["materials"].values():
         if material.get("type") == "dichromatic" and material.get("lobe", "ggx") == "ggx":

@@ -111,12 +111,12 @@ Calibration calibrate(const CalibrationInput& input) {
     by_time[f.exposure_s][static_cast<std::size_t>(kind)].push_back(std::move(f));
   }
   if (by_time.size() < 2)
-    throw InputError(fmt::format("--flat: every frame has the exposure time {} s; the photon transfer needs a series of exposures",
+    throw InputError(fmt::format("--flat: every frame has the exposure time {:.6g} s; the photon transfer needs a series of exposures",
                                  by_time.begin()->first));
   for (const auto& [t, sets] : by_time)
     for (int kind = 0; kind < 2; ++kind)
       if (sets[static_cast<std::size_t>(kind)].size() < 2)
-        throw InputError(fmt::format("{}: {} {} frame{} at {} s, where the series needs at least two (a pair: their difference "
+        throw InputError(fmt::format("{}: {} {} frame{} at {:.6g} s, where the series needs at least two (a pair: their difference "
                                      "cancels the fixed pattern)",
                                      kind == 0 ? "--flat" : "--dark", sets[static_cast<std::size_t>(kind)].size(),
                                      kind == 0 ? "flat" : "dark", sets[static_cast<std::size_t>(kind)].size() == 1 ? "" : "s", t));
@@ -129,7 +129,7 @@ Calibration calibrate(const CalibrationInput& input) {
         for (std::size_t b = a + 1; b < set.size(); ++b)
           if (std::equal(set[a].channels.begin(), set[a].channels.end(), set[b].channels.begin(),
                          [](const Plane& x, const Plane& y) { return x.values == y.values; }))
-            throw InputError(fmt::format("{}: the same image as {} (both {} frames at {} s): the frames of a pair must be two "
+            throw InputError(fmt::format("{}: the same image as {} (both {} frames at {:.6g} s): the frames of a pair must be two "
                                          "exposures, whose difference holds the temporal noise",
                                          set[b].file, set[a].file, kind == 0 ? "flat" : "dark", t));
     }

@@ -128,7 +128,7 @@ void check_steps(const std::vector<ExposureStep>& steps) {
   const int w = steps[0].flats.empty() ? 0 : steps[0].flats[0].width, h = steps[0].flats.empty() ? 0 : steps[0].flats[0].height;
   for (const ExposureStep& s : steps) {
     if (s.flats.size() < 2 || s.darks.size() < 2)
-      throw InputError(fmt::format("exposure {} s has {} flat and {} dark frames; every exposure needs at least two of each "
+      throw InputError(fmt::format("exposure {:.6g} s has {} flat and {} dark frames; every exposure needs at least two of each "
                                    "(a pair: their difference cancels the fixed pattern)",
                                    s.exposure_s, s.flats.size(), s.darks.size()));
     for (const std::vector<Plane>* set : {&s.flats, &s.darks})
@@ -181,7 +181,7 @@ ChannelCalibration calibrate_channel(const std::string& channel, const std::vect
                                  channel));
   if (top + 1 == steps.size())
     throw InputError(fmt::format("channel {}: no exposure saturates (the flats' temporal variance still grows at the longest, "
-                                 "{} s); add exposures up to and beyond saturation",
+                                 "{:.6g} s); add exposures up to and beyond saturation",
                                  channel, steps.back().exposure_s));
   const double signal_sat = flat[top].mean - dark[top].mean;
   c.saturation_mean_dn = flat[top].mean;
@@ -198,7 +198,7 @@ ChannelCalibration calibrate_channel(const std::string& channel, const std::vect
   if (x.size() < 3) {
     // Why there are so few: saturation at the shortest exposure, or too few steps below 70 % of it.
     if (top == 0)
-      throw InputError(fmt::format("channel {}: the shortest exposure, {} s, already saturates (its flats' temporal variance is "
+      throw InputError(fmt::format("channel {}: the shortest exposure, {:.6g} s, already saturates (its flats' temporal variance is "
                                    "the largest of the series); add shorter exposures",
                                    channel, steps[0].exposure_s));
     throw InputError(fmt::format("channel {}: {} exposure{} between black and 70 % of saturation; the gain needs at least three",

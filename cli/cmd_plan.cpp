@@ -86,6 +86,7 @@ Action add_plan(CLI::App& app) {
       o->plan.cycles_noise_ratio_range = {std::max(0.0, r.ratio - 2 * r.se), r.ratio + 2 * r.se};
       o->plan.cycles_group_shares = r.group_shares;
       o->plan.cycles_group_shares_edges_nm = r.edges_nm;
+      o->plan.cycles_min_samples = r.samples;
       o->plan.cycles_noise_ratio_from = fmt::format(
           "Cycles pilots {} and {} ({} samples): mean ΔE00 {:.3f} between them against the tracer's {:.3f}, ratio ± "
           "2 standard errors",

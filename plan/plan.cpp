@@ -755,7 +755,8 @@ int samples_for(const Model& model, double target) {
 // pilots measure the two groups' own parts at 0.80 and 0.44 of the whole and their pair term at −0.12 (twice:
 // noise common to every band moves lightness more than hue), which favours an even split (docs/plan.md). The samples are the
 // fewest in all for the target: a search over the groups' proportions (each a quarter of the most or more: the
-// plan's observer is not the only camera its render will meet), the scale then set by the budget. Empty when the
+// plan's observer is not the only camera its render will meet), the scale then set by the budget, and no group under
+// `min_samples` (those Cycles' noise was measured at: below them it is not the measured ratio's). Empty when the
 // bands and bounces alone miss the target.
 struct CyclesNoise {
   std::size_t groups = 0;
@@ -801,7 +802,7 @@ CyclesNoise cycles_noise(const Model& model, const std::vector<int>& edges, int 
     n.share[g * groups + g] = sum > 0 ? n.share[g * groups + g] / sum : 1.0 / static_cast<double>(groups);
   return n;
 }
-std::vector<int> cycles_samples_for(const CyclesNoise& noise, double bands_error, double target) {
+std::vector<int> cycles_samples_for(const CyclesNoise& noise, double bands_error, double target, int min_samples) {
   if (!(bands_error < target)) return {};
   const double budget = std::sqrt(target * target - bands_error * bands_error);
   // Proportions w (N_g = k·w_g): k = (ratio · at_one / budget)² · variance(w) meets the budget, at a cost of k·Σw.
@@ -829,7 +830,8 @@ std::vector<int> cycles_samples_for(const CyclesNoise& noise, double bands_error
   }
   const double k = std::pow(noise.ratio * noise.at_one / budget, 2) * noise.variance(w);
   std::vector<int> samples(w.size());
-  for (std::size_t g = 0; g < w.size(); ++g) samples[g] = std::max(1, static_cast<int>(std::ceil(k * w[g] - 1e-9)));
+  for (std::size_t g = 0; g < w.size(); ++g)
+    samples[g] = std::max(min_samples, static_cast<int>(std::ceil(k * w[g] - 1e-9)));
   return samples;
 }
 
@@ -1004,8 +1006,9 @@ Plan make_plan(const Scene& scene, const PlanOptions& options) {
       chosen = true;
       break;
     }
+    const int min_samples = options.cycles_min_samples > 0 ? options.cycles_min_samples : kCyclesMinSamples;
     const std::vector<int> samples = cycles_samples_for(cycles_noise(model, trial_edges, plan.max_bounces, ratio, options), a_val,
-                                                        options.target_de00);
+                                                        options.target_de00, min_samples);
     plan.trials.back().cycles_samples = samples;
     const bool cheaper = !samples.empty() && (chosen_samples.empty() || total(samples) < total(chosen_samples));
     if (!chosen || cheaper) {

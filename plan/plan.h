@@ -58,6 +58,8 @@ struct PlanOptions {
   // How Cycles' noise is shared between band groups and pairs of them as measured (NoiseRatio::group_shares), for
   // the bands it was measured with (edges in nm); other bands take the shares of plan's model (no pairs).
   std::vector<double> cycles_group_shares, cycles_group_shares_edges_nm;
+  // No band group below this many samples: those Cycles' noise was measured at (the pilots'; 0: kCyclesMinSamples).
+  int cycles_min_samples = 0;
   // Also predict the mean ΔE00 that comparing the Cycles render with a tracer reference of this many paths per
   // pixel measures (its noise counts too); 0: not.
   int reference_samples = 0;
@@ -78,6 +80,10 @@ constexpr double kCyclesNoiseRatioLow = 0.64, kCyclesNoiseRatioHigh = 1.05;
 // Cycles at 0.85 of the tracer, its renders at 500 samples nearer 0.67) to 14 % over their prediction
 // (docs/plan.md).
 constexpr double kCyclesNoiseModelAccuracy = 0.4;
+// The fewest samples a Cycles band group is given: the samples Cycles' noise was measured at (the pilots', and the
+// test scenes' behind kCyclesNoiseRatio). Below them its noise is not the measured ratio's: at 8 samples a group, a
+// glossy ball's highlight under an F11 panel measured 4.1 to 5.6 where 2.0 was predicted (bench/README.md).
+constexpr int kCyclesMinSamples = 64;
 
 struct BandTrial {
   int bands = 0;

@@ -431,7 +431,9 @@ class CHROMATRACE_OT_plan(bpy.types.Operator):
         s.plan_summary = (f"{planned.report['settings']['band_count']} bands in {len(planned.samples)} Cycles renders, "
                           f"max {planned.max_bounces} bounces; predicted mean ΔE00 "
                           f"{planned.report['prediction']['cycles']['mean_de00']:.2f} "
-                          f"({'-'.join(f'{x:.2f}' for x in planned.report['prediction']['cycles']['mean_de00_range'])})")
+                          f"({'-'.join(f'{x:.2f}' for x in planned.report['prediction']['cycles']['mean_de00_range'])})"
+                          + (f", worst object {worst['name']} {worst['mean_de00']:.2f}"
+                             if (worst := planned.worst_object()) else ""))
         self.report({"INFO"}, planned.summary())
         for note in planned.notes:
             self.report({"WARNING"}, f"Plan: {note}")

@@ -149,6 +149,9 @@ TEST_F(Plan, PredictsTheMeasuredErrorOnTheTexturedScene) {
                "noise floor %.3f\n", o.plan.bands.size(), scene.render.bands.size(), o.plan.max_bounces,
                scene.render.max_bounces, o.plan.predicted_mean, o.measured, o.floor);
   EXPECT_EQ(o.plan.bands.reconstruction(), nullptr);
+  // Its fourth band group carries little of the noise: it still gets the samples Cycles' noise was measured at.
+  ASSERT_FALSE(o.plan.cycles_samples.empty());
+  for (int n : o.plan.cycles_samples) EXPECT_GE(n, plan::kCyclesMinSamples);
   EXPECT_TRUE(o.plan.target_met);
   EXPECT_LE(o.plan.predicted_mean, 1.0);
   EXPECT_LE(o.floor, o.measured / 3);
