@@ -14,8 +14,7 @@
 
 namespace ct::plan {
 
-// How many colours a textured surface is seen as (texture_colours): each multiplies its pixels' cost in the plan's
-// every evaluation.
+// How many colours a textured surface is seen as (texture_colours; each of its pixels in the preview shows one).
 constexpr std::size_t kTextureColours = 16;
 
 Transfer transfer_factors(const Scene& scene, const std::vector<TriangleMesh>& meshes, int samples) {
