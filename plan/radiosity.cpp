@@ -17,6 +17,36 @@ namespace ct::plan {
 // How many colours a textured surface is seen as (texture_colours; each of its pixels in the preview shows one).
 constexpr std::size_t kTextureColours = 16;
 
+namespace {
+
+// Points spread uniformly over a mesh's area: a triangle chosen in proportion to its area, then a uniform point of it,
+// barycentric (1 − u − v, u, v).
+class AreaSampler {
+ public:
+  explicit AreaSampler(const TriangleMesh& mesh) {
+    for (std::size_t tri = 0; tri < mesh.triangles.size(); ++tri) cdf_.push_back(area_ += triangle_area(mesh, tri));
+  }
+  double area() const { return area_; }
+  struct Point {
+    std::size_t triangle;
+    double u, v;
+  };
+  Point sample(Random& rng) const {
+    const double pick = rng.uniform() * area_;
+    const std::size_t tri = std::min<std::size_t>(
+        static_cast<std::size_t>(std::upper_bound(cdf_.begin(), cdf_.end(), pick) - cdf_.begin()), cdf_.size() - 1);
+    double u = rng.uniform(), v = rng.uniform();
+    if (u + v > 1) u = 1 - u, v = 1 - v;
+    return {tri, u, v};
+  }
+
+ private:
+  std::vector<double> cdf_;
+  double area_ = 0;
+};
+
+}  // namespace
+
 Transfer transfer_factors(const Scene& scene, const std::vector<TriangleMesh>& meshes, int samples) {
   std::vector<const TriangleMesh*> ptrs;
   for (const TriangleMesh& m : meshes) ptrs.push_back(&m);
@@ -27,20 +57,14 @@ Transfer transfer_factors(const Scene& scene, const std::vector<TriangleMesh>& m
   t.lit.assign(ids, std::vector<double>(scene.lights.size(), 0.0));
   for (std::size_t m = 0; m < meshes.size(); ++m) {
     const TriangleMesh& mesh = meshes[m];
-    std::vector<double> cdf;
-    double area = 0;
-    for (std::size_t tri = 0; tri < mesh.triangles.size(); ++tri) cdf.push_back(area += triangle_area(mesh, tri));
-    if (!(area > 0)) continue;
+    const AreaSampler points(mesh);
+    if (!(points.area() > 0)) continue;
     std::array<std::vector<double>, 2> hits{std::vector<double>(ids, 0.0), std::vector<double>(ids, 0.0)};
     std::array<std::vector<double>, 2> lit{std::vector<double>(scene.lights.size(), 0.0),
                                            std::vector<double>(scene.lights.size(), 0.0)};
     Random rng(0x706c616eull, m);
     for (int i = 0; i < samples; ++i) {
-      const double pick = rng.uniform() * area;
-      const std::size_t tri = std::min<std::size_t>(
-          static_cast<std::size_t>(std::upper_bound(cdf.begin(), cdf.end(), pick) - cdf.begin()), cdf.size() - 1);
-      double u = rng.uniform(), v = rng.uniform();
-      if (u + v > 1) u = 1 - u, v = 1 - v;
+      const auto [tri, u, v] = points.sample(rng);
       const auto& ix = mesh.triangles[tri];
       const Vec3 p = (1 - u - v) * mesh.positions[ix[0]] + u * mesh.positions[ix[1]] + v * mesh.positions[ix[2]];
       const Vec3 n = face_normal(mesh, tri);
@@ -209,20 +233,14 @@ std::vector<double> surface_texel_weights(const TriangleMesh& mesh, const std::v
                                           const ImageTexture& texture) {
   constexpr int kPoints = 16384;  // a texel's share to ±1/(2·√16384) ≈ 0.4 % of the surface at most
   std::vector<double> weight(texture.texel_count(), 0.0);
-  std::vector<double> cdf;
-  double area = 0;
-  for (std::size_t tri = 0; tri < mesh.triangles.size(); ++tri) cdf.push_back(area += triangle_area(mesh, tri));
-  if (uvs.size() != mesh.triangles.size() || !(area > 0)) {
+  const AreaSampler points(mesh);
+  if (uvs.size() != mesh.triangles.size() || !(points.area() > 0)) {
     std::fill(weight.begin(), weight.end(), 1.0);
     return weight;
   }
   Random rng(0x74657865ull, 0);
   for (int i = 0; i < kPoints; ++i) {
-    const double pick = rng.uniform() * area;
-    const std::size_t tri = std::min<std::size_t>(
-        static_cast<std::size_t>(std::upper_bound(cdf.begin(), cdf.end(), pick) - cdf.begin()), cdf.size() - 1);
-    double a = rng.uniform(), b = rng.uniform();
-    if (a + b > 1) a = 1 - a, b = 1 - b;
+    const auto [tri, a, b] = points.sample(rng);
     const auto& c = uvs[tri];
     const Vec2 uv = (1 - a - b) * c[0] + a * c[1] + b * c[2];
     weight[texture.texel_at(uv.x(), uv.y())] += 1;

@@ -321,6 +321,17 @@ TEST_F(Calibrate, TheCommandWritesSettingsTheSensorTakesAndRefusesSeriesThatCann
   EXPECT_FALSE(fs::exists(bad));
 }
 
+// A 64 × 64 frame of Gaussian noise of `variance` whose mean is exactly `mean` (the noise drawn, then its own mean
+// removed).
+calibrate::Plane exact_mean_frame(std::mt19937_64& random, double mean, double variance) {
+  std::normal_distribution<double> noise(0.0, std::sqrt(variance));
+  calibrate::Plane p{64, 64, std::vector<double>(64 * 64)};
+  double sum = 0;
+  for (double& v : p.values) sum += (v = noise(random));
+  for (double& v : p.values) v += mean - sum / double(p.values.size());
+  return p;
+}
+
 // A compressive response, signal = 1000·t·(1 − 0.03·t) DN over exposures t = 0.1 … 1 s, with flats and darks whose
 // means are exact (their noise drawn, then its mean removed) and whose temporal variance grows as a camera's: the
 // linearity error is EMVA 1288's, the half range of the relative deviations from the line fitted with weights 1/y
@@ -328,14 +339,7 @@ TEST_F(Calibrate, TheCommandWritesSettingsTheSensorTakesAndRefusesSeriesThatCann
 // by far more than the floating-point rounding both are computed to.
 TEST(CalibrateChannel, TheLinearityErrorIsTheStandardsWeightedFit) {
   std::mt19937_64 random(5);
-  auto frame = [&](double mean, double variance) {
-    std::normal_distribution<double> noise(0.0, std::sqrt(variance));
-    calibrate::Plane p{64, 64, std::vector<double>(64 * 64)};
-    double sum = 0;
-    for (double& v : p.values) sum += (v = noise(random));
-    for (double& v : p.values) v += mean - sum / double(p.values.size());
-    return p;
-  };
+  auto frame = [&](double mean, double variance) { return exact_mean_frame(random, mean, variance); };
   auto response = [](double t) { return 1000 * t * (1 - 0.03 * t); };
   std::vector<calibrate::ExposureStep> steps;
   for (int k = 1; k <= 11; ++k) {
@@ -414,14 +418,7 @@ TEST(CalibrateChannel, AGainThatIsNoMeasurementIsRefused) {
 std::vector<calibrate::ExposureStep> gaussian_series(double K, double sigma_d, double dark_current,
                                                      const std::function<double(double)>& dark_mean, unsigned seed) {
   std::mt19937_64 random(seed);
-  auto frame = [&](double mean, double variance) {
-    std::normal_distribution<double> noise(0.0, std::sqrt(variance));
-    calibrate::Plane p{64, 64, std::vector<double>(64 * 64)};
-    double sum = 0;
-    for (double& v : p.values) sum += (v = noise(random));
-    for (double& v : p.values) v += mean - sum / double(p.values.size());
-    return p;
-  };
+  auto frame = [&](double mean, double variance) { return exact_mean_frame(random, mean, variance); };
   std::vector<calibrate::ExposureStep> steps;
   for (int k = 1; k <= 11; ++k) {
     calibrate::ExposureStep s;
