@@ -160,10 +160,10 @@ class Model {
     std::vector<std::array<double, 2>> y;  // [k][lobe]
   };
   std::vector<Sample> samples_;
-  // Template ids of the textured surfaces' colours: per surface id, its colours' (empty: one spectrum); per colour,
-  // its surface.
+  // Template ids of the textured surfaces' colours (after the surfaces'): per surface id, its colours' (empty: one
+  // spectrum).
   std::vector<std::vector<std::size_t>> colour_ids_;
-  std::vector<std::size_t> colour_surface_;
+  bool has_colours() const { return exact_.size() > surfaces_.size(); }
   std::vector<Vec3d> lab_exact_;
   // A realisation of one preview render's noise in the totals, [pixel][preview band] ((a − b)/√2 of two renders
   // with different seeds), and the preview's band edges.
@@ -260,12 +260,9 @@ void Model::set_exact_templates() {
   if (has_environment_) exact.environment = environment_.v;
   exact_ = bounce_templates(exact, transfer_, kmax_, &exact_spectra_);
   colour_ids_.assign(ids, {});
-  colour_surface_.clear();
+  std::size_t next = ids;
   for (std::size_t id = 0; id < ids; ++id)
-    for (std::size_t c = 0; c < surfaces_[id].colours.size(); ++c) {
-      colour_ids_[id].push_back(ids + colour_surface_.size());
-      colour_surface_.push_back(id);
-    }
+    for (std::size_t c = 0; c < surfaces_[id].colours.size(); ++c) colour_ids_[id].push_back(next++);
   add_colour_templates(exact_, exact_spectra_, [](const Sampled& f) { return f.v; }, exact.weight);
   const std::size_t all = exact_.size();
   exact_y_.assign(all, std::vector<std::array<double, 2>>(static_cast<std::size_t>(kmax_) + 1, {0.0, 0.0}));
@@ -632,7 +629,7 @@ Model::BandedTemplates Model::banded_templates(const std::vector<int>& edges, in
   banded.mean_albedo = averages(albedo_);
   if (has_environment_) banded.environment = averages(environment_);
   TemplateSpectra spectra;
-  auto t = bounce_templates(banded, transfer_, K, reconstruct || !colour_surface_.empty() ? &spectra : nullptr);
+  auto t = bounce_templates(banded, transfer_, K, reconstruct || has_colours() ? &spectra : nullptr);
   const std::optional<BandReconstruction> fit = reconstruct ? fit_reconstruction(spectra, edges, K) : std::nullopt;
   if (fit) {
     // The observer's weights of the reconstructed spectrum (band_weights with 1 nm fine bands), and the templates

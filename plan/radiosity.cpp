@@ -284,11 +284,15 @@ SceneSurfaces scene_surfaces(const Scene& scene, const std::vector<TriangleMesh>
       out.textured = true;
       notes.push_back(fmt::format("{} is an image texture: modelled as its texels' mean spectrum over the surface, "
                                   "seen as up to {} colours", what, kTextureColours));
-      const std::vector<double> weight = surface_texel_weights(mesh, uvs, *ref.texture);
-      colours.clear();
-      for (const TextureColour& c : texture_colours(*ref.texture, weight, kTextureColours))
+      // The mean is the colours' spectra at their shares (texture_colours), so the texels are pooled once.
+      Sampled mean = grid.constant(0.0);
+      for (const TextureColour& c : texture_colours(*ref.texture, surface_texel_weights(mesh, uvs, *ref.texture),
+                                                    kTextureColours)) {
         colours.emplace_back(c.share, sampled(c.spectrum));
-      return sampled(mean_texture_spectrum(*ref.texture, weight));
+        for (std::size_t i = 0; i < mean.v.size(); ++i) mean.v[i] += c.share * colours.back().second.v[i];
+      }
+      Grid::finish(mean);
+      return mean;
     }
     return sampled(ref.spectrum);
   };
