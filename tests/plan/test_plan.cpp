@@ -511,6 +511,7 @@ TEST_F(Plan, BadInputGetsExitTwoAndOneLineNamingTheField) {
       {{"plan", kBox.string(), "--camera", "nokia_3310"}, "--camera"},
       {{"plan", kBox.string(), "--cycles-noise-ratio", "-1"}, "--cycles-noise-ratio: must be > 0"},
       {{"plan", kBox.string(), "--reference-spp", "-5"}, "--reference-spp: must be >= 1"},
+      {{"plan", kBox.string(), "--object-target-de00", "-1"}, "--object-target-de00: must be > 0, got -1"},
       {{"plan", kBox.string(), "--cycles-pilot", tracer_a.string(), tracer_b.string()},
        "a.exr: chromatrace.renderer: not a Cycles render"},
       {{"plan", kBox.string(), "--cycles-pilot", tracer_a.string(), tracer_b.string(), "--cycles-noise-ratio", "0.8"},
