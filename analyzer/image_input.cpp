@@ -36,6 +36,7 @@ struct RawImage {
   std::string camera_source;
   int alpha = -1;            // the alpha channel's index, −1 without one
   std::string colour_space;  // oiio:ColorSpace
+  std::string format;        // OpenImageIO's format name ("tiff", "png", "jpeg", …)
   float display_gamma = 0;   // oiio:Gamma (0: not given)
   std::string conversion;    // what OpenImageIO did to give R, G, B from other stored values ("" for nothing)
   std::string first_of_many;  // a file of several images (an animated GIF, a multi-page TIFF): which one was read
@@ -137,6 +138,7 @@ RawImage read_raw(const std::filesystem::path& file) {
   read_camera_metadata(spec, raw);
   raw.alpha = spec.alpha_channel < raw.channels ? spec.alpha_channel : -1;
   raw.colour_space = spec.get_string_attribute("oiio:ColorSpace");
+  raw.format = in->format_name();
   raw.display_gamma = spec.get_float_attribute("oiio:Gamma", 0.0f);
   raw.conversion = conversion_note(spec, in->format_name(), file);
   // An animated GIF's frames, a multi-page TIFF's pages, a multi-part EXR's parts: the first is read. Counted up to
@@ -229,9 +231,8 @@ std::optional<double> camera_number(const RawImage& raw, const char* key) {
   return std::isfinite(v) ? std::optional(v) : std::nullopt;
 }
 
-// Records what the camera did and takes the black level off R, G, B.
-void apply_camera_metadata(const RawImage& raw, AnalysisImage& out) {
-  ImageEncoding& e = out.encoding;
+// What the camera did, as the file's chromatrace.* numbers say (nothing without them).
+void read_camera_encoding(const RawImage& raw, ImageEncoding& e) {
   if (raw.camera_source.empty()) return;
   e.metadata = raw.camera_source;
   e.black_level = camera_number(raw, "chromatrace.black_level");
@@ -243,6 +244,12 @@ void apply_camera_metadata(const RawImage& raw, AnalysisImage& out) {
   if (const auto adc = camera_number(raw, "chromatrace.adc")) e.adc = *adc != 0;
   if (const auto area = camera_number(raw, "chromatrace.pixel_area")) e.pixel_area = *area != 0;
   if (const auto cfa = camera_number(raw, "chromatrace.cfa")) e.demosaiced = *cfa != 0;
+}
+
+// Records what the camera did and takes the black level off R, G, B.
+void apply_camera_metadata(const RawImage& raw, AnalysisImage& out) {
+  ImageEncoding& e = out.encoding;
+  read_camera_encoding(raw, e);
   if (e.black_level && *e.black_level != 0) {
     const auto black = static_cast<float>(*e.black_level);
     for (float& v : out.image.rgb) v -= black;
@@ -267,10 +274,12 @@ std::optional<ToneCurve> simulator_curve(const RawImage& raw, const std::string&
   return curve;
 }
 
-// --input-transfer auto: what the file says of its encoding, else what its type implies.
-void decide_curve(const RawImage& raw, AnalysisImage& out) {
-  ImageEncoding& e = out.encoding;
-  if (const auto curve = simulator_curve(raw, out.file)) {
+// --input-transfer auto: what the file says of its encoding, else what its type implies. An integer file that says
+// nothing is a picture (sRGB), unless it holds a measurement camera's digital numbers (`integer_is_linear`): then
+// only a JPEG (a tone-mapped picture whatever it says) is sRGB, and an sRGB colour space (which EXIF's ColorSpace tag
+// and PNG give by default, whatever the values are) is not taken as a curve.
+void decide_curve(const RawImage& raw, const std::string& file, ImageEncoding& e, bool integer_is_linear = false) {
+  if (const auto curve = simulator_curve(raw, file)) {
     e.curve = curve;
     e.curve_source = fmt::format("the file's chromatrace.curve_* ({})", raw.camera_source);
     return;
@@ -282,7 +291,10 @@ void decide_curve(const RawImage& raw, AnalysisImage& out) {
   }
   std::string space = raw.colour_space;
   std::transform(space.begin(), space.end(), space.begin(), [](unsigned char c) { return std::tolower(c); });
-  if (space == "srgb") {
+  if (integer_is_linear && e.integer && raw.format == "jpeg") {
+    e.curve = ToneCurve{1, 1, true};
+    e.curve_source = "a JPEG: a camera's tone-mapped picture";
+  } else if (space == "srgb" && !(integer_is_linear && e.integer)) {
     e.curve = ToneCurve{1, 1, true};
     e.curve_source = "the file's colour space (oiio:ColorSpace sRGB)";
   } else if (space == "linear" || space == "lin_srgb" || space == "scene_linear" || space == "acescg") {
@@ -294,6 +306,9 @@ void decide_curve(const RawImage& raw, AnalysisImage& out) {
   } else if (!e.integer) {
     e.curve = ToneCurve{};
     e.curve_source = "a float file without a colour space: linear";
+  } else if (integer_is_linear) {
+    e.curve = ToneCurve{};
+    e.curve_source = fmt::format("a {}-bit file without a colour space: a measurement camera's digital numbers", e.bits);
   } else {
     e.curve = ToneCurve{1, 1, true};
     e.curve_source = fmt::format("a {}-bit file without a colour space: sRGB, as cameras and phones store pictures", e.bits);
@@ -381,7 +396,7 @@ AnalysisImage read_analysis_image(const std::filesystem::path& file, const std::
     out.encoding.curve = declared;
     out.encoding.curve_source = fmt::format("--input-transfer {}", input_transfer);
   } else {
-    decide_curve(raw, out);
+    decide_curve(raw, out.file, out.encoding);
   }
   // A renderer's spectral EXR names its components too, but holds them as spectra, not as camera RGB:
   // only RGB layers explain a camera image.
@@ -390,6 +405,41 @@ AnalysisImage read_analysis_image(const std::filesystem::path& file, const std::
   if (const int id = channel_index(raw, exr::kObjectIdChannel); id >= 0)
     out.object_ids = whole_numbers(name, exr::kObjectIdChannel, raw, id);
   out.object_names = parse_object_names(name, raw.objects_attribute);
+  return out;
+}
+
+CameraFrame read_camera_frame(const std::filesystem::path& file, const std::string& input_transfer) {
+  const std::optional<ToneCurve> declared = parse_input_transfer(input_transfer);
+  const std::string name = file.string();
+  const RawImage raw = read_raw(file);
+  std::vector<int> channels;
+  if (const int r = channel_index(raw, "R"), g = channel_index(raw, "G"), b = channel_index(raw, "B"); r >= 0 && g >= 0 && b >= 0) {
+    channels = {r, g, b};
+  } else {
+    for (int c = 0; c < raw.channels; ++c)
+      if (c != raw.alpha) channels.push_back(c);
+    if (channels.size() != 1)
+      throw InputError(fmt::format("{}: needs one channel (a monochrome camera) or R, G, B; has {}", name,
+                                   raw.names.empty() ? std::string("none") : fmt::format("{}", fmt::join(raw.names, ", "))));
+  }
+  CameraFrame out;
+  out.width = raw.width;
+  out.height = raw.height;
+  out.encoding = raw.encoding;
+  read_camera_encoding(raw, out.encoding);
+  if (declared) {
+    out.encoding.curve = declared;
+    out.encoding.curve_source = fmt::format("--input-transfer {}", input_transfer);
+  } else {
+    decide_curve(raw, name, out.encoding, true);
+  }
+  const auto stride = static_cast<std::size_t>(raw.channels);
+  const std::size_t n = static_cast<std::size_t>(raw.width) * static_cast<std::size_t>(raw.height);
+  for (const int c : channels) {
+    out.channels.push_back(raw.names[static_cast<std::size_t>(c)]);
+    std::vector<float>& plane = out.planes.emplace_back(n);
+    for (std::size_t i = 0; i < n; ++i) plane[i] = raw.values[i * stride + static_cast<std::size_t>(c)];
+  }
   return out;
 }
 

@@ -31,6 +31,22 @@ std::optional<ToneCurve> parse_input_transfer(const std::string& text);
 AnalysisImage read_analysis_image(const std::filesystem::path& file, const std::string& input_transfer = "auto",
                                   const RawOptions& raw = {});
 
+// The frame of a camera measurement (chromatrace calibrate): one channel (a monochrome camera) or R, G, B (an alpha
+// channel aside), each as stored: integer files in their stored integers, the black level not subtracted. The
+// encoding says what the file says of the camera (chromatrace.*) and of its curve. Under "auto", an integer TIFF or
+// PNG holds a measurement camera's digital numbers (linear) unless the simulator's chromatrace.curve_* or a gamma
+// (oiio:Gamma) says otherwise, where read_analysis_image takes it for a picture (sRGB): the sRGB colour space that
+// EXIF's ColorSpace tag and PNG give by default says nothing of such frames. A JPEG is a tone-mapped picture (sRGB).
+// InputError naming the file for anything else.
+struct CameraFrame {
+  int width = 0;
+  int height = 0;
+  std::vector<std::string> channels;       // the channels' names
+  std::vector<std::vector<float>> planes;  // one per channel, [y][x]
+  ImageEncoding encoding;
+};
+CameraFrame read_camera_frame(const std::filesystem::path& file, const std::string& input_transfer = "auto");
+
 // A single-channel integer image (a label image), [y][x]. Integer files give their stored integers; a
 // float file must hold whole numbers. InputError naming the file otherwise.
 struct LabelImage {

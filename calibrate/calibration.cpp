@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <numeric>
 
 #include <fmt/format.h>
 
@@ -20,6 +21,9 @@ Json nonuniformity_json(const Nonuniformity& n) {
 }
 
 Json channel_json(const ChannelCalibration& c) {
+  Json dark_points = Json::array();
+  for (const TransferPoint& p : c.dark_points)
+    dark_points.push_back({{"exposure_s", p.exposure_s}, {"dark_mean_dn", p.dark_mean_dn}, {"dark_variance_dn2", p.dark_variance_dn2}});
   Json points = Json::array();
   for (const TransferPoint& p : c.points)
     points.push_back({{"exposure_s", p.exposure_s},
@@ -45,6 +49,7 @@ Json channel_json(const ChannelCalibration& c) {
           {"linearity_error", c.linearity_error},
           {"quantum_efficiency", c.quantum_efficiency ? estimate_json(*c.quantum_efficiency) : Json(nullptr)},
           {"points", points},
+          {"dark_points", dark_points},
           {"notes", c.notes}};
 }
 
@@ -54,12 +59,61 @@ bool dark_current_from_variance(const ChannelCalibration& c) {
   return std::abs(v.value - m.value) > 3 * std::hypot(v.standard_error, m.standard_error);
 }
 
-// The mean of the three channels' values.
+// The mean of the channels' values.
 template <typename Get>
-double channel_mean(const std::array<ChannelCalibration, 3>& channels, Get get) {
+double channel_mean(const std::vector<ChannelCalibration>& channels, Get get) {
   double sum = 0;
   for (const ChannelCalibration& c : channels) sum += get(c);
-  return sum / 3.0;
+  return sum / static_cast<double>(channels.size());
+}
+
+// The correlation of the temporal noise between neighbouring pixels and between channels: in the difference of each
+// pair of flats (consecutive frames of a step), less its mean, products of neighbours summed over every pair and
+// set against the variance. Pooled so, the bright steps (most noise) weigh most.
+NoiseCorrelation noise_correlation(const std::vector<std::vector<const Frame*>>& steps) {
+  const Frame& first = *steps.front().front();
+  const std::size_t channels = first.channels.size();
+  const auto w = static_cast<std::size_t>(first.channels[0].width), h = static_cast<std::size_t>(first.channels[0].height);
+  std::vector<double> squares(channels, 0.0), horizontal(channels, 0.0), vertical(channels, 0.0);
+  std::vector<std::vector<double>> cross(channels, std::vector<double>(channels, 0.0));
+  std::size_t pairs = 0;
+  std::vector<std::vector<double>> d(channels, std::vector<double>(w * h));
+  for (const std::vector<const Frame*>& step : steps)
+    for (std::size_t k = 0; k + 1 < step.size(); k += 2, ++pairs) {
+      for (std::size_t c = 0; c < channels; ++c) {
+        const std::vector<double>&a = step[k]->channels[c].values, &b = step[k + 1]->channels[c].values;
+        double mean = 0;
+        for (std::size_t i = 0; i < d[c].size(); ++i) mean += (d[c][i] = a[i] - b[i]);
+        mean /= static_cast<double>(d[c].size());
+        for (double& v : d[c]) v -= mean;
+        for (std::size_t y = 0; y < h; ++y)
+          for (std::size_t x = 0; x < w; ++x) {
+            const double v = d[c][y * w + x];
+            squares[c] += v * v;
+            if (x + 1 < w) horizontal[c] += v * d[c][y * w + x + 1];
+            if (y + 1 < h) vertical[c] += v * d[c][(y + 1) * w + x];
+          }
+      }
+      for (std::size_t c = 0; c < channels; ++c)
+        for (std::size_t e = c + 1; e < channels; ++e)
+          for (std::size_t i = 0; i < w * h; ++i) cross[c][e] += d[c][i] * d[e][i];
+    }
+  NoiseCorrelation nc;
+  nc.horizontal = nc.vertical = nc.between_channels = -1;
+  auto name = [&](std::size_t c) { return first.channel_names[c]; };
+  const auto n = static_cast<double>(w * h);
+  for (std::size_t c = 0; c < channels; ++c) {
+    if (!(squares[c] > 0)) continue;  // no noise at all: the same-image check names such pairs
+    const double var = squares[c] / n;
+    if (const double r = horizontal[c] / (n - static_cast<double>(h)) / var; r > nc.horizontal) nc.horizontal = r, nc.horizontal_channel = name(c);
+    if (const double r = vertical[c] / (n - static_cast<double>(w)) / var; r > nc.vertical) nc.vertical = r, nc.vertical_channel = name(c);
+    for (std::size_t e = c + 1; e < channels; ++e)
+      if (const double r = cross[c][e] / std::sqrt(squares[c] * squares[e]); squares[e] > 0 && r > nc.between_channels)
+        nc.between_channels = r, nc.channel_pair = name(c) + " and " + name(e);
+  }
+  nc.horizontal = std::max(nc.horizontal, 0.0), nc.vertical = std::max(nc.vertical, 0.0), nc.between_channels = std::max(nc.between_channels, 0.0);
+  nc.standard_error = 1 / std::sqrt(n * static_cast<double>(std::max<std::size_t>(pairs, 1)));
+  return nc;
 }
 
 }  // namespace
@@ -78,7 +132,7 @@ Calibration calibrate(const CalibrationInput& input) {
   // one: naming it as the norm would point at a good file).
   std::vector<std::pair<int, Frame>> frames;  // kind (0 flat, 1 dark), frame
   for (int kind = 0; kind < 2; ++kind)
-    for (const auto& file : kind == 0 ? input.flats : input.darks) frames.emplace_back(kind, read_frame(file));
+    for (const auto& file : kind == 0 ? input.flats : input.darks) frames.emplace_back(kind, read_frame(file, input.input_transfer));
   auto most_common = [&](auto key) {
     std::map<decltype(key(frames[0].second)), std::size_t> count;
     for (const auto& [kind, f] : frames) ++count[key(f)];
@@ -110,47 +164,142 @@ Calibration calibrate(const CalibrationInput& input) {
     else if (!bits && f.white_level_dn) bits = static_cast<int>(std::ceil(std::log2(*f.white_level_dn + 1)));
     by_time[f.exposure_s][static_cast<std::size_t>(kind)].push_back(std::move(f));
   }
-  if (by_time.size() < 2)
-    throw InputError(fmt::format("--flat: every frame has the exposure time {:.6g} s; the photon transfer needs a series of exposures",
-                                 by_time.begin()->first));
+  std::vector<double> flat_times;
   for (const auto& [t, sets] : by_time)
-    for (int kind = 0; kind < 2; ++kind)
-      if (sets[static_cast<std::size_t>(kind)].size() < 2)
-        throw InputError(fmt::format("{}: {} {} frame{} at {:.6g} s, where the series needs at least two (a pair: their difference "
-                                     "cancels the fixed pattern)",
-                                     kind == 0 ? "--flat" : "--dark", sets[static_cast<std::size_t>(kind)].size(),
-                                     kind == 0 ? "flat" : "dark", sets[static_cast<std::size_t>(kind)].size() == 1 ? "" : "s", t));
+    if (!sets[0].empty()) flat_times.push_back(t);
+  for (const auto& [t, sets] : by_time) {
+    const std::size_t flats = sets[0].size(), darks = sets[1].size();
+    if (flats == 1)
+      throw InputError(fmt::format("--flat: 1 flat frame at {:.6g} s, where the series needs at least two (a pair: their difference "
+                                   "cancels the fixed pattern)",
+                                   t));
+    if (flats > 0 && darks < 2)
+      throw InputError(fmt::format("--dark: {} dark frame{} at {:.6g} s, where the series needs at least two (a pair: their difference "
+                                   "cancels the fixed pattern)",
+                                   darks, darks == 1 ? "" : "s", t));
+    if (flats == 0 && darks < 2)
+      throw InputError(fmt::format("--dark: 1 dark frame at {:.6g} s, where no flat was taken: darks alone at a time (for the dark "
+                                   "current) need a pair",
+                                   t));
+  }
+  if (flat_times.empty()) throw InputError("--flat: no flat frames");
+
+  // The steps: one per exposure time of the flats (the first method), or, at one exposure time, one per pair of flats
+  // in the order given (the second: the irradiance varied).
+  const bool one_time = flat_times.size() == 1;
+  std::vector<std::vector<const Frame*>> step_flats;
+  std::vector<double> step_times;
+  if (one_time) {
+    const std::vector<Frame>& set = by_time[flat_times[0]][0];
+    if (set.size() % 2 != 0)
+      throw InputError(fmt::format("--flat: {} flat frames at {:.6g} s: at one exposure time the flats are taken in pairs in the order "
+                                   "given (one pair per irradiance), and the last, {}, has no partner",
+                                   set.size(), flat_times[0], set.back().file));
+    if (set.size() == 2)
+      throw InputError(fmt::format("--flat: one pair of flats, at {:.6g} s: the photon transfer needs a series of exposures (exposure "
+                                   "times, or pairs at one exposure time under different irradiances)",
+                                   flat_times[0]));
+    for (std::size_t k = 0; k < set.size(); k += 2) {
+      step_flats.push_back({&set[k], &set[k + 1]});
+      step_times.push_back(flat_times[0]);
+    }
+  } else {
+    for (const double t : flat_times) {
+      step_flats.emplace_back();
+      for (const Frame& f : by_time[t][0]) step_flats.back().push_back(&f);
+      step_times.push_back(t);
+    }
+  }
+  if (one_time && input.photons_per_s)
+    throw InputError(fmt::format("--photons-per-s: every flat has the exposure time {:.6g} s, so the irradiance varied: give the "
+                                 "photons per pixel of each pair (--photons-per-pixel)",
+                                 flat_times[0]));
+  if (!one_time && !input.photons_per_pixel.empty())
+    throw InputError("--photons-per-pixel: is for flats at one exposure time (a pair per irradiance); these vary the exposure time, "
+                     "so give the irradiance as --photons-per-s");
+  if (!input.photons_per_pixel.empty() && input.photons_per_pixel.size() != step_flats.size())
+    throw InputError(fmt::format("--photons-per-pixel: {} value{} for {} pairs of flats (one per pair, in their order)",
+                                 input.photons_per_pixel.size(), input.photons_per_pixel.size() == 1 ? "" : "s", step_flats.size()));
+  for (const double p : input.photons_per_pixel)
+    if (!(p > 0 && std::isfinite(p))) throw InputError(fmt::format("--photons-per-pixel: must be positive numbers, got {}", p));
 
   // A frame grabber that hands the same buffer twice makes a pair of one image: its difference holds no noise.
+  auto same_image = [](const Frame& a, const Frame& b) {
+    return std::equal(a.channels.begin(), a.channels.end(), b.channels.begin(), [](const Plane& x, const Plane& y) { return x.values == y.values; });
+  };
   for (const auto& [t, sets] : by_time)
     for (int kind = 0; kind < 2; ++kind) {
       const std::vector<Frame>& set = sets[static_cast<std::size_t>(kind)];
       for (std::size_t a = 0; a < set.size(); ++a)
         for (std::size_t b = a + 1; b < set.size(); ++b)
-          if (std::equal(set[a].channels.begin(), set[a].channels.end(), set[b].channels.begin(),
-                         [](const Plane& x, const Plane& y) { return x.values == y.values; }))
+          if (same_image(set[a], set[b]))
             throw InputError(fmt::format("{}: the same image as {} (both {} frames at {:.6g} s): the frames of a pair must be two "
                                          "exposures, whose difference holds the temporal noise",
                                          set[b].file, set[a].file, kind == 0 ? "flat" : "dark", t));
     }
+  // At one exposure time a pair is one irradiance: its two means agree far better than 5 % of their signal (a lamp's
+  // drift is a fraction of a per cent), where two irradiances of the series differ by more.
+  const std::size_t channel_count = step_flats.front().front()->channels.size();
+  if (one_time) {
+    const std::vector<Frame>& darks = by_time[flat_times[0]][1];
+    for (const std::vector<const Frame*>& pair : step_flats)
+      for (std::size_t c = 0; c < channel_count; ++c) {
+        auto mean = [&](const Frame& f) {
+          const std::vector<double>& v = f.channels[c].values;
+          return std::accumulate(v.begin(), v.end(), 0.0) / static_cast<double>(v.size());
+        };
+        const double black = (mean(darks[0]) + mean(darks[1])) / 2, a = mean(*pair[0]) - black, b = mean(*pair[1]) - black;
+        if (std::abs(a - b) > 0.05 * std::max(std::abs(a), std::abs(b)))
+          throw InputError(fmt::format("{}: its channel {} is {:.4g} DN above black where {}, its partner, is {:.4g}: at one exposure time "
+                                       "the flats are taken in pairs in the order given, each pair one irradiance",
+                                       pair[1]->file, pair[1]->channel_names[c], b, pair[0]->file, a));
+      }
+  }
 
+  // Pixels read on their own: the noise of each pair's difference uncorrelated between neighbours and channels.
   Calibration result;
+  result.noise_correlation = noise_correlation(step_flats);
+  if (const NoiseCorrelation& nc = result.noise_correlation; !step_flats.front().front()->photosites) {
+    const double limit = kMaxNoiseCorrelation + 3 * nc.standard_error;
+    for (const auto& [rho, what] : {std::pair{nc.horizontal, "horizontal neighbours in " + nc.horizontal_channel},
+                                    std::pair{nc.vertical, "vertical neighbours in " + nc.vertical_channel},
+                                    std::pair{nc.between_channels, "channels " + nc.channel_pair}})
+      if (rho > limit)
+        throw InputError(fmt::format("--flat: the temporal noise of the flats correlates by {:.2f} between {} (each pixel read on its "
+                                     "own gives 0 ± {:.2g}): the frames were interpolated or filtered, as a demosaiced colour "
+                                     "camera's are, so a pixel's variance is not its own; calibrate from the camera raw, or from "
+                                     "frames whose pixels were each read on their own",
+                                     rho, what, nc.standard_error));
+  }
+
   result.flats = input.flats.size();
   result.darks = input.darks.size();
   result.exposures = by_time.size();
-  for (std::size_t c = 0; c < 3; ++c) {
+  const std::size_t dark_only = by_time.size() - flat_times.size();
+  result.series = one_time ? fmt::format("{} irradiances at {:.6g} s", step_flats.size(), flat_times[0])
+                           : fmt::format("{} exposure times", flat_times.size());
+  if (dark_only > 0) result.series += fmt::format("; darks alone at {} further time{}", dark_only, dark_only == 1 ? "" : "s");
+  for (std::size_t c = 0; c < channel_count; ++c) {
     std::vector<ExposureStep> steps;
-    for (const auto& [t, sets] : by_time) {
+    for (std::size_t k = 0; k < step_flats.size(); ++k) {
       ExposureStep s;
-      s.exposure_s = t;
-      if (input.photons_per_s) s.photons_per_pixel = *input.photons_per_s * t;
-      for (const Frame& f : sets[0]) s.flats.push_back(f.channels[c]);
-      for (const Frame& f : sets[1]) s.darks.push_back(f.channels[c]);
+      s.exposure_s = step_times[k];
+      if (input.photons_per_s) s.photons_per_pixel = *input.photons_per_s * s.exposure_s;
+      if (!input.photons_per_pixel.empty()) s.photons_per_pixel = input.photons_per_pixel[k];
+      for (const Frame* f : step_flats[k]) s.flats.push_back(f->channels[c]);
+      for (const Frame& f : by_time[s.exposure_s][1]) s.darks.push_back(f.channels[c]);
       steps.push_back(std::move(s));
     }
+    for (const auto& [t, sets] : by_time)
+      if (sets[0].empty()) {
+        ExposureStep s;
+        s.exposure_s = t;
+        for (const Frame& f : sets[1]) s.darks.push_back(f.channels[c]);
+        steps.push_back(std::move(s));
+      }
+    const std::string& name = step_flats.front().front()->channel_names[c];
     try {
-      result.channels[c] = calibrate_channel(kChannelNames[c], steps);
-      ChannelCalibration& cc = result.channels[c];
+      ChannelCalibration& cc = result.channels.emplace_back(calibrate_channel(name, steps));
       if (dark_current_from_variance(cc))
         cc.notes.push_back(fmt::format(
             "the dark current from the dark frames' variance, {:.4g} ± {:.2g} e⁻/s, is not the dark mean's, {:.4g} ± {:.2g} "
@@ -193,8 +342,9 @@ Calibration calibrate(const CalibrationInput& input) {
   adc["bits"] = *bits;
   result.sensor = {{"format", "chromatrace-sensor/1"},
                    {"description", fmt::format("Calibrated with chromatrace calibrate (EMVA 1288 Linear) from {} flat and {} dark frames "
-                                               "at {} exposure times; the mean of the R, G and B channels; adc.bits {}",
-                                               result.flats, result.darks, result.exposures, bits_from)},
+                                               "({}); {}; adc.bits {}",
+                                               result.flats, result.darks, result.series,
+                                               ch.size() == 1 ? "one channel (monochrome)" : "the mean of the R, G and B channels", bits_from)},
                    {"noise", noise},
                    {"full_well", {{"enabled", true}, {"electrons", channel_mean(ch, [](const auto& c) {
                                    return c.clip_level_e ? c.clip_level_e->value : c.saturation_capacity_e.value;
@@ -207,7 +357,15 @@ Calibration calibrate(const CalibrationInput& input) {
                    {"flats", result.flats},
                    {"darks", result.darks},
                    {"exposures", result.exposures},
+                   {"series", result.series},
                    {"photons_per_s", input.photons_per_s ? Json(*input.photons_per_s) : Json(nullptr)},
+                   {"photons_per_pixel", input.photons_per_pixel.empty() ? Json(nullptr) : Json(input.photons_per_pixel)},
+                   {"noise_correlation",
+                    {{"horizontal", result.noise_correlation.horizontal},
+                     {"vertical", result.noise_correlation.vertical},
+                     {"between_channels", result.noise_correlation.channel_pair.empty() ? Json(nullptr)
+                                                                                           : Json(result.noise_correlation.between_channels)},
+                     {"standard_error", result.noise_correlation.standard_error}}},
                    {"frame_size", {size.first, size.second}},
                    {"channels", channels},
                    {"sensor", result.sensor}};

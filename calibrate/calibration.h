@@ -14,22 +14,45 @@
 
 namespace ct::calibrate {
 
+// The series: flats and darks at several exposure times (EMVA 1288's first method), or flats at one exposure time
+// under several irradiances (its second method: the flats taken in pairs in the order given, A1 A2 B1 B2 …), with
+// darks at the flats' exposure times and, optionally, darks alone at further times (for the dark current).
 struct CalibrationInput {
   std::vector<std::filesystem::path> flats, darks;
-  std::optional<double> photons_per_s;  // photons per pixel and second reaching each pixel of the flats
+  std::optional<double> photons_per_s;    // photons per pixel and second reaching each pixel of the flats (first method)
+  std::vector<double> photons_per_pixel;  // per pair of flats, in their order (second method)
+  std::string input_transfer = "auto";    // what the frames' values are (analyzer::parse_input_transfer)
+};
+
+// The temporal noise's correlation between neighbouring pixels and between channels, in the difference of each pair
+// of flats (their fixed pattern cancels): about 0 where each pixel is read on its own; a demosaiced or filtered
+// frame's pixels share noise.
+struct NoiseCorrelation {
+  double horizontal = 0, vertical = 0, between_channels = 0;  // the largest over the channels (pairs of channels)
+  std::string horizontal_channel, vertical_channel, channel_pair;
+  double standard_error = 0;                                  // of each: 1/√(pixels compared)
 };
 
 struct Calibration {
-  std::array<ChannelCalibration, 3> channels;
+  std::vector<ChannelCalibration> channels;  // R, G, B, or the one channel of a monochrome camera
   std::size_t flats = 0, darks = 0, exposures = 0;
+  std::string series;  // "16 exposure times" or "12 irradiances at 0.01 s" (and "; darks alone at 2 further times")
+  NoiseCorrelation noise_correlation;
   Json sensor;  // chromatrace-sensor/1 settings
   Json report;  // every estimate with its standard error, per channel, and the measured curves
 };
 
+// Pixels of frames that are not a camera raw's (which are photosites) whose temporal noise correlates by more than
+// this with a neighbour's or another channel's are refused: they were interpolated or filtered, so a pixel's
+// variance is not its own. Bilinear demosaicing gives 0.25 or more; a sensor's own crosstalk a few per cent.
+inline constexpr double kMaxNoiseCorrelation = 0.1;
+
 // InputError, one line naming the file or the option, for a series that cannot support the estimates: no flats
-// or no darks, one exposure time only, an exposure with flats but fewer than two darks (or the reverse), frames of
-// different sizes or from another camera or mosaic, or a channel whose flats never saturate or leave fewer than three exposures below 70 % of
-// saturation.
+// or no darks, one exposure time and one pair of flats only, an exposure with flats but fewer than two darks, one
+// flat or dark alone at its time, a pair at one exposure time whose means differ by more than 5 % (not one
+// irradiance), photons given the wrong way for the series, frames of different sizes or from another camera or
+// mosaic, pixels whose noise correlates (above), or a channel whose flats never saturate or leave fewer than three
+// steps below 70 % of saturation.
 Calibration calibrate(const CalibrationInput& input);
 
 // The dark current the sensor settings take for a channel: the dark mean's estimate, unless the dark variance's

@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "calibrate/frames.h"
 
+#include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <string>
 
@@ -15,7 +17,8 @@
 namespace ct::calibrate {
 namespace {
 
-// The exposure time a file records: EXIF's ExposureTime (camera raw, DNG), else the simulator's settings.
+// The exposure time a file records: EXIF's ExposureTime (camera raw, DNG, a camera's TIFF), else the simulator's
+// settings.
 std::optional<double> recorded_exposure(const std::filesystem::path& file) {
   auto in = OIIO::ImageInput::open(file.string());
   if (!in) {
@@ -35,53 +38,91 @@ std::optional<double> recorded_exposure(const std::filesystem::path& file) {
   return std::nullopt;
 }
 
-}  // namespace
+Plane plane_of(int width, int height, const std::string& file, std::size_t count, auto value) {
+  Plane p{width, height, std::vector<double>(count)};
+  for (std::size_t i = 0; i < count; ++i) {
+    const float v = value(i);
+    if (!std::isfinite(v)) throw InputError(fmt::format("{}: pixel ({}, {}) has a value that is not a number", file,
+                                                        i % static_cast<std::size_t>(width), i / static_cast<std::size_t>(width)));
+    p.values[i] = static_cast<double>(v);
+  }
+  return p;
+}
 
-Frame read_frame(const std::filesystem::path& file) {
-  const std::string name = file.string();
-  const bool raw = analyzer::is_camera_raw(file);
+Frame read_camera_raw_frame(const std::filesystem::path& file) {
   analyzer::RawOptions options;
   options.half_size = true;
   const analyzer::AnalysisImage image = analyzer::read_analysis_image(file, "auto", options);
   const analyzer::ImageEncoding& e = image.encoding;
-  if (!raw && e.demosaiced != false)
-    throw InputError(fmt::format("{}: its pixels {} interpolated from a colour filter array, so neighbours share their noise; "
-                                 "calibrate from the camera raw (or the simulator's DNG) or from frames written without a CFA",
-                                 name, e.demosaiced ? "were" : "may have been"));
-  if (e.curve && !e.curve->linear())
-    throw InputError(fmt::format("{}: its values are encoded with a response curve ({}); calibration needs linear digital numbers", name,
-                                 e.curve->describe()));
-  const std::optional<double> exposure = recorded_exposure(file);
-  if (!exposure)
-    throw InputError(fmt::format("{}: no exposure time (EXIF ExposureTime, or exposure.time_s in chromatrace.sensor)", name));
   Frame f;
-  f.file = name;
-  f.exposure_s = *exposure;
-  if (raw) {
-    std::string camera, cfa;
-    for (const auto& [key, value] : analyzer::describe_camera_raw(file)) {
-      if (key == "camera") camera = value;
-      if (key == "cfa") cfa = value;
-    }
-    f.sensor = fmt::format("camera raw, {}, CFA {}", camera, cfa);
-  } else {
-    f.sensor = fmt::format("linear {}, no CFA", file.extension() == ".exr" || file.extension() == ".EXR" ? "EXR" : "TIFF");
+  f.file = file.string();
+  std::string camera, cfa;
+  for (const auto& [key, value] : analyzer::describe_camera_raw(file)) {
+    if (key == "camera") camera = value;
+    if (key == "cfa") cfa = value;
   }
+  f.sensor = fmt::format("camera raw, {}, CFA {}", camera, cfa);
+  f.photosites = true;
   f.adc_bits = e.adc_bits;
   f.white_level_dn = e.white_level;
   const double black = e.black_subtracted && e.black_level ? *e.black_level : 0.0;
   const analyzer::RgbImage& rgb = image.image;
-  for (int c = 0; c < 3; ++c) {
-    Plane& p = f.channels[static_cast<std::size_t>(c)];
-    p.width = rgb.width;
-    p.height = rgb.height;
-    p.values.resize(rgb.pixel_count());
-    for (std::size_t i = 0; i < p.values.size(); ++i) {
-      const float v = rgb.rgb[3 * i + static_cast<std::size_t>(c)];
-      if (!std::isfinite(v)) throw InputError(fmt::format("{}: pixel {} has a value that is not a number", name, i));
-      p.values[i] = static_cast<double>(v) + black;
-    }
+  for (std::size_t c = 0; c < 3; ++c) {
+    f.channel_names.emplace_back(std::string(1, "RGB"[c]));
+    f.channels.push_back(plane_of(rgb.width, rgb.height, f.file, rgb.pixel_count(),
+                                  [&](std::size_t i) { return rgb.rgb[3 * i + c] + static_cast<float>(black); }));
   }
+  return f;
+}
+
+Frame read_linear_frame(const std::filesystem::path& file, const std::string& input_transfer) {
+  const std::string name = file.string();
+  const analyzer::CameraFrame image = analyzer::read_camera_frame(file, input_transfer);
+  const analyzer::ImageEncoding& e = image.encoding;
+  if (e.demosaiced == true)
+    throw InputError(fmt::format("{}: its pixels were interpolated from a colour filter array, so neighbours share their noise; "
+                                 "calibrate from the camera raw (or the simulator's DNG) or from frames written without a CFA",
+                                 name));
+  if (e.curve && !e.curve->linear())
+    throw InputError(fmt::format("{}: its values are encoded with a response curve ({}, from {}); calibration needs linear digital "
+                                 "numbers{}",
+                                 name, e.curve->describe(), e.curve_source,
+                                 input_transfer == "auto" ? " (if the camera wrote them so, say it: --input-transfer linear)" : ""));
+  Frame f;
+  f.file = name;
+  const std::size_t n = static_cast<std::size_t>(image.width) * static_cast<std::size_t>(image.height);
+  for (std::size_t c = 0; c < image.planes.size(); ++c) {
+    const std::vector<float>& plane = image.planes[c];
+    // A float file that is not the simulator's holds digital numbers only when they are whole: a frame scaled to
+    // 0–1, or processed, would give a gain in its own units and no quantisation to judge the dark noise by.
+    if (!e.integer && e.metadata.empty())
+      for (std::size_t i = 0; i < n; ++i)
+        if (std::isfinite(plane[i]) && plane[i] != std::round(plane[i]))
+          throw InputError(fmt::format("{}: channel {} holds {} at pixel ({}, {}), not a whole number: calibration needs the camera's "
+                                       "digital numbers (a frame scaled to 0–1 or processed is not)",
+                                       name, image.channels[c], plane[i], i % static_cast<std::size_t>(image.width),
+                                       i / static_cast<std::size_t>(image.width)));
+    f.channel_names.push_back(image.channels.size() == 1 ? image.channels[c] : std::string(1, "RGB"[c]));
+    f.channels.push_back(plane_of(image.width, image.height, name, n, [&](std::size_t i) { return plane[i]; }));
+  }
+  std::string format = file.extension().string();
+  if (!format.empty()) format.erase(0, 1);
+  std::transform(format.begin(), format.end(), format.begin(), [](unsigned char ch) { return std::toupper(ch); });
+  f.sensor = f.channels.size() == 1 ? fmt::format("linear {}, one channel (monochrome)", format)
+                                    : fmt::format("linear {}, R, G, B", format);
+  f.adc_bits = e.adc_bits;
+  f.white_level_dn = e.white_level;
+  return f;
+}
+
+}  // namespace
+
+Frame read_frame(const std::filesystem::path& file, const std::string& input_transfer) {
+  Frame f = analyzer::is_camera_raw(file) ? read_camera_raw_frame(file) : read_linear_frame(file, input_transfer);
+  const std::optional<double> exposure = recorded_exposure(file);
+  if (!exposure)
+    throw InputError(fmt::format("{}: no exposure time (EXIF ExposureTime, or exposure.time_s in chromatrace.sensor)", f.file));
+  f.exposure_s = *exposure;
   return f;
 }
 

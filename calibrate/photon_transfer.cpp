@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <numeric>
 
 #include <fmt/format.h>
@@ -125,11 +126,13 @@ LineFit fit_line(const std::vector<double>& x, const std::vector<double>& y, boo
 
 void check_steps(const std::vector<ExposureStep>& steps) {
   if (steps.empty()) throw InputError("no frames");
-  const int w = steps[0].flats.empty() ? 0 : steps[0].flats[0].width, h = steps[0].flats.empty() ? 0 : steps[0].flats[0].height;
+  const auto first = std::find_if(steps.begin(), steps.end(), [](const ExposureStep& s) { return !s.flats.empty(); });
+  if (first == steps.end()) throw InputError("no flat frames");
+  const int w = first->flats[0].width, h = first->flats[0].height;
   for (const ExposureStep& s : steps) {
-    if (s.flats.size() < 2 || s.darks.size() < 2)
-      throw InputError(fmt::format("exposure {:.6g} s has {} flat and {} dark frames; every exposure needs at least two of each "
-                                   "(a pair: their difference cancels the fixed pattern)",
+    if ((!s.flats.empty() && s.flats.size() < 2) || s.darks.size() < 2)
+      throw InputError(fmt::format("exposure {:.6g} s has {} flat and {} dark frames; every exposure needs at least two darks, and "
+                                   "none or at least two flats (a pair: their difference cancels the fixed pattern)",
                                    s.exposure_s, s.flats.size(), s.darks.size()));
     for (const std::vector<Plane>* set : {&s.flats, &s.darks})
       for (const Plane& p : *set)
@@ -143,17 +146,40 @@ void check_steps(const std::vector<ExposureStep>& steps) {
 
 ChannelCalibration calibrate_channel(const std::string& channel, const std::vector<ExposureStep>& input) {
   check_steps(input);
-  std::vector<ExposureStep> steps = input;
-  std::sort(steps.begin(), steps.end(), [](const ExposureStep& a, const ExposureStep& b) { return a.exposure_s < b.exposure_s; });
   ChannelCalibration c;
   c.channel = channel;
-  const std::size_t n = steps[0].flats[0].values.size();
 
+  // The dark frames by exposure time (a series at one exposure time shares its darks between its irradiances;
+  // darks alone at further times measure the dark current).
+  std::map<double, Temporal> dark_at;
+  std::map<double, const ExposureStep*> darks_of;
+  for (const ExposureStep& s : input)
+    if (!dark_at.contains(s.exposure_s)) dark_at[s.exposure_s] = temporal(s.darks), darks_of[s.exposure_s] = &s;
+  for (const auto& [t, d] : dark_at) c.dark_points.push_back({t, std::nullopt, 0, 0, d.mean, d.variance});
+  const Temporal& shortest = dark_at.begin()->second;
+
+  // The flats' steps, by exposure time and then by signal (one exposure time: the irradiance's order).
+  std::vector<ExposureStep> steps;
+  for (const ExposureStep& s : input)
+    if (!s.flats.empty()) steps.push_back(s);
   std::vector<Temporal> flat, dark;
-  for (const ExposureStep& s : steps) {
-    flat.push_back(temporal(s.flats));
-    dark.push_back(temporal(s.darks));
-    c.points.push_back({s.exposure_s, s.photons_per_pixel, flat.back().mean, flat.back().variance, dark.back().mean, dark.back().variance});
+  for (const ExposureStep& s : steps) flat.push_back(temporal(s.flats));
+  {
+    std::vector<std::size_t> order(steps.size());
+    std::iota(order.begin(), order.end(), 0);
+    std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+      return std::pair{steps[a].exposure_s, flat[a].mean} < std::pair{steps[b].exposure_s, flat[b].mean};
+    });
+    std::vector<ExposureStep> sorted_steps;
+    std::vector<Temporal> sorted_flat;
+    for (const std::size_t k : order) sorted_steps.push_back(std::move(steps[k])), sorted_flat.push_back(flat[k]);
+    steps = std::move(sorted_steps), flat = std::move(sorted_flat);
+  }
+  const std::size_t n = steps[0].flats[0].values.size();
+  const bool one_time = steps.front().exposure_s == steps.back().exposure_s;
+  for (std::size_t k = 0; k < steps.size(); ++k) {
+    dark.push_back(dark_at[steps[k].exposure_s]);
+    c.points.push_back({steps[k].exposure_s, steps[k].photons_per_pixel, flat[k].mean, flat[k].variance, dark[k].mean, dark[k].variance});
   }
 
   // Flats no brighter than the darks (by 3 standard errors of the mean at every exposure) show no light at all.
@@ -179,10 +205,15 @@ ChannelCalibration calibrate_channel(const std::string& channel, const std::vect
     throw InputError(fmt::format("channel {}: every exposure clips every pixel (the flats' temporal variance is no more than twice "
                                  "the dark frames'); add shorter exposures, from a few per cent of saturation",
                                  channel));
-  if (top + 1 == steps.size())
+  if (top + 1 == steps.size()) {
+    if (one_time)
+      throw InputError(fmt::format("channel {}: no irradiance saturates (the flats' temporal variance still grows at the brightest "
+                                   "pair); add irradiances up to and beyond saturation",
+                                   channel));
     throw InputError(fmt::format("channel {}: no exposure saturates (the flats' temporal variance still grows at the longest, "
                                  "{:.6g} s); add exposures up to and beyond saturation",
                                  channel, steps.back().exposure_s));
+  }
   const double signal_sat = flat[top].mean - dark[top].mean;
   c.saturation_mean_dn = flat[top].mean;
 
@@ -197,6 +228,10 @@ ChannelCalibration calibrate_channel(const std::string& channel, const std::vect
   }
   if (x.size() < 3) {
     // Why there are so few: saturation at the shortest exposure, or too few steps below 70 % of it.
+    if (top == 0 && one_time)
+      throw InputError(fmt::format("channel {}: the dimmest pair of flats already saturates (its temporal variance is the largest "
+                                   "of the series); add lower irradiances",
+                                   channel));
     if (top == 0)
       throw InputError(fmt::format("channel {}: the shortest exposure, {:.6g} s, already saturates (its flats' temporal variance is "
                                    "the largest of the series); add shorter exposures",
@@ -220,13 +255,13 @@ ChannelCalibration calibrate_channel(const std::string& channel, const std::vect
   // Dark signal against exposure time: the dark current (slope / K), the black level (intercept), and the dark
   // noise from the intercept of the dark variance.
   std::vector<double> times, dark_means, dark_variances;
-  for (std::size_t k = 0; k < steps.size(); ++k) {
-    times.push_back(steps[k].exposure_s);
-    dark_means.push_back(dark[k].mean);
-    dark_variances.push_back(dark[k].variance);
+  for (const auto& [t, d] : dark_at) {
+    times.push_back(t);
+    dark_means.push_back(d.mean);
+    dark_variances.push_back(d.variance);
   }
   const bool several_times = times.front() < times.back();
-  double dark_variance_0 = dark[0].variance, dark_variance_0_se = variance_se(dark[0].variance, n);
+  double dark_variance_0 = shortest.variance, dark_variance_0_se = variance_se(shortest.variance, n);
   if (several_times) {
     const LineFit dm = fit_line(times, dark_means, false);
     c.dark_current_e_per_s = {dm.slope / K, std::hypot(dm.slope_se / K, dm.slope / K * rK)};
@@ -235,9 +270,9 @@ ChannelCalibration calibrate_channel(const std::string& channel, const std::vect
     const double K2 = K * K;
     c.dark_current_from_variance_e_per_s = Estimate{dv.slope / K2, std::hypot(dv.slope_se / K2, dv.slope / K2 * 2 * rK)};
     dark_variance_0 = dv.intercept;
-    dark_variance_0_se = std::max(dv.intercept_se, variance_se(dark[0].variance, n) / std::sqrt(double(steps.size())));
+    dark_variance_0_se = std::max(dv.intercept_se, variance_se(shortest.variance, n) / std::sqrt(double(times.size())));
   } else {
-    c.black_level_dn = {dark[0].mean, std::sqrt(dark[0].variance / double(n))};
+    c.black_level_dn = {shortest.mean, std::sqrt(shortest.variance / double(n))};
     c.notes.push_back("every dark frame has one exposure time: no dark current measured");
   }
   if (dark_variance_0 < kQuantisationLimit) {
@@ -259,7 +294,8 @@ ChannelCalibration calibrate_channel(const std::string& channel, const std::vect
     const double v = std::sqrt(variance) * scale;
     return Estimate{v, v * std::hypot(se / (2 * variance), scale_relative_se)};
   };
-  const SpatialVariance ds = spatial_variance(average(steps[0].darks), dark[0].variance, steps[0].darks.size());
+  const std::vector<Plane>& shortest_darks = darks_of.begin()->second->darks;
+  const SpatialVariance ds = spatial_variance(average(shortest_darks), shortest.variance, shortest_darks.size());
   c.dsnu_e = {spread(ds.total, ds.total_se, 1 / K, rK), spread(ds.row, ds.row_se, 1 / K, rK),
               spread(ds.column, ds.column_se, 1 / K, rK), spread(ds.pixel, ds.pixel_se, 1 / K, rK)};
 
@@ -298,7 +334,10 @@ ChannelCalibration calibrate_channel(const std::string& channel, const std::vect
       signal.push_back(s);
     }
   }
-  if (u.size() >= 3 && u.front() < u.back()) {
+  if (one_time && !photons) {
+    c.notes.push_back("the flats have one exposure time, and the photons per pixel of each pair were not given (--photons-per-pixel): "
+                      "no linearity error, no quantum efficiency");
+  } else if (u.size() >= 3 && u.front() < u.back()) {
     // EMVA 1288's fit: least squares of the relative deviations, each squared residual weighted by 1/y² (so a
     // bright point, whose absolute residual is large, weighs no more than a dim one); LE = (δmax − δmin)/2.
     std::vector<double> weights;
@@ -314,7 +353,7 @@ ChannelCalibration calibrate_channel(const std::string& channel, const std::vect
   } else {
     c.notes.push_back("fewer than three exposures between 5 % and 95 % of saturation: no linearity error");
   }
-  if (!photons) c.notes.push_back("the photons per pixel were not given (--photons-per-s): no quantum efficiency, linearity against exposure time");
+  if (!photons && !one_time) c.notes.push_back("the photons per pixel were not given (--photons-per-s): no quantum efficiency, linearity against exposure time");
 
   // Quantum efficiency η = R / K, R the responsivity (DN per photon) over the gain's range.
   if (photons) {

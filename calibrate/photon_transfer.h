@@ -38,7 +38,9 @@ struct Plane {
   std::vector<double> values;
 };
 
-// All the frames taken at one exposure time, one plane per frame, for one channel.
+// The frames of one step of the series, one plane per frame, for one channel: the flats at one exposure time and
+// irradiance, and the darks at that exposure time. A series at one exposure time has a step per irradiance, each
+// with the same darks; a step without flats holds darks alone (at a further time, for the dark current).
 struct ExposureStep {
   double exposure_s = 0;
   std::optional<double> photons_per_pixel;  // μ_p, when the irradiance is known
@@ -65,7 +67,8 @@ struct TransferPoint {
 
 struct ChannelCalibration {
   std::string channel;
-  std::vector<TransferPoint> points;
+  std::vector<TransferPoint> points;       // per flat step: by exposure time, then by signal
+  std::vector<TransferPoint> dark_points;  // per exposure time of the darks (exposure, dark mean and variance only)
   Estimate gain_dn_per_e;           // K
   Estimate dark_noise_e;            // σ_d
   Estimate saturation_capacity_e;   // μ_e.sat
@@ -91,7 +94,7 @@ struct ChannelCalibration {
 };
 
 // Estimates one channel's parameters. InputError (message without a file name; the caller adds it) when the
-// steps cannot support the estimates: fewer than two flats or two darks at a step, frames of different sizes,
+// steps cannot support the estimates: one flat or fewer than two darks at a step, frames of different sizes,
 // fewer than three exposure steps below saturation, or no step that saturates (the saturation capacity and the
 // 70 % range of the gain fit need it).
 ChannelCalibration calibrate_channel(const std::string& channel, const std::vector<ExposureStep>& steps);

@@ -15,8 +15,11 @@
 namespace ct::calibrate {
 namespace {
 
-// Channel colours (a colour-blind-safe set: vermillion, bluish green, blue).
-constexpr const char* kChannelColour[3] = {"#d55e00", "#009e73", "#0072b2"};
+// Channel colours (a colour-blind-safe set: vermillion, bluish green, blue); a monochrome camera's channel black.
+const char* channel_colour(const Calibration& cal, std::size_t c) {
+  static constexpr const char* kRgb[3] = {"#d55e00", "#009e73", "#0072b2"};
+  return cal.channels.size() == 1 ? "#222222" : kRgb[c % 3];
+}
 
 // An x–y plot: linear or logarithmic axes with the plotting kit's ticks (plot/ticks.h), series of points (markers)
 // and of lines (the model), as SVG.
@@ -137,7 +140,7 @@ bool have_photons(const ChannelCalibration& c) {
 
 std::string photon_transfer(const Calibration& cal) {
   Plot plot("Photon transfer", "mean signal above dark, μy − μy.dark (DN)", "temporal variance above dark, σ²y − σ²y.dark (DN²)", false, false);
-  for (std::size_t c = 0; c < 3; ++c) {
+  for (std::size_t c = 0; c < cal.channels.size(); ++c) {
     const ChannelCalibration& ch = cal.channels[c];
     std::vector<std::pair<double, double>> xy;
     double top = 0;
@@ -145,17 +148,17 @@ std::string photon_transfer(const Calibration& cal) {
       xy.emplace_back(p.mean_dn - p.dark_mean_dn, p.variance_dn2 - p.dark_variance_dn2);
       top = std::max(top, p.mean_dn - p.dark_mean_dn);
     }
-    plot.points(xy, kChannelColour[c], fmt::format("{}: K = {:.4g} DN/e⁻", ch.channel, ch.gain_dn_per_e.value));
+    plot.points(xy, channel_colour(cal, c), fmt::format("{}: K = {:.4g} DN/e⁻", ch.channel, ch.gain_dn_per_e.value));
     const double fit_top = 0.7 * (ch.saturation_mean_dn - ch.points.back().dark_mean_dn);
-    plot.line({{0.0, 0.0}, {fit_top, ch.gain_dn_per_e.value * fit_top}}, kChannelColour[c], "");
+    plot.line({{0.0, 0.0}, {fit_top, ch.gain_dn_per_e.value * fit_top}}, channel_colour(cal, c), "");
   }
   return plot.svg();
 }
 
 std::string snr(const Calibration& cal) {
-  const bool photons = have_photons(cal.channels[1]);
+  const bool photons = have_photons(cal.channels[0]);
   Plot plot("Signal-to-noise ratio", photons ? "photons per pixel, μp" : "signal, μe (e⁻)", "SNR", true, true);
-  for (std::size_t c = 0; c < 3; ++c) {
+  for (std::size_t c = 0; c < cal.channels.size(); ++c) {
     const ChannelCalibration& ch = cal.channels[c];
     const double K = ch.gain_dn_per_e.value, eta = ch.quantum_efficiency ? ch.quantum_efficiency->value : 1.0;
     std::vector<std::pair<double, double>> measured, model;
@@ -169,34 +172,34 @@ std::string snr(const Calibration& cal) {
       const double e = photons ? eta * x : x;
       model.emplace_back(x, e / std::sqrt(ch.dark_noise_e.value * ch.dark_noise_e.value + 1.0 / 12.0 / (K * K) + e));
     }
-    plot.points(measured, kChannelColour[c], ch.channel + (photons ? fmt::format(": η = {:.3g}", eta) : ""));
-    plot.line(model, kChannelColour[c], "");
+    plot.points(measured, channel_colour(cal, c), ch.channel + (photons ? fmt::format(": η = {:.3g}", eta) : ""));
+    plot.line(model, channel_colour(cal, c), "");
   }
   return plot.svg();
 }
 
 std::string linearity(const Calibration& cal) {
-  const bool photons = have_photons(cal.channels[1]);
+  const bool photons = have_photons(cal.channels[0]);
   Plot plot("Linearity", photons ? "photons per pixel, μp" : "exposure time (s)", "mean signal above dark (DN)", false, false);
-  for (std::size_t c = 0; c < 3; ++c) {
+  for (std::size_t c = 0; c < cal.channels.size(); ++c) {
     const ChannelCalibration& ch = cal.channels[c];
     std::vector<std::pair<double, double>> xy;
     for (const TransferPoint& p : ch.points) xy.emplace_back(photons ? *p.photons_per_pixel : p.exposure_s, p.mean_dn - p.dark_mean_dn);
-    plot.points(xy, kChannelColour[c], fmt::format("{}: linearity error {:.2g} %", ch.channel, 100 * ch.linearity_error));
+    plot.points(xy, channel_colour(cal, c), fmt::format("{}: linearity error {:.2g} %", ch.channel, 100 * ch.linearity_error));
   }
   return plot.svg();
 }
 
 std::string dark_signal(const Calibration& cal) {
   Plot plot("Dark signal", "exposure time (s)", "mean dark signal, μy.dark (DN)", false, false);
-  for (std::size_t c = 0; c < 3; ++c) {
+  for (std::size_t c = 0; c < cal.channels.size(); ++c) {
     const ChannelCalibration& ch = cal.channels[c];
     std::vector<std::pair<double, double>> xy;
-    for (const TransferPoint& p : ch.points) xy.emplace_back(p.exposure_s, p.dark_mean_dn);
-    plot.points(xy, kChannelColour[c], fmt::format("{}: {:.3g} e⁻/s", ch.channel, ch.dark_current_e_per_s.value));
-    const double t1 = ch.points.back().exposure_s;
+    for (const TransferPoint& p : ch.dark_points) xy.emplace_back(p.exposure_s, p.dark_mean_dn);
+    plot.points(xy, channel_colour(cal, c), fmt::format("{}: {:.3g} e⁻/s", ch.channel, ch.dark_current_e_per_s.value));
+    const double t1 = ch.dark_points.back().exposure_s;
     plot.line({{0.0, ch.black_level_dn.value}, {t1, ch.black_level_dn.value + ch.gain_dn_per_e.value * ch.dark_current_e_per_s.value * t1}},
-              kChannelColour[c], "");
+              channel_colour(cal, c), "");
   }
   return plot.svg();
 }
@@ -212,10 +215,10 @@ std::string page(const Calibration& cal, const std::vector<std::pair<std::string
 td,th{border-bottom:1px solid #ddd;padding:4px 10px;text-align:right}th:first-child,td:first-child{text-align:left}
 .plots{display:flex;flex-wrap:wrap;gap:12px}figure{margin:0}.note{color:#555;font-size:13px}</style></head><body>)svg";
   html += "<h1>Camera calibration (EMVA 1288 Release 4.0, Linear)</h1>";
-  html += fmt::format("<p class=\"note\">{} flat and {} dark frames at {} exposure times; each estimate with its standard error. "
+  html += fmt::format("<p class=\"note\">{} flat and {} dark frames ({}); each estimate with its standard error. "
                       "Every number, and the sensor settings for <code>chromatrace sensor --config</code> (its <code>sensor</code>), in "
                       "<a href=\"calibration.json\">calibration.json</a>.</p>",
-                      cal.flats, cal.darks, cal.exposures);
+                      cal.flats, cal.darks, escape_html(cal.series));
   html += "<table><tr><th>quantity</th>";
   for (const ChannelCalibration& c : cal.channels) html += "<th>" + escape_html(c.channel) + "</th>";
   html += "</tr>";
@@ -245,7 +248,14 @@ td,th{border-bottom:1px solid #ddd;padding:4px 10px;text-align:right}th:first-ch
   });
   row("linearity error (%)", [](const auto& c) { return fmt::format("{:.2g}", 100 * c.linearity_error); });
   row("quantum efficiency η", [](const auto& c) { return c.quantum_efficiency ? cell(*c.quantum_efficiency) : std::string("—"); });
-  html += "</table><div class=\"plots\">";
+  html += "</table>";
+  const NoiseCorrelation& nc = cal.noise_correlation;
+  html += fmt::format("<p class=\"note\">The temporal noise's correlation (the flats' pair differences): {:.3f} between horizontal "
+                      "and {:.3f} between vertical neighbours{}, ± {:.2g}; about 0 where each pixel is read on its own.</p>",
+                      nc.horizontal, nc.vertical,
+                      nc.channel_pair.empty() ? "" : fmt::format(", {:.3f} between channels ({})", nc.between_channels, nc.channel_pair),
+                      nc.standard_error);
+  html += "<div class=\"plots\">";
   for (const auto& [name, svg] : plots) html += "<figure>" + svg + "</figure>";
   html += "</div>";
   for (const ChannelCalibration& c : cal.channels)
@@ -262,10 +272,14 @@ void write_text(const std::filesystem::path& file, const std::string& text) {
 }  // namespace
 
 std::vector<std::pair<std::string, std::string>> report_plots(const Calibration& calibration) {
-  return {{"photon_transfer.svg", photon_transfer(calibration)},
-          {"snr.svg", snr(calibration)},
-          {"linearity.svg", linearity(calibration)},
-          {"dark_signal.svg", dark_signal(calibration)}};
+  std::vector<std::pair<std::string, std::string>> plots = {{"photon_transfer.svg", photon_transfer(calibration)},
+                                                            {"snr.svg", snr(calibration)}};
+  // Linearity against exposure time needs times that vary; at one time, against the photons when they are given.
+  const std::vector<TransferPoint>& points = calibration.channels[0].points;
+  if (have_photons(calibration.channels[0]) || points.front().exposure_s < points.back().exposure_s)
+    plots.emplace_back("linearity.svg", linearity(calibration));
+  plots.emplace_back("dark_signal.svg", dark_signal(calibration));
+  return plots;
 }
 
 std::vector<std::string> report_files() {

@@ -8,6 +8,7 @@
 
 #include <fmt/core.h>
 
+#include "analyzer/image_input.h"
 #include "calibrate/calibration.h"
 #include "calibrate/report.h"
 #include "cli/app.h"
@@ -23,20 +24,31 @@ Action add_calibrate(CLI::App& app) {
     std::vector<std::string> flats, darks;
     std::string output, report;
     double photons_per_s = 0;
+    std::vector<double> photons_per_pixel;
+    std::string input_transfer = "auto";
     bool quiet = false;
   };
   auto o = std::make_shared<Options>();
   // Checked after parsing rather than marked required: CLI11 takes the word after an option with no value of its own
   // as that value even when it is another option ("--flat --dark D…" gives --flat the frames and says "--dark is
   // required"), so the frame lists are checked for option names first.
-  cmd->add_option("--flat", o->flats, "Flat-field frames: at least two at each exposure time (camera raw, or linear EXR/TIFF)");
-  cmd->add_option("--dark", o->darks, "Dark frames: at least two at each exposure time of the flats");
+  cmd->add_option("--flat", o->flats,
+                  "Flat-field frames: at least two at each exposure time, or, at one exposure time, a pair per irradiance in the "
+                  "order given (camera raw, or linear EXR/TIFF/PNG with R, G, B or one channel)");
+  cmd->add_option("--dark", o->darks,
+                  "Dark frames: at least two at each exposure time of the flats; pairs at further times add to the dark current");
   cmd->add_option("-o,--output", o->output, "Sensor settings written (chromatrace-sensor/1), for chromatrace sensor --config");
   cmd->add_option("--report", o->report,
                   "Report directory: index.html (the datasheet's curves and table), calibration.json (every estimate per "
                   "channel with its standard error, the measured points), the plots as SVG");
   cmd->add_option("--photons-per-s", o->photons_per_s,
                   "Photons per pixel and second reaching the sensor in the flats (for the quantum efficiency)");
+  cmd->add_option("--photons-per-pixel", o->photons_per_pixel,
+                  "Flats at one exposure time: the photons per pixel of each pair, in the pairs' order (for the linearity and the "
+                  "quantum efficiency)");
+  cmd->add_option("--input-transfer", o->input_transfer,
+                  "What the frames' values are: auto (the file's metadata; an integer file that names no colour space holds digital "
+                  "numbers) or linear (say so of a file that names a curve)");
   cmd->add_flag("-q,--quiet", o->quiet, "No summary on stderr");
 
   return [o, cmd] {
@@ -52,6 +64,9 @@ Action add_calibrate(CLI::App& app) {
     for (const std::string& f : o->flats) input.flats.emplace_back(f);
     for (const std::string& f : o->darks) input.darks.emplace_back(f);
     if (cmd->count("--photons-per-s") > 0) input.photons_per_s = o->photons_per_s;
+    input.photons_per_pixel = o->photons_per_pixel;
+    analyzer::parse_input_transfer(o->input_transfer);
+    input.input_transfer = o->input_transfer;
     std::vector<std::filesystem::path> inputs = input.flats;
     inputs.insert(inputs.end(), input.darks.begin(), input.darks.end());
     std::vector<std::filesystem::path> outputs = {o->output};

@@ -10,6 +10,7 @@
 #include <cstdlib>
 #include <fstream>
 #include <functional>
+#include <map>
 #include <filesystem>
 #include <numbers>
 #include <random>
@@ -61,20 +62,39 @@ class Calibrate : public ::testing::Test {
   // As camera raw: DNGs of an RGGB mosaic of twice the size (each 2 × 2 tile's red, first green and blue are read).
   calibrate::CalibrationInput series(const Camera& c, const std::string& name, const std::vector<double>& shares, int per_step,
                                      bool dng = false) {
+    std::vector<Shot> shots;
+    for (const double share : shares) shots.push_back({share, 1.0, per_step, per_step});
+    return shoot(c, name, shots, dng ? Output::Dng : Output::Exr);
+  }
+
+  // One step of a series: `flats` and `darks` frames of `time_s` under `light` times the radiance that fills the full
+  // well in one second.
+  struct Shot {
+    double time_s, light;
+    int flats, darks;
+  };
+  enum class Output { Exr, Dng, Demosaiced };  // the simulator's frames without a CFA, its RGGB DNG, or demosaiced RGB
+  // The frames of `shots`, named <name>-<time>-<flat|dark>[-L<light>]-<k> (the light only where it is not 1).
+  calibrate::CalibrationInput shoot(const Camera& c, const std::string& name, const std::vector<Shot>& shots, Output output) {
+    const bool dng = output == Output::Dng;
     const int size = dng ? 2 * kSize : kSize;
-    const double fill_s = 1.0;  // the flats' light fills the full well in one second
-    const double radiance = c.full_well / c.qe / photons_per_radiance_second() / fill_s;
-    const fs::path flat = dir_.file(name + "-flat.exr"), dark = dir_.file(name + "-dark.exr");
-    test::write_radiance(flat, kBand, size, size, [&](int, int, std::size_t) { return static_cast<float>(radiance); });
+    const double fill = c.full_well / c.qe / photons_per_radiance_second();  // the radiance that fills the well in 1 s
+    const fs::path dark = dir_.file(name + "-dark.exr");
     test::write_radiance(dark, kBand, size, size, [&](int, int, std::size_t) { return 0.0f; });
+    std::map<double, fs::path> lights;
     calibrate::CalibrationInput input;
-    input.photons_per_s = radiance * photons_per_radiance_second();
+    input.photons_per_s = fill * photons_per_radiance_second();
+    for (const Shot& shot : shots)
+      if (!lights.contains(shot.light)) {
+        lights[shot.light] = dir_.file(fmt::format("{}-light-{}.exr", name, shot.light));
+        test::write_radiance(lights[shot.light], kBand, size, size, [&](int, int, std::size_t) { return static_cast<float>(shot.light * fill); });
+      }
     std::uint64_t seed = 1;
-    for (const double share : shares)
+    for (const Shot& shot : shots)
       for (const bool is_flat : {true, false})
-        for (int k = 0; k < per_step; ++k) {
+        for (int k = 0; k < (is_flat ? shot.flats : shot.darks); ++k) {
           Json patch = {{"optics", {{"f_number", kFNumber}, {"cos4", false}}},
-                        {"exposure", {{"time_s", share * fill_s}}},
+                        {"exposure", {{"time_s", shot.time_s}}},
                         {"pixel", {{"pitch_um", kPitchUm}}},
                         {"spectral_response", {{"camera", flat_camera_.string()}, {"basis", "photon"}, {"peak_qe", c.qe}}},
                         {"noise",
@@ -90,9 +110,10 @@ class Calibrate : public ::testing::Test {
                         {"full_well", {{"enabled", true}, {"electrons", c.full_well}}},
                         {"adc", {{"enabled", true}, {"gain_dn_per_e", c.gain}, {"black_level_dn", c.black}, {"bits", c.bits}}},
                         {"display", {{"enabled", false}}}};
-          if (dng) patch["cfa"] = {{"enabled", true}, {"pattern", "RGGB"}};
-          const fs::path out = dir_.file(fmt::format("{}-{}-{}-{}.{}", name, share, is_flat ? "flat" : "dark", k, dng ? "dng" : "exr"));
-          test::run_sensor(is_flat ? flat : dark, out, test::config_of(patch));
+          if (output != Output::Exr) patch["cfa"] = {{"enabled", true}, {"pattern", "RGGB"}};
+          const std::string light = is_flat && shot.light != 1.0 ? fmt::format("-L{}", shot.light) : "";
+          const fs::path out = dir_.file(fmt::format("{}-{}-{}{}-{}.{}", name, shot.time_s, is_flat ? "flat" : "dark", light, k, dng ? "dng" : "exr"));
+          test::run_sensor(is_flat ? lights[shot.light] : dark, out, test::config_of(patch));
           (is_flat ? input.flats : input.darks).push_back(out);
         }
     return input;
@@ -108,7 +129,8 @@ void expect_recovered(const calibrate::Estimate& e, double truth, const std::str
   EXPECT_LE(std::abs(e.value - truth), allowed) << what << ": " << e.value << " ± " << e.standard_error << ", truth " << truth;
 }
 
-void expect_camera(const calibrate::Calibration& cal, const Camera& c) {
+void expect_camera(const calibrate::Calibration& cal, const Camera& c, std::size_t channels = 3) {
+  ASSERT_EQ(cal.channels.size(), channels);
   for (const calibrate::ChannelCalibration& ch : cal.channels) {
     SCOPED_TRACE("channel " + ch.channel);
     expect_recovered(ch.gain_dn_per_e, c.gain, "system gain K");
@@ -318,6 +340,180 @@ TEST_F(Calibrate, TheCommandWritesSettingsTheSensorTakesAndRefusesSeriesThatCann
   EXPECT_EQ(r.exit_code, 2) << r.err;
   EXPECT_NE(r.err.find((inside / "calibration.json").string() + ": is the input"), std::string::npos) << r.err;
   EXPECT_EQ(fs::file_size(inside / "calibration.json"), size);
+  EXPECT_FALSE(fs::exists(bad));
+}
+
+// A frame as an ordinary camera file: the channels `channels` of the simulator's frame, its digital numbers as they
+// are, without the simulator's metadata; the exposure time in EXIF's ExposureTime. `type` UINT16 (a TIFF or PNG) or
+// FLOAT (an EXR), the values times `scale`.
+fs::path write_plain(const fs::path& exr, const std::vector<int>& channels, const fs::path& out, double exposure_s,
+                     OIIO::TypeDesc type = OIIO::TypeDesc::UINT16, float scale = 1) {
+  const test::RgbLayer rgb = test::read_rgb(exr);
+  const auto n = static_cast<std::size_t>(rgb.width) * static_cast<std::size_t>(rgb.height);
+  std::vector<float> values(n * channels.size());
+  for (std::size_t i = 0; i < n; ++i)
+    for (std::size_t k = 0; k < channels.size(); ++k) values[i * channels.size() + k] = rgb.values[i * 3 + static_cast<std::size_t>(channels[k])] * scale;
+  OIIO::ImageSpec spec(rgb.width, rgb.height, static_cast<int>(channels.size()), type);
+  spec.attribute("ExposureTime", static_cast<float>(exposure_s));
+  auto file = OIIO::ImageOutput::create(out.string());
+  EXPECT_TRUE(file);
+  // Integer files take values as fractions of full scale.
+  if (type == OIIO::TypeDesc::UINT16 || type == OIIO::TypeDesc::UINT8)
+    for (float& v : values) v /= type == OIIO::TypeDesc::UINT8 ? 255.0f : 65535.0f;
+  EXPECT_TRUE(file->open(out.string(), spec));
+  EXPECT_TRUE(file->write_image(OIIO::TypeDesc::FLOAT, values.data()));
+  file->close();
+  return out;
+}
+
+// The exposure time of a frame named <name>-<time>-… (as shoot() names them).
+double time_of(const fs::path& frame) {
+  const std::string name = frame.stem().string();
+  const std::size_t a = name.find('-') + 1;
+  return std::stod(name.substr(a, name.find('-', a) - a));
+}
+
+// Every frame of a series as plain 16-bit TIFFs of `channels`.
+calibrate::CalibrationInput plain_series(const calibrate::CalibrationInput& in, const std::vector<int>& channels, const std::string& suffix) {
+  calibrate::CalibrationInput out = in;
+  for (auto* set : {&out.flats, &out.darks})
+    for (fs::path& f : *set) f = write_plain(f, channels, f.parent_path() / (f.stem().string() + suffix + ".tif"), time_of(f));
+  return out;
+}
+
+// Frames as a machine-vision camera writes them: 16-bit TIFFs of digital numbers without any metadata but EXIF's
+// exposure time, three channels or one (a monochrome camera). Calibrated as the simulator's own files are: every
+// parameter recovered, the noise of neighbouring pixels and of the channels uncorrelated (0 within three standard
+// errors), and the ADC's 12 bits found from the largest value (the flats clip at the full well, 3700 DN: 12 bits, not
+// the file's 16).
+TEST_F(Calibrate, OrdinaryFramesOfAColourOrAMonochromeCameraAreCalibrated) {
+  const Camera c{0.6, 0.18, 100, 20000, 5, 100, 2, 0.01, 0, 0, 12};
+  const calibrate::CalibrationInput simulated = series(c, "plain");
+  calibrate::CalibrationInput rgb = plain_series(simulated, {0, 1, 2}, "-rgb");
+  const calibrate::Calibration colour = calibrate::calibrate(rgb);
+  expect_camera(colour, c);
+  EXPECT_EQ(colour.sensor["adc"]["bits"].get<int>(), 12);
+  EXPECT_NE(colour.sensor["description"].get<std::string>().find("from the largest value in the frames"), std::string::npos);
+  const calibrate::NoiseCorrelation& nc = colour.noise_correlation;
+  for (const double rho : {nc.horizontal, nc.vertical, nc.between_channels}) EXPECT_LT(rho, kSigmasPerItem * nc.standard_error);
+  std::cerr << fmt::format("plain frames: noise correlation {:.4f} horizontal, {:.4f} vertical, {:.4f} between channels, ± {:.4f}\n",
+                           nc.horizontal, nc.vertical, nc.between_channels, nc.standard_error);
+
+  calibrate::CalibrationInput grey = plain_series(simulated, {1}, "-mono");
+  const calibrate::Calibration mono = calibrate::calibrate(grey);
+  expect_camera(mono, c, 1);
+  EXPECT_EQ(mono.channels[0].channel, "Y");
+  EXPECT_NE(mono.sensor["description"].get<std::string>().find("one channel (monochrome)"), std::string::npos);
+  EXPECT_NO_THROW(test::config_of(mono.sensor));
+  // Through the command, with the report: one channel in it.
+  const fs::path report = dir_.file("mono-report"), out = dir_.file("mono.json");
+  std::vector<std::string> args = calibrate_args(grey.flats, grey.darks, out);
+  args.insert(args.end(), {"--report", report.string(), "--photons-per-s", fmt::format("{}", *grey.photons_per_s)});
+  const auto r = test::run_chromatrace(args);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(read_json(report / "calibration.json")["channels"].size(), 1u);
+
+  // A monochrome frame among colour ones: named against the rest.
+  calibrate::CalibrationInput mixed = rgb;
+  mixed.darks.back() = grey.darks.back();
+  try {
+    calibrate::calibrate(mixed);
+    ADD_FAILURE() << "a monochrome frame among colour frames was accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find(grey.darks.back().string() + ": linear TIF, one channel (monochrome), but"), std::string::npos) << e.what();
+  }
+}
+
+// Frames whose pixels share noise, or that are not digital numbers, are refused by name: the simulator's demosaiced
+// frames written as plain TIFFs (no metadata says so; bilinear interpolation correlates a pixel's noise with its
+// neighbours' by about 0.5), a float EXR scaled to 0–1, and a JPEG (a tone-mapped picture, unless the user says it is
+// linear).
+TEST_F(Calibrate, FramesWhosePixelsShareNoiseOrAreNotDigitalNumbersAreRefused) {
+  const Camera c{0.6, 0.18, 100, 20000, 5, 100, 2, 0.01, 0, 0, 12};
+  const std::vector<Shot> shots = {{0.2, 1, 2, 2}, {0.4, 1, 2, 2}, {0.6, 1, 2, 2}, {1.2, 1, 2, 2}};
+  const calibrate::CalibrationInput demosaiced = plain_series(shoot(c, "demosaiced", shots, Output::Demosaiced), {0, 1, 2}, "-plain");
+  const fs::path bad = dir_.file("bad.json");
+  auto r = test::run_chromatrace(calibrate_args(demosaiced.flats, demosaiced.darks, bad));
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("--flat: the temporal noise of the flats correlates by"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("the frames were interpolated or filtered"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(bad));
+  std::cerr << r.err;
+
+  const calibrate::CalibrationInput frames = shoot(c, "formats", shots, Output::Exr);
+  const fs::path scaled = write_plain(frames.flats[0], {0, 1, 2}, dir_.file("scaled.exr"), 0.2, OIIO::TypeDesc::FLOAT, 1.0f / 4095);
+  std::vector<fs::path> flats = frames.flats;
+  flats[0] = scaled;
+  r = test::run_chromatrace(calibrate_args(flats, frames.darks, bad));
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find(scaled.string() + ": channel R holds"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("not a whole number"), std::string::npos) << r.err;
+
+  const fs::path jpeg = write_plain(frames.flats[0], {0, 1, 2}, dir_.file("frame.jpg"), 0.2, OIIO::TypeDesc::UINT8, 1.0f / 16);
+  flats[0] = jpeg;
+  r = test::run_chromatrace(calibrate_args(flats, frames.darks, bad));
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find(jpeg.string() + ": its values are encoded with a response curve (the sRGB curve, from a JPEG"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("--input-transfer linear"), std::string::npos) << r.err;
+  std::vector<std::string> linear = calibrate_args(flats, frames.darks, bad);
+  linear.insert(linear.end(), {"--input-transfer", "linear"});
+  r = test::run_chromatrace(linear);
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_EQ(r.err.find("response curve"), std::string::npos) << r.err;  // taken as linear: on to the next question
+  EXPECT_FALSE(fs::exists(bad));
+}
+
+// EMVA 1288's second method: one exposure time (0.5 s), the irradiance varied, the flats in pairs in the order given,
+// with the photons per pixel of each pair; darks at 0.5 s, and darks alone at 0.1 and 1.5 s for the dark current.
+// Every parameter is recovered as from an exposure series.
+TEST_F(Calibrate, ASeriesAtOneExposureTimeUnderVaryingIrradiance) {
+  const Camera c{0.6, 0.25, 100, 20000, 5, 100, 2, 0.01, 0, 0, 16};
+  const double t = 0.5;
+  std::vector<Shot> shots;
+  for (const double share : kExposureShares) shots.push_back({t, share / t, 2, 0});
+  shots.push_back({t, 1, 0, 2});
+  shots.push_back({0.1, 1, 0, 2});
+  shots.push_back({1.5, 1, 0, 2});
+  calibrate::CalibrationInput in = shoot(c, "irradiance", shots, Output::Exr);
+  const double photons_per_s = *in.photons_per_s;
+  in.photons_per_s.reset();
+  for (const double share : kExposureShares) in.photons_per_pixel.push_back(photons_per_s * share);
+  const calibrate::Calibration cal = calibrate::calibrate(in);
+  expect_camera(cal, c);
+  EXPECT_EQ(cal.series, fmt::format("{} irradiances at 0.5 s; darks alone at 2 further times", kExposureShares.size()));
+  EXPECT_EQ(cal.channels[0].dark_points.size(), 3u);
+
+  // Without the photons: no linearity, no quantum efficiency, said.
+  calibrate::CalibrationInput no_photons = in;
+  no_photons.photons_per_pixel.clear();
+  const calibrate::Calibration without = calibrate::calibrate(no_photons);
+  EXPECT_FALSE(without.channels[1].quantum_efficiency);
+  bool said = false;
+  for (const std::string& n : without.channels[1].notes) said = said || n.find("--photons-per-pixel") != std::string::npos;
+  EXPECT_TRUE(said);
+
+  // Refused by name: two flats swapped between pairs (A1 B1 A2 B2), an odd flat, photons per second, and a wrong count.
+  const fs::path bad = dir_.file("bad.json");
+  std::vector<fs::path> swapped = in.flats;
+  std::swap(swapped[1], swapped[2]);
+  auto r = test::run_chromatrace(calibrate_args(swapped, in.darks, bad));
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find(swapped[1].string() + ": its channel R is"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("each pair one irradiance"), std::string::npos) << r.err;
+  std::vector<fs::path> odd = in.flats;
+  odd.pop_back();
+  r = test::run_chromatrace(calibrate_args(odd, in.darks, bad));
+  EXPECT_NE(r.err.find(fmt::format("--flat: {} flat frames at 0.5 s", odd.size())), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find(odd.back().string() + ", has no partner"), std::string::npos) << r.err;
+  std::vector<std::string> args = calibrate_args(in.flats, in.darks, bad);
+  args.insert(args.end(), {"--photons-per-s", "1000"});
+  r = test::run_chromatrace(args);
+  EXPECT_NE(r.err.find("--photons-per-s: every flat has the exposure time 0.5 s, so the irradiance varied"), std::string::npos) << r.err;
+  args = calibrate_args(in.flats, in.darks, bad);
+  args.insert(args.end(), {"--photons-per-pixel", "1000", "2000"});
+  r = test::run_chromatrace(args);
+  EXPECT_NE(r.err.find(fmt::format("--photons-per-pixel: 2 values for {} pairs of flats", kExposureShares.size())), std::string::npos) << r.err;
+  EXPECT_EQ(r.exit_code, 2);
   EXPECT_FALSE(fs::exists(bad));
 }
 
