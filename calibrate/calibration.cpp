@@ -2,6 +2,7 @@
 #include "calibrate/calibration.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <map>
 #include <numeric>
@@ -254,6 +255,42 @@ Calibration calibrate(const CalibrationInput& input) {
                                        "the flats are taken in pairs in the order given, each pair one irradiance",
                                        pair[1]->file, pair[1]->channel_names[c], b, pair[0]->file, a));
       }
+  }
+
+  // One channel that is a colour camera's mosaic (a raw file written as a grey TIFF, as dcraw -D does): its flats'
+  // 2 × 2 phases differ as the filters' colours do, which its PRNU would report as the pixels' own. A monochrome
+  // sensor's phases agree to a fraction of a per cent (its PRNU averaged over a quarter of the pixels; an even/odd
+  // column amplifier's offset a per cent or so). Measured at the flat step nearest half of the brightest.
+  if (channel_count == 1) {
+    std::size_t mid = 0;
+    double brightest = 0;
+    std::vector<double> means;
+    for (const auto& pair : step_flats) {
+      const std::vector<double>& v = pair[0]->channels[0].values;
+      means.push_back(std::accumulate(v.begin(), v.end(), 0.0) / static_cast<double>(v.size()));
+      brightest = std::max(brightest, means.back());
+    }
+    for (std::size_t k = 0; k < means.size(); ++k)
+      if (std::abs(means[k] - brightest / 2) < std::abs(means[mid] - brightest / 2)) mid = k;
+    const Plane& plane = step_flats[mid][0]->channels[0];
+    const std::vector<Frame>& mid_darks = by_time[step_times[mid]][1];
+    std::array<double, 4> phase{};
+    std::array<std::size_t, 4> count{};
+    for (int y = 0; y < plane.height; ++y)
+      for (int x = 0; x < plane.width; ++x) {
+        const std::size_t i = static_cast<std::size_t>(y) * static_cast<std::size_t>(plane.width) + static_cast<std::size_t>(x);
+        const std::size_t p = static_cast<std::size_t>(2 * (y % 2) + x % 2);
+        for (const Frame* f : step_flats[mid]) phase[p] += f->channels[0].values[i];
+        for (const Frame& d : mid_darks) phase[p] -= d.channels[0].values[i] * static_cast<double>(step_flats[mid].size()) / static_cast<double>(mid_darks.size());
+        count[p] += step_flats[mid].size();
+      }
+    for (std::size_t p = 0; p < 4; ++p) phase[p] /= static_cast<double>(count[p]);
+    const auto [lo, hi] = std::minmax_element(phase.begin(), phase.end());
+    if (*lo > 0 && *hi / *lo - 1 > 0.05)
+      throw InputError(fmt::format("{}: its one channel's 2 × 2 phases differ by {:.0f} % in the flats (from {:.4g} to {:.4g} DN above "
+                                   "black): a colour camera's mosaic, whose filters would count as the pixels' non-uniformity; "
+                                   "calibrate from the camera raw itself, which is read a colour at a time",
+                                   step_flats[mid][0]->file, 100 * (*hi / *lo - 1), *lo, *hi));
   }
 
   // Pixels read on their own: the noise of each pair's difference uncorrelated between neighbours and channels.

@@ -75,7 +75,8 @@ class Calibrate : public ::testing::Test {
   };
   enum class Output { Exr, Dng, Demosaiced };  // the simulator's frames without a CFA, its RGGB DNG, or demosaiced RGB
   // The frames of `shots`, named <name>-<time>-<flat|dark>[-L<light>]-<k> (the light only where it is not 1).
-  calibrate::CalibrationInput shoot(const Camera& c, const std::string& name, const std::vector<Shot>& shots, Output output) {
+  calibrate::CalibrationInput shoot(const Camera& c, const std::string& name, const std::vector<Shot>& shots, Output output,
+                                    const Json& overrides = Json::object()) {
     const bool dng = output == Output::Dng;
     const int size = dng ? 2 * kSize : kSize;
     const double fill = c.full_well / c.qe / photons_per_radiance_second();  // the radiance that fills the well in 1 s
@@ -111,6 +112,7 @@ class Calibrate : public ::testing::Test {
                         {"adc", {{"enabled", true}, {"gain_dn_per_e", c.gain}, {"black_level_dn", c.black}, {"bits", c.bits}}},
                         {"display", {{"enabled", false}}}};
           if (output != Output::Exr) patch["cfa"] = {{"enabled", true}, {"pattern", "RGGB"}};
+          patch.merge_patch(overrides);
           const std::string light = is_flat && shot.light != 1.0 ? fmt::format("-L{}", shot.light) : "";
           const fs::path out = dir_.file(fmt::format("{}-{}-{}{}-{}.{}", name, shot.time_s, is_flat ? "flat" : "dark", light, k, dng ? "dng" : "exr"));
           test::run_sensor(is_flat ? lights[shot.light] : dark, out, test::config_of(patch));
@@ -412,6 +414,26 @@ TEST_F(Calibrate, OrdinaryFramesOfAColourOrAMonochromeCameraAreCalibrated) {
   const auto r = test::run_chromatrace(args);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_EQ(read_json(report / "calibration.json")["channels"].size(), 1u);
+
+  // A colour camera's mosaic written as one grey channel (dcraw -D -4 -T: the raw values, not demosaiced), under a
+  // green light that its red and blue photosites see far less of: refused, where its PRNU would report the filters.
+  const std::vector<Shot> shots = {{0.2, 1, 2, 2}, {0.4, 1, 2, 2}, {0.6, 1, 2, 2}, {1.2, 1, 2, 2}};
+  const calibrate::CalibrationInput dngs =
+      shoot(c, "mosaic", shots, Output::Dng, {{"spectral_response", {{"camera", "nikon_d810"}, {"peak_qe", c.qe}}}});
+  std::vector<std::string> mosaic_args = {"calibrate", "-o", dir_.file("mosaic.json").string(), "-q", "--flat"};
+  for (const auto* set : {&dngs.flats, &dngs.darks}) {
+    if (set == &dngs.darks) mosaic_args.push_back("--dark");
+    for (const fs::path& dng : *set) {
+      const int status = std::system(fmt::format("dcraw -D -4 -T '{}'", dng.string()).c_str());
+      ASSERT_EQ(status, 0) << "dcraw -D -4 -T " << dng;
+      mosaic_args.push_back(fs::path(dng).replace_extension(".tiff").string());
+    }
+  }
+  const auto refused = test::run_chromatrace(mosaic_args);
+  EXPECT_EQ(refused.exit_code, 2);
+  EXPECT_NE(refused.err.find("2 × 2 phases differ by"), std::string::npos) << refused.err;
+  EXPECT_NE(refused.err.find("a colour camera's mosaic"), std::string::npos) << refused.err;
+  std::cerr << refused.err;
 
   // A monochrome frame among colour ones: named against the rest.
   calibrate::CalibrationInput mixed = rgb;
