@@ -11,6 +11,8 @@
 
 #include "calibrate/frames.h"
 #include "core/error.h"
+#include "core/spectrum.h"
+#include "sensor_sim/spectral_response.h"
 
 namespace ct::calibrate {
 namespace {
@@ -40,6 +42,7 @@ Json channel_json(const ChannelCalibration& c) {
           {"saturation_capacity_e", estimate_json(c.saturation_capacity_e)},
           {"saturation_mean_dn", c.saturation_mean_dn},
           {"clip_level_e", c.clip_level_e ? estimate_json(*c.clip_level_e) : Json(nullptr)},
+          {"clips_at_adc", c.clips_at_adc},
           {"dark_current_e_per_s", estimate_json(c.dark_current_e_per_s)},
           {"dark_current_from_variance_e_per_s",
            c.dark_current_from_variance_e_per_s ? estimate_json(*c.dark_current_from_variance_e_per_s) : Json(nullptr)},
@@ -117,6 +120,35 @@ NoiseCorrelation noise_correlation(const std::vector<std::vector<const Frame*>>&
   return nc;
 }
 
+// The peak QE from each channel's η at the flats' wavelength, through the camera's curves.
+PeakQe peak_qe_of(const std::vector<ChannelCalibration>& channels, double wavelength_nm, const std::string& camera, const std::string& basis) {
+  const sensor::CameraCurves curves = sensor::camera_curves(camera, {"r", "g", "b"}, "--camera");
+  const sensor::ResponseBasis b = basis == "photon" ? sensor::ResponseBasis::Photon : sensor::ResponseBasis::Energy;
+  // η_c(λ) for a peak QE of 1: the electrons per photon of a band 0.1 nm wide at λ, through the simulator's own
+  // normalisation.
+  const double half = 0.05;
+  const Bands band = Bands::from_edges({wavelength_nm - half, wavelength_nm + half});
+  sensor::check_band_coverage(band, curves, "--wavelength");
+  const auto q = sensor::photon_response(band, curves, b, 1.0, PiecewiseLinearSpectrum::constant(1.0));
+  const double photons = wavelength_nm * 1e-9 / (kPlanck * kLightSpeed) * 2 * half;
+  PeakQe p;
+  double weights = 0, sum = 0;
+  for (std::size_t c = 0; c < channels.size(); ++c) {
+    const double relative = q[c][0] / photons;
+    if (!(relative > 0))
+      throw InputError(fmt::format("--camera: channel {} of {} does not respond at {:g} nm, where the flats' light is", curves.channels[c],
+                                   camera, wavelength_nm));
+    const Estimate& eta = *channels[c].quantum_efficiency;
+    p.relative_qe.push_back(relative);
+    p.per_channel.push_back({eta.value / relative, eta.standard_error / relative});
+    const double w = 1 / std::pow(std::max(p.per_channel.back().standard_error, 1e-12), 2);
+    weights += w, sum += w * p.per_channel.back().value;
+  }
+  p.value = {sum / weights, 1 / std::sqrt(weights)};
+  for (const Estimate& e : p.per_channel) p.channels_agree = p.channels_agree && std::abs(e.value - p.value.value) <= 3 * std::hypot(e.standard_error, p.value.standard_error);
+  return p;
+}
+
 }  // namespace
 
 double simulated_dark_current(const ChannelCalibration& c) {
@@ -128,6 +160,15 @@ Calibration calibrate(const CalibrationInput& input) {
   if (input.darks.empty()) throw InputError("--dark: no dark frames");
   if (input.photons_per_s && !(*input.photons_per_s > 0 && std::isfinite(*input.photons_per_s)))
     throw InputError(fmt::format("--photons-per-s: must be a positive number, got {}", *input.photons_per_s));
+  if (input.wavelength_nm.has_value() != !input.camera.empty())
+    throw InputError(input.camera.empty() ? "--wavelength: needs the camera's curves too (--camera), to turn η there into a peak QE"
+                                          : "--camera: needs the flats' wavelength too (--wavelength), where η is measured");
+  if (input.wavelength_nm && !input.photons_per_s && input.photons_per_pixel.empty())
+    throw InputError("--wavelength: the quantum efficiency needs the photons per pixel (--photons-per-s or --photons-per-pixel)");
+  if (input.wavelength_nm && !(*input.wavelength_nm > 0 && std::isfinite(*input.wavelength_nm)))
+    throw InputError(fmt::format("--wavelength: must be a positive number of nanometres, got {}", *input.wavelength_nm));
+  if (input.basis != "energy" && input.basis != "photon")
+    throw InputError(fmt::format("--basis: \"{}\" is not energy or photon", input.basis));
 
   // Every frame, then the odd one out named against the most common camera and size (the first frame may be the odd
   // one: naming it as the norm would point at a good file).
@@ -224,9 +265,14 @@ Calibration calibrate(const CalibrationInput& input) {
   for (const double p : input.photons_per_pixel)
     if (!(p > 0 && std::isfinite(p))) throw InputError(fmt::format("--photons-per-pixel: must be positive numbers, got {}", p));
 
-  // A frame grabber that hands the same buffer twice makes a pair of one image: its difference holds no noise.
+  // A frame grabber that hands the same buffer twice makes a pair of one image: its difference holds no noise. (Two
+  // frames that hold one code everywhere, clipped at the ADC's top code beyond saturation, are equal as they should be.)
   auto same_image = [](const Frame& a, const Frame& b) {
-    return std::equal(a.channels.begin(), a.channels.end(), b.channels.begin(), [](const Plane& x, const Plane& y) { return x.values == y.values; });
+    const bool uniform = std::all_of(a.channels.begin(), a.channels.end(), [](const Plane& p) {
+      return std::all_of(p.values.begin(), p.values.end(), [&](double v) { return v == p.values.front(); });
+    });
+    return !uniform &&
+           std::equal(a.channels.begin(), a.channels.end(), b.channels.begin(), [](const Plane& x, const Plane& y) { return x.values == y.values; });
   };
   for (const auto& [t, sets] : by_time)
     for (int kind = 0; kind < 2; ++kind) {
@@ -377,18 +423,66 @@ Calibration calibrate(const CalibrationInput& input) {
     bits_from = fmt::format("from the largest value in the frames, {:g} DN", largest);
   }
   adc["bits"] = *bits;
+  // The full well: the clip level (else EMVA's saturation capacity). Where the ADC's top code clips the pixels, the
+  // well lies beyond it: placed six standard deviations of the read noise and DSNU above the clip, so that the
+  // simulated pixels reach the top code and stay there, one code, as this camera's do (at the clip itself, the read
+  // noise added after the well would spread them below it).
+  double full_well = channel_mean(ch, [](const auto& c) { return c.clip_level_e ? c.clip_level_e->value : c.saturation_capacity_e.value; });
+  if (std::all_of(ch.begin(), ch.end(), [](const ChannelCalibration& c) { return c.clips_at_adc; })) {
+    // In the settings' own terms (the channels' mean gain and black level), where the top code lies.
+    const double top_dn = channel_mean(ch, [](const auto& c) { return c.black_level_dn.value + c.gain_dn_per_e.value * c.clip_level_e->value; });
+    const double spread = channel_mean(ch, [](const auto& c) { return std::hypot(c.dark_noise_e.value, c.dsnu_e.total.value); });
+    full_well = (top_dn - adc["black_level_dn"].get<double>()) / adc["gain_dn_per_e"].get<double>() + 6 * spread;
+    result.notes.push_back(fmt::format("the clipped flats hold one code (the ADC's top code clips the pixels before their full well, which "
+                                       "is not measured): the settings' full well, {:.6g} e⁻, lies six standard deviations of the read noise "
+                                       "and DSNU above the clip level, so that the simulated ADC clips as this one does",
+                                       full_well));
+  }
+  if (input.wavelength_nm) {
+    if (ch.size() != 3)
+      throw InputError("--camera: a monochrome camera has one channel, where the simulator's camera curves have three");
+    result.peak_qe = peak_qe_of(ch, *input.wavelength_nm, input.camera, input.basis);
+    const PeakQe& p = *result.peak_qe;
+    std::string per_channel;
+    for (std::size_t c = 0; c < ch.size(); ++c)
+      per_channel += fmt::format("{}{} {:.4g} ± {:.2g}", c ? ", " : "", ch[c].channel, p.per_channel[c].value, p.per_channel[c].standard_error);
+    result.notes.push_back(
+        p.channels_agree
+            ? fmt::format("peak QE {:.4g} ± {:.2g} (spectral_response.peak_qe): each channel's η at {:g} nm over the relative QE of {}'s "
+                          "curves there ({})",
+                          p.value.value, p.value.standard_error, *input.wavelength_nm, input.camera, per_channel)
+            : fmt::format("the channels' η at {:g} nm over the relative QE of {}'s curves there disagree ({}): the curves' ratios at "
+                          "that wavelength are not this camera's; the settings take their weighted mean, {:.4g} ± {:.2g}",
+                          *input.wavelength_nm, input.camera, per_channel, p.value.value, p.value.standard_error));
+  } else if (ch.front().quantum_efficiency) {
+    result.notes.push_back("η is the flats' light's; give its wavelength and the camera's curves (--wavelength, --camera) to set the "
+                           "simulator's peak QE from it (the settings leave spectral_response as the preset has it)");
+  }
   result.sensor = {{"format", "chromatrace-sensor/1"},
                    {"description", fmt::format("Calibrated with chromatrace calibrate (EMVA 1288 Linear) from {} flat and {} dark frames "
                                                "({}); {}; adc.bits {}",
                                                result.flats, result.darks, result.series,
                                                ch.size() == 1 ? "one channel (monochrome)" : "the mean of the R, G and B channels", bits_from)},
                    {"noise", noise},
-                   {"full_well", {{"enabled", true}, {"electrons", channel_mean(ch, [](const auto& c) {
-                                   return c.clip_level_e ? c.clip_level_e->value : c.saturation_capacity_e.value;
-                                 })}}},
+                   {"full_well", {{"enabled", true}, {"electrons", full_well}}},
                    {"adc", adc}};
+  if (result.peak_qe) {
+    // A CSV file named relative to here would be read relative to the settings file: give it whole.
+    const bool file = input.camera.find('/') != std::string::npos || input.camera.ends_with(".csv");
+    result.sensor["spectral_response"] = {{"camera", file ? std::filesystem::absolute(input.camera).string() : input.camera},
+                                          {"basis", input.basis},
+                                          {"peak_qe", result.peak_qe->value.value}};
+  }
   Json channels = Json::array();
   for (const ChannelCalibration& c : ch) channels.push_back(channel_json(c));
+  Json peak_qe_json = nullptr;
+  if (const auto& p = result.peak_qe) {
+    Json per_channel = Json::array();
+    for (std::size_t c = 0; c < ch.size(); ++c)
+      per_channel.push_back({{"channel", ch[c].channel}, {"relative_qe", p->relative_qe[c]}, {"peak_qe", estimate_json(p->per_channel[c])}});
+    peak_qe_json = {{"wavelength_nm", *input.wavelength_nm}, {"camera", input.camera}, {"basis", input.basis},
+                    {"value", estimate_json(p->value)}, {"channels_agree", p->channels_agree}, {"per_channel", per_channel}};
+  }
   result.report = {{"format", "chromatrace-calibration/1"},
                    {"standard", "EMVA 1288 Release 4.0 Linear"},
                    {"flats", result.flats},
@@ -405,6 +499,8 @@ Calibration calibrate(const CalibrationInput& input) {
                      {"standard_error", result.noise_correlation.standard_error}}},
                    {"frame_size", {size.first, size.second}},
                    {"channels", channels},
+                   {"peak_qe", peak_qe_json},
+                   {"notes", result.notes},
                    {"sensor", result.sensor}};
   return result;
 }

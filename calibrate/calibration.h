@@ -22,6 +22,21 @@ struct CalibrationInput {
   std::optional<double> photons_per_s;    // photons per pixel and second reaching each pixel of the flats (first method)
   std::vector<double> photons_per_pixel;  // per pair of flats, in their order (second method)
   std::string input_transfer = "auto";    // what the frames' values are (analyzer::parse_input_transfer)
+  // The flats' light (monochromatic, as EMVA 1288 measures η) and the camera's spectral curves: with the photons,
+  // the measured η at that wavelength sets the settings' spectral_response.peak_qe (η over the curves' relative
+  // value there).
+  std::optional<double> wavelength_nm;
+  std::string camera;              // a shipped camera, cie1931, or a CSV file (sensor::camera_curves)
+  std::string basis = "energy";    // what the curves are proportional to: energy or photon (docs/sensor.md)
+};
+
+// The peak quantum efficiency the simulator takes (spectral_response.peak_qe): per channel, η measured at the
+// flats' wavelength over the camera curves' relative QE there; and their mean weighted by 1/SE².
+struct PeakQe {
+  std::vector<Estimate> per_channel;
+  std::vector<double> relative_qe;  // η_c(λ) / peak_qe of the curves
+  Estimate value;
+  bool channels_agree = true;       // each within 3 of its standard errors (and the mean's) of the mean
 };
 
 // The temporal noise's correlation between neighbouring pixels and between channels, in the difference of each pair
@@ -38,6 +53,8 @@ struct Calibration {
   std::size_t flats = 0, darks = 0, exposures = 0;
   std::string series;  // "16 exposure times" or "12 irradiances at 0.01 s" (and "; darks alone at 2 further times")
   NoiseCorrelation noise_correlation;
+  std::optional<PeakQe> peak_qe;
+  std::vector<std::string> notes;  // of the series as a whole
   Json sensor;  // chromatrace-sensor/1 settings
   Json report;  // every estimate with its standard error, per channel, and the measured curves
 };

@@ -313,10 +313,14 @@ ChannelCalibration calibrate_channel(const std::string& channel, const std::vect
             prnu_part(fs.column, fs.column_se, dh.column, dh.column_se), prnu_part(fs.pixel, fs.pixel_se, dh.pixel, dh.pixel_se)};
 
   // The clip level, from the exposures beyond saturation at which every pixel is clipped.
-  double clipped_sum = 0;
+  double clipped_sum = 0, clipped_variance = 0, clipped_dark_variance = 0;
   std::size_t clipped = 0;
   for (std::size_t k = top + 1; k < steps.size(); ++k)
-    if (flat[k].variance <= 2 * dark[k].variance) clipped_sum += flat[k].mean, ++clipped;
+    if (flat[k].variance <= 2 * dark[k].variance)
+      clipped_sum += flat[k].mean, clipped_variance += flat[k].variance, clipped_dark_variance += dark[k].variance, ++clipped;
+  // Pixels clipped by the well still carry the read noise (about the darks' variance); clipped by the ADC, they hold
+  // its top code and no variance.
+  c.clips_at_adc = clipped > 0 && clipped_variance < 0.5 * clipped_dark_variance;
   if (clipped > 0) {
     const double level = (clipped_sum / double(clipped) - c.black_level_dn.value) / K;
     c.clip_level_e = Estimate{level, level * std::hypot(rK, c.black_level_dn.standard_error / (level * K))};

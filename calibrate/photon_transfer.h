@@ -77,6 +77,9 @@ struct ChannelCalibration {
   // (or the ADC's top code) the pixels stop at, (μ_y − black) / K. EMVA's saturation capacity lies a little below it,
   // where the brightest pixels of a frame start to clip. Absent when no exposure clips every pixel.
   std::optional<Estimate> clip_level_e;
+  // The clipped flats hold one code (their temporal variance under half the darks'): the ADC's top code clips them
+  // before the full well, which lies beyond and is not measured; a well's clip leaves the read noise on them.
+  bool clips_at_adc = false;
   Estimate dark_current_e_per_s;    // from μ_y.dark against t
   // The dark current from σ²_y.dark against t (slope / K²: the dark electrons' shot noise), which a camera that
   // subtracts its dark offset on chip still shows; absent with one exposure time.

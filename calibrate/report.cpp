@@ -249,6 +249,7 @@ td,th{border-bottom:1px solid #ddd;padding:4px 10px;text-align:right}th:first-ch
   row("linearity error (%)", [](const auto& c) { return fmt::format("{:.2g}", 100 * c.linearity_error); });
   row("quantum efficiency η", [](const auto& c) { return c.quantum_efficiency ? cell(*c.quantum_efficiency) : std::string("—"); });
   html += "</table>";
+  for (const std::string& n : cal.notes) html += fmt::format("<p class=\"note\">{}</p>", escape_html(n));
   const NoiseCorrelation& nc = cal.noise_correlation;
   html += fmt::format("<p class=\"note\">The temporal noise's correlation (the flats' pair differences): {:.3f} between horizontal "
                       "and {:.3f} between vertical neighbours{}, ± {:.2g}; about 0 where each pixel is read on its own.</p>",

@@ -26,6 +26,8 @@ Action add_calibrate(CLI::App& app) {
     double photons_per_s = 0;
     std::vector<double> photons_per_pixel;
     std::string input_transfer = "auto";
+    double wavelength = 0;
+    std::string camera, basis = "energy";
     bool quiet = false;
   };
   auto o = std::make_shared<Options>();
@@ -46,6 +48,10 @@ Action add_calibrate(CLI::App& app) {
   cmd->add_option("--photons-per-pixel", o->photons_per_pixel,
                   "Flats at one exposure time: the photons per pixel of each pair, in the pairs' order (for the linearity and the "
                   "quantum efficiency)");
+  cmd->add_option("--wavelength", o->wavelength,
+                  "The flats' light's wavelength in nm (monochromatic): with --camera, the measured η sets the settings' peak QE");
+  cmd->add_option("--camera", o->camera, "The camera's spectral curves (a shipped camera, cie1931, or a CSV file), for --wavelength");
+  cmd->add_option("--basis", o->basis, "What --camera's curves are proportional to: energy (default) or photon");
   cmd->add_option("--input-transfer", o->input_transfer,
                   "What the frames' values are: auto (the file's metadata; an integer file that names no colour space holds digital "
                   "numbers) or linear (say so of a file that names a curve)");
@@ -67,6 +73,9 @@ Action add_calibrate(CLI::App& app) {
     input.photons_per_pixel = o->photons_per_pixel;
     analyzer::parse_input_transfer(o->input_transfer);
     input.input_transfer = o->input_transfer;
+    if (cmd->count("--wavelength") > 0) input.wavelength_nm = o->wavelength;
+    input.camera = o->camera;
+    input.basis = o->basis;
     std::vector<std::filesystem::path> inputs = input.flats;
     inputs.insert(inputs.end(), input.darks.begin(), input.darks.end());
     std::vector<std::filesystem::path> outputs = {o->output};

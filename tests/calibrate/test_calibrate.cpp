@@ -539,6 +539,102 @@ TEST_F(Calibrate, ASeriesAtOneExposureTimeUnderVaryingIrradiance) {
   EXPECT_FALSE(fs::exists(bad));
 }
 
+// The quantum efficiency measured at the flats' wavelength sets the simulator's peak QE through the camera's curves.
+// Curves (photon basis) of 1 up to 600 nm and 2 from 700 nm, simulated with a peak QE of 0.6: η at 550 nm is 0.3, and
+// calibrate with --wavelength 550 gives the peak QE 0.6 back (within 2 % or 3 standard errors), every channel
+// agreeing, written as spectral_response. Curves whose red channel is half the others' at 550 nm give the red
+// channel's peak QE twice the others': the disagreement is said. --wavelength without --camera is refused.
+TEST_F(Calibrate, TheMeasuredQuantumEfficiencySetsThePeakQeThroughTheCameraCurves) {
+  auto write_curves = [&](const std::string& name, double red_at_550) {
+    const fs::path csv = dir_.file(name);
+    std::ofstream(csv) << "wavelength_nm,r,g,b\n"
+                       << fmt::format("300,{0},1,1\n600,{0},1,1\n700,2,2,2\n900,2,2,2\n", red_at_550);
+    return csv;
+  };
+  const fs::path curves = write_curves("curves.csv", 1), red_half = write_curves("red-half.csv", 0.5);
+  const Camera c{0.3, 0.25, 100, 20000, 5, 100, 2, 0.01, 0, 0, 16};  // qe: η at 550 nm
+  const std::vector<double> shares(kExposureShares.begin(), kExposureShares.end());
+  std::vector<Shot> shots;
+  for (const double share : shares) shots.push_back({share, 1, 2, 2});
+  calibrate::CalibrationInput in =
+      shoot(c, "peak", shots, Output::Exr, {{"spectral_response", {{"camera", curves.string()}, {"basis", "photon"}, {"peak_qe", 0.6}}}});
+  in.wavelength_nm = 550;
+  in.camera = curves.string();
+  in.basis = "photon";
+  const calibrate::Calibration cal = calibrate::calibrate(in);
+  expect_camera(cal, c);
+  ASSERT_TRUE(cal.peak_qe);
+  expect_recovered(cal.peak_qe->value, 0.6, "peak QE");
+  EXPECT_TRUE(cal.peak_qe->channels_agree);
+  for (const double r : cal.peak_qe->relative_qe) EXPECT_NEAR(r, 0.5, 1e-6);
+  EXPECT_EQ(cal.sensor["spectral_response"]["peak_qe"].get<double>(), cal.peak_qe->value.value);
+  EXPECT_EQ(cal.sensor["spectral_response"]["basis"], "photon");
+  EXPECT_EQ(test::config_of(cal.sensor).response.peak_qe, cal.peak_qe->value.value);
+
+  in.camera = red_half.string();
+  const calibrate::Calibration disagreeing = calibrate::calibrate(in);
+  ASSERT_TRUE(disagreeing.peak_qe);
+  EXPECT_FALSE(disagreeing.peak_qe->channels_agree);
+  expect_recovered(disagreeing.peak_qe->per_channel[0], 1.2, "the red channel's peak QE through curves half the truth");
+  bool said = false;
+  for (const std::string& n : disagreeing.notes) said = said || n.find("disagree") != std::string::npos;
+  EXPECT_TRUE(said);
+
+  in.camera.clear();
+  EXPECT_THROW(calibrate::calibrate(in), InputError);
+  std::vector<std::string> args = calibrate_args(in.flats, in.darks, dir_.file("bad.json"));
+  args.insert(args.end(), {"--wavelength", "550"});
+  const auto r = test::run_chromatrace(args);
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_EQ(r.err, "chromatrace calibrate: error: --wavelength: needs the camera's curves too (--camera), to turn η there into a peak QE\n");
+}
+
+// A camera whose 12-bit ADC clips before its full well (K 0.25 DN/e⁻ × 20 000 e⁻ + 100 DN would be 5 100 DN): its
+// over-exposed pixels all hold the top code, 4 095. Calibrate finds the clip at (4095 − 100)/K = 15 980 e⁻, says the
+// ADC clips there, and writes the full well above it, so that the camera simulated from its settings gives every
+// over-exposed pixel 4 095 too (no variance), where a well at the clip level itself leaves the read noise on them.
+TEST_F(Calibrate, ACameraThatClipsAtItsAdcIsSimulatedClippingToOneCode) {
+  const Camera c{0.6, 0.25, 100, 20000, 5, 100, 2, 0.01, 0, 0, 12};
+  const calibrate::Calibration cal = calibrate::calibrate(series(c, "adc"));
+  for (const calibrate::ChannelCalibration& ch : cal.channels) {
+    expect_recovered(ch.gain_dn_per_e, c.gain, "system gain K");
+    ASSERT_TRUE(ch.clip_level_e);
+    expect_recovered(*ch.clip_level_e, (4095 - c.black) / c.gain, "clip level at the ADC's top code");
+    EXPECT_TRUE(ch.clips_at_adc);
+  }
+  // The top code in the settings' electrons (their gain and black level), and the well written above it.
+  const double K = cal.sensor["adc"]["gain_dn_per_e"].get<double>(), black = cal.sensor["adc"]["black_level_dn"].get<double>();
+  const double well = cal.sensor["full_well"]["electrons"].get<double>(), top = (4095 - black) / K;
+  EXPECT_GT(well, top + 5 * c.read);
+  EXPECT_EQ(cal.sensor["adc"]["bits"].get<int>(), 12);
+
+  // Over-exposed (1.3 × the time that fills the well) through the calibrated settings, and through a well at the
+  // clip level.
+  auto overexposed = [&](double full_well, const std::string& name) {
+    Json patch = cal.sensor;
+    patch.merge_patch({{"optics", {{"f_number", kFNumber}, {"cos4", false}}},
+                       {"exposure", {{"time_s", 1.3}}},
+                       {"pixel", {{"pitch_um", kPitchUm}}},
+                       {"spectral_response", {{"camera", flat_camera_.string()}, {"basis", "photon"}, {"peak_qe", c.qe}}},
+                       {"full_well", {{"electrons", full_well}}},
+                       {"display", {{"enabled", false}}}});
+    const fs::path out = dir_.file(name);
+    test::run_sensor(dir_.file("adc-light-1.exr"), out, test::config_of(patch));
+    const test::RgbLayer rgb = test::read_rgb(out);
+    double lowest = 1e9, highest = 0;
+    for (const float v : rgb.values) lowest = std::min(lowest, double(v)), highest = std::max(highest, double(v));
+    return std::pair{lowest, highest};
+  };
+  const auto [lo, hi] = overexposed(well, "calibrated.exr");
+  EXPECT_EQ(lo, 4095);
+  EXPECT_EQ(hi, 4095);
+  const auto [spread_lo, spread_hi] = overexposed(top, "at-the-clip.exr");
+  EXPECT_LT(spread_lo, 4095);  // the defect the settings avoid
+  bool said = false;
+  for (const std::string& n : cal.notes) said = said || n.find("the ADC's top code clips the pixels") != std::string::npos;
+  EXPECT_TRUE(said);
+}
+
 // A 64 × 64 frame of Gaussian noise of `variance` whose mean is exactly `mean` (the noise drawn, then its own mean
 // removed).
 calibrate::Plane exact_mean_frame(std::mt19937_64& random, double mean, double variance) {
