@@ -329,6 +329,28 @@ TEST_F(Calibrate, TheCommandWritesSettingsTheSensorTakesAndRefusesSeriesThatCann
   EXPECT_FALSE(fs::exists(bad));
   EXPECT_FALSE(fs::exists(bad_report));
 
+  // A full disk where the settings go (a 64 KiB tmpfs, nearly filled, in a mount namespace of its own): the settings
+  // cannot be written, the command says so naming the file and fails (exit 1: the machine, not the input), and neither the report (staged in full on
+  // another disk) nor a half-written settings file is left.
+  {
+    const fs::path disk = dir_.file("full-disk"), full_report = dir_.file("full-disk-report");
+    fs::create_directory(disk);
+    std::string command = fmt::format("mount -t tmpfs -o size=64k tmpfs '{}' || {{ echo mount-failed; exit 0; }}; "
+                                      "head -c 64000 /dev/zero > '{}/filler' 2>/dev/null; '{}'",
+                                      disk.string(), disk.string(), CHROMATRACE_EXE);
+    for (const std::string& a : calibrate_args(in.flats, in.darks, disk / "camera.json")) command += " '" + a + "'";
+    command += fmt::format(" --report '{}'; echo exit=$?; ls -A '{}'", full_report.string(), disk.string());
+    const auto full = test::run_program("/usr/bin/unshare", {"-m", "sh", "-c", command});
+    if (full.out.find("mount-failed") != std::string::npos) {
+      std::cerr << "no mount namespace here (unshare -m and a tmpfs need CAP_SYS_ADMIN): the full-disk case was not run\n";
+    } else {
+      EXPECT_NE(full.out.find("exit=1\nfiller\n"), std::string::npos) << full.out << full.err;
+      EXPECT_EQ(full.out.find("camera.json"), std::string::npos) << full.out;
+      EXPECT_NE(full.err.find((disk / "camera.json").string()), std::string::npos) << full.err;
+      EXPECT_FALSE(fs::exists(full_report));
+    }
+  }
+
   // An input frame inside the report's folder under a name the report writes is refused, and left as it was.
   const fs::path inside = dir_.file("report-with-input");
   fs::create_directory(inside);
