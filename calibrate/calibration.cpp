@@ -35,6 +35,26 @@ Json channel_json(const ChannelCalibration& c) {
                       {"variance_dn2", p.variance_dn2},
                       {"dark_mean_dn", p.dark_mean_dn},
                       {"dark_variance_dn2", p.dark_variance_dn2}});
+  const Sensitivity figures = sensitivity(c);
+  Json linearity = nullptr;
+  if (c.linearity) {
+    Json deviations = Json::array();
+    for (const auto& [x, d] : c.linearity->deviations) deviations.push_back({x, d});
+    linearity = {{"intercept_dn", c.linearity->intercept}, {"slope", c.linearity->slope}, {"min", c.linearity->min},
+                 {"max", c.linearity->max}, {"deviations", deviations}};
+  }
+  Json datasheet = {{"inverse_gain_e_per_dn", figures.inverse_gain},
+                    {"dark_sigma_dn", figures.dark_sigma_dn},
+                    {"threshold_e", figures.threshold_e},
+                    {"threshold_photons", figures.threshold_photons ? Json(*figures.threshold_photons) : Json(nullptr)},
+                    {"saturation_photons", c.saturation_photons ? Json(*c.saturation_photons) : Json(nullptr)},
+                    {"snr_max", figures.snr_max},
+                    {"snr_max_db", 20 * std::log10(figures.snr_max)},
+                    {"snr_max_bits", std::log2(figures.snr_max)},
+                    {"dynamic_range", figures.dynamic_range},
+                    {"dynamic_range_db", 20 * std::log10(figures.dynamic_range)},
+                    {"dynamic_range_bits", std::log2(figures.dynamic_range)},
+                    {"dsnu_dn", figures.dsnu_dn}};
   return {{"channel", c.channel},
           {"gain_dn_per_e", estimate_json(c.gain_dn_per_e)},
           {"dark_noise_e", estimate_json(c.dark_noise_e)},
@@ -51,6 +71,10 @@ Json channel_json(const ChannelCalibration& c) {
           {"prnu", nonuniformity_json(c.prnu)},
           {"prnu_level_fraction", c.prnu_level_fraction},
           {"linearity_error", c.linearity_error},
+          {"linearity", linearity},
+          {"dark_variance_dn2", c.dark_variance_dn2},
+          {"responsivity_dn_per_photon", c.responsivity ? estimate_json(*c.responsivity) : Json(nullptr)},
+          {"datasheet", datasheet},
           {"quantum_efficiency", c.quantum_efficiency ? estimate_json(*c.quantum_efficiency) : Json(nullptr)},
           {"points", points},
           {"dark_points", dark_points},
@@ -358,6 +382,15 @@ Calibration calibrate(const CalibrationInput& input) {
   result.flats = input.flats.size();
   result.darks = input.darks.size();
   result.exposures = by_time.size();
+  result.camera = sensor;
+  result.frame_size = size;
+  result.flat_exposure_min_s = flat_times.front();
+  result.flat_exposure_max_s = flat_times.back();
+  result.wavelength_nm = input.wavelength_nm;
+  for (const auto& [t, sets] : by_time)
+    for (const auto& set : sets)
+      for (const Frame& f : set)
+        if (result.date.empty()) result.date = f.date;
   const std::size_t dark_only = by_time.size() - flat_times.size();
   result.series = one_time ? fmt::format("{} irradiances at {:.6g} s", step_flats.size(), flat_times[0])
                            : fmt::format("{} exposure times", flat_times.size());
@@ -489,6 +522,12 @@ Calibration calibrate(const CalibrationInput& input) {
                    {"darks", result.darks},
                    {"exposures", result.exposures},
                    {"series", result.series},
+                   {"operating_point",
+                    {{"camera", result.camera},
+                     {"frame_size", {size.first, size.second}},
+                     {"flat_exposure_s", {result.flat_exposure_min_s, result.flat_exposure_max_s}},
+                     {"wavelength_nm", result.wavelength_nm ? Json(*result.wavelength_nm) : Json(nullptr)},
+                     {"date", result.date.empty() ? Json(nullptr) : Json(result.date)}}},
                    {"photons_per_s", input.photons_per_s ? Json(*input.photons_per_s) : Json(nullptr)},
                    {"photons_per_pixel", input.photons_per_pixel.empty() ? Json(nullptr) : Json(input.photons_per_pixel)},
                    {"noise_correlation",

@@ -52,6 +52,13 @@ struct Calibration {
   std::vector<ChannelCalibration> channels;  // R, G, B, or the one channel of a monochrome camera
   std::size_t flats = 0, darks = 0, exposures = 0;
   std::string series;  // "16 exposure times" or "12 irradiances at 0.01 s" (and "; darks alone at 2 further times")
+  // The operating point: what took the frames ("camera raw, <camera>, CFA RGGB", "linear TIFF, R, G, B"), their size
+  // per channel, the flats' exposure times, the light's wavelength (when given), and the first frame's date (EXIF).
+  std::string camera;
+  std::pair<int, int> frame_size;
+  double flat_exposure_min_s = 0, flat_exposure_max_s = 0;
+  std::optional<double> wavelength_nm;
+  std::string date;
   NoiseCorrelation noise_correlation;
   std::optional<PeakQe> peak_qe;
   std::vector<std::string> notes;  // of the series as a whole

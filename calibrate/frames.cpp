@@ -18,14 +18,15 @@ namespace ct::calibrate {
 namespace {
 
 // The exposure time a file records: EXIF's ExposureTime (camera raw, DNG, a camera's TIFF), else the simulator's
-// settings.
-std::optional<double> recorded_exposure(const std::filesystem::path& file) {
+// settings; and its date (EXIF DateTime).
+std::optional<double> recorded_exposure(const std::filesystem::path& file, std::string& date) {
   auto in = OIIO::ImageInput::open(file.string());
   if (!in) {
     (void)OIIO::geterror();
     return std::nullopt;
   }
   const OIIO::ImageSpec& spec = in->spec();
+  date = spec.get_string_attribute("DateTime");
   // EXIF's time is a float here: read as the decimal it is the nearest float to (0.0012, not 0.0012000000569969416),
   // so that it prints as the camera wrote it.
   if (const float t = spec.get_float_attribute("ExposureTime", 0.0f); t > 0) return std::stod(fmt::format("{}", t));
@@ -119,7 +120,7 @@ Frame read_linear_frame(const std::filesystem::path& file, const std::string& in
 
 Frame read_frame(const std::filesystem::path& file, const std::string& input_transfer) {
   Frame f = analyzer::is_camera_raw(file) ? read_camera_raw_frame(file) : read_linear_frame(file, input_transfer);
-  const std::optional<double> exposure = recorded_exposure(file);
+  const std::optional<double> exposure = recorded_exposure(file, f.date);
   if (!exposure)
     throw InputError(fmt::format("{}: no exposure time (EXIF ExposureTime, or exposure.time_s in chromatrace.sensor)", f.file));
   f.exposure_s = *exposure;

@@ -24,6 +24,7 @@ struct Frame {
   // Each pixel read on its own, as a camera raw's photosites are. Otherwise a file's pixels may have been
   // interpolated (demosaiced) or filtered, which the calibration tests on the noise of neighbouring pixels.
   bool photosites = false;
+  std::string date;             // EXIF DateTime ("YYYY:MM:DD HH:MM:SS"), when the file has it
   std::optional<int> adc_bits;  // from the file, when it says
   std::optional<double> white_level_dn;
 };

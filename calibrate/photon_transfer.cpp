@@ -270,11 +270,13 @@ ChannelCalibration calibrate_channel(const std::string& channel, const std::vect
     const double K2 = K * K;
     c.dark_current_from_variance_e_per_s = Estimate{dv.slope / K2, std::hypot(dv.slope_se / K2, dv.slope / K2 * 2 * rK)};
     dark_variance_0 = dv.intercept;
+    c.dark_variance_slope = dv.slope;
     dark_variance_0_se = std::max(dv.intercept_se, variance_se(shortest.variance, n) / std::sqrt(double(times.size())));
   } else {
     c.black_level_dn = {shortest.mean, std::sqrt(shortest.variance / double(n))};
     c.notes.push_back("every dark frame has one exposure time: no dark current measured");
   }
+  c.dark_variance_dn2 = dark_variance_0;
   if (dark_variance_0 < kQuantisationLimit) {
     c.dark_noise_upper_limit = true;
     c.dark_noise_e = {std::sqrt(kQuantisationLimit - kQuantisationVariance) / K, 0.0};
@@ -313,14 +315,15 @@ ChannelCalibration calibrate_channel(const std::string& channel, const std::vect
             prnu_part(fs.column, fs.column_se, dh.column, dh.column_se), prnu_part(fs.pixel, fs.pixel_se, dh.pixel, dh.pixel_se)};
 
   // The clip level, from the exposures beyond saturation at which every pixel is clipped.
-  double clipped_sum = 0, clipped_variance = 0, clipped_dark_variance = 0;
+  double clipped_sum = 0, clipped_variance = 0;
   std::size_t clipped = 0;
   for (std::size_t k = top + 1; k < steps.size(); ++k)
     if (flat[k].variance <= 2 * dark[k].variance)
-      clipped_sum += flat[k].mean, clipped_variance += flat[k].variance, clipped_dark_variance += dark[k].variance, ++clipped;
-  // Pixels clipped by the well still carry the read noise (about the darks' variance); clipped by the ADC, they hold
-  // its top code and no variance.
-  c.clips_at_adc = clipped > 0 && clipped_variance < 0.5 * clipped_dark_variance;
+      clipped_sum += flat[k].mean, clipped_variance += flat[k].variance, ++clipped;
+  // Pixels clipped by the well still carry the read noise added after it (the dark variance at no exposure: the
+  // dark current's shot noise is clipped away with the signal's); clipped by the ADC, they hold its top code and no
+  // variance.
+  c.clips_at_adc = clipped > 0 && clipped_variance / double(clipped) < 0.5 * c.dark_variance_dn2;
   if (clipped > 0) {
     const double level = (clipped_sum / double(clipped) - c.black_level_dn.value) / K;
     c.clip_level_e = Estimate{level, level * std::hypot(rK, c.black_level_dn.standard_error / (level * K))};
@@ -347,13 +350,15 @@ ChannelCalibration calibrate_channel(const std::string& channel, const std::vect
     std::vector<double> weights;
     for (const double y : signal) weights.push_back(1 / (y * y));
     const LineFit lin = fit_line(u, signal, false, weights);
-    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+    ChannelCalibration::Linearity l{lin.intercept, lin.slope, std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity(), {}};
     for (std::size_t i = 0; i < u.size(); ++i) {
       const double fitted = lin.intercept + lin.slope * u[i];
       const double d = (signal[i] - fitted) / fitted;
-      lo = std::min(lo, d), hi = std::max(hi, d);
+      l.min = std::min(l.min, d), l.max = std::max(l.max, d);
+      l.deviations.emplace_back(u[i], d);
     }
-    c.linearity_error = (hi - lo) / 2;
+    c.linearity_error = (l.max - l.min) / 2;
+    c.linearity = std::move(l);
   } else {
     c.notes.push_back("fewer than three exposures between 5 % and 95 % of saturation: no linearity error");
   }
@@ -370,9 +375,24 @@ ChannelCalibration calibrate_channel(const std::string& channel, const std::vect
       }
     }
     const LineFit r = fit_line(p, s, true);
+    c.responsivity = Estimate{r.slope, r.slope_se};
     c.quantum_efficiency = Estimate{r.slope / K, r.slope / K * std::hypot(relative(r.slope_se, r.slope), rK)};
+    c.saturation_photons = *steps[top].photons_per_pixel;
   }
   return c;
+}
+
+Sensitivity sensitivity(const ChannelCalibration& c) {
+  Sensitivity s;
+  const double K = c.gain_dn_per_e.value;
+  s.inverse_gain = 1 / K;
+  s.dark_sigma_dn = std::sqrt(std::max(c.dark_variance_dn2, kQuantisationLimit));
+  s.threshold_e = s.dark_sigma_dn / K + 0.5;
+  if (c.quantum_efficiency) s.threshold_photons = s.threshold_e / c.quantum_efficiency->value;
+  s.snr_max = std::sqrt(c.saturation_capacity_e.value);
+  s.dynamic_range = c.saturation_capacity_e.value / s.threshold_e;
+  s.dsnu_dn = c.dsnu_e.total.value * K;
+  return s;
 }
 
 }  // namespace ct::calibrate

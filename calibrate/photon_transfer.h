@@ -77,8 +77,9 @@ struct ChannelCalibration {
   // (or the ADC's top code) the pixels stop at, (μ_y − black) / K. EMVA's saturation capacity lies a little below it,
   // where the brightest pixels of a frame start to clip. Absent when no exposure clips every pixel.
   std::optional<Estimate> clip_level_e;
-  // The clipped flats hold one code (their temporal variance under half the darks'): the ADC's top code clips them
-  // before the full well, which lies beyond and is not measured; a well's clip leaves the read noise on them.
+  // The clipped flats hold one code (their temporal variance under half the read noise's, the dark variance at no
+  // exposure): the ADC's top code clips them before the full well, which lies beyond and is not measured; a well's
+  // clip leaves the read noise on them.
   bool clips_at_adc = false;
   Estimate dark_current_e_per_s;    // from μ_y.dark against t
   // The dark current from σ²_y.dark against t (slope / K²: the dark electrons' shot noise), which a camera that
@@ -92,9 +93,34 @@ struct ChannelCalibration {
   Nonuniformity prnu;               // PRNU, a fraction
   double prnu_level_fraction = 0;   // the flat level PRNU was measured at, as a share of saturation
   double linearity_error = 0;       // a fraction (EMVA's LE / 100)
+  // The linearity fit, where there is one: signal = intercept + slope·x (x the photons per pixel, or the exposure
+  // time), and each fitted point's relative deviation from it; LE_min and LE_max the extremes (signed fractions).
+  struct Linearity {
+    double intercept = 0, slope = 0, min = 0, max = 0;
+    std::vector<std::pair<double, double>> deviations;  // (x, (signal − fitted)/fitted)
+  };
+  std::optional<Linearity> linearity;
+  // σ²_y.dark at no exposure (DN²): the dark variance's line against exposure time at t = 0, or the shortest
+  // exposure's with one time; its line's slope (DN²/s) with several.
+  double dark_variance_dn2 = 0;
+  std::optional<double> dark_variance_slope;
+  std::optional<double> saturation_photons;   // μp.sat, when the photons are known
+  std::optional<Estimate> responsivity;       // R = ηK, DN per photon
   std::optional<Estimate> quantum_efficiency;
   std::vector<std::string> notes;   // what could not be estimated, and why
 };
+
+// The datasheet's derived figures (EMVA 1288 Release 4.0, as its reference implementation computes them).
+struct Sensitivity {
+  double inverse_gain = 0;           // 1/K, e⁻/DN
+  double dark_sigma_dn = 0;          // σ_y.dark, DN (at least √0.24: the quantisation limit)
+  double threshold_e = 0;            // μe.min = σ_y.dark/K + 1/2, the absolute sensitivity threshold in electrons
+  std::optional<double> threshold_photons;  // μp.min = μe.min/η
+  double snr_max = 0;                // √μe.sat
+  double dynamic_range = 0;          // μe.sat/μe.min (= μp.sat/μp.min)
+  double dsnu_dn = 0;                // DSNU in DN
+};
+Sensitivity sensitivity(const ChannelCalibration& c);
 
 // Estimates one channel's parameters. InputError (message without a file name; the caller adds it) when the
 // steps cannot support the estimates: one flat or fewer than two darks at a step, frames of different sizes,

@@ -31,8 +31,13 @@ class Plot {
   void points(const std::vector<std::pair<double, double>>& xy, const char* colour, std::string label) {
     series_.push_back({xy, colour, std::move(label), false});
   }
-  void line(const std::vector<std::pair<double, double>>& xy, const char* colour, std::string label) {
-    series_.push_back({xy, colour, std::move(label), true});
+  // Filled markers: a point of note (saturation).
+  void marks(const std::vector<std::pair<double, double>>& xy, const char* colour, std::string label) {
+    series_.push_back({xy, colour, std::move(label), false, false, true});
+  }
+  // A line; dashed for a reference (an ideal, a threshold) rather than a fitted model.
+  void line(const std::vector<std::pair<double, double>>& xy, const char* colour, std::string label, bool dashed = false) {
+    series_.push_back({xy, colour, std::move(label), true, dashed});
   }
 
   std::string svg() const {
@@ -81,15 +86,19 @@ class Plot {
         if (series.is_line) {
           path += fmt::format("{}{:.1f},{:.1f}", path.empty() ? "M" : " L", X(x), Y(y));
         } else {
-          s += fmt::format(R"svg(<circle cx="{:.1f}" cy="{:.1f}" r="3" fill="none" stroke="{}"/>)svg", X(x), Y(y), series.colour);
+          s += fmt::format(R"svg(<circle cx="{:.1f}" cy="{:.1f}" r="{}" fill="{}" stroke="{}"/>)svg", X(x), Y(y), series.filled ? 4 : 3,
+                           series.filled ? series.colour : "none", series.colour);
         }
       }
       if (series.is_line && !path.empty())
-        s += fmt::format(R"svg(<path d="{}" fill="none" stroke="{}" stroke-width="1.2"/>)svg", path, series.colour);
+        s += fmt::format(R"svg(<path d="{}" fill="none" stroke="{}" stroke-width="1.2"{}/>)svg", path, series.colour,
+                         series.dashed ? R"( stroke-dasharray="5 4")" : "");
       if (!series.label.empty()) {
         const double ly = kTop + 14 + 16 * legend++;
-        s += series.is_line ? fmt::format(R"svg(<line x1="{}" y1="{:.1f}" x2="{}" y2="{:.1f}" stroke="{}"/>)svg", kLeft + 10, ly - 4, kLeft + 28, ly - 4, series.colour)
-                            : fmt::format(R"svg(<circle cx="{}" cy="{:.1f}" r="3" fill="none" stroke="{}"/>)svg", kLeft + 19, ly - 4, series.colour);
+        s += series.is_line ? fmt::format(R"svg(<line x1="{}" y1="{:.1f}" x2="{}" y2="{:.1f}" stroke="{}"{}/>)svg", kLeft + 10, ly - 4, kLeft + 28,
+                                          ly - 4, series.colour, series.dashed ? R"( stroke-dasharray="5 4")" : "")
+                            : fmt::format(R"svg(<circle cx="{}" cy="{:.1f}" r="3" fill="{}" stroke="{}"/>)svg", kLeft + 19, ly - 4,
+                                          series.filled ? series.colour : "none", series.colour);
         s += fmt::format(R"svg(<text x="{}" y="{:.1f}">{}</text>)svg", kLeft + 34, ly, escape_html(series.label));
       }
     }
@@ -98,12 +107,15 @@ class Plot {
 
  private:
   static constexpr double kInf = std::numeric_limits<double>::infinity();
-  static constexpr int kWidth = 520, kHeight = 360, kLeft = 70, kRight = 16, kTop = 30, kBottom = 46;
+  // kRight leaves room for half the last x tick's label ("60000" centred on the frame's edge).
+  static constexpr int kWidth = 520, kHeight = 360, kLeft = 70, kRight = 36, kTop = 30, kBottom = 46;
   struct Series {
     std::vector<std::pair<double, double>> xy;
     const char* colour;
     std::string label;
     bool is_line;
+    bool dashed = false;
+    bool filled = false;
   };
   struct Axis {
     double lo, hi;
@@ -152,6 +164,14 @@ std::string photon_transfer(const Calibration& cal) {
     const double fit_top = 0.7 * (ch.saturation_mean_dn - ch.points.back().dark_mean_dn);
     plot.line({{0.0, 0.0}, {fit_top, ch.gain_dn_per_e.value * fit_top}}, channel_colour(cal, c), "");
   }
+  // The saturation point of each channel: the exposure of largest temporal variance.
+  for (std::size_t c = 0; c < cal.channels.size(); ++c) {
+    const ChannelCalibration& ch = cal.channels[c];
+    for (const TransferPoint& p : ch.points)
+      if (p.mean_dn == ch.saturation_mean_dn)
+        plot.marks({{p.mean_dn - p.dark_mean_dn, p.variance_dn2 - p.dark_variance_dn2}}, channel_colour(cal, c),
+                   c == 0 ? "saturation, μy.sat (filled)" : "");
+  }
   return plot.svg();
 }
 
@@ -175,6 +195,22 @@ std::string snr(const Calibration& cal) {
     plot.points(measured, channel_colour(cal, c), ch.channel + (photons ? fmt::format(": η = {:.3g}", eta) : ""));
     plot.line(model, channel_colour(cal, c), "");
   }
+  // The ideal sensor (η = 1, no noise but the photons' own: SNR = √μp), and the first channel's absolute sensitivity
+  // threshold (SNR = 1) and saturation, as EMVA 1288's SNR plot marks them.
+  const ChannelCalibration& first = cal.channels[0];
+  const Sensitivity f = sensitivity(first);
+  const double eta = first.quantum_efficiency ? first.quantum_efficiency->value : 1.0;
+  const double lo = f.threshold_e / eta / 10, hi = first.saturation_capacity_e.value / eta * 1.0001;
+  std::vector<std::pair<double, double>> ideal;
+  for (double x = lo; x <= hi * 1.2; x *= 1.2) ideal.emplace_back(x, std::sqrt(x));
+  plot.line(ideal, "#888888", photons ? "ideal: √μp" : "ideal: √μe", true);
+  const double threshold = photons && f.threshold_photons ? *f.threshold_photons : f.threshold_e;
+  const double saturation = photons && first.saturation_photons ? *first.saturation_photons : first.saturation_capacity_e.value;
+  auto number = [](double v) { return v >= 1000 ? fmt::format("{:.0f}", v) : fmt::format("{:.3g}", v); };
+  plot.line({{threshold, 0.1}, {threshold, std::sqrt(hi * 1.2)}}, "#444444",
+            fmt::format("{}: {} ({})", photons ? "μp.min" : "μe.min", number(threshold), first.channel), true);
+  plot.line({{saturation, 0.1}, {saturation, std::sqrt(hi * 1.2)}}, "#aaaaaa",
+            fmt::format("{}: {} ({})", photons ? "μp.sat" : "μe.sat", number(saturation), first.channel), true);
   return plot.svg();
 }
 
@@ -186,6 +222,47 @@ std::string linearity(const Calibration& cal) {
     std::vector<std::pair<double, double>> xy;
     for (const TransferPoint& p : ch.points) xy.emplace_back(photons ? *p.photons_per_pixel : p.exposure_s, p.mean_dn - p.dark_mean_dn);
     plot.points(xy, channel_colour(cal, c), fmt::format("{}: linearity error {:.2g} %", ch.channel, 100 * ch.linearity_error));
+    if (ch.linearity) {
+      const double x0 = ch.linearity->deviations.front().first, x1 = ch.linearity->deviations.back().first;
+      plot.line({{x0, ch.linearity->intercept + ch.linearity->slope * x0}, {x1, ch.linearity->intercept + ch.linearity->slope * x1}},
+                channel_colour(cal, c), "");
+    }
+  }
+  return plot.svg();
+}
+
+// EMVA 1288's deviation plot: each fitted point's relative deviation from the linearity fit, in per cent.
+std::string linearity_deviation(const Calibration& cal) {
+  const bool photons = have_photons(cal.channels[0]);
+  Plot plot("Deviation from linearity", photons ? "photons per pixel, μp" : "exposure time (s)", "deviation (%)", false, false);
+  for (std::size_t c = 0; c < cal.channels.size(); ++c) {
+    const ChannelCalibration& ch = cal.channels[c];
+    if (!ch.linearity) continue;
+    std::vector<std::pair<double, double>> xy;
+    for (const auto& [x, d] : ch.linearity->deviations) xy.emplace_back(x, 100 * d);
+    plot.points(xy, channel_colour(cal, c),
+                fmt::format("{}: LE min {:.3g} %, max {:.3g} %", ch.channel, 100 * ch.linearity->min, 100 * ch.linearity->max));
+    plot.line(xy, channel_colour(cal, c), "");
+  }
+  return plot.svg();
+}
+
+// The dark variance against exposure time: its slope over K² is the dark current from the variance, its intercept
+// the temporal dark noise.
+std::string dark_variance(const Calibration& cal) {
+  Plot plot("Dark noise", "exposure time (s)", "temporal dark variance, σ²y.dark (DN²)", false, false);
+  for (std::size_t c = 0; c < cal.channels.size(); ++c) {
+    const ChannelCalibration& ch = cal.channels[c];
+    std::vector<std::pair<double, double>> xy;
+    for (const TransferPoint& p : ch.dark_points) xy.emplace_back(p.exposure_s, p.dark_variance_dn2);
+    plot.points(xy, channel_colour(cal, c),
+                ch.dark_current_from_variance_e_per_s
+                    ? fmt::format("{}: {:.3g} e⁻/s from the variance", ch.channel, ch.dark_current_from_variance_e_per_s->value)
+                    : ch.channel);
+    if (ch.dark_variance_slope) {
+      const double t1 = ch.dark_points.back().exposure_s;
+      plot.line({{0.0, ch.dark_variance_dn2}, {t1, ch.dark_variance_dn2 + *ch.dark_variance_slope * t1}}, channel_colour(cal, c), "");
+    }
   }
   return plot.svg();
 }
@@ -219,6 +296,21 @@ td,th{border-bottom:1px solid #ddd;padding:4px 10px;text-align:right}th:first-ch
                       "Every number, and the sensor settings for <code>chromatrace sensor --config</code> (its <code>sensor</code>), in "
                       "<a href=\"calibration.json\">calibration.json</a>.</p>",
                       cal.flats, cal.darks, escape_html(cal.series));
+  // The operating point, as a datasheet opens with it.
+  html += "<table><tr><th>operating point</th><th></th></tr>";
+  auto fact = [&](const std::string& name, const std::string& value) {
+    html += "<tr><td>" + name + "</td><td style=\"text-align:left\">" + escape_html(value) + "</td></tr>";
+  };
+  fact("camera (the frames)", cal.camera);
+  fact("pixels per channel", fmt::format("{} × {}", cal.frame_size.first, cal.frame_size.second));
+  fact("series", cal.series);
+  fact("flats' exposure time", cal.flat_exposure_min_s == cal.flat_exposure_max_s
+                                   ? fmt::format("{:.6g} s", cal.flat_exposure_min_s)
+                                   : fmt::format("{:.6g} – {:.6g} s", cal.flat_exposure_min_s, cal.flat_exposure_max_s));
+  fact("light", cal.wavelength_nm ? fmt::format("{:g} nm", *cal.wavelength_nm) : std::string("wavelength not given (--wavelength)"));
+  if (!cal.date.empty()) fact("date (EXIF, first frame)", cal.date);
+  html += "</table>";
+
   html += "<table><tr><th>quantity</th>";
   for (const ChannelCalibration& c : cal.channels) html += "<th>" + escape_html(c.channel) + "</th>";
   html += "</tr>";
@@ -227,27 +319,44 @@ td,th{border-bottom:1px solid #ddd;padding:4px 10px;text-align:right}th:first-ch
     for (const ChannelCalibration& c : cal.channels) html += "<td>" + get(c) + "</td>";
     html += "</tr>";
   };
+  auto optional_cell = [](const std::optional<Estimate>& e, double scale = 1) { return e ? cell(*e, scale) : std::string("—"); };
+  auto ratio = [](double v) { return fmt::format("{:.4g} = {:.1f} dB = {:.1f} bits", v, 20 * std::log10(v), std::log2(v)); };
   row("system gain K (DN/e⁻)", [](const auto& c) { return cell(c.gain_dn_per_e); });
+  row("&nbsp;&nbsp;1/K (e⁻/DN)", [](const auto& c) { return fmt::format("{:.4g}", sensitivity(c).inverse_gain); });
+  row("quantum efficiency η", [&](const auto& c) { return optional_cell(c.quantum_efficiency); });
+  row("responsivity R = ηK (DN/photon)", [&](const auto& c) { return optional_cell(c.responsivity); });
   row("temporal dark noise σd (e⁻)", [](const auto& c) {
     return c.dark_noise_upper_limit ? fmt::format("≤ {:.3g} (quantisation)", c.dark_noise_e.value) : cell(c.dark_noise_e);
   });
-  row("saturation capacity μe.sat (e⁻)", [](const auto& c) { return cell(c.saturation_capacity_e); });
-  row("clip level (e⁻)", [](const auto& c) { return c.clip_level_e ? cell(*c.clip_level_e) : std::string("—"); });
-  row("dark current from the dark mean (e⁻/s)", [](const auto& c) { return cell(c.dark_current_e_per_s); });
-  row("dark current from the dark variance (e⁻/s)", [](const auto& c) {
-    return c.dark_current_from_variance_e_per_s ? cell(*c.dark_current_from_variance_e_per_s) : std::string("—");
+  row("&nbsp;&nbsp;σy.dark (DN)", [](const auto& c) { return fmt::format("{:.4g}", sensitivity(c).dark_sigma_dn); });
+  row("absolute sensitivity threshold μe.min (e⁻)", [](const auto& c) { return fmt::format("{:.4g}", sensitivity(c).threshold_e); });
+  row("&nbsp;&nbsp;μp.min (photons)", [](const auto& c) {
+    const auto t = sensitivity(c).threshold_photons;
+    return t ? fmt::format("{:.4g}", *t) : std::string("—");
   });
+  row("saturation capacity μe.sat (e⁻)", [](const auto& c) { return cell(c.saturation_capacity_e); });
+  row("&nbsp;&nbsp;μp.sat (photons)", [](const auto& c) { return c.saturation_photons ? fmt::format("{:.6g}", *c.saturation_photons) : std::string("—"); });
+  row("clip level (e⁻)", [](const auto& c) {
+    return c.clip_level_e ? cell(*c.clip_level_e) + (c.clips_at_adc ? " (the ADC's top code)" : "") : std::string("—");
+  });
+  row("maximum SNR", [&](const auto& c) { return ratio(sensitivity(c).snr_max); });
+  row("dynamic range μe.sat / μe.min", [&](const auto& c) { return ratio(sensitivity(c).dynamic_range); });
+  row("dark current from the dark mean (e⁻/s)", [](const auto& c) { return cell(c.dark_current_e_per_s); });
+  row("dark current from the dark variance (e⁻/s)", [&](const auto& c) { return optional_cell(c.dark_current_from_variance_e_per_s); });
   row("black level (DN)", [](const auto& c) { return cell(c.black_level_dn); });
   row("DSNU (e⁻): total", [](const auto& c) { return cell(c.dsnu_e.total); });
   row("&nbsp;&nbsp;row / column / pixel", [](const auto& c) {
     return fmt::format("{:.3g} / {:.3g} / {:.3g}", c.dsnu_e.row.value, c.dsnu_e.column.value, c.dsnu_e.pixel.value);
   });
+  row("&nbsp;&nbsp;DSNU (DN)", [](const auto& c) { return fmt::format("{:.4g}", sensitivity(c).dsnu_dn); });
   row("PRNU (%): total", [](const auto& c) { return cell(c.prnu.total, 100); });
   row("&nbsp;&nbsp;row / column / pixel", [](const auto& c) {
     return fmt::format("{:.3g} / {:.3g} / {:.3g}", 100 * c.prnu.row.value, 100 * c.prnu.column.value, 100 * c.prnu.pixel.value);
   });
-  row("linearity error (%)", [](const auto& c) { return fmt::format("{:.2g}", 100 * c.linearity_error); });
-  row("quantum efficiency η", [](const auto& c) { return c.quantum_efficiency ? cell(*c.quantum_efficiency) : std::string("—"); });
+  row("linearity error LE (%)", [](const auto& c) { return c.linearity ? fmt::format("{:.2g}", 100 * c.linearity_error) : std::string("—"); });
+  row("&nbsp;&nbsp;LE min / max (%)", [](const auto& c) {
+    return c.linearity ? fmt::format("{:.3g} / {:.3g}", 100 * c.linearity->min, 100 * c.linearity->max) : std::string("—");
+  });
   html += "</table>";
   for (const std::string& n : cal.notes) html += fmt::format("<p class=\"note\">{}</p>", escape_html(n));
   const NoiseCorrelation& nc = cal.noise_correlation;
@@ -279,12 +388,16 @@ std::vector<std::pair<std::string, std::string>> report_plots(const Calibration&
   const std::vector<TransferPoint>& points = calibration.channels[0].points;
   if (have_photons(calibration.channels[0]) || points.front().exposure_s < points.back().exposure_s)
     plots.emplace_back("linearity.svg", linearity(calibration));
+  if (std::any_of(calibration.channels.begin(), calibration.channels.end(), [](const ChannelCalibration& c) { return c.linearity.has_value(); }))
+    plots.emplace_back("linearity_deviation.svg", linearity_deviation(calibration));
   plots.emplace_back("dark_signal.svg", dark_signal(calibration));
+  plots.emplace_back("dark_variance.svg", dark_variance(calibration));
   return plots;
 }
 
 std::vector<std::string> report_files() {
-  return {"index.html", "calibration.json", "photon_transfer.svg", "snr.svg", "linearity.svg", "dark_signal.svg"};
+  return {"index.html",  "calibration.json",        "photon_transfer.svg", "snr.svg",
+          "linearity.svg", "linearity_deviation.svg", "dark_signal.svg",     "dark_variance.svg"};
 }
 
 void write_report(const Calibration& calibration, const std::filesystem::path& staging) {

@@ -34,6 +34,14 @@ def main(descriptor):
         "PRNU_pixel": r.PRNU1288_pixel / 100.0,
         "LE_min": r.LE_min / 100.0,
         "LE_max": r.LE_max / 100.0,
+        "R": r.R,
+        "inverse_K": r.inverse_K(),
+        "u_p_min": r.u_p_min,
+        "u_e_min": r.u_e_min,
+        "u_p_sat": r.u_p_sat,
+        "SNR_max": r.SNR_max,
+        "DR": r.DR,
+        "DSNU_DN": r.DSNU1288_DN(),
     }
     # NaN (a part the reference cannot split off) as null.
     print(json.dumps({k: (None if v != v else float(v)) for k, v in out.items()}))

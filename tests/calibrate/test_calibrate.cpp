@@ -143,6 +143,7 @@ void expect_camera(const calibrate::Calibration& cal, const Camera& c, std::size
     expect_recovered(ch.black_level_dn, c.black, "black level", 0.002);
     ASSERT_TRUE(ch.clip_level_e);
     expect_recovered(*ch.clip_level_e, c.full_well, "clip level (the full well)");
+    EXPECT_FALSE(ch.clips_at_adc);  // the well clips these cameras, below the ADC's top code
     // EMVA's saturation capacity: the exposure of largest temporal variance, where a frame's brightest pixels start to
     // clip — below the full well by the dark electrons, up to three standard deviations of the pixels' spread there
     // (shot noise and PRNU), and up to one step of the exposure series (3 % of the full well near saturation).
@@ -891,6 +892,35 @@ TEST_F(Calibrate, AgreesWithTheEmva1288ReferenceImplementation) {
   agree(g.prnu.total, ref["PRNU"].get<double>(), "PRNU");
   agree(g.prnu.column, ref["PRNU_col"].get<double>(), "PRNU, column part");
   agree(g.prnu.pixel, ref["PRNU_pixel"].get<double>(), "PRNU, pixel part");
+  ASSERT_TRUE(g.responsivity);
+  agree(*g.responsivity, ref["R"].get<double>(), "responsivity R");
+  // The datasheet's derived figures, each within 4 standard errors propagated from the estimates it derives from
+  // (first order, relative).
+  const calibrate::Sensitivity f = calibrate::sensitivity(g);
+  auto rel = [](const calibrate::Estimate& e) { return e.standard_error / e.value; };
+  auto close = [&](double ours, double theirs, double relative_se, const std::string& what) {
+    EXPECT_LE(std::abs(ours - theirs), kSigmasPerItem * relative_se * std::abs(ours)) << what << ": calibrate " << ours << ", reference " << theirs;
+  };
+  close(f.inverse_gain, ref["inverse_K"].get<double>(), rel(g.gain_dn_per_e), "1/K");
+  close(f.dark_sigma_dn, ref["sigma_y_dark"].get<double>(), std::hypot(rel(g.dark_noise_e), rel(g.gain_dn_per_e)), "σ_y.dark (DN)");
+  const double threshold_rel = std::hypot(rel(g.dark_noise_e), rel(g.gain_dn_per_e));
+  close(f.threshold_e, ref["u_e_min"].get<double>(), threshold_rel, "μe.min");
+  ASSERT_TRUE(f.threshold_photons);
+  close(*f.threshold_photons, ref["u_p_min"].get<double>(), std::hypot(threshold_rel, rel(*g.quantum_efficiency)), "μp.min");
+  ASSERT_TRUE(g.saturation_photons);
+  EXPECT_NEAR(*g.saturation_photons, ref["u_p_sat"].get<double>(), 1e-9 * *g.saturation_photons);  // the same step's photons
+  close(f.snr_max, ref["SNR_max"].get<double>(), rel(g.saturation_capacity_e) / 2, "SNR_max");
+  close(f.dynamic_range, ref["DR"].get<double>(), std::hypot(rel(g.saturation_capacity_e), threshold_rel), "dynamic range");
+  close(f.dsnu_dn, ref["DSNU_DN"].get<double>(), std::hypot(rel(g.dsnu_e.total), rel(g.gain_dn_per_e)), "DSNU (DN)");
+  // The linearity's extremes: the same weighted fit (the standard's 5–95 % range) on the same means, but at half
+  // saturation the reference's temporal mean is its first pair's where calibrate's is all eight flats': they differ
+  // by that pair's temporal noise, a relative standard error of √(σ²_y/(2n))/(μ_y − μ_y.dark) for n pixels.
+  ASSERT_TRUE(g.linearity);
+  const auto half = std::find_if(g.points.begin(), g.points.end(), [](const calibrate::TransferPoint& p) { return p.exposure_s == 0.5; });
+  ASSERT_NE(half, g.points.end());
+  const double pair_se = std::sqrt(half->variance_dn2 / (2.0 * kSize * kSize)) / (half->mean_dn - half->dark_mean_dn);
+  EXPECT_NEAR(g.linearity->min, ref["LE_min"].get<double>(), kSigmasPerItem * pair_se);
+  EXPECT_NEAR(g.linearity->max, ref["LE_max"].get<double>(), kSigmasPerItem * pair_se);
 }
 
 }  // namespace
