@@ -27,10 +27,20 @@ std::string base64_of(const std::vector<T>& values) {  // little-endian, as type
   return base64(std::string_view(reinterpret_cast<const char*>(values.data()), values.size() * sizeof(T)));
 }
 
-// Inside <script>, "</" would end the element early; "<\/" means the same to JSON and JavaScript.
+// Inside <script>, "</" would end the element early; "<\/" means the same to JavaScript (the viewer's own code).
 std::string script_safe(std::string text) {
   for (std::size_t at = text.find("</"); at != std::string::npos; at = text.find("</", at + 3)) text.replace(at, 2, "<\\/");
   return text;
+}
+
+// JSON inside <script>: every "<" as \u003c (JSON has "<" only in strings), so that no text in it (a name from a
+// file's header) can end the element or turn the HTML parser's script states ("<!--<script>" would swallow the
+// element's end and the viewer after it).
+std::string json_script_safe(const std::string& json) {
+  std::string out;
+  out.reserve(json.size());
+  for (const char c : json) out += c == '<' ? std::string("\\u003c") : std::string(1, c);
+  return out;
 }
 
 struct Display {
@@ -367,7 +377,7 @@ Colour: <select id="colour-mode"><option value="own">own colour</option><option 
       fmt::arg("regions", a.results.size()), fmt::arg("plural", a.results.size() == 1 ? "" : "s"), fmt::arg("notes", notes),
       fmt::arg("image", image_png(input, layer, a, d)), fmt::arg("illuminant", illuminant), fmt::arg("legend", legend),
       fmt::arg("unit", escape_html(unit.description)), fmt::arg("region_table", region_table),
-      fmt::arg("data", script_safe(data.dump())), fmt::arg("bundle", script_safe(std::string(viewer_bundle()))));
+      fmt::arg("data", json_script_safe(data.dump())), fmt::arg("bundle", script_safe(std::string(viewer_bundle()))));
 }
 
 }  // namespace ct::analyzer

@@ -85,14 +85,26 @@ bySize.forEach(([r, index]) => {
 });
 
 const details = document.getElementById('details');
+// Every text is the analysis's (region names come from the file, and may be anyone's): set as text, never as HTML.
+function element(tag, text, className) {
+  const e = document.createElement(tag);
+  if (text !== undefined) e.textContent = text;
+  if (className) e.className = className;
+  return e;
+}
 function showDetails(r) {
   const ranges = r.ranges.map((lh, c) => `${'RGB'[c]} ${lh[0].toPrecision(4)} to ${lh[1].toPrecision(4)}`).join(', ');
-  const range = `<tr><th>cube shown</th><td>${ranges} (${data.unit})</td></tr>`;
-  const rows = range + r.summary.map(([k, v]) => `<tr><th>${k}</th><td>${v}</td></tr>`).join('');
-  const stored = r.class_as_stored ? `<p>As stored (the file's curve not undone): ${r.class_as_stored}</p>` : '';
+  const table = element('table');
+  for (const [k, v] of [['cube shown', `${ranges} (${data.unit})`], ...r.summary]) {
+    const row = table.insertRow();
+    row.appendChild(element('th', String(k)));
+    row.appendChild(element('td', String(v)));
+  }
   const light = r.class_as_stored ? ' in linear light' : '';
-  details.innerHTML = `<h2>${r.name}</h2><p class="class">${r.class}${light}</p>${stored}<p>${r.reason}</p>` +
-    `<p class="explanation">${r.explanation ?? ''}</p><table>${rows}</table>`;
+  const parts = [element('h2', r.name), element('p', `${r.class}${light}`, 'class')];
+  if (r.class_as_stored) parts.push(element('p', `As stored (the file's curve not undone): ${r.class_as_stored}`));
+  parts.push(element('p', r.reason), element('p', r.explanation ?? '', 'explanation'), table);
+  details.replaceChildren(...parts);
 }
 
 // ---- histogram pane ------------------------------------------------------------------------------

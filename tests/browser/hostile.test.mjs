@@ -1,0 +1,83 @@
+// SPDX-License-Identifier: Apache-2.0
+// Hostile names in report.html, in a real browser (Debian's Chromium, headless, playwright-core).
+//
+// Region names come from the file's header (chromatrace.objects), and the file's name from whoever sent it: a
+// spectral EXR whose objects are named as HTML that runs script, under a file name that does too. The report must
+// show every name as the text it is: no dialog opens, no element the names spelled is made, and each region's
+// details show its name exactly as analysis.json has it, for every region clicked. ("<!--<script>" in the data would
+// put the HTML parser in a state where the data's end is not seen, and the viewer would not load.)
+// Environment: CHROMATRACE_EXE, CHROMATRACE_SYNTHETIC_IMAGES (the two executables).
+import { test, before, after } from 'node:test';
+import assert from 'node:assert/strict';
+import { execFileSync } from 'node:child_process';
+import fs from 'node:fs';
+import os from 'node:os';
+import path from 'node:path';
+import { openOffline } from './offline_page.mjs';
+
+const work = fs.mkdtempSync(path.join(os.tmpdir(), 'chromatrace-hostile-'));
+const names = {
+  1: 'floor<img src=x onerror=alert(1)>',
+  2: '<script>alert(2)</script>',
+  3: '"><svg onload=alert(3)>',
+  4: "x' onmouseover='alert(4)' &amp; &lt;b&gt; <!--<script>",
+};
+const file = path.join(work, 'scene<img src=y onerror=alert(5)>.exr');
+let context;
+let page;
+const problems = [];
+let dialogs = 0;
+let analysis;
+
+before(async () => {
+  execFileSync(process.env.CHROMATRACE_SYNTHETIC_IMAGES, [work]);
+  execFileSync('oiiotool', ['--evaloff', path.join(work, 'scene.exr'), '--attrib:type=string', 'chromatrace.objects', JSON.stringify(names), '-o', file]);
+  execFileSync(process.env.CHROMATRACE_EXE, ['analyze', file, '-o', path.join(work, 'out'), '--quiet']);
+  analysis = JSON.parse(fs.readFileSync(path.join(work, 'out', 'analysis.json'), 'utf8'));
+  ({ context, page } = await openOffline(work, { width: 1280, height: 900 }, problems));
+  page.on('dialog', async (d) => {
+    ++dialogs;
+    await d.dismiss();
+  });
+  await page.goto('file://' + path.join(work, 'out', 'report.html'));
+  await page.waitForFunction(() => document.body.dataset.ready === '1', null, { timeout: 30000 });
+});
+
+after(async () => {
+  await context?.close();
+  fs.rmSync(work, { recursive: true, force: true });
+});
+
+// No element that a hostile name spells: no script, svg or img but the report's own, nothing with an event handler.
+const spelled = () =>
+  page.evaluate(() => ({
+    handlers: [...document.querySelectorAll('*')].filter((e) => [...e.attributes].some((a) => a.name.startsWith('on'))).length,
+    // The analysis's data is JSON in a script element of type application/json, which never runs.
+    scripts: [...document.querySelectorAll('script')].filter((s) => s.type !== 'application/json' && s.textContent.includes('alert(')).length,
+    svgs: document.querySelectorAll('#details svg, #region-list svg').length,
+    images: document.querySelectorAll('#details img, #region-list img, header img').length,
+  }));
+
+test('every hostile name reaches the analysis', () => {
+  const regionNames = analysis.regions.map((r) => r.name).join('\n');
+  for (const n of Object.values(names)) assert.ok(regionNames.includes(n), `${n} is not a region's name`);
+});
+
+test('every region shows its name as text, and no script runs', async () => {
+  const buttons = await page.locator('#region-list button').count();
+  assert.ok(buttons >= 5);
+  for (let i = 0; i < buttons; ++i) {
+    const button = page.locator('#region-list button').nth(i);
+    const index = Number(await button.getAttribute('data-region'));
+    await button.click();
+    await button.hover();
+    const heading = await page.locator('#details h2').textContent();
+    assert.equal(heading, analysis.regions[index].name);
+  }
+  await page.locator('#details').hover();
+  assert.deepEqual(await spelled(), { handlers: 0, scripts: 0, svgs: 0, images: 0 });
+  assert.equal(dialogs, 0);
+  // The file's name, shown as written.
+  assert.ok((await page.locator('body').innerText()).includes('scene<img src=y onerror=alert(5)>.exr'));
+  assert.deepEqual(problems, []);
+});
