@@ -17,6 +17,8 @@
 
 namespace ct::cli {
 
+constexpr int kMaxPreviewSize = 1024, kMaxPreviewSamples = 4096;
+
 Action add_plan(CLI::App& app) {
   auto* cmd = add_command(app, "plan");
   struct Options {
@@ -34,7 +36,7 @@ Action add_plan(CLI::App& app) {
   cmd->add_option("--renderer", o->renderer, "cycles (bands in groups of 3) or tracer")->capture_default_str();
   cmd->add_option("--edge-step", o->plan.edge_step_nm, "Band edges on multiples of this many nm")->capture_default_str();
   cmd->add_option("--preview-size", o->plan.preview_size, "Longer side of the preview render, pixels")->capture_default_str();
-  cmd->add_option("--preview-spp", o->plan.preview_samples, "Paths per pixel of the preview render")->capture_default_str();
+  cmd->add_option("--preview-spp", o->plan.preview_samples, "Paths per pixel of the preview render (1 to 4096)")->capture_default_str();
   cmd->add_flag("--bounce-components", o->plan.bounce_components,
                 "Cost Cycles renders for separate bounce components (one render per bounce order)");
   cmd->add_flag("!--no-reconstruction", o->plan.reconstruction,
@@ -58,10 +60,12 @@ Action add_plan(CLI::App& app) {
     if (o->renderer == "cycles") o->plan.renderer = plan::Renderer::Cycles;
     else if (o->renderer == "tracer") o->plan.renderer = plan::Renderer::Tracer;
     else throw InputError(fmt::format("--renderer: must be cycles or tracer, got \"{}\"", o->renderer));
-    if (o->plan.preview_size < 1)
-      throw InputError(fmt::format("--preview-size: must be >= 1, got {}", o->plan.preview_size));
-    if (o->plan.preview_samples < 1)
-      throw InputError(fmt::format("--preview-spp: must be >= 1, got {}", o->plan.preview_samples));
+    // The preview is the plan's cheap look at the scene: bounded, so that a mistyped number does not start a render
+    // that never ends (the 4096 paths of a reference, on at most 1024 × 1024 pixels).
+    if (o->plan.preview_size < 1 || o->plan.preview_size > kMaxPreviewSize)
+      throw InputError(fmt::format("--preview-size: must be 1 to {}, got {}", kMaxPreviewSize, o->plan.preview_size));
+    if (o->plan.preview_samples < 1 || o->plan.preview_samples > kMaxPreviewSamples)
+      throw InputError(fmt::format("--preview-spp: must be 1 to {}, got {}", kMaxPreviewSamples, o->plan.preview_samples));
     if (o->plan.cycles_noise_ratio < 0 || !std::isfinite(o->plan.cycles_noise_ratio))
       throw InputError(fmt::format("--cycles-noise-ratio: must be > 0, got {:g}", o->plan.cycles_noise_ratio));
     if (o->plan.object_target_de00 < 0 || !std::isfinite(o->plan.object_target_de00))

@@ -2,6 +2,7 @@
 #include "reference_tracer/render.h"
 
 #include <algorithm>
+#include <cmath>
 #include <chrono>
 #include <mutex>
 
@@ -23,7 +24,8 @@ void check_options(const RenderOptions& o) {
   if (o.samples && *o.samples < 1) throw InputError(fmt::format("--spp: must be at least 1, got {}", *o.samples));
   if (o.max_bounces && (*o.max_bounces < 0 || *o.max_bounces > kMaxBounces))
     throw InputError(fmt::format("--max-bounces: must be in [0, {}], got {}", kMaxBounces, *o.max_bounces));
-  if (o.time_limit_s < 0) throw InputError(fmt::format("--time-limit: must be >= 0 s, got {}", o.time_limit_s));
+  if (!(o.time_limit_s >= 0) || !std::isfinite(o.time_limit_s))
+    throw InputError(fmt::format("--time-limit: must be a finite number of seconds >= 0 (0: no limit), got {}", o.time_limit_s));
   if (o.threads < 0) throw InputError(fmt::format("--threads: must be >= 0, got {}", o.threads));
 }
 

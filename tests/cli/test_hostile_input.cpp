@@ -359,6 +359,10 @@ TEST(HostileInput, OutOfRangeOptionsAndOverlongNamesAreBadInputNamingTheOption) 
       {{"render", kMinimal.string(), "-o", long_name}, "the output path is"},
       {{"render", kMinimal.string(), "-o", long_part}, "a name in the output path is 304 bytes long"},
       {{"compare", kMinimal.string(), kMinimal.string(), "-o", long_name}, "the output path is"},
+      {{"render", kMinimal.string(), "--time-limit", "nan", "-o", dir.file("r.exr").string()}, "--time-limit: must be a finite number of seconds >= 0"},
+      {{"render", kMinimal.string(), "--time-limit", "inf", "-o", dir.file("r.exr").string()}, "--time-limit: must be a finite number of seconds >= 0"},
+      {{"plan", kMinimal.string(), "--preview-spp", "2000000000", "-o", dir.file("p").string()}, "--preview-spp: must be 1 to 4096, got 2000000000"},
+      {{"plan", kMinimal.string(), "--preview-size", "100000", "-o", dir.file("p").string()}, "--preview-size: must be 1 to 1024, got 100000"},
   };
   for (const auto& c : cases) expect_refused(run_chromatrace(c.args), 2, c.says, c.args[0]);
   EXPECT_TRUE(fs::is_empty(dir.path()));
