@@ -11,6 +11,7 @@
 #include "analyzer/report.h"
 #include "core/error.h"
 #include "core/file_io.h"
+#include "core/json_input.h"
 #include "plot/png.h"
 
 namespace ct::analyzer {
@@ -60,7 +61,7 @@ void write_analysis(const std::filesystem::path& dir, const AnalysisImage& input
     const std::string stem = region_stem(i);
     const RegionSamples samples = gather_samples(layer, analysis.regions[i]);
     write_file_atomically(dir / "histograms" / (stem + ".json"),
-                          histogram_to_json(analysis.results[i].histogram, chromaticity_histogram(samples.rgb, analysis.context.spec.bins)).dump());
+                          histogram_to_json(analysis.results[i].histogram, chromaticity_histogram(samples.rgb, analysis.context.spec.bins)).dump(-1, ' ', false, kReplaceInvalidUtf8));
     if (!options.plots || !plotted[i]) continue;
     write_png(dir / "plots" / (stem + ".png"), plot_region(layer, analysis, i, PlotColouring::Own, components));
     write_png(dir / "plots" / (stem + "-density.png"), plot_region(layer, analysis, i, PlotColouring::Density, components));
@@ -69,7 +70,7 @@ void write_analysis(const std::filesystem::path& dir, const AnalysisImage& input
   }
   if (options.report) write_file_atomically(dir / "report.html", report_html(input, analysis, options.report_points));
   // Last, so that a complete analysis.json means a complete directory.
-  write_file_atomically(dir / "analysis.json", analysis_to_json(analysis, options.plots ? plotted : std::vector<bool>(analysis.results.size(), false)).dump(1));
+  write_file_atomically(dir / "analysis.json", analysis_to_json(analysis, options.plots ? plotted : std::vector<bool>(analysis.results.size(), false)).dump(1, ' ', false, kReplaceInvalidUtf8));
 }
 
 }  // namespace ct::analyzer

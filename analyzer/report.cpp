@@ -13,6 +13,7 @@
 #include "analyzer/viewer_bundle.h"
 #include "core/colour.h"
 #include "core/html_text.h"
+#include "core/json_input.h"
 #include "core/statistics.h"
 #include "plot/png.h"
 #include "plot/ticks.h"
@@ -377,7 +378,7 @@ Colour: <select id="colour-mode"><option value="own">own colour</option><option 
       fmt::arg("regions", a.results.size()), fmt::arg("plural", a.results.size() == 1 ? "" : "s"), fmt::arg("notes", notes),
       fmt::arg("image", image_png(input, layer, a, d)), fmt::arg("illuminant", illuminant), fmt::arg("legend", legend),
       fmt::arg("unit", escape_html(unit.description)), fmt::arg("region_table", region_table),
-      fmt::arg("data", json_script_safe(data.dump())), fmt::arg("bundle", script_safe(std::string(viewer_bundle()))));
+      fmt::arg("data", json_script_safe(data.dump(-1, ' ', false, kReplaceInvalidUtf8))), fmt::arg("bundle", script_safe(std::string(viewer_bundle()))));
 }
 
 }  // namespace ct::analyzer

@@ -10,6 +10,7 @@
 
 #include "core/file_io.h"
 #include "core/html_text.h"
+#include "core/json_input.h"
 #include "plot/ticks.h"
 
 namespace ct::calibrate {
@@ -363,7 +364,7 @@ td,th{border-bottom:1px solid #ddd;padding:4px 10px;text-align:right}th:first-ch
   html += fmt::format("<p class=\"note\">The temporal noise's correlation (the flats' pair differences): {:.3f} between horizontal "
                       "and {:.3f} between vertical neighbours{}, ± {:.2g}; about 0 where each pixel is read on its own.</p>",
                       nc.horizontal, nc.vertical,
-                      nc.channel_pair.empty() ? "" : fmt::format(", {:.3f} between channels ({})", nc.between_channels, nc.channel_pair),
+                      nc.channel_pair.empty() ? "" : fmt::format(", {:.3f} between channels ({})", nc.between_channels, escape_html(nc.channel_pair)),
                       nc.standard_error);
   html += "<div class=\"plots\">";
   for (const auto& [name, svg] : plots) html += "<figure>" + svg + "</figure>";
@@ -402,7 +403,7 @@ std::vector<std::string> report_files() {
 
 void write_report(const Calibration& calibration, const std::filesystem::path& staging) {
   const auto plots = report_plots(calibration);
-  write_text(staging / "calibration.json", calibration.report.dump(2) + "\n");
+  write_text(staging / "calibration.json", calibration.report.dump(2, ' ', false, kReplaceInvalidUtf8) + "\n");
   for (const auto& [name, svg] : plots) write_text(staging / name, svg);
   write_text(staging / "index.html", page(calibration, plots));
 }

@@ -15,6 +15,7 @@
 #include "cli/command.h"
 #include "core/error.h"
 #include "core/file_io.h"
+#include "core/json_input.h"
 
 namespace ct::cli {
 
@@ -90,7 +91,7 @@ Action add_calibrate(CLI::App& app) {
       report.emplace(o->report, std::vector<std::string>{"index.html"});
       calibrate::write_report(c, report->path());
     }
-    write_file_atomically(o->output, c.sensor.dump(2) + "\n");
+    write_file_atomically(o->output, c.sensor.dump(2, ' ', false, kReplaceInvalidUtf8) + "\n");
     if (report) report->commit();
     if (!o->quiet)
       for (const calibrate::ChannelCalibration& ch : c.channels)

@@ -209,7 +209,7 @@ void print_variant(const Json& v) {
   fmt::print("  {}{}: from {}; materials {}, {} light(s), max {} bounces, {} pixels; sensor {}; expects {}\n",
              v["name"].get<std::string>(), figure.empty() ? "" : fmt::format(" (figure {})", fmt::join(figure, ", ")),
              extends.empty() ? "the base" : extends, materials_text(s["materials"]), s["lights"].get<int>(),
-             s["render"]["max_bounces"].get<int>(), s["render"]["pixel_filter"].get<std::string>(), v["sensor"].dump(),
+             s["render"]["max_bounces"].get<int>(), s["render"]["pixel_filter"].get<std::string>(), v["sensor"].dump(-1, ' ', false, kReplaceInvalidUtf8),
              expects.empty() ? "nothing" : fmt::format("{}", fmt::join(expects, ", ")));
 }
 
@@ -225,12 +225,12 @@ void emit_variant(const CheckSceneOptions& options, const Series& series) {
   if (!options.emit.empty()) {
     const std::filesystem::path out = std::filesystem::absolute(options.emit);
     const Json scene = rebase_scene_paths(variant->scene.json, {}, out.parent_path());
-    write_file_atomically(out, scene.dump(2) + "\n");
+    write_file_atomically(out, scene.dump(2, ' ', false, kReplaceInvalidUtf8) + "\n");
   }
   if (!options.emit_sensor.empty()) {
     const std::filesystem::path series_dir = std::filesystem::path(series.source).parent_path();
     Json sensor = sensor::config_patch(variant->sensor, options.file, series_dir).patch;
-    write_file_atomically(options.emit_sensor, sensor.dump(2) + "\n");
+    write_file_atomically(options.emit_sensor, sensor.dump(2, ' ', false, kReplaceInvalidUtf8) + "\n");
   }
 }
 
@@ -274,7 +274,7 @@ int check(const CheckSceneOptions& options) {
 
   if (options.quiet) return 0;
   if (options.json) {
-    fmt::print("{}\n", report.dump(2));
+    fmt::print("{}\n", report.dump(2, ' ', false, kReplaceInvalidUtf8));
     return 0;
   }
   if (report.contains("scene")) {

@@ -79,7 +79,7 @@ int run(const ExportMeshesOptions& o) {
   }
   staged.commit();
   if (o.json)
-    fmt::print("{}\n", Json({{"scene", o.scene}, {"directory", o.directory}, {"objects", objects}, {"lights", lights}}).dump(1));
+    fmt::print("{}\n", Json({{"scene", o.scene}, {"directory", o.directory}, {"objects", objects}, {"lights", lights}}).dump(1, ' ', false, kReplaceInvalidUtf8));
   else if (!o.quiet)
     fmt::print("{}: {} meshes, {} triangles\n", o.directory, meshes.size(), triangles);
   return 0;

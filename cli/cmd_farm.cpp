@@ -16,6 +16,7 @@
 #include "core/band_plan.h"
 #include "core/error.h"
 #include "core/file_io.h"
+#include "core/json_input.h"
 #include "core/scene.h"
 #include "core/series_format.h"
 #include "farm/blender_preflight.h"
@@ -212,7 +213,7 @@ int run_cycles(CyclesOptions& o) {
   explain.insert(explain.end(), {"--explain", "-"});
   const farm::BlenderPreflight preflight =
       farm::run_blender_preflight(explain, series::BlenderBatchCommand::environment(own_executable()), o.source);
-  job.notes.emplace_back("preflight.json", preflight.summary.dump(1) + "\n");
+  job.notes.emplace_back("preflight.json", preflight.summary.dump(1, ' ', false, kReplaceInvalidUtf8) + "\n");
   const int groups = preflight.band_groups;
   // With the bounces components every group has a render per bounce limit: one task each.
   const std::vector<std::string>& variants = preflight.render_variants;

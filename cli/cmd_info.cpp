@@ -15,6 +15,7 @@
 #include "cli/app.h"
 #include "cli/command.h"
 #include "core/error.h"
+#include "core/json_input.h"
 #include "core/parallel.h"
 #include "core/progress.h"
 #include "core/spectral_exr.h"
@@ -258,7 +259,7 @@ int run_raw_info(const InfoOptions& options) {
   if (options.json) {
     nlohmann::json j = {{"file", options.file}, {"kind", "camera raw"}};
     for (const auto& [key, value] : items) j[key] = value;
-    fmt::print("{}\n", j.dump(2));
+    fmt::print("{}\n", j.dump(2, ' ', false, kReplaceInvalidUtf8));
   } else {
     fmt::print("{:<16}{}\n", "file", options.file);
     fmt::print("{:<16}{}\n", "kind", "camera raw");
@@ -289,7 +290,7 @@ int run_info(const InfoOptions& options) {
   }
 
   if (options.json)
-    fmt::print("{}\n", to_json(info, scan).dump(2));
+    fmt::print("{}\n", to_json(info, scan).dump(2, ' ', false, kReplaceInvalidUtf8));
   else
     print_text(info, scan, options.check);
   if (scan) fail_on_bad_pixels(info, *scan);

@@ -12,6 +12,7 @@
 #include "cli/command.h"
 #include "core/error.h"
 #include "core/file_io.h"
+#include "core/json_input.h"
 #include "core/scene.h"
 #include "plan/plan.h"
 
@@ -98,9 +99,9 @@ Action add_plan(CLI::App& app) {
     }
     const plan::Plan p = plan::make_plan(scene, o->plan);
     const Json report = plan::report_document(p, scene, o->plan);
-    if (!o->output.empty()) write_file_atomically(o->output, plan::bands_document(p).dump(2) + "\n");
-    if (!o->report.empty()) write_file_atomically(o->report, report.dump(2) + "\n");
-    fmt::print("{}\n", report.dump(2));
+    if (!o->output.empty()) write_file_atomically(o->output, plan::bands_document(p).dump(2, ' ', false, kReplaceInvalidUtf8) + "\n");
+    if (!o->report.empty()) write_file_atomically(o->report, report.dump(2, ' ', false, kReplaceInvalidUtf8) + "\n");
+    fmt::print("{}\n", report.dump(2, ' ', false, kReplaceInvalidUtf8));
     if (!o->quiet) {
       std::string cycles;
       if (!p.cycles_samples.empty())

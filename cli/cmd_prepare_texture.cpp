@@ -35,7 +35,7 @@ int check_only(const PrepareTextureOptions& o, TextureUse use, std::optional<Tex
                         {"width", texture.width},
                         {"height", texture.height},
                         {"negative_texels", negative_texels_json(texture.negatives)}};
-  fmt::print("{}\n", summary.dump(1));
+  fmt::print("{}\n", summary.dump(1, ' ', false, kReplaceInvalidUtf8));
   return 0;
 }
 
@@ -112,7 +112,7 @@ int run(const PrepareTextureOptions& o) {
                           {"manifest", r.manifest.string()},
                           {"groups", groups},
                           {"seconds", r.seconds}};
-    fmt::print("{}\n", summary.dump(1));
+    fmt::print("{}\n", summary.dump(1, ' ', false, kReplaceInvalidUtf8));
   } else {
     for (const auto& f : r.files) fmt::print("{}\n", f.string());
   }

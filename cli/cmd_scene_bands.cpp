@@ -122,7 +122,7 @@ int run(const SceneBandsOptions& o) {
   }
 
   if (o.json) {
-    fmt::print("{}\n", report.dump(1));
+    fmt::print("{}\n", report.dump(1, ' ', false, kReplaceInvalidUtf8));
     return 0;
   }
   auto row = [](const Json& values) {

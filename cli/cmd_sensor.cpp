@@ -13,6 +13,7 @@
 #include "cli/app.h"
 #include "cli/command.h"
 #include "core/error.h"
+#include "core/json_input.h"
 #include "core/parallel.h"
 #include "core/spectral_exr.h"
 #include "sensor_sim/config.h"
@@ -95,7 +96,7 @@ sensor::SensorConfig configuration(const SensorOptions& o) {
 int run(const SensorOptions& o) {
   const sensor::SensorConfig config = configuration(o);
   if (o.print_config) {
-    fmt::print("{}\n", sensor::config_json(config).dump(2));
+    fmt::print("{}\n", sensor::config_json(config).dump(2, ' ', false, kReplaceInvalidUtf8));
     return 0;
   }
   if (o.input.empty()) throw InputError("input: no spectral EXR given");

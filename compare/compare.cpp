@@ -15,6 +15,7 @@
 #include "core/cie.h"
 #include "core/colour.h"
 #include "core/error.h"
+#include "core/json_input.h"
 #include "core/spectral_exr.h"
 #include "core/render_delta_e.h"
 #include "core/statistics.h"
@@ -153,7 +154,7 @@ void check_comparable(const Render& a, const Render& b) {
   if (sa.is_object() && sb.is_object() && sa.contains("name") && sb.contains("name") && sa["name"] != sb["name"])
     throw InputError(fmt::format("{}: attribute chromatrace.scene: scene {} but {} renders {} (incomparable: "
                                  "different scenes)",
-                                 b.file, sb["name"].dump(), a.file, sa["name"].dump()));
+                                 b.file, sb["name"].dump(-1, ' ', false, kReplaceInvalidUtf8), a.file, sa["name"].dump(-1, ' ', false, kReplaceInvalidUtf8)));
   if (!a.info.object_names.empty() && !b.info.object_names.empty() && a.info.object_names != b.info.object_names) {
     for (const auto& [id, name] : a.info.object_names) {
       auto it = b.info.object_names.find(id);

@@ -16,6 +16,7 @@
 #include "core/error.h"
 #include "core/file_io.h"
 #include "core/html_text.h"
+#include "core/json_input.h"
 #include "plot/png.h"
 
 namespace ct::cmp {
@@ -206,7 +207,7 @@ object ids left out); tolerance {tolerance}, plus {sigmas:g} standard errors.</p
       fmt::arg("bands", c.bands.size()), fmt::arg("lo", c.bands.min_wavelength()), fmt::arg("hi", c.bands.max_wavelength()),
       fmt::arg("components", escape_html(fmt::format("{}", fmt::join(c.components, ", ")))),
       fmt::arg("pixels", c.pixels_mode), fmt::arg("mismatch", c.id_mismatch_pixels),
-      fmt::arg("tolerance", escape_html(c.tolerance_mode)), fmt::arg("sigmas", c.sigmas), fmt::arg("camera", c.camera),
+      fmt::arg("tolerance", escape_html(c.tolerance_mode)), fmt::arg("sigmas", c.sigmas), fmt::arg("camera", escape_html(c.camera)),
       fmt::arg("de_mean", c.delta_e_mean), fmt::arg("de_p95", c.delta_e_p95), fmt::arg("de_max", c.delta_e_max),
       fmt::arg("png", base64(png_bytes)), fmt::arg("rows", rows));
 }
@@ -219,7 +220,7 @@ void write_outputs(const Comparison& c, const std::filesystem::path& dir) {
   check_output_directory(dir, inputs);
   // Everything is formed before anything is written, into a staging directory moved into place when complete
   // (compare.json last), so that no run leaves compare.json without its page.
-  const std::string json_text = to_json(c).dump(1) + "\n";
+  const std::string json_text = to_json(c).dump(1, ' ', false, kReplaceInvalidUtf8) + "\n";
   const std::string png_bytes = png(c);
   const std::string html_text = html(c, png_bytes);
   StagedDirectory staged(dir, {"compare.json"});

@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/error.h"
+#include "core/json_input.h"
 
 namespace ct::exr {
 
@@ -23,7 +24,7 @@ void check_object_id(double value, const std::string& file, std::size_t x, std::
 std::string object_names_text(const std::map<std::int32_t, std::string>& names) {
   nlohmann::json json = nlohmann::json::object();
   for (const auto& [id, name] : names) json[std::to_string(id)] = name;
-  return json.dump();
+  return json.dump(-1, ' ', false, kReplaceInvalidUtf8);
 }
 
 std::map<std::int32_t, std::string> parse_object_names(std::string_view text, const std::string& where) {

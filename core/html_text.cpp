@@ -15,7 +15,10 @@ std::string escape_html(std::string_view text) {
       case '>': out += "&gt;"; break;
       case '"': out += "&quot;"; break;
       case '\'': out += "&#39;"; break;
-      default: out += c;
+      // C0 controls but tab, line feed and carriage return are not characters XML allows, even as references: an
+      // SVG holding one (a name from a file's header) would not open. U+FFFD shows where one was.
+      case '\t': case '\n': case '\r': out += c; break;
+      default: out += static_cast<unsigned char>(c) < 0x20 ? std::string("\xEF\xBF\xBD") : std::string(1, c);
     }
   }
   return out;

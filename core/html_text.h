@@ -8,7 +8,8 @@
 
 namespace ct {
 
-// &, <, >, " and ' as character references: safe in element text and in quoted attributes.
+// &, <, >, " and ' as character references: safe in element text and in quoted attributes, of HTML and of XML
+// (SVG). Control characters XML does not allow (C0 but tab, LF, CR) become U+FFFD.
 std::string escape_html(std::string_view text);
 
 // RFC 4648 base64 with padding.

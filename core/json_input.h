@@ -22,6 +22,10 @@ namespace ct {
 
 using Json = nlohmann::ordered_json;
 
+// How every document is written (Json::dump's error handler): text from file names and headers that is not UTF-8
+// (Linux allows any bytes in a name) has each invalid byte as U+FFFD, where the default would end the run.
+inline constexpr auto kReplaceInvalidUtf8 = nlohmann::ordered_json::error_handler_t::replace;
+
 // Parses JSON text. A syntax error is an InputError "source: line L, column C: <reason>"; a key repeated in
 // one object is an InputError naming its JSON path (JSON parsers would silently keep one of the two).
 Json parse_json(std::string_view text, const std::string& source);

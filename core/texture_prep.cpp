@@ -220,7 +220,7 @@ TexturePrepResult prepare_texture(const TexturePrepRequest& request, const std::
                          {"alpha_ignored", result.had_alpha},
                          {"negative_texels", negative_texels_json(result.negatives)},
                          {"groups", groups}};
-  write_file_atomically(result.manifest, manifest.dump(1) + "\n");
+  write_file_atomically(result.manifest, manifest.dump(1, ' ', false, kReplaceInvalidUtf8) + "\n");
   result.seconds = elapsed();
   return result;
 }

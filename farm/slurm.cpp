@@ -177,7 +177,7 @@ void write_record(const FarmJob& job, const Record& r) {
                                {"result", job.result.string()}, {"tasks_job", r.tasks_job},
                                {"assembly_job", r.assembly_job}, {"tasks", r.tasks},
                                {"all_tasks", tasks},            {"assembly", job.assembly_command}};
-  write_file_atomically(record_file(job), json.dump(1) + "\n");
+  write_file_atomically(record_file(job), json.dump(1, ' ', false, kReplaceInvalidUtf8) + "\n");
 }
 
 std::string join_ids(const std::vector<QueuedJob>& jobs) {

@@ -6,6 +6,7 @@
 #include <fmt/core.h>
 #include <nlohmann/json.hpp>
 
+#include "core/json_input.h"
 #include "core/spectral_exr.h"
 #include "reference_tracer/render.h"
 
@@ -35,8 +36,8 @@ void write_render(const std::filesystem::path& path, const Scene& scene, const R
                                               image.settings.max_bounces);
   layout.attributes["chromatrace.samples"] = std::to_string(image.samples);
   layout.attributes["chromatrace.seed"] = std::to_string(image.settings.seed);
-  layout.attributes["chromatrace.scene"] = scene.json.dump();
-  layout.attributes["chromatrace.camera"] = camera.dump();
+  layout.attributes["chromatrace.scene"] = scene.json.dump(-1, ' ', false, kReplaceInvalidUtf8);
+  layout.attributes["chromatrace.camera"] = camera.dump(-1, ' ', false, kReplaceInvalidUtf8);
 
   SpectralExrWriter writer(path, std::move(layout));
   SpectralRowBlock block;

@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/error.h"
+#include "core/json_input.h"
 #include "core/progress.h"
 #include "core/spectral_exr.h"
 
@@ -132,7 +133,7 @@ void combine_parts(const std::vector<fs::path>& paths, const fs::path& output, b
   }
   layout.attributes["chromatrace.samples"] = std::to_string(total);
   layout.attributes["chromatrace.seed"] = std::to_string(parts.front()->seed);
-  layout.attributes["chromatrace.parts"] = listing.dump();
+  layout.attributes["chromatrace.parts"] = listing.dump(-1, ' ', false, kReplaceInvalidUtf8);
 
   SpectralExrWriter writer(output, layout);
   const int width = first.width, height = first.height, bands = static_cast<int>(first.bands.size());

@@ -28,6 +28,7 @@
 #include "core/exr_output.h"
 #include "core/exr_vocabulary.h"
 #include "core/file_io.h"
+#include "core/json_input.h"
 
 namespace ct::sensor {
 namespace {
@@ -160,7 +161,7 @@ SensorImageWriter::SensorImageWriter(const fs::path& path, OutputLayout layout)
       spec.attribute(key, value);
       description[key] = value;
     }
-    if (!description.empty()) spec.attribute("ImageDescription", description.dump());
+    if (!description.empty()) spec.attribute("ImageDescription", description.dump(-1, ' ', false, kReplaceInvalidUtf8));
     if (!file->image->open(temporary, spec))
       throw std::runtime_error(fmt::format("{}: cannot start writing: {}", name, file->image->geterror()));
   }

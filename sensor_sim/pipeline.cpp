@@ -16,6 +16,7 @@
 #include "core/colour.h"
 #include "core/error.h"
 #include "core/file_io.h"
+#include "core/json_input.h"
 #include "core/parallel.h"
 #include "core/progress.h"
 #include "core/spectral_exr.h"
@@ -354,14 +355,14 @@ void describe_output(const SpectralExrInfo& info, const SensorConfig& config, co
     // The renderer's description of the scene and camera travels on with the image.
     for (const auto& [key, value] : info.metadata)
       if (key.starts_with("chromatrace.") && key != exr::kComponentsAttribute) layout.attributes[key] = value;
-    layout.attributes["chromatrace.sensor"] = report.effective_config.dump();
-    layout.attributes["chromatrace.units"] = units_json(config, run.intent).dump();
+    layout.attributes["chromatrace.sensor"] = report.effective_config.dump(-1, ' ', false, kReplaceInvalidUtf8);
+    layout.attributes["chromatrace.units"] = units_json(config, run.intent).dump(-1, ' ', false, kReplaceInvalidUtf8);
     if (!components.empty())
       layout.attributes[exr::kComponentsAttribute] = exr::component_list_text(components);
     if (want_display) {
       layout.display = true;
       display_description["scale"] = display_scale;
-      layout.attributes["chromatrace.display"] = display_description.dump();
+      layout.attributes["chromatrace.display"] = display_description.dump(-1, ' ', false, kReplaceInvalidUtf8);
     }
   }
   camera_levels(config, run.exposure_s, layout);

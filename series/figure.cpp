@@ -12,6 +12,7 @@
 
 #include "core/file_io.h"
 #include "core/html_text.h"
+#include "core/json_input.h"
 #include "plot/png.h"
 #include "plot/ticks.h"
 #include "series/figure_data.h"
@@ -46,9 +47,9 @@ std::string options_text(const Json& result, bool for_raster) {
   const Json& o = result["options"];
   if (o.contains("renderer") && o["renderer"].is_string()) parts.push_back("renderer " + o["renderer"].get<std::string>());
   if (o.contains("resolution") && o["resolution"].is_array() && o["resolution"].size() == 2)
-    parts.push_back(fmt::format("{} {} {} px", o["resolution"][0].dump(), for_raster ? "x" : "×", o["resolution"][1].dump()));
-  if (o.contains("spp") && o["spp"].is_number()) parts.push_back(fmt::format("{} paths per pixel", o["spp"].dump()));
-  if (o.contains("seed") && o["seed"].is_number()) parts.push_back(fmt::format("seed {}", o["seed"].dump()));
+    parts.push_back(fmt::format("{} {} {} px", o["resolution"][0].dump(-1, ' ', false, kReplaceInvalidUtf8), for_raster ? "x" : "×", o["resolution"][1].dump(-1, ' ', false, kReplaceInvalidUtf8)));
+  if (o.contains("spp") && o["spp"].is_number()) parts.push_back(fmt::format("{} paths per pixel", o["spp"].dump(-1, ' ', false, kReplaceInvalidUtf8)));
+  if (o.contains("seed") && o["seed"].is_number()) parts.push_back(fmt::format("seed {}", o["seed"].dump(-1, ' ', false, kReplaceInvalidUtf8)));
   if (o.contains("components") && o["components"].is_string()) parts.push_back("components " + o["components"].get<std::string>());
   return fmt::format("{}", fmt::join(parts, for_raster ? ", " : " · "));
 }

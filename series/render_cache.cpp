@@ -9,6 +9,7 @@
 
 #include "core/band_plan.h"
 #include "core/file_io.h"
+#include "core/json_input.h"
 
 namespace ct::series {
 namespace {
@@ -69,6 +70,6 @@ Json render_inputs(const Scene& scene, const RunOptions& options) {
   return inputs;
 }
 
-std::string render_key(const Json& inputs) { return fmt::format("{:016x}", fnv1a(inputs.dump())); }
+std::string render_key(const Json& inputs) { return fmt::format("{:016x}", fnv1a(inputs.dump(-1, ' ', false, kReplaceInvalidUtf8))); }
 
 }  // namespace ct::series

@@ -20,6 +20,7 @@
 #include "core/band_plan.h"
 #include "core/error.h"
 #include "core/file_io.h"
+#include "core/json_input.h"
 #include "core/parallel.h"
 #include "core/process.h"
 #include "core/spectral_exr.h"
@@ -225,10 +226,10 @@ VariantResult run_variant(const Series& series, const SeriesVariant& variant, co
   const fs::path series_dir = fs::path(series.source).parent_path();
 
   const fs::path scene_file = out / "scene.json";
-  write_file_atomically(scene_file, rebase_scene_paths(variant.scene.json, {}, fs::absolute(out)).dump(2) + "\n");
+  write_file_atomically(scene_file, rebase_scene_paths(variant.scene.json, {}, fs::absolute(out)).dump(2, ' ', false, kReplaceInvalidUtf8) + "\n");
   const sensor::ConfigPatch sensor_patch = sensor::config_patch(
       variant.sensor, fmt::format("{}: variant \"{}\" sensor", series.source, variant.name), series_dir);
-  write_file_atomically(out / "sensor.json", sensor_patch.patch.dump(2) + "\n");
+  write_file_atomically(out / "sensor.json", sensor_patch.patch.dump(2, ' ', false, kReplaceInvalidUtf8) + "\n");
 
   // Render, or take it from the cache.
   const Json inputs = render_inputs(variant.scene, options);
@@ -241,7 +242,7 @@ VariantResult run_variant(const Series& series, const SeriesVariant& variant, co
     stage(fmt::format("rendering with {}", renderer_name(options.renderer)));
     const auto start = Clock::now();
     const double start_cpu = cpu_seconds();
-    write_file_atomically(dir / "renders" / (result.render_key + ".json"), inputs.dump(2) + "\n");
+    write_file_atomically(dir / "renders" / (result.render_key + ".json"), inputs.dump(2, ' ', false, kReplaceInvalidUtf8) + "\n");
     if (options.renderer == Renderer::Tracer)
       render_with_tracer(variant.scene, render, options);
     else
@@ -366,7 +367,7 @@ SeriesResult run_series(const Series& series, const fs::path& dir, const RunOpti
     }
   }
   result.seconds = seconds_since(start);
-  if (!options.renders_only) write_file_atomically(dir / "series.json", result_json(result).dump(2) + "\n");
+  if (!options.renders_only) write_file_atomically(dir / "series.json", result_json(result).dump(2, ' ', false, kReplaceInvalidUtf8) + "\n");
   return result;
 }
 

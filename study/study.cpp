@@ -15,6 +15,7 @@
 #include "core/error.h"
 #include "core/colour.h"
 #include "core/file_io.h"
+#include "core/json_input.h"
 #include "plan/plan.h"
 #include "study/charts.h"
 #include "study/page.h"
@@ -282,7 +283,7 @@ StudyResult run_study(const fs::path& scene_file, const fs::path& dir, const Stu
   std::vector<Setting> all = settings;
   all.push_back(ref);
   const fs::path series_file = dir / "study-series.json";
-  write_file_atomically(series_file, series_document(scene_file, all, scene.name).dump(2) + "\n");
+  write_file_atomically(series_file, series_document(scene_file, all, scene.name).dump(2, ' ', false, kReplaceInvalidUtf8) + "\n");
   const Series series = load_series(series_file, options.threads);
   const fs::path runs = dir / "runs";
 
@@ -298,7 +299,7 @@ StudyResult run_study(const fs::path& scene_file, const fs::path& dir, const Stu
     ro.bands = s.bands;
     ro.bands_file = fs::absolute(dir / "plans" / (s.name + ".json"));
     ro.cycles_samples = s.cycles_samples;
-    write_file_atomically(ro.bands_file, band_plan_document(s.bands, s.cycles_samples).dump(2) + "\n");
+    write_file_atomically(ro.bands_file, band_plan_document(s.bands, s.cycles_samples).dump(2, ' ', false, kReplaceInvalidUtf8) + "\n");
     ro.components = kComponents;
     ro.threads = options.threads;
     ro.progress = options.progress;
@@ -311,7 +312,7 @@ StudyResult run_study(const fs::path& scene_file, const fs::path& dir, const Stu
     // What the render cost, kept beside it: a render taken from the cache (a study run again) keeps its cost.
     const fs::path cost = runs / "renders" / (v.render_key + ".cost.json");
     if (!v.render_reused) {
-      write_file_atomically(cost, Json{{"wall_seconds", v.render_s}, {"cpu_seconds", v.render_cpu_s}}.dump() + "\n");
+      write_file_atomically(cost, Json{{"wall_seconds", v.render_s}, {"cpu_seconds", v.render_cpu_s}}.dump(-1, ' ', false, kReplaceInvalidUtf8) + "\n");
     } else if (fs::exists(cost)) {
       std::ifstream in(cost);
       const Json c = Json::parse(in);
@@ -399,7 +400,7 @@ StudyResult run_study(const fs::path& scene_file, const fs::path& dir, const Stu
   mark_pareto_front(result.settings);
   result.seconds = std::chrono::duration<double>(Clock::now() - start).count();
 
-  write_file_atomically(dir / "study.json", result_json(result).dump(2) + "\n");
+  write_file_atomically(dir / "study.json", result_json(result).dump(2, ' ', false, kReplaceInvalidUtf8) + "\n");
   write_charts(dir, result);
   write_page(dir / "index.html", result);
   return result;

@@ -395,6 +395,20 @@ TEST(HostileInput, LineBreaksInNamesAndLibraryMessagesStayOnOneLine) {
   for (const auto& c : cases) expect_refused(run_chromatrace(c.args), 2, c.says, c.args[1]);
 }
 
+// Linux allows any bytes in a file's name; JSON holds only UTF-8. An image whose name is not UTF-8 is analysed and
+// compared like any other: its name in analysis.json and compare.json with U+FFFD for the byte, not a failed run.
+TEST(HostileInput, AFileNameThatIsNotUtf8IsWrittenWithAReplacementCharacter) {
+  test::TempDir dir;
+  const fs::path image = dir.file("r\xff.exr");
+  fs::copy_file(write_render(dir, "r.exr", 8, 6), image);
+  const auto analysed = run_chromatrace({"analyze", image.string(), "-o", dir.file("a").string(), "-q", "--no-plots"});
+  ASSERT_EQ(analysed.exit_code, 0) << analysed.err;
+  EXPECT_NE(read_text(dir.file("a") / "analysis.json").find("r\xEF\xBF\xBD.exr"), std::string::npos);
+  const auto compared = run_chromatrace({"compare", image.string(), image.string(), "-o", dir.file("c").string()});
+  ASSERT_EQ(compared.exit_code, 0) << compared.err;
+  EXPECT_NE(read_text(dir.file("c") / "compare.json").find("r\xEF\xBF\xBD.exr"), std::string::npos);
+}
+
 // ---- 13: outputs that appear whole or not at all ----------------------------------------------------------
 
 TEST(HostileInput, CompareAndSensorLeaveNoPartialOrUnreadableOutput) {

@@ -286,6 +286,17 @@ TEST_F(Compare, IdenticalRendersHaveZeroDeltaE) {
   EXPECT_EQ(by_object.at("(image)"), d2["image"]["delta_e00"]["mean"].get<double>());
   EXPECT_GT(by_object.at("ball"), by_object.at("(image)"));
   EXPECT_GT(by_object.at("(image)"), 0.0);
+
+  // A camera's curves from a file under a hostile folder name: its path reaches compare.html as text, not as a tag.
+  const fs::path folder = dir_.file("cam<img src=x onerror=alert(1)>");
+  fs::create_directory(folder);
+  std::ofstream(folder / "c.csv") << "wavelength_nm,r,g,b\n300,1,0.5,0.2\n900,1,0.5,0.2\n";
+  const auto r3 = run({fa, fa, "-o", dir_.file("out3").string(), "--camera", (folder / "c.csv").string()});
+  ASSERT_EQ(r3.exit_code, 0) << r3.err;
+  std::ifstream page(dir_.file("out3") / "compare.html");
+  const std::string html((std::istreambuf_iterator<char>(page)), std::istreambuf_iterator<char>());
+  EXPECT_EQ(html.find("<img src=x"), std::string::npos);
+  EXPECT_NE(html.find("cam&lt;img src=x onerror=alert(1)&gt;"), std::string::npos);
 }
 
 // Noiseless renders whose ball differs by 0.5 %, inside its 2 % tolerance: its cells have no standard error, so

@@ -21,6 +21,8 @@ TEST(HtmlText, Base64MatchesTheRfc4648TestVectors) {
 TEST(HtmlText, EscapesWhatEndsTextOrAQuotedAttribute) {
   EXPECT_EQ(escape_html(R"(<a href="x">Tom & Jerry's</a>)"), "&lt;a href=&quot;x&quot;&gt;Tom &amp; Jerry&#39;s&lt;/a&gt;");
   EXPECT_EQ(escape_html("σ₁ ≥ 3 × noise"), "σ₁ ≥ 3 × noise");  // UTF-8 passes through
+  // XML (SVG) allows no C0 control but tab, LF and CR, not even as a reference: each other becomes U+FFFD.
+  EXPECT_EQ(escape_html(std::string("a\x01" "b\tc\nd\x1f", 8)), "a\xEF\xBF\xBD" "b\tc\nd\xEF\xBF\xBD");
 }
 
 }  // namespace
