@@ -194,6 +194,19 @@ void check_distinct_outputs(const std::vector<fs::path>& outputs) {
     }
 }
 
+namespace {
+
+// An existing file this user may not write (its permissions, or a read-only file system) is not replaced behind its
+// back through the rename, which needs only the directory's permission: refused as cp refuses it. (Root may write any
+// file, and replaces it, as cp does.)
+void check_writable_file(const fs::path& output, const fs::path& resolved) {
+  if (::access(resolved.c_str(), F_OK) == 0 && ::access(resolved.c_str(), W_OK) != 0 && (errno == EACCES || errno == EROFS))
+    throw InputError(fmt::format("{}: exists and is not writable ({}); it is not replaced, as cp would not replace it", output.string(),
+                                 std::strerror(errno)));
+}
+
+}  // namespace
+
 void check_output_file(const fs::path& output, const std::vector<fs::path>& inputs) {
   check_name_length(output);
   check_not_an_input(output, inputs);
@@ -201,6 +214,7 @@ void check_output_file(const fs::path& output, const std::vector<fs::path>& inpu
   struct stat st{};
   if (::stat(resolved.c_str(), &st) == 0 && !S_ISREG(st.st_mode))
     throw InputError(not_a_regular_file(output, resolved, st.st_mode));
+  check_writable_file(output, resolved);
   if (output.filename().empty()) throw InputError(fmt::format("{}: no file name", output.string()));
   const fs::path parent = fs::absolute(resolved).parent_path();
   if (!fs::is_directory(parent))
@@ -231,11 +245,17 @@ AtomicFile::AtomicFile(fs::path target) : target_(std::move(target)), destinatio
   struct stat st{};
   if (::stat(destination_.c_str(), &st) == 0 && !S_ISREG(st.st_mode))
     throw InputError(not_a_regular_file(target_, destination_, st.st_mode));
+  check_writable_file(target_, destination_);
+  const bool replaces = ::stat(destination_.c_str(), &st) == 0;
   const fs::path directory = destination_.has_parent_path() ? destination_.parent_path() : fs::path(".");
   for (int attempt = 0;; ++attempt) {
     temporary_ = directory / fmt::format(".{}.{}-{}.tmp", destination_.filename().string(), static_cast<long>(::getpid()), attempt);
     fd_ = ::open(temporary_.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
-    if (fd_ >= 0) return;
+    if (fd_ >= 0) {
+      // A file replaced keeps its permissions, as one cp writes over does.
+      if (replaces) (void)::fchmod(fd_, st.st_mode & 07777);
+      return;
+    }
     if (errno != EEXIST || attempt >= 1000) {
       const int error = errno;
       temporary_.clear();

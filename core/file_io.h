@@ -53,10 +53,10 @@ bool same_file(const std::filesystem::path& a, const std::filesystem::path& b);
 // InputError "<output>: is the same file as the input <input>; …" when `output` names one of `inputs`.
 void check_not_an_input(const std::filesystem::path& output, const std::vector<std::filesystem::path>& inputs);
 
-// What a file output may be: nothing yet, or a regular file (through any symbolic links). InputError naming
-// `output` when its directory does not exist, when it is (or links to) a directory, a FIFO, a device or a
-// socket, when it is one of `inputs`, or when its name is longer than the system takes (4095 bytes a path,
-// 255 a component).
+// What a file output may be: nothing yet, or a regular file (through any symbolic links) this user may write.
+// InputError naming `output` when its directory does not exist, when it is (or links to) a directory, a FIFO, a
+// device or a socket, when it exists and this user may not write it (as cp refuses; root may), when it is one of
+// `inputs`, or when its name is longer than the system takes (4095 bytes a path, 255 a component).
 void check_output_file(const std::filesystem::path& output, const std::vector<std::filesystem::path>& inputs = {});
 
 // What an output directory may be: nothing yet (its parent must exist) or a directory. InputError naming
@@ -72,12 +72,13 @@ void check_output_directory(const std::filesystem::path& directory,
 std::filesystem::path follow_links(const std::filesystem::path& path);
 
 // A temporary file beside `target` (so the final rename stays on one file system and is atomic), created
-// with O_EXCL and the permissions a plain new file gets. commit() flushes it to disk and renames it to
+// with O_EXCL and the permissions a plain new file gets (those of the file it replaces, when there is one). commit() flushes it to disk and renames it to
 // `target`; destroyed without commit(), it removes the temporary. Nothing half-written is ever left behind.
 //
 // A `target` that is a symbolic link is followed: the file it points to is replaced (atomically, the
 // temporary file beside it) and the link stays. A target that is a directory, FIFO, device or socket is
-// never replaced by a regular file: the constructor refuses it.
+// never replaced by a regular file: the constructor refuses it, and an existing file this user may not write (see
+// check_output_file).
 class AtomicFile {
  public:
   // InputError naming the target when it is not a regular file (see above) or no temporary file can be

@@ -395,6 +395,24 @@ TEST(HostileInput, LineBreaksInNamesAndLibraryMessagesStayOnOneLine) {
   for (const auto& c : cases) expect_refused(run_chromatrace(c.args), 2, c.says, c.args[1]);
 }
 
+// An existing output this user may not write is refused, as cp refuses it, and left as it was: the rename that
+// replaces a file needs only the directory's permission. Run as the unprivileged user nobody (root may write any file,
+// and replaces it as cp does); skipped where this test cannot switch user.
+TEST(HostileInput, AReadOnlyOutputIsNotReplaced) {
+  if (::geteuid() != 0) GTEST_SKIP() << "needs root to run the command as another user";
+  test::TempDir dir;
+  fs::permissions(dir.path(), fs::perms::all);  // nobody may create files here
+  const fs::path output = dir.file("locked.exr");
+  write_text(output, "the user's file");
+  fs::permissions(output, fs::perms::owner_read | fs::perms::group_read | fs::perms::others_read);
+  std::vector<std::string> args = {"--reuid=65534", "--regid=65534", "--clear-groups", CHROMATRACE_EXE, "render", kMinimal.string(),
+                                   "--spp", "1", "-o", output.string()};
+  const auto r = test::run_program("/usr/bin/setpriv", args);
+  expect_refused(r, 2, output.string() + ": exists and is not writable (Permission denied); it is not replaced", "render");
+  EXPECT_EQ(read_text(output), "the user's file");
+  EXPECT_EQ(std::distance(fs::directory_iterator(dir.path()), fs::directory_iterator()), 1);
+}
+
 // Linux allows any bytes in a file's name; JSON holds only UTF-8. An image whose name is not UTF-8 is analysed and
 // compared like any other: its name in analysis.json and compare.json with U+FFFD for the byte, not a failed run.
 TEST(HostileInput, AFileNameThatIsNotUtf8IsWrittenWithAReplacementCharacter) {

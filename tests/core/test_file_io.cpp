@@ -152,6 +152,16 @@ TEST(AtomicFile, ASymbolicLinkIsFollowedAndKept) {
             dir.file("loop_a").string() + ": too many levels of symbolic links");
 }
 
+// A file written over keeps its permissions, as one cp writes over does (a private 0600 file stays private).
+TEST(AtomicFile, AReplacedFileKeepsItsPermissions) {
+  test::TempDir dir;
+  write_text(dir.file("private.json"), "old");
+  fs::permissions(dir.file("private.json"), fs::perms::owner_read | fs::perms::owner_write);
+  write_atomically(dir.file("private.json"), "new");
+  EXPECT_EQ(text_of(dir.file("private.json")), "new");
+  EXPECT_EQ(fs::status(dir.file("private.json")).permissions() & fs::perms::all, fs::perms::owner_read | fs::perms::owner_write);
+}
+
 TEST(AtomicFile, AFifoADirectoryAndALinkToThemAreNeverReplaced) {
   test::TempDir dir;
   const fs::path fifo = dir.file("pipe");
