@@ -2,6 +2,7 @@
 // chromatrace check-scene: validates a scene or an experiment series file and summarises it.
 #include <algorithm>
 #include <cstdio>
+#include <exception>
 #include <filesystem>
 #include <memory>
 #include <optional>
@@ -19,6 +20,7 @@
 #include "core/file_io.h"
 #include "core/geometry.h"
 #include "core/json_input.h"
+#include "core/parallel.h"
 #include "core/scene.h"
 #include "core/series_format.h"
 #include "plan/render_check.h"
@@ -248,14 +250,28 @@ int check(const CheckSceneOptions& options) {
                                 fmt::format("{}: variants[{}] \"{}\" sensor", options.file, i, series.variants[i].name),
                                 std::filesystem::path(options.file).parent_path())});
     if (!options.variant.empty()) emit_variant(options, series);
+    // Each variant's summary holds its render warnings (a small preview render each): on every thread, in file order.
+    std::vector<Json> summaries(series.variants.size());
+    std::vector<std::exception_ptr> errors(series.variants.size());
+    parallel_for(series.variants.size(), options.threads, [&](std::size_t i) {
+      try {
+        summaries[i] = scene_summary(series.variants[i].scene, plan::scene_settings(series.variants[i].scene));
+      } catch (...) {
+        errors[i] = std::current_exception();
+      }
+    });
+    for (const std::exception_ptr& error : errors)
+      if (error) std::rethrow_exception(error);
     Json variants = Json::array();
-    for (const SeriesVariant& v : series.variants)
+    for (std::size_t i = 0; i < series.variants.size(); ++i) {
+      const SeriesVariant& v = series.variants[i];
       variants.push_back({{"name", v.name},
                           {"extends", v.extends},
                           {"figure", v.figure},
                           {"expect", expect_json(v.expect)},
                           {"sensor", v.sensor},
-                          {"scene", scene_summary(v.scene, plan::scene_settings(v.scene))}});
+                          {"scene", std::move(summaries[i])}});
+    }
     report = {{"file", options.file}, {"format", kSeriesFormat}, {"valid", true},
               {"name", series.name},  {"base", series.base},     {"variants", variants}};
   } else {

@@ -147,6 +147,10 @@ Series load_series(const std::filesystem::path& file, int threads) {
   // are made absolute first: the base scene's relative to its file, a patch's relative to the series file.
   const Json base_json = rebase_scene_paths(series.base_scene.json, series.base_scene.directory, {});
   const JsonNode variants = root["variants"];
+  // A figure's worth of variants, or a study's grid: a thousand is far beyond either, and each costs a parse and a
+  // render, so a file that lists more is refused before any is read.
+  if (variants.json().is_array() && variants.json().size() > kMaxSeriesVariants)
+    variants.fail(fmt::format("{} variants; a series holds at most {} (split it into several)", variants.json().size(), kMaxSeriesVariants));
   std::vector<Json> merged;  // merged[i]: variant i's scene document
   std::vector<std::optional<JsonNode>> expects;
   for (const JsonNode& node : variants.elements()) {

@@ -78,6 +78,9 @@ struct Series {
   const SeriesVariant& variant(std::string_view name, std::string_view what) const;
 };
 
+// The most variants a series may list (more is an InputError naming "variants").
+inline constexpr std::size_t kMaxSeriesVariants = 1000;
+
 // Loads a series: the base scene must be valid on its own, and each variant's merged scene is validated,
 // on up to `threads` threads (0: all); the error reported is that of the first invalid variant in file order.
 Series load_series(const std::filesystem::path& file, int threads = 0);

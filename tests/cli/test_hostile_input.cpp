@@ -19,6 +19,7 @@
 #include <OpenImageIO/imageio.h>
 #include <fmt/core.h>
 
+#include "core/json_input.h"
 #include "tests/cli/run_command.h"
 #include "tests/cli/text_files.h"
 #include "tests/core/image_fixtures.h"
@@ -411,6 +412,18 @@ TEST(HostileInput, AReadOnlyOutputIsNotReplaced) {
   expect_refused(r, 2, output.string() + ": exists and is not writable (Permission denied); it is not replaced", "render");
   EXPECT_EQ(read_text(output), "the user's file");
   EXPECT_EQ(std::distance(fs::directory_iterator(dir.path()), fs::directory_iterator()), 1);
+}
+
+// A series of 1001 chained variants (each extending the last): refused before any is read, where each would cost a
+// parse and a preview render (about 16 ms each here: 5 000 of them took over a minute).
+TEST(HostileInput, ASeriesOfMoreThanAThousandVariantsIsRefused) {
+  test::TempDir dir;
+  Json variants = Json::array({{{"name", "v0"}, {"patch", {{"render", {{"seed", 0}}}}}}});
+  for (int i = 1; i <= 1000; ++i)
+    variants.push_back({{"name", fmt::format("v{}", i)}, {"extends", fmt::format("v{}", i - 1)}, {"patch", {{"render", {{"seed", i}}}}}});
+  write_text(dir.file("long.json"), Json({{"format", "chromatrace-series/1"}, {"base", kMinimal.string()}, {"variants", variants}}).dump());
+  expect_refused(run_chromatrace({"check-scene", dir.file("long.json").string()}), 2,
+                 "long.json: variants: 1001 variants; a series holds at most 1000 (split it into several)", "check-scene");
 }
 
 // Linux allows any bytes in a file's name; JSON holds only UTF-8. An image whose name is not UTF-8 is analysed and
