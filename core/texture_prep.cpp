@@ -190,13 +190,30 @@ TexturePrepResult prepare_texture(const TexturePrepRequest& request, const std::
   result.negatives = texture.negatives;
 
   std::error_code ec;
+  const bool made_directory = !std::filesystem::exists(directory, ec);
   std::filesystem::create_directories(directory, ec);
   if (!std::filesystem::is_directory(directory))
     throw InputError(fmt::format("{}: cannot create the output directory", directory.string()));
+  // All the groups and their manifest, or none: a run that fails part way (a full disk) removes the group files it
+  // wrote, and the directory it made, so that no group is left without the manifest that says what it is.
+  std::size_t written = 0;
+  struct Cleanup {
+    const std::vector<std::filesystem::path>& files;
+    const std::filesystem::path& directory;
+    const std::size_t& written;
+    bool made_directory, done = false;
+    ~Cleanup() {
+      if (done) return;
+      std::error_code ignored;
+      for (std::size_t g = 0; g < written; ++g) std::filesystem::remove(files[g], ignored);
+      if (made_directory) std::filesystem::remove(directory, ignored);  // only when empty
+    }
+  } cleanup{result.files, directory, written, made_directory};
   set_exr_threads(request.threads);
   Json groups = Json::array();
   for (std::size_t g = 0; g < result.groups.size(); ++g) {
     write_group(result.files[g], texture, spectra, averages, request.bands.size(), result.groups[g], request.replicate);
+    written = g + 1;
     std::vector<double> lo, hi;
     for (const std::size_t b : result.groups[g]) {
       lo.push_back(request.bands.lo(b));
@@ -221,6 +238,7 @@ TexturePrepResult prepare_texture(const TexturePrepRequest& request, const std::
                          {"negative_texels", negative_texels_json(result.negatives)},
                          {"groups", groups}};
   write_file_atomically(result.manifest, manifest.dump(1, ' ', false, kReplaceInvalidUtf8) + "\n");
+  cleanup.done = true;
   result.seconds = elapsed();
   return result;
 }

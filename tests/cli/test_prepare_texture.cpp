@@ -315,5 +315,29 @@ TEST_F(PrepareTexture, CaptureNoiseIsZeroedAndNegativeLightRefused) {
   }
 }
 
+// A full disk part way (a tmpfs, in a mount namespace of its own, with room for about three of the ten group files):
+// the command fails naming the file it could not write, and leaves no group file without its manifest, nor the
+// cache directory it made.
+TEST_F(PrepareTexture, AFullDiskLeavesNoGroupWithoutItsManifest) {
+  std::vector<float> pixels(64 * 64 * 3);
+  for (std::size_t i = 0; i < pixels.size(); ++i) pixels[i] = static_cast<float>((i * 7919) % 251) / 251.0f;  // no long runs
+  const fs::path image = write_image("noisy.exr", 64, 64, pixels);
+  const json whole = run_json({image.string(), "--bands", "400:700:10", "--kind", "reflectance"});
+  ASSERT_EQ(whole["groups"].size(), 10u);
+  const std::uintmax_t group = fs::file_size(whole["groups"][0]["file"].get<std::string>());
+  const std::uintmax_t room = (3 * group + 4095) / 4096 * 4096;
+  const fs::path disk = dir_ / "disk";
+  fs::create_directory(disk);
+  const std::string command =
+      fmt::format("mount -t tmpfs -o size={} tmpfs '{}' || {{ echo mount-failed; exit 0; }}; '{}' prepare-texture '{}' --bands 400:700:10 "
+                  "--kind reflectance -o '{}/cache' --quiet; echo exit=$?; ls -A '{}'",
+                  room, disk.string(), CHROMATRACE_EXE, image.string(), disk.string(), disk.string());
+  const auto r = test::run_program("/usr/bin/unshare", {"-m", "sh", "-c", command});
+  if (r.out.find("mount-failed") != std::string::npos) GTEST_SKIP() << "no mount namespace here (unshare -m and a tmpfs need CAP_SYS_ADMIN)";
+  EXPECT_EQ(r.out, "exit=1\n") << r.out << r.err;  // nothing listed: no cache directory
+  EXPECT_EQ(line_count(r.err), 1) << r.err;
+  EXPECT_NE(r.err.find("No space left on device"), std::string::npos) << r.err;
+}
+
 }  // namespace
 }  // namespace ct
