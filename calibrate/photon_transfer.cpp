@@ -378,6 +378,10 @@ ChannelCalibration calibrate_channel(const std::string& channel, const std::vect
     c.responsivity = Estimate{r.slope, r.slope_se};
     c.quantum_efficiency = Estimate{r.slope / K, r.slope / K * std::hypot(relative(r.slope_se, r.slope), rK)};
     c.saturation_photons = *steps[top].photons_per_pixel;
+    // With the photons known, EMVA 1288 gives the saturation capacity as η·μp.sat (its reference implementation too),
+    // which differs from the signal's (μy.sat − μy.dark)/K where the response is not linear up to saturation.
+    const Estimate& eta = *c.quantum_efficiency;
+    c.saturation_capacity_e = {eta.value * *c.saturation_photons, eta.standard_error * *c.saturation_photons};
   }
   return c;
 }

@@ -9,7 +9,8 @@
 //   likewise from C, D. Then
 //   - the overall system gain K: the slope of σ_y² − σ_y.dark² against μ_y − μ_y.dark, a line through the origin
 //     fitted from the darkest flat up to 70 % of saturation;
-//   - saturation: the flat level at which σ_y² is largest; the saturation capacity μ_e.sat = (μ_y − μ_y.dark)/K there;
+//   - saturation: the flat level at which σ_y² is largest; the saturation capacity μ_e.sat = η·μ_p.sat there when the
+//     photons are known (as the standard gives it), else (μ_y − μ_y.dark)/K;
 //   - the temporal dark noise σ_d = √(σ_y.dark² − σ_q²)/K at the shortest exposure, σ_q² = 1/12 DN²; where
 //     σ_y.dark² < 0.24 DN² quantisation hides it, and the upper limit √(0.24 − 1/12)/K = 0.40/K is given instead;
 //   - the dark current, both ways the standard gives: the slope of μ_y.dark against t over K, and the slope of

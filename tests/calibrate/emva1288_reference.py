@@ -11,7 +11,8 @@ import sys
 from emva1288.process import Data1288, LoadImageData, ParseEmvaDescriptorFile, Results1288
 
 
-def main(descriptor):
+def reference_results(descriptor):
+    """The reference implementation's results on a descriptor file, as a dict (NaN as None)."""
     parser = ParseEmvaDescriptorFile(descriptor, loglevel=logging.ERROR)
     images = LoadImageData(parser.images, loglevel=logging.ERROR)
     data = Data1288(images.data, loglevel=logging.ERROR)
@@ -44,7 +45,11 @@ def main(descriptor):
         "DSNU_DN": r.DSNU1288_DN(),
     }
     # NaN (a part the reference cannot split off) as null.
-    print(json.dumps({k: (None if v != v else float(v)) for k, v in out.items()}))
+    return {k: (None if v != v else float(v)) for k, v in out.items()}
+
+
+def main(descriptor):
+    print(json.dumps(reference_results(descriptor)))
 
 
 if __name__ == "__main__":
