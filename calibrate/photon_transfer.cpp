@@ -9,6 +9,7 @@
 
 #include <fmt/format.h>
 
+#include "calibrate/spatial.h"
 #include "core/error.h"
 
 namespace ct::calibrate {
@@ -297,7 +298,9 @@ ChannelCalibration calibrate_channel(const std::string& channel, const std::vect
     return Estimate{v, v * std::hypot(se / (2 * variance), scale_relative_se)};
   };
   const std::vector<Plane>& shortest_darks = darks_of.begin()->second->darks;
-  const SpatialVariance ds = spatial_variance(average(shortest_darks), shortest.variance, shortest_darks.size());
+  const Plane dark_average = average(shortest_darks);
+  const SpatialVariance ds = spatial_variance(dark_average, shortest.variance, shortest_darks.size());
+  c.dsnu_curves = spatial_curves(dark_average, 1, shortest.variance / double(shortest_darks.size()));
   c.dsnu_e = {spread(ds.total, ds.total_se, 1 / K, rK), spread(ds.row, ds.row_se, 1 / K, rK),
               spread(ds.column, ds.column_se, 1 / K, rK), spread(ds.pixel, ds.pixel_se, 1 / K, rK)};
 
@@ -306,8 +309,15 @@ ChannelCalibration calibrate_channel(const std::string& channel, const std::vect
     if (std::abs(flat[k].mean - dark[k].mean - 0.5 * signal_sat) < std::abs(flat[half].mean - dark[half].mean - 0.5 * signal_sat)) half = k;
   const double signal_half = flat[half].mean - dark[half].mean;
   c.prnu_level_fraction = signal_half / signal_sat;
-  const SpatialVariance fs = spatial_variance(average(steps[half].flats), flat[half].variance, steps[half].flats.size());
-  const SpatialVariance dh = spatial_variance(average(steps[half].darks), dark[half].variance, steps[half].darks.size());
+  const Plane flat_mean = average(steps[half].flats), dark_mean = average(steps[half].darks);
+  const SpatialVariance fs = spatial_variance(flat_mean, flat[half].variance, steps[half].flats.size());
+  const SpatialVariance dh = spatial_variance(dark_mean, dark[half].variance, steps[half].darks.size());
+  {
+    Plane light = flat_mean;
+    for (std::size_t p = 0; p < light.values.size(); ++p) light.values[p] -= dark_mean.values[p];
+    c.prnu_curves = spatial_curves(light, 100 / signal_half,
+                                   flat[half].variance / double(steps[half].flats.size()) + dark[half].variance / double(steps[half].darks.size()));
+  }
   auto prnu_part = [&](double flat_part, double flat_se, double dark_part, double dark_se) {
     return spread(flat_part - dark_part, std::hypot(flat_se, dark_se), 1 / signal_half, 0.0);
   };

@@ -48,6 +48,19 @@ struct ExposureStep {
   std::vector<Plane> flats, darks;
 };
 
+// The spatial non-uniformity as EMVA 1288 Release 4.0 shows it beside its numbers (calibrate/spatial.h).
+struct SpatialCurves {
+  // σ of the image's deviation from its mean at each spatial frequency k/N, k = 1 … N/2 (cycles per pixel): along the
+  // rows (horizontal; the power averaged over the rows) and along the columns (vertical). For white noise of σ every
+  // value is about σ.
+  std::vector<double> spectrum_horizontal, spectrum_vertical;
+  // The temporal noise left in the mean of the frames, √(σ²_temporal / L): the floor a spectrogram cannot go below.
+  double temporal_floor = 0;
+  std::vector<double> profile_horizontal, profile_vertical;  // column means and row means, less the image's mean
+  std::vector<std::pair<double, double>> histogram;          // (deviation from the mean, pixels), nonzero bins
+  std::vector<std::pair<double, double>> accumulated;        // (x, % of pixels whose |deviation| ≥ x)
+};
+
 struct Estimate {
   double value = 0;
   double standard_error = 0;
@@ -91,6 +104,8 @@ struct ChannelCalibration {
   bool dark_noise_upper_limit = false;
   Estimate black_level_dn;          // μ_y.dark extrapolated to t = 0
   Nonuniformity dsnu_e;             // DSNU, e⁻
+  SpatialCurves dsnu_curves;        // of the dark mean at the shortest exposure, in DN
+  SpatialCurves prnu_curves;        // of the flats' mean less the darks' at the PRNU's level, in % of its signal
   Nonuniformity prnu;               // PRNU, a fraction
   double prnu_level_fraction = 0;   // the flat level PRNU was measured at, as a share of saturation
   double linearity_error = 0;       // a fraction (EMVA's LE / 100)

@@ -282,6 +282,52 @@ std::string dark_signal(const Calibration& cal) {
   return plot.svg();
 }
 
+// The spatial plots (calibrate/spatial.h): for DSNU (`prnu` false, in DN) or PRNU (in %), one line per channel,
+// horizontal solid and vertical dashed where both are drawn.
+using Curves = SpatialCurves ChannelCalibration::*;
+std::string spectrogram(const Calibration& cal, Curves curves, const std::string& what, const std::string& unit) {
+  Plot plot(what + " spectrogram", "spatial frequency (cycles per pixel)", "standard deviation (" + unit + ")", false, true);
+  for (std::size_t c = 0; c < cal.channels.size(); ++c) {
+    const SpatialCurves& s = cal.channels[c].*curves;
+    for (const bool vertical : {false, true}) {
+      const std::vector<double>& sigma = vertical ? s.spectrum_vertical : s.spectrum_horizontal;
+      std::vector<std::pair<double, double>> xy;
+      const double n = 2.0 * static_cast<double>(sigma.size());
+      for (std::size_t k = 0; k < sigma.size(); ++k) xy.emplace_back(static_cast<double>(k + 1) / n, sigma[k]);
+      plot.line(xy, channel_colour(cal, c),
+                vertical ? (c == 0 ? "vertical (dashed)" : "") : cal.channels[c].channel + (c == 0 ? " horizontal (solid)" : ""), vertical);
+    }
+  }
+  const SpatialCurves& first = cal.channels[0].*curves;
+  plot.line({{0.0, first.temporal_floor}, {0.5, first.temporal_floor}}, "#888888", "temporal noise left in the mean", true);
+  return plot.svg();
+}
+
+std::string profiles(const Calibration& cal, Curves curves, const std::string& what, const std::string& unit) {
+  Plot plot(what + " profiles", "column (solid) or row (dashed)", "mean deviation (" + unit + ")", false, false);
+  for (std::size_t c = 0; c < cal.channels.size(); ++c) {
+    const SpatialCurves& s = cal.channels[c].*curves;
+    for (const bool vertical : {false, true}) {
+      const std::vector<double>& p = vertical ? s.profile_vertical : s.profile_horizontal;
+      std::vector<std::pair<double, double>> xy;
+      for (std::size_t i = 0; i < p.size(); ++i) xy.emplace_back(static_cast<double>(i), p[i]);
+      plot.line(xy, channel_colour(cal, c), vertical ? "" : cal.channels[c].channel, vertical);
+    }
+  }
+  return plot.svg();
+}
+
+std::string histogram(const Calibration& cal, Curves curves, const std::string& what, const std::string& unit, bool accumulated) {
+  Plot plot(what + (accumulated ? " accumulated histogram" : " histogram"),
+            accumulated ? "deviation from the mean, at least (" + unit + ")" : "deviation from the mean (" + unit + ")",
+            accumulated ? "pixels (%)" : "pixels", false, true);
+  for (std::size_t c = 0; c < cal.channels.size(); ++c) {
+    const SpatialCurves& s = cal.channels[c].*curves;
+    plot.line(accumulated ? s.accumulated : s.histogram, channel_colour(cal, c), cal.channels[c].channel);
+  }
+  return plot.svg();
+}
+
 std::string cell(const Estimate& e, double scale = 1) {
   const double v = e.value * scale, se = e.standard_error * scale;
   return std::abs(v) >= 1000 ? fmt::format("{:.0f} ± {:.0f}", v, se) : fmt::format("{:.4g} ± {:.2g}", v, se);
@@ -393,12 +439,23 @@ std::vector<std::pair<std::string, std::string>> report_plots(const Calibration&
     plots.emplace_back("linearity_deviation.svg", linearity_deviation(calibration));
   plots.emplace_back("dark_signal.svg", dark_signal(calibration));
   plots.emplace_back("dark_variance.svg", dark_variance(calibration));
+  const Curves dsnu = &ChannelCalibration::dsnu_curves, prnu = &ChannelCalibration::prnu_curves;
+  plots.emplace_back("dsnu_spectrogram.svg", spectrogram(calibration, dsnu, "DSNU", "DN"));
+  plots.emplace_back("prnu_spectrogram.svg", spectrogram(calibration, prnu, "PRNU", "%"));
+  plots.emplace_back("dsnu_profiles.svg", profiles(calibration, dsnu, "DSNU", "DN"));
+  plots.emplace_back("prnu_profiles.svg", profiles(calibration, prnu, "PRNU", "%"));
+  plots.emplace_back("dsnu_histogram.svg", histogram(calibration, dsnu, "DSNU", "DN", false));
+  plots.emplace_back("prnu_histogram.svg", histogram(calibration, prnu, "PRNU", "%", false));
+  plots.emplace_back("dsnu_accumulated.svg", histogram(calibration, dsnu, "DSNU", "DN", true));
+  plots.emplace_back("prnu_accumulated.svg", histogram(calibration, prnu, "PRNU", "%", true));
   return plots;
 }
 
 std::vector<std::string> report_files() {
-  return {"index.html",  "calibration.json",        "photon_transfer.svg", "snr.svg",
-          "linearity.svg", "linearity_deviation.svg", "dark_signal.svg",     "dark_variance.svg"};
+  return {"index.html",           "calibration.json",     "photon_transfer.svg",  "snr.svg",
+          "linearity.svg",        "linearity_deviation.svg", "dark_signal.svg",   "dark_variance.svg",
+          "dsnu_spectrogram.svg", "prnu_spectrogram.svg", "dsnu_profiles.svg",    "prnu_profiles.svg",
+          "dsnu_histogram.svg",   "prnu_histogram.svg",   "dsnu_accumulated.svg", "prnu_accumulated.svg"};
 }
 
 void write_report(const Calibration& calibration, const std::filesystem::path& staging) {

@@ -39,5 +39,5 @@ JSON
 done
 "$exe" calibrate --flat "${flats[@]}" --dark "${darks[@]}" -o "$tmp/settings.json" --report "$tmp/report" \
     --photons-per-s 33298 --quiet
-chromium --headless --no-sandbox --disable-gpu --hide-scrollbars --window-size=1150,2250 \
+chromium --headless --no-sandbox --disable-gpu --hide-scrollbars --window-size=1150,3800 \
     --screenshot="$root/docs/images/calibrate_report.png" "file://$tmp/report/index.html" > /dev/null 2>&1

@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "calibrate/calibration.h"
+#include "calibrate/spatial.h"
 #include "core/error.h"
 #include "core/spectrum.h"
 #include "core/json_input.h"
@@ -856,6 +857,42 @@ TEST(CalibrateChannel, TheDarkCurrentFromTheVarianceSeesACameraThatSubtractsItsD
       calibrate::calibrate_channel("G", gaussian_series(K, 6, I, [&](double t) { return 100.0 + K * I * t; }, 7));
   EXPECT_NEAR(kept.dark_current_e_per_s.value, I, kSigmasPerItem * kept.dark_current_e_per_s.standard_error);
   EXPECT_NEAR(calibrate::simulated_dark_current(kept), kept.dark_current_e_per_s.value, 1e-12);
+}
+
+// The spatial curves on an image of known make-up: white noise of σ = 1 plus a column pattern A·cos(2π·k₀·j/N) of
+// A = 0.5 at k₀ = 20 of N = 256 columns (M = 128 rows). The horizontal spectrogram (along the rows) holds the pattern
+// at k₀ as A·√N/2 = 4 over the noise (|DFT|²/N of a cosine), and σ elsewhere; the vertical one is σ everywhere; the
+// horizontal profile is the pattern within the noise of a mean of M values; the histogram counts every pixel and the
+// accumulated one starts at 100 %.
+TEST(CalibrateChannel, TheSpatialCurvesShowAColumnPatternAboveWhiteNoise) {
+  constexpr int M = 128, N = 256, k0 = 20;
+  constexpr double A = 0.5;
+  std::mt19937_64 random(11);
+  std::normal_distribution<double> noise(0.0, 1.0);
+  calibrate::Plane image{N, M, std::vector<double>(M * N)};
+  for (int i = 0; i < M; ++i)
+    for (int j = 0; j < N; ++j) image.values[static_cast<std::size_t>(i * N + j)] = 100 + noise(random) + A * std::cos(2 * std::numbers::pi * k0 * j / N);
+  const calibrate::SpatialCurves c = calibrate::spatial_curves(image, 1, 0.25);
+  ASSERT_EQ(c.spectrum_horizontal.size(), N / 2u);
+  ASSERT_EQ(c.spectrum_vertical.size(), M / 2u);
+  // Each value averages M (or N) lines' power, an exponential of mean σ²: relative error 1/√lines in the power.
+  const double peak = std::sqrt(A * A * N / 4 + 1);
+  EXPECT_NEAR(c.spectrum_horizontal[k0 - 1], peak, kSigmasPerItem * peak / std::sqrt(double(M)));
+  double rest = 0;
+  for (std::size_t k = 0; k < c.spectrum_horizontal.size(); ++k)
+    if (k != k0 - 1) rest += c.spectrum_horizontal[k] * c.spectrum_horizontal[k] / double(N / 2 - 1);
+  EXPECT_NEAR(std::sqrt(rest), 1.0, kSigmasPerItem / std::sqrt(double(M) * (N / 2 - 1)));
+  double vertical = 0;
+  for (const double v : c.spectrum_vertical) vertical += v * v / double(M / 2);
+  EXPECT_NEAR(std::sqrt(vertical), 1.0, kSigmasPerItem / std::sqrt(double(N) * (M / 2)));
+  EXPECT_NEAR(c.temporal_floor, 0.5, 1e-12);
+  for (int j = 0; j < N; ++j)
+    EXPECT_NEAR(c.profile_horizontal[static_cast<std::size_t>(j)], A * std::cos(2 * std::numbers::pi * k0 * j / N), 4.5 / std::sqrt(double(M)));
+  double counted = 0;
+  for (const auto& [x, n] : c.histogram) counted += n;
+  EXPECT_EQ(counted, M * N);
+  EXPECT_EQ(c.accumulated.front().first, 0.0);
+  EXPECT_NEAR(c.accumulated.front().second, 100.0, 1e-9);
 }
 
 // Where the dark frames' temporal variance is below 0.24 DN², quantisation hides the read noise: a camera with
