@@ -6,6 +6,9 @@
 // show every name as the text it is: no dialog opens, no element the names spelled is made, and each region's
 // details show its name exactly as analysis.json has it, for every region clicked. ("<!--<script>" in the data would
 // put the HTML parser in a state where the data's end is not seen, and the viewer would not load.)
+//
+// The same for the series figure page and the compare page: a scene whose objects, material, light and variant are
+// named (and described) as HTML that runs script, and a camera's curves under a folder so named.
 // Environment: CHROMATRACE_EXE, CHROMATRACE_SYNTHETIC_IMAGES (the two executables).
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
@@ -80,4 +83,71 @@ test('every region shows its name as text, and no script runs', async () => {
   // The file's name, shown as written.
   assert.ok((await page.locator('body').innerText()).includes('scene<img src=y onerror=alert(5)>.exr'));
   assert.deepEqual(problems, []);
+});
+
+// ---- the series figure page and the compare page ----------------------------------------------------------------
+const hostile = {
+  floor: 'floor<img src=x onerror=alert(11)>',
+  ball: '<script>alert(12)</script>',
+  lamp: 'lamp"><svg onload=alert(13)>',
+  material: "wall'><img src=x onerror=alert(14)>",
+  variant: 'v<b onmouseover=alert(15)>1',
+  description: '<img src=y onerror=alert(16)> &amp;',
+  folder: 'cam<img src=z onerror=alert(17)>',
+};
+
+async function openPage(file) {
+  const pageProblems = [];
+  const { context: c, page: p } = await openOffline(fs.mkdtempSync(path.join(work, 'profile-')), { width: 1280, height: 900 }, pageProblems);
+  let opened = 0;
+  p.on('dialog', async (d) => {
+    ++opened;
+    await d.dismiss();
+  });
+  await p.goto('file://' + file);
+  await p.mouse.move(200, 200);
+  await p.mouse.move(600, 500);
+  const found = await p.evaluate(() => ({
+    handlers: [...document.querySelectorAll('*')].filter((e) => [...e.attributes].some((a) => a.name.startsWith('on'))).length,
+    scripts: [...document.querySelectorAll('script')].filter((s) => s.type !== 'application/json' && s.textContent.includes('alert(')).length,
+    text: document.body.innerText,
+  }));
+  await c.close();
+  return { found, opened, pageProblems };
+}
+
+test('the series figure page and the compare page show hostile names as text', async () => {
+  const minimal = new URL('../data/scenes/minimal.json', import.meta.url);
+  const scene = JSON.parse(fs.readFileSync(minimal, 'utf8'));
+  scene.materials = { [hostile.material]: scene.materials.wall, plastic: scene.materials.plastic };
+  scene.objects[0].name = hostile.floor;
+  scene.objects[0].material = hostile.material;
+  scene.objects[1].name = hostile.ball;
+  scene.lights[0].name = hostile.lamp;
+  scene.lights[0].group = 'lamp'; // a component's name is a plain word; the light's own name may be anything
+  const sceneFile = path.join(work, 'hostile-scene.json');
+  fs.writeFileSync(sceneFile, JSON.stringify(scene));
+  const seriesFile = path.join(work, 'hostile-series.json');
+  fs.writeFileSync(seriesFile, JSON.stringify({
+    format: 'chromatrace-series/1', base: sceneFile,
+    variants: [{ name: hostile.variant, description: hostile.description, patch: { render: { samples: 4 } } }],
+  }));
+  const exe = process.env.CHROMATRACE_EXE;
+  execFileSync(exe, ['series', seriesFile, '-o', path.join(work, 'series'), '--resolution', '32x24', '--quiet']);
+  execFileSync(exe, ['render', sceneFile, '-o', path.join(work, 'a.exr'), '--spp', '4', '--resolution', '32x24', '--quiet']);
+  const folder = path.join(work, hostile.folder);
+  fs.mkdirSync(folder);
+  fs.writeFileSync(path.join(folder, 'c.csv'), 'wavelength_nm,r,g,b\n300,1,0.5,0.2\n900,1,0.5,0.2\n');
+  execFileSync(exe, ['compare', path.join(work, 'a.exr'), path.join(work, 'a.exr'), '-o', path.join(work, 'compare'), '--camera',
+    path.join(folder, 'c.csv')]);
+
+  const series = await openPage(path.join(work, 'series', 'index.html'));
+  assert.deepEqual([series.found.handlers, series.found.scripts, series.opened], [0, 0, 0]);
+  for (const text of [hostile.variant, hostile.description]) assert.ok(series.found.text.includes(text), `${text} not shown`);
+  assert.deepEqual(series.pageProblems, []);
+
+  const compare = await openPage(path.join(work, 'compare', 'compare.html'));
+  assert.deepEqual([compare.found.handlers, compare.found.scripts, compare.opened], [0, 0, 0]);
+  for (const text of [hostile.floor, hostile.ball, hostile.folder]) assert.ok(compare.found.text.includes(text), `${text} not shown`);
+  assert.deepEqual(compare.pageProblems, []);
 });

@@ -382,6 +382,7 @@ fs::path write_plain(const fs::path& exr, const std::vector<int>& channels, cons
     for (std::size_t k = 0; k < channels.size(); ++k) values[i * channels.size() + k] = rgb.values[i * 3 + static_cast<std::size_t>(channels[k])] * scale;
   OIIO::ImageSpec spec(rgb.width, rgb.height, static_cast<int>(channels.size()), type);
   spec.attribute("ExposureTime", static_cast<float>(exposure_s));
+  spec.attribute("DateTime", "2026:11:29 <img src=x onerror=alert(1)>");  // a hostile date: the report shows it as text
   auto file = OIIO::ImageOutput::create(out.string());
   EXPECT_TRUE(file);
   // Integer files take values as fractions of full scale.
@@ -439,6 +440,11 @@ TEST_F(Calibrate, OrdinaryFramesOfAColourOrAMonochromeCameraAreCalibrated) {
   const auto r = test::run_chromatrace(args);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_EQ(read_json(report / "calibration.json")["channels"].size(), 1u);
+  // The frames' EXIF date, made hostile (TIFF keeps its first 19 characters), is in the datasheet as text.
+  std::ifstream page(report / "index.html");
+  const std::string html((std::istreambuf_iterator<char>(page)), std::istreambuf_iterator<char>());
+  EXPECT_NE(html.find("2026:11:29 &lt;img src="), std::string::npos);
+  EXPECT_EQ(html.find("<img"), std::string::npos);
 
   // A colour camera's mosaic written as one grey channel (dcraw -D -4 -T: the raw values, not demosaiced), under a
   // green light that its red and blue photosites see far less of: refused, where its PRNU would report the filters.
