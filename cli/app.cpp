@@ -82,6 +82,26 @@ std::optional<int> refuse_unknown_command(int argc, char** argv) {
   return 2;
 }
 
+// CLI11 gives an option that takes several values (--rect, --flat, --variant, --set, --cycles-pilot) the words after
+// it even when one is another option of the command: `--variant -o DIR` made -o a variant's name and then said
+// "--output is required". Such a word is named as what it is: the first option of a parsed command one of whose values
+// is the name of another of its options.
+std::optional<std::string> swallowed_option(const CLI::App& app) {
+  for (const CLI::App* command : app.get_subcommands()) {
+    if (!command->parsed()) continue;
+    const std::vector<const CLI::Option*> options = command->get_options();
+    for (const CLI::Option* option : options) {
+      if (option->get_items_expected_max() <= 1 || option->count() == 0) continue;
+      for (const std::string& value : option->results())
+        if (value.size() > 1 && value[0] == '-')
+          for (const CLI::Option* other : options)
+            if (other != option && other->check_name(value))
+              return fmt::format("{}: no value given before the option {}", option->get_name(), value);
+    }
+  }
+  return std::nullopt;
+}
+
 }  // namespace
 
 std::optional<int> parse_command_line(CLI::App& app, int argc, char** argv) {
@@ -96,10 +116,15 @@ std::optional<int> parse_command_line(CLI::App& app, int argc, char** argv) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
     // Named by the subcommand it is an error of (refuse_unknown_command has checked the name), as its other errors
-    // are.
+    // are; an option taken for another's value first (the error CLI11 saw follows from it).
     const bool command = argc >= 2 && argv[1][0] != '-';
+    const std::optional<std::string> swallowed = swallowed_option(app);
     fmt::print(stderr, "chromatrace{}{}: error: {}\n", command ? " " : "", command ? one_line(argv[1]) : "",
-               one_line(e.what()));
+               one_line(swallowed ? *swallowed : std::string(e.what())));
+    return 2;
+  }
+  if (const std::optional<std::string> swallowed = swallowed_option(app)) {
+    fmt::print(stderr, "chromatrace {}: error: {}\n", one_line(argv[1]), one_line(*swallowed));
     return 2;
   }
   return std::nullopt;

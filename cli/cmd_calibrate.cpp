@@ -32,9 +32,8 @@ Action add_calibrate(CLI::App& app) {
     bool quiet = false;
   };
   auto o = std::make_shared<Options>();
-  // Checked after parsing rather than marked required: CLI11 takes the word after an option with no value of its own
-  // as that value even when it is another option ("--flat --dark D…" gives --flat the frames and says "--dark is
-  // required"), so the frame lists are checked for option names first.
+  // Checked after parsing rather than marked required, so that an option taken for --flat's frames ("--flat --dark D…")
+  // is named as such (cli/app.cpp) rather than "--dark is required".
   cmd->add_option("--flat", o->flats,
                   "Flat-field frames: at least two at each exposure time, or, at one exposure time, a pair per irradiance in the "
                   "order given (camera raw, or linear EXR/TIFF/PNG with R, G, B or one channel)");
@@ -59,11 +58,6 @@ Action add_calibrate(CLI::App& app) {
   cmd->add_flag("-q,--quiet", o->quiet, "No summary on stderr");
 
   return [o, cmd] {
-    for (const auto& [name, values] : {std::pair{"--flat", &o->flats}, std::pair{"--dark", &o->darks}})
-      for (const std::string& v : *values)
-        for (const CLI::Option* option : cmd->get_options())
-          if (v.starts_with("-") && option->check_name(v))
-            throw InputError(fmt::format("{}: no frame given before the option {}", name, v));
     if (o->flats.empty()) throw InputError("--flat: no flat frames");
     if (o->darks.empty()) throw InputError("--dark: no dark frames");
     if (o->output.empty()) throw InputError("--output: no settings file to write (-o CAMERA.json)");

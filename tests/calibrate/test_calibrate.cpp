@@ -305,9 +305,9 @@ TEST_F(Calibrate, TheCommandWritesSettingsTheSensorTakesAndRefusesSeriesThatCann
   // An option where the frames should be: named as what it is, not as a missing option.
   auto no_frames = test::run_chromatrace({"calibrate", "--flat", "--dark", in.darks[0].string(), in.darks[1].string(), "-o", bad.string()});
   EXPECT_EQ(no_frames.exit_code, 2);
-  EXPECT_EQ(no_frames.err, "chromatrace calibrate: error: --flat: no frame given before the option --dark\n");
+  EXPECT_EQ(no_frames.err, "chromatrace calibrate: error: --flat: no value given before the option --dark\n");
   no_frames = test::run_chromatrace({"calibrate", "--dark", in.darks[0].string(), "--flat", "-o", bad.string()});
-  EXPECT_EQ(no_frames.err, "chromatrace calibrate: error: --flat: no frame given before the option -o\n");
+  EXPECT_EQ(no_frames.err, "chromatrace calibrate: error: --flat: no value given before the option -o\n");
   EXPECT_FALSE(fs::exists(bad));
 
   // A frame grabber that hands one buffer twice: each exposure's second flat a copy of its first. Refused naming both

@@ -426,6 +426,27 @@ TEST(HostileInput, ASeriesOfMoreThanAThousandVariantsIsRefused) {
                  "long.json: variants: 1001 variants; a series holds at most 1000 (split it into several)", "check-scene");
 }
 
+// An option that takes several values is given the words after it by the parser, even another option of the command:
+// each such command line is named as what it is, one line, exit 2, nothing written (no "--output is required", no
+// "--target-de00: cannot open file").
+TEST(HostileInput, AnOptionTakenForAnothersValueIsNamed) {
+  test::TempDir dir;
+  const fs::path render = write_render(dir, "r.exr", 8, 6);
+  const fs::path series = fs::path(CHROMATRACE_TEST_DATA) / "scenes" / "series_merge.json";
+  const struct {
+    std::vector<std::string> args;
+    std::string says;
+  } cases[] = {
+      {{"analyze", render.string(), "--rect", "--quiet", "-o", dir.file("a").string()}, "--rect: no value given before the option --quiet"},
+      {{"plan", kMinimal.string(), "--cycles-pilot", "--target-de00", "1", "-o", dir.file("p.json").string()},
+       "--cycles-pilot: no value given before the option --target-de00"},
+      {{"series", series.string(), "--variant", "-o", dir.file("s").string()}, "--variant: no value given before the option -o"},
+      {{"sensor", render.string(), "--set", "-o", dir.file("x.exr").string()}, "--set: no value given before the option -o"},
+  };
+  for (const auto& c : cases) expect_refused(run_chromatrace(c.args), 2, "chromatrace " + c.args[0] + ": error: " + c.says, c.args[0]);
+  EXPECT_EQ(std::distance(fs::directory_iterator(dir.path()), fs::directory_iterator()), 1);  // the render alone
+}
+
 // Linux allows any bytes in a file's name; JSON holds only UTF-8. An image whose name is not UTF-8 is analysed and
 // compared like any other: its name in analysis.json and compare.json with U+FFFD for the byte, not a failed run.
 TEST(HostileInput, AFileNameThatIsNotUtf8IsWrittenWithAReplacementCharacter) {
