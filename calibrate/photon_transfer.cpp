@@ -20,6 +20,8 @@ constexpr double kQuantisationVariance = 1.0 / 12.0;  // σ_q², DN²
 constexpr double kQuantisationLimit = 0.24;
 constexpr double kGainFitTop = 0.7;                    // the gain is fitted up to this share of saturation
 constexpr double kLinearityLow = 0.05, kLinearityHigh = 0.95;
+// The brightest flats' signal may exceed the signal at saturation by this factor at most (see its use).
+constexpr double kSaturationHeadroom = 1.2;
 
 double mean_of(const std::vector<double>& v) { return std::accumulate(v.begin(), v.end(), 0.0) / static_cast<double>(v.size()); }
 
@@ -217,6 +219,31 @@ ChannelCalibration calibrate_channel(const std::string& channel, const std::vect
   }
   const double signal_sat = flat[top].mean - dark[top].mean;
   c.saturation_mean_dn = flat[top].mean;
+  // Beyond saturation the mean can only approach the clip level: at the exposure of largest variance it lies within a
+  // few spatial standard deviations of it (a few per cent). A series whose signal goes on well beyond that point either
+  // jumps from below saturation to beyond it (its brighter flats clip every pixel: the variance's peak was missed), or
+  // has a variance that falls while the signal still grows (they are not clipped): a response curve, not saturation.
+  {
+    double brightest = signal_sat;
+    bool beyond_all_clipped = true;
+    for (std::size_t k = top + 1; k < steps.size(); ++k) {
+      const double s = flat[k].mean - dark[k].mean;
+      if (s > kSaturationHeadroom * signal_sat) beyond_all_clipped = beyond_all_clipped && flat[k].variance <= 2 * dark[k].variance;
+      brightest = std::max(brightest, s);
+    }
+    const std::string where = one_time ? std::string("an irradiance") : fmt::format("{:.6g} s", steps[top].exposure_s);
+    if (brightest > kSaturationHeadroom * signal_sat && beyond_all_clipped)
+      throw InputError(fmt::format("channel {}: the series jumps from {} ({:.4g} DN above dark, the largest temporal variance) to flats "
+                                   "that clip every pixel ({:.4g} DN): saturation lies between, unmeasured; add exposures up to and "
+                                   "through saturation in steps of a few per cent",
+                                   channel, where, signal_sat, brightest));
+    if (brightest > kSaturationHeadroom * signal_sat)
+      throw InputError(fmt::format("channel {}: the temporal variance is largest at {}, where the signal ({:.4g} DN above dark) is far "
+                                   "below what the brighter flats reach ({:.4g} DN): the variance falls while the signal still grows, as "
+                                   "in frames encoded with a response curve (sRGB, a gamma); calibration needs the camera's linear "
+                                   "digital numbers (its raw frames)",
+                                   channel, where, signal_sat, brightest));
+  }
 
   // The system gain K from the photon transfer below 70 % of saturation.
   std::vector<double> x, y;

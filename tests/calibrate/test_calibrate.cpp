@@ -265,6 +265,9 @@ TEST_F(Calibrate, TheCommandWritesSettingsTheSensorTakesAndRefusesSeriesThatCann
       {only(in.flats, {0.94, 0.97, 1.0, 1.03, 1.3, 1.6}), only(in.darks, {0.94, 0.97, 1.0, 1.03, 1.3, 1.6}),
        "the shortest exposure, 0.94 s, already saturates"},
       {only(in.flats, {1.3, 1.6}), only(in.darks, {1.3, 1.6}), "every exposure clips every pixel"},
+      // From a quarter of the full well straight to clipping: the peak of the variance, saturation, never measured.
+      {only(in.flats, {0.04, 0.11, 0.18, 0.25, 1.3, 1.6}), only(in.darks, {0.04, 0.11, 0.18, 0.25, 1.3, 1.6}),
+       "the series jumps from 0.25 s"},
       {in.darks, in.darks, "no flat is brighter than the dark frames of its exposure time"},
   };
   for (const Case& k : cases) {
@@ -479,8 +482,8 @@ TEST_F(Calibrate, OrdinaryFramesOfAColourOrAMonochromeCameraAreCalibrated) {
 
 // Frames whose pixels share noise, or that are not digital numbers, are refused by name: the simulator's demosaiced
 // frames written as plain TIFFs (no metadata says so; bilinear interpolation correlates a pixel's noise with its
-// neighbours' by about 0.5), a float EXR scaled to 0–1, and a JPEG (a tone-mapped picture, unless the user says it is
-// linear).
+// neighbours' by about 0.5), a float EXR scaled to 0–1, a series encoded with the sRGB curve, and a JPEG (a
+// tone-mapped picture, unless the user says it is linear).
 TEST_F(Calibrate, FramesWhosePixelsShareNoiseOrAreNotDigitalNumbersAreRefused) {
   const Camera c{0.6, 0.18, 100, 20000, 5, 100, 2, 0.01, 0, 0, 12};
   const std::vector<Shot> shots = {{0.2, 1, 2, 2}, {0.4, 1, 2, 2}, {0.6, 1, 2, 2}, {1.2, 1, 2, 2}};
@@ -501,6 +504,31 @@ TEST_F(Calibrate, FramesWhosePixelsShareNoiseOrAreNotDigitalNumbersAreRefused) {
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.err.find(scaled.string() + ": channel R holds"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("not a whole number"), std::string::npos) << r.err;
+
+  // A series encoded with the sRGB curve (a 16-bit TIFF that says nothing of it): its temporal variance peaks while its
+  // signal still grows, named as what that is rather than as too few exposures below saturation.
+  calibrate::CalibrationInput encoded = series(c, "srgb");
+  for (auto* set : {&encoded.flats, &encoded.darks})
+    for (fs::path& f : *set) {
+      const test::RgbLayer rgb = test::read_rgb(f);
+      std::vector<float> v(rgb.values.size());
+      for (std::size_t i = 0; i < v.size(); ++i) {
+        const double x = std::clamp(rgb.values[i] / 4095.0, 0.0, 1.0);
+        v[i] = static_cast<float>(x <= 0.0031308 ? 12.92 * x : 1.055 * std::pow(x, 1 / 2.4) - 0.055);
+      }
+      OIIO::ImageSpec spec(rgb.width, rgb.height, 3, OIIO::TypeDesc::UINT16);
+      spec.attribute("ExposureTime", static_cast<float>(time_of(f)));
+      const fs::path out = f.parent_path() / (f.stem().string() + "-srgb.tif");
+      auto file = OIIO::ImageOutput::create(out.string());
+      ASSERT_TRUE(file && file->open(out.string(), spec) && file->write_image(OIIO::TypeDesc::FLOAT, v.data()));
+      file->close();
+      f = out;
+    }
+  r = test::run_chromatrace(calibrate_args(encoded.flats, encoded.darks, bad));
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("the variance falls while the signal still grows, as in frames encoded with a response curve"), std::string::npos)
+      << r.err;
+  EXPECT_FALSE(fs::exists(bad));
 
   const fs::path jpeg = write_plain(frames.flats[0], {0, 1, 2}, dir_.file("frame.jpg"), 0.2, OIIO::TypeDesc::UINT8, 1.0f / 16);
   flats[0] = jpeg;
@@ -752,9 +780,9 @@ TEST(CalibrateChannel, TheLinearityErrorIsTheStandardsWeightedFit) {
   for (int k = 1; k <= 11; ++k) {
     calibrate::ExposureStep s;
     s.exposure_s = 0.1 * k;
-    const bool clipped = k == 11;  // beyond saturation: every pixel at the top code
+    const bool clipped = k == 11;  // beyond saturation: every pixel at the clip, a little above the last signal
     for (int i = 0; i < 2; ++i) {
-      s.flats.push_back(clipped ? calibrate::Plane{64, 64, std::vector<double>(64 * 64, 4095.0)}
+      s.flats.push_back(clipped ? calibrate::Plane{64, 64, std::vector<double>(64 * 64, 100 + 1.05 * response(1.0))}
                                 : frame(100 + response(s.exposure_s), 4 + 0.5 * response(s.exposure_s)));
       s.darks.push_back(frame(100, 4));
     }
@@ -802,9 +830,9 @@ TEST(CalibrateChannel, AGainThatIsNoMeasurementIsRefused) {
   for (std::size_t k = 0; k <= above_dark.size(); ++k) {
     calibrate::ExposureStep s;
     s.exposure_s = 0.01 * double(k + 1);
-    const bool clipped = k == above_dark.size();  // every pixel at the top code: no temporal variance
+    const bool clipped = k == above_dark.size();  // every pixel at the clip, just above the last signal: no temporal variance
     for (int i = 0; i < 2; ++i) {
-      s.flats.push_back(clipped ? calibrate::Plane{64, 64, std::vector<double>(64 * 64, 4095.0)} : frame(100.0 * double(k + 1), 4 + above_dark[k]));
+      s.flats.push_back(clipped ? calibrate::Plane{64, 64, std::vector<double>(64 * 64, 100.0 * double(k + 1))} : frame(100.0 * double(k + 1), 4 + above_dark[k]));
       s.darks.push_back(frame(0, 4));
     }
     steps.push_back(s);
@@ -821,7 +849,8 @@ TEST(CalibrateChannel, AGainThatIsNoMeasurementIsRefused) {
 
 // A series of Gaussian frames with exact means (noise drawn, its mean removed) and the temporal variance a camera
 // gives: K²·(σ_d² + dark electrons + signal electrons) + 1/12 DN², the dark electrons I·t; darks at `dark_mean(t)`,
-// flats that many DN above, ten exposures of 0.01 … 0.1 s reaching 20 000 e⁻, then one where every pixel clips.
+// flats that many DN above, ten exposures of 0.01 … 0.1 s reaching 20 000 e⁻, then one where every pixel clips (at
+// 5 % above that).
 std::vector<calibrate::ExposureStep> gaussian_series(double K, double sigma_d, double dark_current,
                                                      const std::function<double(double)>& dark_mean, unsigned seed) {
   std::mt19937_64 random(seed);
@@ -832,7 +861,7 @@ std::vector<calibrate::ExposureStep> gaussian_series(double K, double sigma_d, d
     s.exposure_s = 0.01 * k;
     const double dark_e = dark_current * s.exposure_s, signal_e = 2e5 * s.exposure_s;
     for (int i = 0; i < 2; ++i) {
-      s.flats.push_back(k == 11 ? calibrate::Plane{64, 64, std::vector<double>(64 * 64, 4095.0)}
+      s.flats.push_back(k == 11 ? calibrate::Plane{64, 64, std::vector<double>(64 * 64, dark_mean(s.exposure_s) + 1.05 * K * 2e4)}
                                 : frame(dark_mean(s.exposure_s) + K * signal_e,
                                         K * K * (sigma_d * sigma_d + dark_e + signal_e) + 1.0 / 12));
       s.darks.push_back(frame(dark_mean(s.exposure_s), K * K * (sigma_d * sigma_d + dark_e) + 1.0 / 12));
