@@ -240,8 +240,9 @@ ChannelCalibration calibrate_channel(const std::string& channel, const std::vect
     if (brightest > kSaturationHeadroom * signal_sat)
       throw InputError(fmt::format("channel {}: the temporal variance is largest at {}, where the signal ({:.4g} DN above dark) is far "
                                    "below what the brighter flats reach ({:.4g} DN): the variance falls while the signal still grows, as "
-                                   "in frames encoded with a response curve (sRGB, a gamma); calibration needs the camera's linear "
-                                   "digital numbers (its raw frames)",
+                                   "in frames encoded with a response curve (sRGB, a gamma), or under a light far from uniform over the "
+                                   "sensor (EMVA 1288 asks for 3 %); calibration needs the camera's linear digital numbers (its raw "
+                                   "frames) under a uniform light",
                                    channel, where, signal_sat, brightest));
   }
 
