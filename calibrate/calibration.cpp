@@ -191,6 +191,10 @@ Calibration calibrate(const CalibrationInput& input) {
     throw InputError("--wavelength: the quantum efficiency needs the photons per pixel (--photons-per-s or --photons-per-pixel)");
   if (input.wavelength_nm && !(*input.wavelength_nm > 0 && std::isfinite(*input.wavelength_nm)))
     throw InputError(fmt::format("--wavelength: must be a positive number of nanometres, got {}", *input.wavelength_nm));
+  if (input.pixel_pitch_um && !(*input.pixel_pitch_um > 0 && std::isfinite(*input.pixel_pitch_um)))
+    throw InputError(fmt::format("--pixel-um: must be a positive number of micrometres, got {}", *input.pixel_pitch_um));
+  if (input.temperature_c && !(*input.temperature_c > -273.15 && std::isfinite(*input.temperature_c)))
+    throw InputError(fmt::format("--temperature: must be a temperature in °C above absolute zero, got {}", *input.temperature_c));
   if (input.basis != "energy" && input.basis != "photon")
     throw InputError(fmt::format("--basis: \"{}\" is not energy or photon", input.basis));
 
@@ -387,6 +391,8 @@ Calibration calibrate(const CalibrationInput& input) {
   result.flat_exposure_min_s = flat_times.front();
   result.flat_exposure_max_s = flat_times.back();
   result.wavelength_nm = input.wavelength_nm;
+  result.pixel_pitch_um = input.pixel_pitch_um;
+  result.temperature_c = input.temperature_c;
   for (const auto& [t, sets] : by_time)
     for (const auto& set : sets)
       for (const Frame& f : set)
@@ -527,6 +533,8 @@ Calibration calibrate(const CalibrationInput& input) {
                      {"frame_size", {size.first, size.second}},
                      {"flat_exposure_s", {result.flat_exposure_min_s, result.flat_exposure_max_s}},
                      {"wavelength_nm", result.wavelength_nm ? Json(*result.wavelength_nm) : Json(nullptr)},
+                     {"pixel_pitch_um", result.pixel_pitch_um ? Json(*result.pixel_pitch_um) : Json(nullptr)},
+                     {"temperature_c", result.temperature_c ? Json(*result.temperature_c) : Json(nullptr)},
                      {"date", result.date.empty() ? Json(nullptr) : Json(result.date)}}},
                    {"photons_per_s", input.photons_per_s ? Json(*input.photons_per_s) : Json(nullptr)},
                    {"photons_per_pixel", input.photons_per_pixel.empty() ? Json(nullptr) : Json(input.photons_per_pixel)},

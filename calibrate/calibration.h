@@ -28,6 +28,9 @@ struct CalibrationInput {
   std::optional<double> wavelength_nm;
   std::string camera;              // a shipped camera, cie1931, or a CSV file (sensor::camera_curves)
   std::string basis = "energy";    // what the curves are proportional to: energy or photon (docs/sensor.md)
+  // The operating point as the user measured it (the datasheet states them; the frames do not say): the pixel pitch
+  // (µm; gives the thresholds per area) and the sensor's temperature (°C).
+  std::optional<double> pixel_pitch_um, temperature_c;
 };
 
 // The peak quantum efficiency the simulator takes (spectral_response.peak_qe): per channel, η measured at the
@@ -58,6 +61,7 @@ struct Calibration {
   std::pair<int, int> frame_size;
   double flat_exposure_min_s = 0, flat_exposure_max_s = 0;
   std::optional<double> wavelength_nm;
+  std::optional<double> pixel_pitch_um, temperature_c;
   std::string date;
   NoiseCorrelation noise_correlation;
   std::optional<PeakQe> peak_qe;

@@ -355,6 +355,8 @@ td,th{border-bottom:1px solid #ddd;padding:4px 10px;text-align:right}th:first-ch
                                    ? fmt::format("{:.6g} s", cal.flat_exposure_min_s)
                                    : fmt::format("{:.6g} – {:.6g} s", cal.flat_exposure_min_s, cal.flat_exposure_max_s));
   fact("light", cal.wavelength_nm ? fmt::format("{:g} nm", *cal.wavelength_nm) : std::string("wavelength not given (--wavelength)"));
+  fact("pixel pitch", cal.pixel_pitch_um ? fmt::format("{:g} µm", *cal.pixel_pitch_um) : std::string("not given (--pixel-um)"));
+  fact("temperature", cal.temperature_c ? fmt::format("{:g} °C", *cal.temperature_c) : std::string("not given (--temperature)"));
   if (!cal.date.empty()) fact("date (EXIF, first frame)", cal.date);
   html += "</table>";
 
@@ -381,7 +383,18 @@ td,th{border-bottom:1px solid #ddd;padding:4px 10px;text-align:right}th:first-ch
     const auto t = sensitivity(c).threshold_photons;
     return t ? fmt::format("{:.4g}", *t) : std::string("—");
   });
+  if (cal.pixel_pitch_um) {
+    const double area = *cal.pixel_pitch_um * *cal.pixel_pitch_um;
+    row("&nbsp;&nbsp;μp.min per area (photons/µm²)", [&](const auto& c) {
+      const auto t = sensitivity(c).threshold_photons;
+      return t ? fmt::format("{:.4g}", *t / area) : std::string("—");
+    });
+  }
   row("saturation capacity μe.sat (e⁻)", [](const auto& c) { return cell(c.saturation_capacity_e); });
+  if (cal.pixel_pitch_um) {
+    const double area = *cal.pixel_pitch_um * *cal.pixel_pitch_um;
+    row("&nbsp;&nbsp;μe.sat per area (e⁻/µm²)", [&](const auto& c) { return fmt::format("{:.4g}", c.saturation_capacity_e.value / area); });
+  }
   row("&nbsp;&nbsp;μp.sat (photons)", [](const auto& c) { return c.saturation_photons ? fmt::format("{:.6g}", *c.saturation_photons) : std::string("—"); });
   row("clip level (e⁻)", [](const auto& c) {
     return c.clip_level_e ? cell(*c.clip_level_e) + (c.clips_at_adc ? " (the ADC's top code)" : "") : std::string("—");

@@ -27,7 +27,7 @@ Action add_calibrate(CLI::App& app) {
     double photons_per_s = 0;
     std::vector<double> photons_per_pixel;
     std::string input_transfer = "auto";
-    double wavelength = 0;
+    double wavelength = 0, pixel_um = 0, temperature = 0;
     std::string camera, basis = "energy";
     bool quiet = false;
   };
@@ -51,6 +51,8 @@ Action add_calibrate(CLI::App& app) {
   cmd->add_option("--wavelength", o->wavelength,
                   "The flats' light's wavelength in nm (monochromatic): with --camera, the measured η sets the settings' peak QE");
   cmd->add_option("--camera", o->camera, "The camera's spectral curves (a shipped camera, cie1931, or a CSV file), for --wavelength");
+  cmd->add_option("--pixel-um", o->pixel_um, "The pixel pitch in µm, for the datasheet (and its thresholds per area)");
+  cmd->add_option("--temperature", o->temperature, "The sensor's temperature in °C while the frames were taken, for the datasheet");
   cmd->add_option("--basis", o->basis, "What --camera's curves are proportional to: energy (default) or photon");
   cmd->add_option("--input-transfer", o->input_transfer,
                   "What the frames' values are: auto (the file's metadata; an integer file that names no colour space holds digital "
@@ -69,6 +71,8 @@ Action add_calibrate(CLI::App& app) {
     analyzer::parse_input_transfer(o->input_transfer);
     input.input_transfer = o->input_transfer;
     if (cmd->count("--wavelength") > 0) input.wavelength_nm = o->wavelength;
+    if (cmd->count("--pixel-um") > 0) input.pixel_pitch_um = o->pixel_um;
+    if (cmd->count("--temperature") > 0) input.temperature_c = o->temperature;
     input.camera = o->camera;
     input.basis = o->basis;
     std::vector<std::filesystem::path> inputs = input.flats;

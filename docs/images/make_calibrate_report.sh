@@ -38,6 +38,6 @@ JSON
   done
 done
 "$exe" calibrate --flat "${flats[@]}" --dark "${darks[@]}" -o "$tmp/settings.json" --report "$tmp/report" \
-    --photons-per-s 33298 --quiet
+    --photons-per-s 33298 --wavelength 550 --camera "$tmp/flat_camera.csv" --basis photon --pixel-um 5 --temperature 25 --quiet
 chromium --headless --no-sandbox --disable-gpu --hide-scrollbars --window-size=1150,3800 \
     --screenshot="$root/docs/images/calibrate_report.png" "file://$tmp/report/index.html" > /dev/null 2>&1

@@ -233,9 +233,12 @@ TEST_F(Calibrate, TheCommandWritesSettingsTheSensorTakesAndRefusesSeriesThatCann
   const calibrate::CalibrationInput in = series(c, "cli");
   const fs::path out = dir_.file("camera.json"), report = dir_.file("report");
   std::vector<std::string> args = calibrate_args(in.flats, in.darks, out);
-  args.insert(args.end(), {"--report", report.string(), "--photons-per-s", fmt::format("{}", *in.photons_per_s)});
+  args.insert(args.end(), {"--report", report.string(), "--photons-per-s", fmt::format("{}", *in.photons_per_s), "--pixel-um", "5",
+                           "--temperature", "25"});
   const auto ok = test::run_chromatrace(args);
   ASSERT_EQ(ok.exit_code, 0) << ok.err;
+  EXPECT_EQ(read_json(report / "calibration.json")["operating_point"]["pixel_pitch_um"].get<double>(), 5.0);
+  EXPECT_EQ(read_json(report / "calibration.json")["operating_point"]["temperature_c"].get<double>(), 25.0);
   const sensor::SensorConfig settings = test::config_of(read_json(out));
   EXPECT_NEAR(settings.adc.gain_dn_per_e, c.gain, 0.02 * c.gain);
   EXPECT_NEAR(settings.full_well.electrons, c.full_well, 0.02 * c.full_well);
@@ -304,6 +307,12 @@ TEST_F(Calibrate, TheCommandWritesSettingsTheSensorTakesAndRefusesSeriesThatCann
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.err.find(mosaic.string() + ": its pixels were interpolated from a colour filter array"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(bad));
+
+  std::vector<std::string> bad_pitch = calibrate_args(in.flats, in.darks, bad);
+  bad_pitch.insert(bad_pitch.end(), {"--pixel-um", "0"});
+  r = test::run_chromatrace(bad_pitch);
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_EQ(r.err, "chromatrace calibrate: error: --pixel-um: must be a positive number of micrometres, got 0\n");
 
   // An option where the frames should be: named as what it is, not as a missing option.
   auto no_frames = test::run_chromatrace({"calibrate", "--flat", "--dark", in.darks[0].string(), in.darks[1].string(), "-o", bad.string()});
