@@ -7,8 +7,10 @@
 // details show its name exactly as analysis.json has it, for every region clicked. ("<!--<script>" in the data would
 // put the HTML parser in a state where the data's end is not seen, and the viewer would not load.)
 //
-// The same for the series figure page and the compare page: a scene whose objects, material, light and variant are
-// named (and described) as HTML that runs script, and a camera's curves under a folder so named.
+// The same for the series figure page and the compare page (a scene whose objects, material, light and variant are
+// named and described as HTML that runs script, a camera's curves under a folder so named), the study page (such a
+// scene, under a file name so named), and the calibration datasheet (a monochrome camera's frames whose channel and
+// EXIF date are so named).
 // Environment: CHROMATRACE_EXE, CHROMATRACE_SYNTHETIC_IMAGES (the two executables).
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
@@ -150,4 +152,55 @@ test('the series figure page and the compare page show hostile names as text', a
   assert.deepEqual([compare.found.handlers, compare.found.scripts, compare.opened], [0, 0, 0]);
   for (const text of [hostile.floor, hostile.ball, hostile.folder]) assert.ok(compare.found.text.includes(text), `${text} not shown`);
   assert.deepEqual(compare.pageProblems, []);
+});
+
+test('the study page and the calibration datasheet show hostile names as text', async () => {
+  const exe = process.env.CHROMATRACE_EXE;
+  const scene = JSON.parse(fs.readFileSync(new URL('../data/scenes/minimal.json', import.meta.url), 'utf8'));
+  scene.objects[0].name = hostile.floor;
+  scene.objects[1].name = hostile.ball;
+  const sceneFile = path.join(work, 'scene<img src=w onerror=alert(18)>.json');
+  fs.writeFileSync(sceneFile, JSON.stringify(scene));
+  execFileSync(exe, ['study', sceneFile, '-o', path.join(work, 'study'), '--resolution', '32x24', '--bands', '3', '--fitted', '1', '--samples', '4',
+    '--bounces', '1', '--no-plan', '--reference-spp', '16', '--quiet']);
+  const study = await openPage(path.join(work, 'study', 'index.html'));
+  assert.deepEqual([study.found.handlers, study.found.scripts, study.opened], [0, 0, 0]);
+  assert.ok(study.found.text.includes('scene<img src=w onerror=alert(18)>.json'));
+  assert.deepEqual(study.pageProblems, []);
+
+  // A photon-transfer series of a monochrome camera (the sensor simulator's green plane, as
+  // docs/images/make_calibrate_report.sh makes the colour one), its channel and date named as HTML.
+  const frames = path.join(work, 'frames');
+  fs.mkdirSync(frames);
+  execFileSync('oiiotool', ['--create', '64x64', '1', '--chnames', 'S0.550nm', '-d', 'float', '-o', path.join(frames, 'dark.exr')]);
+  execFileSync('oiiotool', ['--create', '64x64', '1', '--chnames', 'S0.550nm', '-d', 'float', '--addc', '0.0098', '-o', path.join(frames, 'flat.exr')]);
+  fs.writeFileSync(path.join(frames, 'camera.csv'), 'wavelength_nm,r,g,b\n300,1,1,1\n900,1,1,1\n');
+  const channel = '<img src=v onerror=alert(19)>';
+  const args = { flat: [], dark: [] };
+  let seed = 1;
+  for (const share of [0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.94, 0.97, 1.0, 1.03, 1.3]) {
+    for (const kind of ['flat', 'dark']) {
+      for (const k of [0, 1]) {
+        const config = path.join(frames, 'camera.json');
+        fs.writeFileSync(config, JSON.stringify({
+          optics: { f_number: 4, cos4: false }, exposure: { time_s: share }, pixel: { pitch_um: 5 },
+          spectral_response: { camera: path.join(frames, 'camera.csv'), basis: 'photon', peak_qe: 0.6 },
+          noise: { enabled: true, dark_current_e_per_s: 100, read_e: 5, seed: seed++ },
+          full_well: { enabled: true, electrons: 20000 }, adc: { enabled: true, gain_dn_per_e: 0.25, black_level_dn: 100, bits: 16 },
+          display: { enabled: false },
+        }));
+        const rgb = path.join(frames, `${share}-${kind}-${k}-rgb.exr`), mono = path.join(frames, `${share}-${kind}-${k}.exr`);
+        execFileSync(exe, ['sensor', path.join(frames, `${kind}.exr`), '-o', rgb, '--config', config, '--quiet']);
+        execFileSync('oiiotool', ['--evaloff', rgb, '--ch', 'G', '--chnames', channel, '--attrib:type=string', 'DateTime',
+          '2026:11:29 <svg onload=alert(20)>', '-o', mono]);
+        args[kind].push(mono);
+      }
+    }
+  }
+  execFileSync(exe, ['calibrate', '--flat', ...args.flat, '--dark', ...args.dark, '-o', path.join(work, 'settings.json'), '--report',
+    path.join(work, 'datasheet'), '--photons-per-s', '33298', '--quiet']);
+  const datasheet = await openPage(path.join(work, 'datasheet', 'index.html'));
+  assert.deepEqual([datasheet.found.handlers, datasheet.found.scripts, datasheet.opened], [0, 0, 0]);
+  for (const text of [channel, '2026:11:29 <svg onload=alert(20)>']) assert.ok(datasheet.found.text.includes(text), `${text} not shown`);
+  assert.deepEqual(datasheet.pageProblems, []);
 });
