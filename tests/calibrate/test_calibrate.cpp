@@ -421,8 +421,8 @@ calibrate::CalibrationInput plain_series(const calibrate::CalibrationInput& in, 
   return out;
 }
 
-// Frames as a machine-vision camera writes them: 16-bit TIFFs of digital numbers without any metadata but EXIF's
-// exposure time, three channels or one (a monochrome camera). Calibrated as the simulator's own files are: every
+// Frames as a machine-vision camera writes them: 16-bit TIFFs (or float EXRs) of digital numbers without any metadata
+// but EXIF's exposure time, three channels or one (a monochrome camera). Calibrated as the simulator's own files are: every
 // parameter recovered, the noise of neighbouring pixels and of the channels uncorrelated (0 within three standard
 // errors), and the ADC's 12 bits found from the largest value (the flats clip at the full well, 3700 DN: 12 bits, not
 // the file's 16).
@@ -438,6 +438,12 @@ TEST_F(Calibrate, OrdinaryFramesOfAColourOrAMonochromeCameraAreCalibrated) {
   for (const double rho : {nc.horizontal, nc.vertical, nc.between_channels}) EXPECT_LT(rho, kSigmasPerItem * nc.standard_error);
   std::cerr << fmt::format("plain frames: noise correlation {:.4f} horizontal, {:.4f} vertical, {:.4f} between channels, ± {:.4f}\n",
                            nc.horizontal, nc.vertical, nc.between_channels, nc.standard_error);
+
+  // The same as float EXRs of whole digital numbers, with no metadata but the exposure time.
+  calibrate::CalibrationInput exr = simulated;
+  for (auto* set : {&exr.flats, &exr.darks})
+    for (fs::path& f : *set) f = write_plain(f, {0, 1, 2}, f.parent_path() / (f.stem().string() + "-plain.exr"), time_of(f), OIIO::TypeDesc::FLOAT);
+  expect_camera(calibrate::calibrate(exr), c);
 
   calibrate::CalibrationInput grey = plain_series(simulated, {1}, "-mono");
   const calibrate::Calibration mono = calibrate::calibrate(grey);
