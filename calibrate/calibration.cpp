@@ -313,7 +313,8 @@ Calibration calibrate(const CalibrationInput& input) {
                                          set[b].file, set[a].file, kind == 0 ? "flat" : "dark", t));
     }
   // At one exposure time a pair is one irradiance: its two means agree far better than 5 % of their signal (a lamp's
-  // drift is a fraction of a per cent), where two irradiances of the series differ by more.
+  // drift is a fraction of a per cent), where two irradiances of the series differ by more; or, near black, within five
+  // standard errors of their difference's mean (the temporal noise over the pixels).
   const std::size_t channel_count = step_flats.front().front()->channels.size();
   if (one_time) {
     const std::vector<Frame>& darks = by_time[flat_times[0]][1];
@@ -324,7 +325,11 @@ Calibration calibrate(const CalibrationInput& input) {
           return std::accumulate(v.begin(), v.end(), 0.0) / static_cast<double>(v.size());
         };
         const double black = (mean(darks[0]) + mean(darks[1])) / 2, a = mean(*pair[0]) - black, b = mean(*pair[1]) - black;
-        if (std::abs(a - b) > 0.05 * std::max(std::abs(a), std::abs(b)))
+        const std::vector<double>&x = pair[0]->channels[c].values, &y = pair[1]->channels[c].values;
+        double d2 = 0;
+        for (std::size_t i = 0; i < x.size(); ++i) d2 += (x[i] - y[i] - (a - b)) * (x[i] - y[i] - (a - b));
+        const double difference_se = std::sqrt(d2 / static_cast<double>(x.size() - 1) / static_cast<double>(x.size()));
+        if (std::abs(a - b) > std::max(0.05 * std::max(std::abs(a), std::abs(b)), 5 * difference_se))
           throw InputError(fmt::format("{}: its channel {} is {:.4g} DN above black where {}, its partner, is {:.4g}: at one exposure time "
                                        "the flats are taken in pairs in the order given, each pair one irradiance",
                                        pair[1]->file, pair[1]->channel_names[c], b, pair[0]->file, a));
