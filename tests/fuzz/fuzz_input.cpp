@@ -8,13 +8,26 @@
 
 namespace ct::fuzz {
 
+namespace {
+
+// The harness's scratch directory, removed when the process exits normally (libFuzzer's -max_total_time ends in
+// exit()); a crash leaves it, with the input that was being read.
+struct Scratch {
+  std::filesystem::path path = std::filesystem::temp_directory_path() / ("chromatrace-fuzz-" + std::to_string(::getpid()));
+  Scratch() { std::filesystem::create_directories(path); }
+  ~Scratch() {
+    std::error_code ignored;
+    std::filesystem::remove_all(path, ignored);
+  }
+  Scratch(const Scratch&) = delete;
+  Scratch& operator=(const Scratch&) = delete;
+};
+
+}  // namespace
+
 const std::filesystem::path& scratch_directory() {
-  static const std::filesystem::path directory = [] {
-    const auto path = std::filesystem::temp_directory_path() / ("chromatrace-fuzz-" + std::to_string(::getpid()));
-    std::filesystem::create_directories(path);
-    return path;
-  }();
-  return directory;
+  static const Scratch directory;
+  return directory.path;
 }
 
 std::filesystem::path input_file(const std::uint8_t* data, std::size_t size, std::string_view name) {
