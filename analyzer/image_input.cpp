@@ -343,34 +343,10 @@ void set_aside_invalid_pixels(const RawImage& raw, AnalysisImage& out) {
                                  out.transparent_pixels, out.negative_pixels, non_finite));
 }
 
-}  // namespace
-
-std::optional<ToneCurve> parse_input_transfer(const std::string& text) {
-  if (text == "auto") return std::nullopt;
-  if (text == "linear") return ToneCurve{};
-  if (text == "srgb" || text == "sRGB") return ToneCurve{1, 1, true};
-  if (text.starts_with("gamma=")) {
-    const std::string number = text.substr(6);
-    char* end = nullptr;
-    const double g = std::strtod(number.c_str(), &end);
-    if (!number.empty() && *end == '\0' && std::isfinite(g) && g > 0) return ToneCurve{1.0 / g, 1, false};
-  }
-  throw InputError(fmt::format("--input-transfer: \"{}\" is not auto, linear, srgb or gamma=G with G > 0", text));
-}
-
-AnalysisImage read_analysis_image(const std::filesystem::path& file, const std::string& input_transfer,
-                                  const RawOptions& raw_options) {
-  const std::optional<ToneCurve> declared = parse_input_transfer(input_transfer);
-  if (is_camera_raw(file)) {
-    AnalysisImage capture = read_camera_raw(file, raw_options);
-    if (declared) {
-      capture.encoding.curve = declared;
-      capture.encoding.curve_source = fmt::format("--input-transfer {}", input_transfer);
-    }
-    return capture;
-  }
-  const std::string name = file.string();
-  RawImage raw = read_raw(file);
+// What read_analysis_image and read_analysis_pixels share once the stored values are read: R, G, B and the extra
+// layers, the camera's numbers, what was set aside, and the curve.
+AnalysisImage analysis_image_of(RawImage raw, const std::string& name, const std::string& input_transfer,
+                                const std::optional<ToneCurve>& declared) {
   AnalysisImage out;
   out.file = name;
   out.encoding = raw.encoding;
@@ -406,6 +382,57 @@ AnalysisImage read_analysis_image(const std::filesystem::path& file, const std::
     out.object_ids = whole_numbers(name, exr::kObjectIdChannel, raw, id);
   out.object_names = parse_object_names(name, raw.objects_attribute);
   return out;
+}
+
+}  // namespace
+
+std::optional<ToneCurve> parse_input_transfer(const std::string& text) {
+  if (text == "auto") return std::nullopt;
+  if (text == "linear") return ToneCurve{};
+  if (text == "srgb" || text == "sRGB") return ToneCurve{1, 1, true};
+  if (text.starts_with("gamma=")) {
+    const std::string number = text.substr(6);
+    char* end = nullptr;
+    const double g = std::strtod(number.c_str(), &end);
+    if (!number.empty() && *end == '\0' && std::isfinite(g) && g > 0) return ToneCurve{1.0 / g, 1, false};
+  }
+  throw InputError(fmt::format("--input-transfer: \"{}\" is not auto, linear, srgb or gamma=G with G > 0", text));
+}
+
+AnalysisImage read_analysis_image(const std::filesystem::path& file, const std::string& input_transfer,
+                                  const RawOptions& raw_options) {
+  const std::optional<ToneCurve> declared = parse_input_transfer(input_transfer);
+  if (is_camera_raw(file)) {
+    AnalysisImage capture = read_camera_raw(file, raw_options);
+    if (declared) {
+      capture.encoding.curve = declared;
+      capture.encoding.curve_source = fmt::format("--input-transfer {}", input_transfer);
+    }
+    return capture;
+  }
+  return analysis_image_of(read_raw(file), file.string(), input_transfer, declared);
+}
+
+AnalysisImage read_analysis_pixels(const std::string& name, int width, int height, std::vector<float> rgb, int integer_bits,
+                                   const std::string& input_transfer) {
+  const std::optional<ToneCurve> declared = parse_input_transfer(input_transfer);
+  if (width < 1 || height < 1) throw InputError(fmt::format("{}: image has no pixels", name));
+  if (rgb.size() != static_cast<std::size_t>(width) * static_cast<std::size_t>(height) * 3)
+    throw InputError(fmt::format("{}: {} values for {} x {} pixels of R, G, B", name, rgb.size(), width, height));
+  if (integer_bits != 0 && integer_bits != 8 && integer_bits != 16 && integer_bits != 32)
+    throw InputError(fmt::format("{}: integer samples of {} bits; 8, 16 or 32 (or float)", name, integer_bits));
+  RawImage raw;
+  raw.width = width;
+  raw.height = height;
+  raw.channels = 3;
+  raw.names = {"R", "G", "B"};
+  raw.values = std::move(rgb);
+  if (integer_bits > 0) {
+    raw.encoding.integer = true;
+    raw.encoding.bits = integer_bits;
+    raw.encoding.full_scale = std::ldexp(1.0, integer_bits) - 1.0;
+  }
+  return analysis_image_of(std::move(raw), name, input_transfer, declared);
 }
 
 CameraFrame read_camera_frame(const std::filesystem::path& file, const std::string& input_transfer) {
