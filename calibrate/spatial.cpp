@@ -3,34 +3,27 @@
 
 #include <algorithm>
 #include <cmath>
-#include <numbers>
+
+#include <opencv2/core.hpp>
 
 namespace ct::calibrate {
 namespace {
 
-// σ per frequency k = 1 … n/2 of `lines` sequences of length n, each read with stride `step` from `start(line)`:
-// √(mean over the lines of |DFT_k|² / n), the DFT of the deviations from the image's mean.
-std::vector<double> spectrum(const std::vector<double>& values, std::size_t lines, std::size_t n, auto at) {
-  const std::size_t half = n / 2;
-  std::vector<double> cosines(n), sines(n), power(half + 1, 0.0);
-  for (std::size_t j = 0; j < n; ++j) {
-    const double phase = 2 * std::numbers::pi * static_cast<double>(j) / static_cast<double>(n);
-    cosines[j] = std::cos(phase), sines[j] = std::sin(phase);
-  }
-  std::vector<double> line(n);
-  for (std::size_t l = 0; l < lines; ++l) {
-    for (std::size_t j = 0; j < n; ++j) line[j] = values[at(l, j)];
-    for (std::size_t k = 1; k <= half; ++k) {
-      double re = 0, im = 0;
-      for (std::size_t j = 0; j < n; ++j) {
-        const std::size_t w = (k * j) % n;
-        re += line[j] * cosines[w], im -= line[j] * sines[w];
-      }
-      power[k] += (re * re + im * im) / static_cast<double>(n);
-    }
-  }
+// σ per frequency k = 1 … n/2 along the rows of `lines` (one line per row, n values each): √(mean over the rows of
+// |DFT_k|² / n), by OpenCV's FFT (a camera raw's planes hold thousands of rows of thousands of values).
+std::vector<double> spectrum(const cv::Mat& lines) {
+  cv::Mat transform;
+  cv::dft(lines, transform, cv::DFT_ROWS | cv::DFT_COMPLEX_OUTPUT);
+  const int n = lines.cols;
   std::vector<double> sigma;
-  for (std::size_t k = 1; k <= half; ++k) sigma.push_back(std::sqrt(power[k] / static_cast<double>(lines)));
+  for (int k = 1; k <= n / 2; ++k) {
+    double power = 0;
+    for (int row = 0; row < lines.rows; ++row) {
+      const cv::Vec2d v = transform.at<cv::Vec2d>(row, k);
+      power += (v[0] * v[0] + v[1] * v[1]) / n;
+    }
+    sigma.push_back(std::sqrt(power / lines.rows));
+  }
   return sigma;
 }
 
@@ -45,8 +38,9 @@ SpatialCurves spatial_curves(const Plane& image, double scale, double temporal_v
   for (std::size_t i = 0; i < d.size(); ++i) d[i] = (image.values[i] - mean) * scale;
 
   SpatialCurves c;
-  c.spectrum_horizontal = spectrum(d, M, N, [&](std::size_t row, std::size_t j) { return row * N + j; });
-  c.spectrum_vertical = spectrum(d, N, M, [&](std::size_t column, std::size_t j) { return j * N + column; });
+  const cv::Mat rows(static_cast<int>(M), static_cast<int>(N), CV_64F, d.data());
+  c.spectrum_horizontal = spectrum(rows);
+  c.spectrum_vertical = spectrum(rows.t());
   c.temporal_floor = std::sqrt(std::max(0.0, temporal_variance_of_mean)) * std::abs(scale);
   c.profile_horizontal.assign(N, 0.0);
   c.profile_vertical.assign(M, 0.0);
