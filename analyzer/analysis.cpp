@@ -84,11 +84,18 @@ std::vector<Region> select_regions(const AnalysisImage& input, const RgbImage& l
     const LabelImage labels = read_label_image(options.labels);
     check_size(labels, layer, options.labels);
     append(label_regions(labels.labels, "label", {}, {0}));
+  } else if (options.label_image) {
+    check_size(*options.label_image, layer, "labels");
+    append(label_regions(options.label_image->labels, "label", {}, {0}));
   }
   for (const std::string& m : options.masks) {
     const LabelImage mask = read_label_image(m);
     check_size(mask, layer, m);
     regions.push_back(mask_region(mask, fmt::format("mask {}", std::filesystem::path(m).filename().string())));
+  }
+  for (const auto& [name, mask] : options.mask_images) {
+    check_size(mask, layer, "mask " + name);
+    regions.push_back(mask_region(mask, "mask " + name));
   }
   for (const Rect& r : options.rects) regions.push_back(rect_region(r, layer.width, layer.height));
   if (options.segment) {

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "analyzer/explain.h"
+#include "analyzer/image_input.h"  // LabelImage
 #include "analyzer/interpretation.h"
 #include "analyzer/illuminant.h"
 #include "analyzer/region_analysis.h"
@@ -19,14 +20,17 @@ struct RegionOptions {
   std::string labels;               // a channel of the image ("object_id") or a label image file; "" = object_id if present
   bool no_labels = false;           // ignore the image's object ids
   std::vector<std::string> masks;   // mask image files (non-zero = in)
+  // Labels and masks already in memory (the Python module's arrays), named as their regions are: label k, mask <name>.
+  std::optional<LabelImage> label_image;
+  std::vector<std::pair<std::string, LabelImage>> mask_images;
   std::vector<Rect> rects;
   bool segment = false;             // automatic segmentation
   SegmentationOptions segmentation;
 };
 
-// The whole image first, then labels (id 0, "no object", left out unless the file names it), masks,
-// rectangles and segments (by decreasing size, then the unassigned pixels as a region of their own), in that
-// order. Label and mask images must match the image's size (InputError naming the file otherwise).
+// The whole image first, then labels (id 0, "no object", left out unless the file names it), masks (files, then
+// images in memory), rectangles and segments (by decreasing size, then the unassigned pixels as a region of their
+// own), in that order. Label and mask images must match the image's size (InputError naming the file otherwise).
 // With options.segment and `segmentation`, the segmentation's label map and numbers are kept there (its
 // regions are moved into the result); with `progress`, the segmentation shows a progress bar on stderr.
 std::vector<Region> select_regions(const AnalysisImage& input, const RgbImage& layer, const RegionOptions& options,

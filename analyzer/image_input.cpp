@@ -303,15 +303,20 @@ void decide_curve(const RawImage& raw, const std::string& file, ImageEncoding& e
   } else if (space == "gammacorrected" && raw.display_gamma > 0) {
     e.curve = ToneCurve{1.0 / raw.display_gamma, 1, false};
     e.curve_source = fmt::format("the file's gamma (oiio:Gamma {:g})", raw.display_gamma);
-  } else if (!e.integer) {
-    e.curve = ToneCurve{};
-    e.curve_source = "a float file without a colour space: linear";
-  } else if (integer_is_linear) {
-    e.curve = ToneCurve{};
-    e.curve_source = fmt::format("a {}-bit file without a colour space: a measurement camera's digital numbers", e.bits);
   } else {
-    e.curve = ToneCurve{1, 1, true};
-    e.curve_source = fmt::format("a {}-bit file without a colour space: sRGB, as cameras and phones store pictures", e.bits);
+    // An array in memory (read_analysis_pixels) has no colour space to name.
+    const std::string what = raw.format == "array" ? "array" : "file without a colour space";
+    const std::string bits = fmt::format("{} {}-bit {}", e.bits == 8 ? "an" : "a", e.bits, what);
+    if (!e.integer) {
+      e.curve = ToneCurve{};
+      e.curve_source = fmt::format("a float {}: linear", what);
+    } else if (integer_is_linear) {
+      e.curve = ToneCurve{};
+      e.curve_source = bits + ": a measurement camera's digital numbers";
+    } else {
+      e.curve = ToneCurve{1, 1, true};
+      e.curve_source = bits + ": sRGB, as cameras and phones store pictures";
+    }
   }
 }
 
@@ -350,7 +355,11 @@ AnalysisImage analysis_image_of(RawImage raw, const std::string& name, const std
   AnalysisImage out;
   out.file = name;
   out.encoding = raw.encoding;
-  if (auto rgb = extract_rgb(raw, "")) {
+  if (raw.channels == 3 && raw.alpha < 0 && channel_index(raw, "R") == 0 && channel_index(raw, "G") == 1 && channel_index(raw, "B") == 2) {
+    // R, G, B alone and in order: the values are the image, taken as they are (no copy). Nothing below reads them.
+    out.image = RgbImage{raw.width, raw.height, std::move(raw.values)};
+    raw.values.clear();
+  } else if (auto rgb = extract_rgb(raw, "")) {
     out.image = std::move(*rgb);
   } else if (raw.channels >= 3 && channel_index(raw, "R") < 0) {
     // Files whose channels are not named R, G, B (some TIFFs, unnamed EXR layers): the first three.
@@ -426,6 +435,7 @@ AnalysisImage read_analysis_pixels(const std::string& name, int width, int heigh
   raw.height = height;
   raw.channels = 3;
   raw.names = {"R", "G", "B"};
+  raw.format = "array";
   raw.values = std::move(rgb);
   if (integer_bits > 0) {
     raw.encoding.integer = true;

@@ -180,8 +180,8 @@ double simulated_dark_current(const ChannelCalibration& c) {
 }
 
 Calibration calibrate(const CalibrationInput& input) {
-  if (input.flats.empty()) throw InputError("--flat: no flat frames");
-  if (input.darks.empty()) throw InputError("--dark: no dark frames");
+  if (input.flats.empty() && input.flat_frames.empty()) throw InputError("--flat: no flat frames");
+  if (input.darks.empty() && input.dark_frames.empty()) throw InputError("--dark: no dark frames");
   if (input.photons_per_s && !(*input.photons_per_s > 0 && std::isfinite(*input.photons_per_s)))
     throw InputError(fmt::format("--photons-per-s: must be a positive number, got {}", *input.photons_per_s));
   if (input.wavelength_nm.has_value() != !input.camera.empty())
@@ -201,8 +201,10 @@ Calibration calibrate(const CalibrationInput& input) {
   // Every frame, then the odd one out named against the most common camera and size (the first frame may be the odd
   // one: naming it as the norm would point at a good file).
   std::vector<std::pair<int, Frame>> frames;  // kind (0 flat, 1 dark), frame
-  for (int kind = 0; kind < 2; ++kind)
+  for (int kind = 0; kind < 2; ++kind) {
     for (const auto& file : kind == 0 ? input.flats : input.darks) frames.emplace_back(kind, read_frame(file, input.input_transfer));
+    for (const Frame& f : kind == 0 ? input.flat_frames : input.dark_frames) frames.emplace_back(kind, f);
+  }
   auto most_common = [&](auto key) {
     std::map<decltype(key(frames[0].second)), std::size_t> count;
     for (const auto& [kind, f] : frames) ++count[key(f)];
@@ -388,8 +390,8 @@ Calibration calibrate(const CalibrationInput& input) {
                                      rho, what, nc.standard_error));
   }
 
-  result.flats = input.flats.size();
-  result.darks = input.darks.size();
+  result.flats = input.flats.size() + input.flat_frames.size();
+  result.darks = input.darks.size() + input.dark_frames.size();
   result.exposures = by_time.size();
   result.camera = sensor;
   result.frame_size = size;

@@ -9,6 +9,7 @@
 #include <optional>
 #include <vector>
 
+#include "calibrate/frames.h"
 #include "calibrate/photon_transfer.h"
 #include "core/json_input.h"
 
@@ -19,6 +20,7 @@ namespace ct::calibrate {
 // darks at the flats' exposure times and, optionally, darks alone at further times (for the dark current).
 struct CalibrationInput {
   std::vector<std::filesystem::path> flats, darks;
+  std::vector<Frame> flat_frames, dark_frames;  // frames already in memory, after the files' (frame_in_memory)
   std::optional<double> photons_per_s;    // photons per pixel and second reaching each pixel of the flats (first method)
   std::vector<double> photons_per_pixel;  // per pair of flats, in their order (second method)
   std::string input_transfer = "auto";    // what the frames' values are (analyzer::parse_input_transfer)

@@ -127,4 +127,29 @@ Frame read_frame(const std::filesystem::path& file, const std::string& input_tra
   return f;
 }
 
+Frame frame_in_memory(const std::string& name, double exposure_s, int width, int height, const std::vector<std::vector<double>>& planes) {
+  if (!(exposure_s > 0 && std::isfinite(exposure_s)))
+    throw InputError(fmt::format("{}: the exposure time must be a positive number of seconds, got {}", name, exposure_s));
+  if (planes.size() != 1 && planes.size() != 3)
+    throw InputError(fmt::format("{}: needs one channel (a monochrome camera) or R, G, B; has {}", name, planes.size()));
+  const std::size_t n = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
+  Frame f;
+  f.file = name;
+  f.exposure_s = exposure_s;
+  for (std::size_t c = 0; c < planes.size(); ++c) {
+    const std::vector<double>& plane = planes[c];
+    if (width < 1 || height < 1 || plane.size() != n)
+      throw InputError(fmt::format("{}: {} values for {} x {} pixels", name, plane.size(), width, height));
+    for (std::size_t i = 0; i < n; ++i)
+      if (std::isfinite(plane[i]) && plane[i] != std::round(plane[i]))
+        throw InputError(fmt::format("{}: channel {} holds {} at pixel ({}, {}), not a whole number: calibration needs the camera's "
+                                     "digital numbers (a frame scaled to 0–1 or processed is not)",
+                                     name, c, plane[i], i % static_cast<std::size_t>(width), i / static_cast<std::size_t>(width)));
+    f.channel_names.push_back(planes.size() == 1 ? "Y" : std::string(1, "RGB"[c]));
+    f.channels.push_back(plane_of(width, height, name, n, [&](std::size_t i) { return static_cast<float>(plane[i]); }));
+  }
+  f.sensor = planes.size() == 1 ? "array, one channel (monochrome)" : "array, R, G, B";
+  return f;
+}
+
 }  // namespace ct::calibrate

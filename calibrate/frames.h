@@ -35,4 +35,10 @@ struct Frame {
 // (EXIF ExposureTime, or exposure.time_s in the simulator's chromatrace.sensor).
 Frame read_frame(const std::filesystem::path& file, const std::string& input_transfer = "auto");
 
+// A frame already in memory (the Python module's arrays), named `name` in messages: one plane (a monochrome camera) or
+// three (R, G, B) of `width` × `height` digital numbers, [y][x], black level included, each pixel read on its own
+// (their noise's correlation is tested as a file's is). InputError naming `name` for a non-positive exposure time,
+// another count of planes, planes of the wrong size, or values that are not finite whole numbers.
+Frame frame_in_memory(const std::string& name, double exposure_s, int width, int height, const std::vector<std::vector<double>>& planes);
+
 }  // namespace ct::calibrate

@@ -1,23 +1,20 @@
 // SPDX-License-Identifier: Apache-2.0
 // chromatrace analyze IMAGE -o DIR: colour-histogram analysis of image regions (docs/analyze.md).
 #include <algorithm>
-#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
 #include <optional>
 
 #include <fmt/format.h>
-#include <OpenImageIO/imageio.h>
-
 #include "analyzer/analysis.h"
+#include "analyzer/camera_noise.h"
 #include "analyzer/output.h"
 #include "analyzer/raw_input.h"
 #include "cli/app.h"
 #include "cli/command.h"
 #include "core/error.h"
 #include "core/file_io.h"
-#include "sensor_sim/config.h"
 
 namespace ct::cli {
 namespace {
@@ -42,37 +39,6 @@ void check_output(const std::filesystem::path& dir, const std::string& image, co
       if (same_file(input.parent_path().empty() ? std::filesystem::path(".") : input.parent_path(), dir / sub))
         throw InputError(fmt::format("{}: the input {} is in the directory {} that analyze writes", dir.string(),
                                      input.string(), (dir / sub).string()));
-}
-
-// The camera's noise from its settings file, for an image whose final layer holds its digital numbers: a camera raw,
-// or the simulator's EXR whose chromatrace.signal is DN.
-analyzer::CameraNoiseModel camera_noise(const std::string& file, const std::string& image, const std::string& layer) {
-  const sensor::SensorConfig c = sensor::resolve_config({sensor::read_config_patch(file)});
-  if (!c.adc.enabled || !c.noise.enabled)
-    throw InputError(fmt::format("--camera-config: {}: {} is off, so the settings give no noise in digital numbers", file,
-                                 !c.adc.enabled ? "adc.enabled" : "noise.enabled"));
-  if (!layer.empty() && layer != "final")
-    throw InputError(fmt::format("--camera-config: the camera's noise is that of the final layer's digital numbers, not of --layer {}", layer));
-  if (!analyzer::is_camera_raw(image)) {
-    std::string signal = "of unknown units";
-    if (auto in = OIIO::ImageInput::open(image)) {
-      const std::string s = in->spec().get_string_attribute("chromatrace.signal");
-      if (!s.empty()) signal = "in " + s;
-    } else {
-      (void)OIIO::geterror();
-    }
-    if (signal != "in DN")
-      throw InputError(fmt::format("--camera-config: {}'s values are {}, but the camera's noise is in its digital numbers (a camera "
-                                   "raw, or the simulator's EXR with chromatrace.signal DN)",
-                                   image, signal));
-  }
-  analyzer::CameraNoiseModel m;
-  m.gain_dn_per_e = c.adc.gain_dn_per_e;
-  m.read_e = c.noise.read_e;
-  m.dsnu_e = std::sqrt(c.noise.dsnu_e * c.noise.dsnu_e + c.noise.dsnu_row_e * c.noise.dsnu_row_e + c.noise.dsnu_column_e * c.noise.dsnu_column_e);
-  m.prnu = std::sqrt(c.noise.prnu * c.noise.prnu + c.noise.prnu_row * c.noise.prnu_row + c.noise.prnu_column * c.noise.prnu_column);
-  m.source = file;
-  return m;
 }
 
 }  // namespace
@@ -169,7 +135,10 @@ Action add_analyze(CLI::App& app) {
     if (!o->quiet)
       for (const std::string& note : input.notes) fmt::print(stderr, "{}: note: {}\n", o->image, note);
     analyzer::AnalyzeOptions options;
-    if (!o->camera_config.empty()) options.camera_noise = camera_noise(o->camera_config, o->image, o->layer);
+    if (!o->camera_config.empty()) {
+      options.camera_noise = analyzer::camera_noise_from_settings(o->camera_config);
+      analyzer::check_camera_numbers(o->image, o->layer);
+    }
     options.bins = o->bins;
     options.threads = o->threads;
     options.seed = o->seed;
