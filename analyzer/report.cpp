@@ -264,7 +264,7 @@ main { display: flex; gap: 16px; padding: 12px 16px; flex-wrap: wrap; }
 
 }  // namespace
 
-std::string report_html(const AnalysisImage& input, const ImageAnalysis& a, std::size_t max_points) {
+std::string report_html(const AnalysisImage& input, const ImageAnalysis& a, std::size_t max_points, bool beside_files) {
   const RgbImage& layer = select_layer(input, a.layer);
   const Display d = display_size(a.width, a.height);
   const std::vector<int> dominant = input.components.empty() ? std::vector<int>{} : dominant_component_map(input);
@@ -347,7 +347,7 @@ std::string report_html(const AnalysisImage& input, const ImageAnalysis& a, std:
 <body data-ready="0">
 <header>
 <h1>chromatrace analysis — {title}</h1>
-<div>{width}×{height}, layer {layer}, {regions} region{plural}. Numbers: <a href="analysis.json">analysis.json</a>, plots in <a href="plots/">plots/</a>.</div>
+<div>{width}×{height}, layer {layer}, {regions} region{plural}. {numbers}</div>
 <div class="hint">Values: {unit}.</div>
 {notes}
 </header>
@@ -375,7 +375,10 @@ Colour: <select id="colour-mode"><option value="own">own colour</option><option 
 )html",
       fmt::arg("title", escape_html(std::filesystem::path(a.file).filename().string())), fmt::arg("style", kStyle),
       fmt::arg("width", a.width), fmt::arg("height", a.height), fmt::arg("layer", escape_html(a.layer)),
-      fmt::arg("regions", a.results.size()), fmt::arg("plural", a.results.size() == 1 ? "" : "s"), fmt::arg("notes", notes),
+      fmt::arg("regions", a.results.size()), fmt::arg("plural", a.results.size() == 1 ? "" : "s"),
+      fmt::arg("numbers", beside_files ? R"(Numbers: <a href="analysis.json">analysis.json</a>, plots in <a href="plots/">plots/</a>.)"
+                                       : "Numbers: the analysis's data (analysis.json's content)."),
+      fmt::arg("notes", notes),
       fmt::arg("image", image_png(input, layer, a, d)), fmt::arg("illuminant", illuminant), fmt::arg("legend", legend),
       fmt::arg("unit", escape_html(unit.description)), fmt::arg("region_table", region_table),
       fmt::arg("data", json_script_safe(data.dump(-1, ' ', false, kReplaceInvalidUtf8))), fmt::arg("bundle", script_safe(std::string(viewer_bundle()))));

@@ -11,8 +11,10 @@
 
 namespace ct::analyzer {
 
-// max_points: points per region in the 3D view, an even stride over larger regions.
-std::string report_html(const AnalysisImage& input, const ImageAnalysis& analysis, std::size_t max_points);
+// max_points: points per region in the 3D view, an even stride over larger regions. beside_files: the page lies in
+// the analysis directory and links analysis.json and plots/; without it (a page shown on its own, as the Python
+// module's notebook display) it says where the numbers are instead.
+std::string report_html(const AnalysisImage& input, const ImageAnalysis& analysis, std::size_t max_points, bool beside_files = true);
 
 // The page's image and maps are at most this many pixels on the long side.
 inline constexpr int kReportImageSize = 1024;

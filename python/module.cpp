@@ -87,7 +87,7 @@ struct Analysis {
   }
   std::string report_html(std::size_t points) const {
     if (points < 1) throw InputError("--report-points: must be >= 1");
-    return analyzer::report_html(input, analysis, points);
+    return analyzer::report_html(input, analysis, points, false);
   }
   // As analyze -o DIR writes it, staged and moved into place.
   void write(const std::filesystem::path& dir, bool plots, bool report, std::size_t points, std::optional<std::size_t> plot_limit) const {

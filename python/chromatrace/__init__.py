@@ -84,7 +84,8 @@ class Analysis:
         return self._native.plot_png(self.region(key)["index"], colouring)
 
     def report_html(self, report_points: int = 20000) -> str:
-        """The report page analyze writes as report.html: one self-contained HTML document."""
+        """analyze's report page (report.html) as one self-contained HTML document shown on its own: it links no
+        analysis.json or plots (write() writes the page beside them)."""
         return self._native.report_html(report_points)
 
     def write(self, directory: str | os.PathLike, *, plots: bool = True, report: bool = True, report_points: int = 20000,
@@ -103,7 +104,7 @@ class Analysis:
     # network), and the whole image's plot for front ends that show no HTML.
     def _repr_html_(self) -> str:
         page = self.report_html(5000)
-        return ('<iframe style="width:100%;height:760px;border:1px solid #ccc" sandbox="allow-scripts" '
+        return ('<iframe style="width:100%;height:820px;border:1px solid #ccc" sandbox="allow-scripts" '
                 f'srcdoc="{html.escape(page, quote=True)}"></iframe>')
 
     def _repr_png_(self) -> bytes:
@@ -298,8 +299,10 @@ def _capture_from_exr(path: str, report: dict) -> Capture:
 
 
 def sensor(spectral: Any, config: Any = None, *, preset: str | None = None, wavelengths_nm: Sequence[float] | None = None,
-           band_edges_nm: Sequence[float] | None = None, illuminant: str | None = None, set: Mapping[str, Any] | None = None,
-           seed: int | None = None, threads: int = 0, output: str | os.PathLike | None = None) -> Capture:
+           band_edges_nm: Sequence[float] | None = None, illuminant: str | None = None, camera: str | None = None,
+           exposure_s: float | str | None = None, cfa: str | None = None, noise: bool = True,
+           set: Mapping[str, Any] | None = None, seed: int | None = None, threads: int = 0,
+           output: str | os.PathLike | None = None) -> Capture:
     """Simulates a camera on a spectral image, as `chromatrace sensor IN.exr -o OUT.exr` does.
 
     spectral: a spectral EXR path, or a height x width x bands array with its wavelengths_nm (band centres) or
@@ -308,6 +311,9 @@ def sensor(spectral: Any, config: Any = None, *, preset: str | None = None, wave
     config: sensor settings, a chromatrace-sensor/1 file path or a dict of settings over the preset.
     preset: ideal, canon_eos_5d_mkiii, machine_vision_ccd or smartphone.
     illuminant: lights a reflectance image (a CIE illuminant name or a CSV file).
+    camera: the spectral response, a shipped camera, cie1931 or a CSV file (--camera).
+    exposure_s: the exposure time in seconds, or "auto" (--exposure-s; the presets fix one).
+    cfa: a Bayer pattern (RGGB, BGGR, GRBG, GBRG) or "none" (--cfa). noise=False: every pixel at its expected value.
     set: settings by their dotted keys, {"noise.read_e": 3}, applied last, as --set.
     seed: the temporal noise's seed (noise.seed).
     output: where to keep the simulator's EXR (.exr) as the command writes it; a temporary file otherwise.
@@ -323,6 +329,16 @@ def sensor(spectral: Any, config: Any = None, *, preset: str | None = None, wave
             patches.append((json.dumps(config), "--config"))
         else:
             raise InputError("--config: a settings file's path or a dict of settings")
+    if camera is not None:
+        patches.append((json.dumps({"spectral_response": {"camera": camera}}), "--camera"))
+    if exposure_s is not None:
+        if not (exposure_s == "auto" or (isinstance(exposure_s, (int, float)) and not isinstance(exposure_s, bool))):
+            raise InputError(f'--exposure-s: must be a time in seconds or "auto", got "{exposure_s}"')
+        patches.append((json.dumps({"exposure": {"time_s": exposure_s}}), "--exposure-s"))
+    if cfa is not None:
+        patches.append((json.dumps({"cfa": {"enabled": False} if cfa == "none" else {"enabled": True, "pattern": cfa}}), "--cfa"))
+    if not noise:
+        patches.append((json.dumps({"noise": {"enabled": False}}), "--no-noise"))
     if seed is not None:
         patches.append((json.dumps({"noise": {"seed": int(seed)}}), "--seed"))
     for key, value in (set or {}).items():

@@ -33,4 +33,10 @@ addon="$prefix/share/chromatrace/blender_addon"
 ( cd / && env -u CHROMATRACE_EXE PATH=/usr/bin:/bin python3 -c "import sys; sys.path.insert(0, '$addon'); \
   from chromatrace import spectra, tool; assert tool.find_executable() == '$prefix/bin/chromatrace', tool.find_executable(); \
   assert 'cornell_box.csv:red' in spectra.library_entries()" ) || fail "installed add-on does not find bin/chromatrace or the spectra"
+# The Python module, where it was built: the package beside its extension, importable from the prefix.
+if [ -n "${CHROMATRACE_PYTHON:-}" ]; then
+  module=$(find "$prefix/lib" -path '*-packages/chromatrace/__init__.py' | head -1)
+  [ -n "$module" ] && ls "$(dirname "$module")"/_chromatrace*.so > /dev/null || fail "Python module chromatrace missing"
+  ( cd / && PYTHONPATH="$(dirname "$(dirname "$module")")" PYTHONDONTWRITEBYTECODE=1 "$CHROMATRACE_PYTHON" -c "import chromatrace, numpy;     a = chromatrace.analyze(numpy.full((8, 8, 3), 0.5, numpy.float32)); assert a.regions[0]['pixels'] == 64" )     || fail "installed Python module does not import or run"
+fi
 echo "install: ok"

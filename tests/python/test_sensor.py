@@ -61,11 +61,12 @@ def test_the_camera_on_an_array_is_the_command_on_its_file(chromatrace, tmp_path
     settings = {"noise": {"read_e": 4}, "adc": {"bits": 12}}
     (tmp_path / "camera.json").write_text(json.dumps(settings))
     run("sensor", written, "-o", tmp_path / "command.exr", "--illuminant", "D65", "--preset", "canon_eos_5d_mkiii",
-        "--config", tmp_path / "camera.json", "--seed", "7", "--set", "noise.dsnu_e=2", "--quiet")
+        "--config", tmp_path / "camera.json", "--seed", "7", "--set", "noise.dsnu_e=2", "--exposure-s", "auto", "--cfa", "GRBG",
+        "--quiet")
     expected, attributes = exr_layers(tmp_path / "command.exr")
     for source in (written, reflectance):
         capture = chromatrace.sensor(source, settings, preset="canon_eos_5d_mkiii", band_edges_nm=macbeth["band_edges_nm"],
-                                     illuminant="D65", seed=7, set={"noise.dsnu_e": 2})
+                                     illuminant="D65", seed=7, set={"noise.dsnu_e": 2}, exposure_s="auto", cfa="GRBG")
         assert capture.signal == "DN" == attributes["chromatrace.signal"]
         assert capture.rgb.shape == (100, 150, 3)
         for k, c in enumerate("RGB"):
@@ -75,6 +76,7 @@ def test_the_camera_on_an_array_is_the_command_on_its_file(chromatrace, tmp_path
         assert capture.metadata["chromatrace.black_level"] == attributes["chromatrace.black_level"]
         assert capture.settings["noise"]["read_e"] == 4 and capture.settings["noise"]["dsnu_e"] == 2
         assert capture.settings["adc"]["bits"] == 12 and capture.settings["noise"]["seed"] == 7
+        assert capture.settings["cfa"]["pattern"] == "GRBG" and capture.exposure_s != 0.01  # the preset's time, replaced
 
 
 def test_camera_refusals_raise_the_commands_message(chromatrace, tmp_path):
