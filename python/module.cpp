@@ -107,17 +107,26 @@ struct Analysis {
   }
 };
 
-Analysis analyse(analyzer::AnalysisImage input, AnalyzeArgs args, bool camera_numbers_checked) {
+// The options checked before the image is read, in the command's order, so that a bad option is named first as the
+// command names it; the rectangles parsed into the regions.
+AnalyzeArgs checked(AnalyzeArgs args) {
   if (args.bins < 2 || args.bins > 1024) throw InputError(fmt::format("--bins: must be in [2, 1024], got {}", args.bins));
   if (args.threads < 0) throw InputError(fmt::format("--threads: must be >= 0, got {}", args.threads));
   if (args.regions.segment) analyzer::check_segmentation_options(args.regions.segmentation);
-  std::optional<analyzer::Vec3> known;
   if (args.illuminant) {
-    known = analyzer::Vec3((*args.illuminant)[0], (*args.illuminant)[1], (*args.illuminant)[2]);
-    if (!known->allFinite() || known->minCoeff() < 0 || known->sum() <= 0)
+    const analyzer::Vec3 known((*args.illuminant)[0], (*args.illuminant)[1], (*args.illuminant)[2]);
+    if (!known.allFinite() || known.minCoeff() < 0 || known.sum() <= 0)
       throw InputError("--illuminant: expected R,G,B with non-negative numbers, not all 0");
   }
   for (const std::string& r : args.rects) args.regions.rects.push_back(analyzer::parse_rect(r, "--rect"));
+  args.rects.clear();
+  return args;
+}
+
+// analyze's steps after reading (cli/cmd_analyze.cpp), on `args` as checked() leaves them.
+Analysis analyse(analyzer::AnalysisImage input, const AnalyzeArgs& args, bool camera_numbers_checked) {
+  std::optional<analyzer::Vec3> known;
+  if (args.illuminant) known = analyzer::Vec3((*args.illuminant)[0], (*args.illuminant)[1], (*args.illuminant)[2]);
   Analysis out;
   out.input = std::move(input);
   const analyzer::RgbImage& layer = analyzer::select_layer(out.input, args.layer);
@@ -136,8 +145,9 @@ Analysis analyse(analyzer::AnalysisImage input, AnalyzeArgs args, bool camera_nu
   return out;
 }
 
-Analysis analyze_file(const std::string& path, const AnalyzeArgs& args) {
+Analysis analyze_file(const std::string& path, const AnalyzeArgs& options) {
   py::gil_scoped_release release;
+  const AnalyzeArgs args = checked(options);
   return analyse(analyzer::read_analysis_image(path, args.input_transfer, args.raw), args, false);
 }
 
@@ -146,7 +156,8 @@ bool camera_config_allowed_for_array(const AnalyzeArgs& args) { return args.came
 
 // An H × W × 3 array of uint8, uint16, uint32 (their stored integers) or float32/float64, as the image named `name`.
 // One copy, into the analyzer's own float image (which it sets aside pixels in), whatever the array's strides.
-Analysis analyze_array(const py::array& array, const std::string& name, const AnalyzeArgs& args) {
+Analysis analyze_array(const py::array& array, const std::string& name, const AnalyzeArgs& options) {
+  const AnalyzeArgs args = checked(options);
   if (array.ndim() != 3 || array.shape(2) != 3)
     throw InputError(fmt::format("{}: an image array is height × width × 3 (R, G, B), got shape ({})", name,
                                  fmt::join(std::vector<py::ssize_t>(array.shape(), array.shape() + array.ndim()), ", ")));

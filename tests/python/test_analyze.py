@@ -99,7 +99,11 @@ def test_refusals_raise_the_commands_message(chromatrace, tmp_path):
         (dict(image=photo, encoding="gamma=-1"), ["analyze", photo, "-o", tmp_path / "b", "--input-transfer", "gamma=-1"]),
         (dict(image=photo, layer="diffuse"), ["analyze", photo, "-o", tmp_path / "c", "--layer", "diffuse"]),
         (dict(image=photo, mask=tmp_path / "nothing.png"), ["analyze", photo, "-o", tmp_path / "d", "--mask", tmp_path / "nothing.png"]),
-        (dict(image=photo, rects=["1,2,3"]), None),
+        (dict(image=photo, rects=["1,2,3"]), ["analyze", photo, "-o", tmp_path / "e", "--rect", "1,2,3"]),
+        # Options are checked before the image is read, as the command checks them.
+        (dict(image=missing, bins=1), ["analyze", missing, "-o", tmp_path / "f", "--bins", "1"]),
+        (dict(image=np.zeros((2, 2)), segment=True, segment_min_area=2.0),
+         ["analyze", missing, "-o", tmp_path / "g", "--segment", "--segment-min-area", "2"]),
     ]
     for kwargs, command in cases:
         with pytest.raises(chromatrace.InputError) as raised:

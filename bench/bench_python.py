@@ -1,0 +1,122 @@
+#!/usr/bin/env python3
+# SPDX-License-Identifier: Apache-2.0
+"""The Python module against the command (docs/python.md), side by side in one run.
+
+1. Per image: a loop over the test photographs (tests/data/photos/masks.json), analysed as Python calls
+   (chromatrace.analyze(path), the results as Python objects) and as one process per image
+   (`chromatrace analyze FILE -o DIR --no-plots --no-report`, analysis.json read back), alternating, best of N.
+2. Memory: a 24-megapixel image (6000 x 4000, 8-bit: coffee.png tiled 10 x 10), analysed by the command from an
+   uncompressed TIFF and by the module from the same pixels as a NumPy array, each in a process of its own: the peak
+   resident memory of each, and the module's peak less what the process held before the call (Python, NumPy, the
+   array), which is what the analysis itself took.
+
+Usage: CHROMATRACE_EXE=build/cli/chromatrace PYTHONPATH=build/python python3 bench/bench_python.py [--repeats N]
+"""
+import argparse
+import json
+import os
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+SOURCE = Path(__file__).resolve().parents[1]
+EXE = os.environ.get("CHROMATRACE_EXE", str(SOURCE / "build/cli/chromatrace"))
+
+
+def photographs():
+    photos = json.loads((SOURCE / "tests/data/photos/masks.json").read_text())["photos"]
+    return [Path(p["file"]) if Path(p["file"]).is_absolute() else SOURCE / "tests/data/photos" / p["file"] for p in photos]
+
+
+def per_image(repeats, work):
+    import chromatrace
+    print(f"{'photograph':<22} {'pixels':>10} {'python (s)':>11} {'process (s)':>12} {'ratio':>7}")
+    totals = [0.0, 0.0]
+    for photo in photographs():
+        best = [float("inf"), float("inf")]
+        for _ in range(repeats):
+            start = time.perf_counter()
+            a = chromatrace.analyze(photo)
+            regions = len(a.regions)
+            best[0] = min(best[0], time.perf_counter() - start)
+            start = time.perf_counter()
+            out = work / "out"
+            subprocess.run([EXE, "analyze", str(photo), "-o", str(out), "--no-plots", "--no-report", "--quiet"], check=True)
+            regions_command = len(json.loads((out / "analysis.json").read_text())["regions"])
+            best[1] = min(best[1], time.perf_counter() - start)
+            assert regions == regions_command
+        totals = [t + b for t, b in zip(totals, best)]
+        print(f"{photo.name:<22} {a.data['image']['width'] * a.data['image']['height']:>10} {best[0]:>11.3f} {best[1]:>12.3f} "
+              f"{best[1] / best[0]:>6.2f}x")
+    n = len(photographs())
+    print(f"{'mean per image':<22} {'':>10} {totals[0] / n:>11.3f} {totals[1] / n:>12.3f} {totals[1] / totals[0]:>6.2f}x")
+
+
+MODULE_CHILD = """
+import resource, sys, numpy as np, OpenImageIO as oiio, chromatrace
+image = oiio.ImageInput.open(sys.argv[1]); pixels = image.read_image(0, 0, 0, 3, "uint8"); image.close()
+before = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+a = chromatrace.analyze(pixels)
+print(before, resource.getrusage(resource.RUSAGE_SELF).ru_maxrss, len(a.regions))
+"""
+
+
+def child_peak_kib(args):
+    """Runs `args` in a child process; its stdout and its peak resident memory (KiB)."""
+    pid = os.fork()
+    if pid == 0:
+        os.execvp(args[0], args)
+    # The child's own rusage, not the sum over every child so far.
+    _, status, usage = os.wait4(pid, 0)
+    assert os.waitstatus_to_exitcode(status) == 0, args
+    return usage.ru_maxrss
+
+
+def memory(work):
+    import numpy as np
+    import OpenImageIO as oiio
+    tile = oiio.ImageInput.open("/usr/lib/python3/dist-packages/skimage/data/coffee.png")
+    pixels = tile.read_image(0, 0, 0, 3, "uint8")
+    tile.close()
+    big = np.ascontiguousarray(np.tile(pixels, (10, 10, 1)))
+    path = work / "24mp.tif"
+    out = oiio.ImageOutput.create(str(path))
+    spec = oiio.ImageSpec(big.shape[1], big.shape[0], 3, "uint8")
+    spec.attribute("compression", "none")
+    out.open(str(path), spec)
+    out.write_image(big)
+    out.close()
+    del big
+    command = child_peak_kib([EXE, "analyze", str(path), "-o", str(work / "big"), "--no-plots", "--no-report", "--quiet"])
+    result = work / "module.txt"
+    fd = os.open(result, os.O_WRONLY | os.O_CREAT | os.O_TRUNC)
+    pid = os.fork()
+    if pid == 0:
+        os.dup2(fd, 1)
+        os.execvp(sys.executable, [sys.executable, "-c", MODULE_CHILD, str(path)])
+    os.close(fd)
+    _, status, usage = os.wait4(pid, 0)
+    assert os.waitstatus_to_exitcode(status) == 0
+    before, after, _ = map(int, result.read_text().split())
+    mib = lambda k: k / 1024
+    print(f"24-megapixel 8-bit image ({6000 * 4000 * 3 / 2**20:.0f} MiB as uint8, {6000 * 4000 * 12 / 2**20:.0f} MiB as float):")
+    print(f"  command, from a TIFF:          peak {mib(command):8.0f} MiB")
+    print(f"  module, from a NumPy array:    peak {mib(usage.ru_maxrss):8.0f} MiB; before the call {mib(before):.0f} MiB "
+          f"(Python, NumPy, OpenImageIO, the array); the analysis took {mib(usage.ru_maxrss - before):.0f} MiB")
+    print(f"  the analysis's memory, module / command: {(usage.ru_maxrss - before) / command:.2f}")
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--repeats", type=int, default=3)
+    args = parser.parse_args()
+    print(f"load average {' '.join(f'{v:.2f}' for v in os.getloadavg())}, {os.cpu_count()} cores")
+    with tempfile.TemporaryDirectory(prefix="chromatrace-bench-") as scratch:
+        per_image(args.repeats, Path(scratch))
+        memory(Path(scratch))
+
+
+if __name__ == "__main__":
+    main()
