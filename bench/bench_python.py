@@ -10,7 +10,13 @@
    resident memory of each, and the module's peak less what the process held before the call (Python, NumPy, the
    array), which is what the analysis itself took.
 
+3. With --blender EXE: what the Blender add-on's command calls cost, the question before it calls the module in
+   process. The batch renders the paper box (64 x 64, 16 samples: a preview) with CHROMATRACE_EXE pointing at a
+   wrapper that times each call; printed per subcommand beside the batch's wall time and a bare start of the full
+   program (`scene-bands --help`).
+
 Usage: CHROMATRACE_EXE=build/cli/chromatrace PYTHONPATH=build/python python3 bench/bench_python.py [--repeats N]
+       [--blender blender]
 """
 import argparse
 import json
@@ -108,14 +114,60 @@ def memory(work):
     print(f"  the analysis's memory, module / command: {(usage.ru_maxrss - before) / command:.2f}")
 
 
+WRAPPER = """#!/bin/sh
+start=$(date +%s.%N)
+"{exe}" "$@"
+status=$?
+echo "$1 $start $(date +%s.%N)" >> "{log}"
+exit $status
+"""
+
+
+def blender_calls(blender, work):
+    log = work / "calls.log"
+    wrapper = work / "chromatrace"
+    wrapper.write_text(WRAPPER.format(exe=os.path.abspath(EXE), log=log))
+    wrapper.chmod(0o755)
+    start = time.perf_counter()
+    subprocess.run([blender, "--background", "--factory-startup", "--python", str(SOURCE / "blender_addon/batch.py"), "--",
+                    "--scene", str(SOURCE / "scenes/paper/box.json"), "--out", str(work / "box.exr"), "--resolution", "64x64",
+                    "--samples", "16", "--quiet"], check=True, env={**os.environ, "CHROMATRACE_EXE": str(wrapper)},
+                   stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    wall = time.perf_counter() - start
+    calls: dict[str, list[float]] = {}
+    for line in log.read_text().splitlines():
+        name, t0, t1 = line.split()
+        calls.setdefault(name, []).append(float(t1) - float(t0))
+    bare = min(_timed([EXE, "scene-bands", "--help"]) for _ in range(5))
+    print(f"Blender add-on batch ({blender}), paper box 64 x 64, 16 samples: {wall:.2f} s wall")
+    print(f"{'subcommand':<14} {'calls':>5} {'seconds':>8} {'each':>7}")
+    for name, times in sorted(calls.items(), key=lambda kv: -sum(kv[1])):
+        print(f"{name:<14} {len(times):>5} {sum(times):>8.2f} {sum(times) / len(times):>7.3f}")
+    total = sum(sum(t) for t in calls.values())
+    count = sum(len(t) for t in calls.values())
+    print(f"{'all':<14} {count:>5} {total:>8.2f} {total / count:>7.3f}   ({100 * total / wall:.0f} % of the batch's wall time)")
+    print(f"a bare start of the full program (scene-bands --help): {bare:.3f} s; {count} starts: {count * bare:.2f} s")
+
+
+def _timed(args):
+    start = time.perf_counter()
+    subprocess.run(args, check=True, stdout=subprocess.DEVNULL)
+    return time.perf_counter() - start
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeats", type=int, default=3)
+    parser.add_argument("--blender", help="also time the Blender add-on's command calls in a batch run with this Blender")
+    parser.add_argument("--only-blender", action="store_true", help="only that")
     args = parser.parse_args()
     print(f"load average {' '.join(f'{v:.2f}' for v in os.getloadavg())}, {os.cpu_count()} cores")
     with tempfile.TemporaryDirectory(prefix="chromatrace-bench-") as scratch:
-        per_image(args.repeats, Path(scratch))
-        memory(Path(scratch))
+        if not args.only_blender:
+            per_image(args.repeats, Path(scratch))
+            memory(Path(scratch))
+        if args.blender:
+            blender_calls(args.blender, Path(scratch))
 
 
 if __name__ == "__main__":
