@@ -247,6 +247,29 @@ AnalysisImage read_camera_raw(const std::filesystem::path& path, const RawOption
   return out;
 }
 
+CameraMosaic read_camera_mosaic(const std::filesystem::path& path) {
+  const std::string file = path.string();
+  OpenRaw r;
+  open_raw(file, r);
+  LibRaw& raw = *r.raw;
+  CameraMosaic out;
+  out.pattern = bayer_pattern(raw);
+  const std::uint16_t* data = raw.imgdata.rawdata.raw_image;
+  if (out.pattern.empty() || data == nullptr)
+    throw InputError(fmt::format("{}: LibRaw finds no 2 x 2 Bayer mosaic in it", file));
+  const libraw_image_sizes_t& s = raw.imgdata.sizes;
+  out.width = s.width;
+  out.height = s.height;
+  out.values.resize(static_cast<std::size_t>(s.width) * static_cast<std::size_t>(s.height));
+  for (int y = 0; y < s.height; ++y)
+    for (int x = 0; x < s.width; ++x)
+      out.values[static_cast<std::size_t>(y) * static_cast<std::size_t>(s.width) + static_cast<std::size_t>(x)] =
+          data[static_cast<std::size_t>(y + s.top_margin) * s.raw_pitch / 2 + static_cast<std::size_t>(x + s.left_margin)];
+  out.black_level = mean_black(raw);
+  out.white_level = raw.imgdata.color.maximum;
+  return out;
+}
+
 std::vector<std::pair<std::string, std::string>> describe_camera_raw(const std::filesystem::path& path) {
   const std::string file = path.string();
   OpenRaw r;

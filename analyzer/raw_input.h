@@ -7,6 +7,7 @@
 // demosaicing, at half size: each 2×2 Bayer tile gives its red, its first green (in row order) and its blue
 // exactly as captured.
 
+#include <cstdint>
 #include <filesystem>
 #include <string>
 #include <utility>
@@ -33,6 +34,17 @@ const std::vector<std::string>& raw_demosaic_names();
 // ending early or corrupt), when it holds no Bayer mosaic and half size is asked for, or for an unknown
 // demosaicing method.
 AnalysisImage read_camera_raw(const std::filesystem::path& file, const RawOptions& options);
+
+// A camera raw's Bayer mosaic as stored: one value per visible photosite, [y][x], its black level not subtracted; the
+// 2×2 pattern of its top-left tile ("RGGB" …), the mean black level of a tile and the white level. InputError naming
+// the file when LibRaw cannot decode it or finds no 2×2 Bayer mosaic in it.
+struct CameraMosaic {
+  int width = 0, height = 0;
+  std::vector<std::uint16_t> values;
+  std::string pattern;
+  double black_level = 0, white_level = 0;
+};
+CameraMosaic read_camera_mosaic(const std::filesystem::path& file);
 
 // What `chromatrace info` says of a camera raw: one "key: value" per line, in order.
 std::vector<std::pair<std::string, std::string>> describe_camera_raw(const std::filesystem::path& file);

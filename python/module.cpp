@@ -30,6 +30,7 @@
 #include "analyzer/image_input.h"
 #include "analyzer/output.h"
 #include "analyzer/plots.h"
+#include "analyzer/raw_input.h"
 #include "analyzer/regions.h"
 #include "analyzer/report.h"
 #include "calibrate/calibration.h"
@@ -400,6 +401,23 @@ py::dict sensor_file(const std::filesystem::path& input, const std::filesystem::
   return out;
 }
 
+// A camera raw's (or the simulator's DNG's) Bayer mosaic as stored.
+py::dict read_raw_mosaic(const std::filesystem::path& path) {
+  analyzer::CameraMosaic m;
+  {
+    py::gil_scoped_release release;
+    m = analyzer::read_camera_mosaic(path);
+  }
+  py::array_t<std::uint16_t> values({static_cast<py::ssize_t>(m.height), static_cast<py::ssize_t>(m.width)});
+  std::memcpy(values.mutable_data(), m.values.data(), m.values.size() * sizeof(std::uint16_t));
+  py::dict out;
+  out["mosaic"] = values;
+  out["pattern"] = m.pattern;
+  out["black_level"] = m.black_level;
+  out["white_level"] = m.white_level;
+  return out;
+}
+
 // ---------------------------------------------------------------------------------------------------------------
 // Calibration
 
@@ -531,6 +549,7 @@ PYBIND11_MODULE(_chromatrace, m) {
   m.def("write_spectral_exr", &write_spectral_exr, py::arg("path"), py::arg("spectral"), py::arg("band_edges_nm"), py::arg("reflective"),
         py::arg("components"), py::arg("object_ids"), py::arg("object_names"), py::arg("attributes"));
   m.def("read_image_channels", &read_image_channels, py::arg("path"));
+  m.def("read_raw_mosaic", &read_raw_mosaic, py::arg("path"));
   m.def("sensor_file", &sensor_file, py::arg("input"), py::arg("output"), py::arg("patches"), py::arg("config_file"),
         py::arg("illuminant"), py::arg("threads"), py::arg("block_rows"));
   m.def("calibrate_files", &calibrate_files, py::arg("flats"), py::arg("darks"), py::arg("flat_arrays"), py::arg("dark_arrays"),

@@ -7,6 +7,7 @@ Each function does what its command does, with the same library code and the sam
 - sensor(spectral, ...)            chromatrace sensor: a Capture (the camera's R, G, B, its layers and numbers)
 - read_spectral_exr(path)          a spectral EXR (the JCGT layout) as arrays
 - write_spectral_exr(path, ...)    arrays as a spectral EXR, as the renderers write it
+- read_raw_mosaic(path)            a camera raw's Bayer mosaic as stored
 - calibrate(flats, darks, ...)     chromatrace calibrate: EMVA 1288 sensor settings from frames
 
 Bad input raises InputError (a ValueError) whose message is the line the command prints after "error: ": it names
@@ -27,7 +28,8 @@ import numpy as np
 from . import _chromatrace
 from ._chromatrace import InputError
 
-__all__ = ["InputError", "Analysis", "Capture", "analyze", "sensor", "read_spectral_exr", "write_spectral_exr", "calibrate"]
+__all__ = ["InputError", "Analysis", "Capture", "analyze", "sensor", "read_spectral_exr", "write_spectral_exr", "read_raw_mosaic",
+           "calibrate"]
 
 
 def _path(value: Any) -> str | None:
@@ -239,6 +241,17 @@ def write_spectral_exr(path: str | os.PathLike, spectral: Any, wavelengths_nm: S
 
 
 # ----------------------------------------------------------------------------------------------------------------
+# Camera raw files
+
+
+def read_raw_mosaic(path: str | os.PathLike) -> dict:
+    """A camera raw's Bayer mosaic as stored (DNG, CR2, NEF … through LibRaw): "mosaic" (height x width uint16, one
+    value per visible photosite, the black level not subtracted), "pattern" (the top-left 2 x 2 tile, "RGGB" …),
+    "black_level" (a tile's mean) and "white_level"."""
+    return _chromatrace.read_raw_mosaic(os.fspath(path))
+
+
+# ----------------------------------------------------------------------------------------------------------------
 # The camera
 
 
@@ -248,7 +261,9 @@ class Capture:
 
     rgb: the final R, G, B (height x width x 3 float32) in the units `signal` names: "DN" with the ADC on, "e-" with
     it off, "normalised" with a rendering intent. linear: the noise-free linear camera signal (e-); display: the
-    sRGB picture for people, in [0, 1]; components: each light-path component's linear camera RGB (e-); object_ids.
+    sRGB picture for people, in [0, 1]; components: each light-path component's linear camera RGB (e-); object_ids;
+    with mosaic=True, mosaic: the colour filter array's photosites before demosaicing (height x width uint16 DN,
+    black level included) and cfa_pattern (its top-left 2 x 2 tile, "RGGB" …).
     metadata: the camera's numbers as the EXR header gives them (chromatrace.black_level, white_level, signal,
     units, curve …); settings: the effective sensor settings; notes: decisions taken.
     """
@@ -258,6 +273,8 @@ class Capture:
     display: np.ndarray | None = None
     components: dict[str, np.ndarray] = field(default_factory=dict)
     object_ids: np.ndarray | None = None
+    mosaic: np.ndarray | None = None
+    cfa_pattern: str | None = None
     exposure_s: float = 0.0
     metadata: dict[str, Any] = field(default_factory=dict)
     settings: dict = field(default_factory=dict)
@@ -302,7 +319,7 @@ def sensor(spectral: Any, config: Any = None, *, preset: str | None = None, wave
            band_edges_nm: Sequence[float] | None = None, illuminant: str | None = None, camera: str | None = None,
            exposure_s: float | str | None = None, cfa: str | None = None, noise: bool = True,
            set: Mapping[str, Any] | None = None, seed: int | None = None, threads: int = 0,
-           output: str | os.PathLike | None = None) -> Capture:
+           output: str | os.PathLike | None = None, mosaic: bool = False) -> Capture:
     """Simulates a camera on a spectral image, as `chromatrace sensor IN.exr -o OUT.exr` does.
 
     spectral: a spectral EXR path, or a height x width x bands array with its wavelengths_nm (band centres) or
@@ -317,6 +334,9 @@ def sensor(spectral: Any, config: Any = None, *, preset: str | None = None, wave
     set: settings by their dotted keys, {"noise.read_e": 3}, applied last, as --set.
     seed: the temporal noise's seed (noise.seed).
     output: where to keep the simulator's EXR (.exr) as the command writes it; a temporary file otherwise.
+    mosaic: also the colour filter array's photosites as read out, before demosaicing (needs a CFA): the simulator
+        runs a second time into a DNG, as `-o capture.dng` does (the noise is the same, keyed by pixel and seed), whose
+        mosaic is then read back.
     """
     patches: list[tuple[str, str]] = []
     config_file = ""
@@ -357,7 +377,15 @@ def sensor(spectral: Any, config: Any = None, *, preset: str | None = None, wave
         if not out.lower().endswith(".exr"):
             raise InputError(f"output: {out}: the Python module keeps the simulator's EXR (.exr), which holds every layer")
         report = _chromatrace.sensor_file(path, out, patches, config_file, illuminant or "", threads, 0)
-        return _capture_from_exr(out, report)
+        capture = _capture_from_exr(out, report)
+        if mosaic:
+            if not capture.settings["cfa"]["enabled"]:
+                raise InputError('mosaic: the settings have no colour filter array (cfa.enabled is false): give cfa="RGGB" or another')
+            dng = os.path.join(scratch, "mosaic.dng")
+            _chromatrace.sensor_file(path, dng, patches, config_file, illuminant or "", threads, 0)
+            raw = read_raw_mosaic(dng)
+            capture.mosaic, capture.cfa_pattern = raw["mosaic"], raw["pattern"]
+        return capture
 
 
 # ----------------------------------------------------------------------------------------------------------------

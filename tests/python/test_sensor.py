@@ -1,6 +1,8 @@
 # SPDX-License-Identifier: Apache-2.0
 # chromatrace.sensor, read_spectral_exr and write_spectral_exr against the command and the files' known contents.
 import json
+import subprocess
+from pathlib import Path
 
 import numpy as np
 import OpenImageIO as oiio
@@ -90,3 +92,37 @@ def test_camera_refusals_raise_the_commands_message(chromatrace, tmp_path):
         assert str(raised.value) == message
     with pytest.raises(chromatrace.InputError, match="^wavelengths_nm: 3 centres for 4 bands in the array$"):
         chromatrace.sensor(np.ones((2, 2, 4), np.float32), wavelengths_nm=[400, 500, 600])
+
+
+def dcraw_mosaic(raw, tmp_path):
+    """dcraw's own reading of a raw file's mosaic (-D: no scaling, no interpolation; -4: 16 bits), an independent
+    reader."""
+    out = tmp_path / (raw.stem + "-dcraw.tiff")
+    with open(out, "wb") as f:
+        subprocess.run(["dcraw", "-D", "-4", "-T", "-c", str(raw)], stdout=f, check=True)
+    image = oiio.ImageInput.open(str(out))
+    pixels = image.read_image(0, 0, 0, 1, "uint16")[:, :, 0]
+    image.close()
+    return pixels
+
+
+def test_a_camera_raws_mosaic_is_read_as_dcraw_reads_it(chromatrace, tmp_path):
+    raw = Path("/usr/share/doc/rawtran/IMG_5952.CR2")
+    m = chromatrace.read_raw_mosaic(raw)
+    assert m["pattern"] == "RGGB" and m["mosaic"].dtype == np.uint16 and m["mosaic"].shape == (2348, 3522)
+    assert np.array_equal(m["mosaic"], dcraw_mosaic(raw, tmp_path))
+    with pytest.raises(chromatrace.InputError) as raised:
+        chromatrace.read_raw_mosaic(SAMPLES / "spectral-exr_D65_emissive.exr")
+    assert "LibRaw" in str(raised.value)
+
+
+def test_the_cameras_mosaic_is_the_commands_dng(chromatrace, tmp_path):
+    source = SAMPLES / "spectral-exr_Macbeth_reflective.exr"
+    run("sensor", source, "-o", tmp_path / "command.dng", "--illuminant", "D65", "--preset", "canon_eos_5d_mkiii",
+        "--exposure-s", "auto", "--cfa", "BGGR", "--seed", "3", "--quiet")
+    capture = chromatrace.sensor(source, preset="canon_eos_5d_mkiii", illuminant="D65", exposure_s="auto", cfa="BGGR", seed=3,
+                                 mosaic=True)
+    assert capture.cfa_pattern == "BGGR" and capture.mosaic.shape == capture.rgb.shape[:2]
+    assert np.array_equal(capture.mosaic, dcraw_mosaic(tmp_path / "command.dng", tmp_path))
+    with pytest.raises(chromatrace.InputError, match="^mosaic: the settings have no colour filter array"):
+        chromatrace.sensor(source, illuminant="D65", preset="ideal", mosaic=True)
