@@ -20,7 +20,8 @@ packages=(
   slurm-wlm munge  # chromatrace farm's test on a single-node Slurm on localhost (tests/farm), and bench/bench_farm.sh
   python3-venv  # the virtual environments of the Blender modules below
   python3-dev pybind11-dev python3-numpy  # the Python module (python/)
-  python3-pytest python3-openimageio python3-nbclient python3-nbformat python3-ipykernel python3-nbconvert  # its tests and notebook (tests/python)
+  python3-pytest python3-openimageio python3-nbclient python3-nbformat python3-ipykernel python3-nbconvert \
+    python3-matplotlib python3-pil  # its tests and the worked notebook (tests/python, docs/notebooks)
 )
 # The report viewer is bundled from npm packages (package.json): node and npm from Debian unless a node
 # with its own npm (e.g. NodeSource's) is already there.

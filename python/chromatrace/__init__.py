@@ -306,7 +306,7 @@ def _capture_from_exr(path: str, report: dict) -> Capture:
             return None
         return np.ascontiguousarray(values[:, :, [index[k] for k in keys]])
 
-    layers = sorted({n.rsplit(".", 1)[0] for n in names if n.count(".") >= 1 and n.rsplit(".", 1)[1] in "RGB"})
+    layers = sorted({n.rsplit(".", 1)[0] for n in names if "." in n and n.rsplit(".", 1)[1] in ("R", "G", "B")})
     components = {l: rgb(l + ".") for l in layers if l not in ("linear", "display") and rgb(l + ".") is not None}
     ids = values[:, :, index["object_id"]].astype(np.int32) if "object_id" in index else None
     return Capture(rgb=rgb(""), signal=str(attributes.get("chromatrace.signal", "")), linear=rgb("linear."),
@@ -323,8 +323,9 @@ def sensor(spectral: Any, config: Any = None, *, preset: str | None = None, wave
     """Simulates a camera on a spectral image, as `chromatrace sensor IN.exr -o OUT.exr` does.
 
     spectral: a spectral EXR path, or a height x width x bands array with its wavelengths_nm (band centres) or
-        band_edges_nm: radiance (S0, W m^-2 sr^-1 nm^-1), or reflectance lit by `illuminant`. An array is written to a temporary spectral EXR first: the simulator streams its
-        input in blocks of rows from a file, as it does for any size of image.
+        band_edges_nm: radiance (S0, W m^-2 sr^-1 nm^-1), or reflectance lit by `illuminant`. An array is written to
+        a temporary spectral EXR first: the simulator streams its input in blocks of rows from a file, as it does for
+        any size of image.
     config: sensor settings, a chromatrace-sensor/1 file path or a dict of settings over the preset.
     preset: ideal, canon_eos_5d_mkiii, machine_vision_ccd or smartphone.
     illuminant: lights a reflectance image (a CIE illuminant name or a CSV file).

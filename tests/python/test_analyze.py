@@ -67,6 +67,8 @@ def test_an_array_of_any_layout_or_type_is_read_as_its_values(chromatrace):
     wide = np.zeros((40, 120, 3), np.float32)
     wide[:, ::2] = base
     assert chromatrace.analyze(wide[:, ::2]).data == reference
+    flipped = chromatrace.analyze(np.ascontiguousarray(base[::-1, :, ::-1])).data
+    assert chromatrace.analyze(base[::-1, :, ::-1]).data == flipped  # negative strides
 
 
 def test_labels_and_masks_as_arrays_are_the_files_regions(chromatrace, tmp_path):
