@@ -12,7 +12,9 @@
 #include <limits>
 #include <cstring>
 #include <filesystem>
+#include <memory>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -237,43 +239,32 @@ py::array_t<float, py::array::c_style | py::array::forcecast> float_array(const 
   return a;
 }
 
+// Each layer is read straight into the NumPy array returned (no copy).
 py::dict read_spectral_exr(const std::filesystem::path& path) {
   std::optional<SpectralExrReader> reader;
-  struct Layer {
-    std::string component, quantity;
-    std::vector<float> values;
-  };
-  std::vector<Layer> layers;
-  std::vector<std::int32_t> ids;
   {
     py::gil_scoped_release release;
     reader.emplace(path);
-    const SpectralExrInfo& info = reader->info();
-    if (!info.spectral()) throw InputError(fmt::format("{}: no spectral channels (an RGB EXR)", path.string()));
-    for (const SpectralLayer& l : info.layers) {
-      std::string q = l.name();
-      if (!l.component.empty()) q = q.substr(l.component.size() + 1);
-      layers.push_back({l.component, q, reader->read_layer(l)});
-    }
-    if (info.has_object_ids) {
-      ids.resize(static_cast<std::size_t>(info.width) * static_cast<std::size_t>(info.height));
-      reader->read_object_ids(0, info.height, ids);
-    }
   }
   const SpectralExrInfo& info = reader->info();
+  if (!info.spectral()) throw InputError(fmt::format("{}: no spectral channels (an RGB EXR)", path.string()));
+  const auto height = static_cast<py::ssize_t>(info.height), width = static_cast<py::ssize_t>(info.width);
   const auto bands = static_cast<py::ssize_t>(info.centres_nm.size());
-  const auto cube = [&](const std::vector<float>& v) {
-    py::array_t<float> a({static_cast<py::ssize_t>(info.height), static_cast<py::ssize_t>(info.width), bands});
-    std::memcpy(a.mutable_data(), v.data(), v.size() * sizeof(float));
-    return a;
-  };
   py::dict out, components;
-  for (const Layer& l : layers) {
+  for (const SpectralLayer& l : info.layers) {
+    py::array_t<float> cube({height, width, bands});
+    const std::span<float> values(cube.mutable_data(), static_cast<std::size_t>(cube.size()));
+    {
+      py::gil_scoped_release release;
+      reader->read_rows(l, 0, info.height, values);
+    }
+    std::string quantity = l.name();
     if (l.component.empty()) {
-      out[py::str(l.quantity)] = cube(l.values);
+      out[py::str(quantity)] = cube;
     } else {
+      quantity = quantity.substr(l.component.size() + 1);
       if (!components.contains(l.component)) components[py::str(l.component)] = py::dict();
-      components[py::str(l.component)][py::str(l.quantity)] = cube(l.values);
+      components[py::str(l.component)][py::str(quantity)] = cube;
     }
   }
   out["components"] = components;
@@ -281,9 +272,13 @@ py::dict read_spectral_exr(const std::filesystem::path& path) {
   out["band_edges_nm"] = info.bands.edges();
   out["kind"] = info.kind();
   if (info.has_object_ids) {
-    py::array_t<std::int32_t> a({static_cast<py::ssize_t>(info.height), static_cast<py::ssize_t>(info.width)});
-    std::memcpy(a.mutable_data(), ids.data(), ids.size() * sizeof(std::int32_t));
-    out["object_ids"] = a;
+    py::array_t<std::int32_t> ids({height, width});
+    const std::span<std::int32_t> values(ids.mutable_data(), static_cast<std::size_t>(ids.size()));
+    {
+      py::gil_scoped_release release;
+      reader->read_object_ids(0, info.height, values);
+    }
+    out["object_ids"] = ids;
   } else {
     out["object_ids"] = py::none();
   }
@@ -337,19 +332,21 @@ void write_spectral_exr(const std::filesystem::path& path, const py::object& tot
 // as numbers, others as text):
 // the camera simulator's EXR output as the Python side reads it back.
 py::tuple read_image_channels(const std::filesystem::path& path) {
-  std::vector<float> values;
-  OIIO::ImageSpec spec;
+  std::unique_ptr<OIIO::ImageInput> in;
   {
     py::gil_scoped_release release;
-    auto in = OIIO::ImageInput::open(path.string());
-    if (!in) throw InputError(fmt::format("{}: {}", path.string(), one_line(OIIO::geterror())));
-    spec = in->spec();
-    values.resize(static_cast<std::size_t>(spec.width) * static_cast<std::size_t>(spec.height) * static_cast<std::size_t>(spec.nchannels));
-    if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, values.data()))
-      throw InputError(fmt::format("{}: {}", path.string(), one_line(in->geterror())));
+    in = OIIO::ImageInput::open(path.string());
   }
+  if (!in) throw InputError(fmt::format("{}: {}", path.string(), one_line(OIIO::geterror())));
+  const OIIO::ImageSpec spec = in->spec();
+  // Read straight into the NumPy array returned.
   py::array_t<float> a({static_cast<py::ssize_t>(spec.height), static_cast<py::ssize_t>(spec.width), static_cast<py::ssize_t>(spec.nchannels)});
-  std::memcpy(a.mutable_data(), values.data(), values.size() * sizeof(float));
+  bool read = false;
+  {
+    py::gil_scoped_release release;
+    read = in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, a.mutable_data());
+  }
+  if (!read) throw InputError(fmt::format("{}: {}", path.string(), one_line(in->geterror())));
   py::dict attributes;
   for (const OIIO::ParamValue& p : spec.extra_attribs) {
     const OIIO::TypeDesc t = p.type();
