@@ -91,6 +91,28 @@ std::string image_png(const AnalysisImage& input, const RgbImage& layer, const I
   return "data:image/png;base64," + base64(plot::encode_png(shown));
 }
 
+// The segmentation's label map at the page's size, each segment in a colour of its own (hues a golden angle apart,
+// so that neighbouring labels differ), unassigned pixels dark grey; "" without a segmentation.
+std::string segment_map_png(const ImageAnalysis& a, const Display& d) {
+  if (!a.segmentation) return "";
+  const Segmentation& s = *a.segmentation;
+  const std::uint16_t last = s.labels.empty() ? 0 : *std::max_element(s.labels.begin(), s.labels.end());
+  cv::Mat palette(1, last + 1, CV_8UC3);  // OpenCV's 8-bit HSV: hue in [0, 180)
+  for (int k = 0; k <= last; ++k)
+    palette.at<cv::Vec3b>(0, k) = cv::Vec3b(static_cast<std::uint8_t>(std::fmod(k * 137.50776, 360.0) / 2.0), 170, 230);
+  cv::cvtColor(palette, palette, cv::COLOR_HSV2BGR);
+  palette.at<cv::Vec3b>(0, 0) = cv::Vec3b(40, 40, 40);
+  cv::Mat shown(d.height, d.width, CV_8UC3);
+  for (int y = 0; y < d.height; ++y)
+    for (int x = 0; x < d.width; ++x) {
+      const int sx = std::min(s.width - 1, static_cast<int>((x + 0.5) / d.scale));
+      const int sy = std::min(s.height - 1, static_cast<int>((y + 0.5) / d.scale));
+      const std::uint16_t k = s.labels[static_cast<std::size_t>(sy) * static_cast<std::size_t>(s.width) + static_cast<std::size_t>(sx)];
+      shown.at<cv::Vec3b>(y, x) = palette.at<cv::Vec3b>(0, k);
+    }
+  return "data:image/png;base64," + base64(plot::encode_png(shown));
+}
+
 // Per displayed pixel: the index of the smallest region that holds it (the whole image, 0, if none other).
 std::vector<std::uint16_t> label_map(const ImageAnalysis& a, const Display& d) {
   std::vector<std::uint16_t> smallest(static_cast<std::size_t>(a.width) * static_cast<std::size_t>(a.height), 0);
@@ -243,7 +265,7 @@ header h1 { font-size: 17px; margin: 0 0 4px; }
 main { display: flex; gap: 16px; padding: 12px 16px; flex-wrap: wrap; }
 #image-pane { flex: 1 1 420px; max-width: 640px; }
 #image-wrap { position: relative; line-height: 0; }
-#image, #overlay { width: 100%; image-rendering: pixelated; }
+#image, #overlay, #segments { width: 100%; image-rendering: pixelated; }
 #overlay { position: absolute; left: 0; top: 0; height: 100%; cursor: crosshair; }
 #histogram-pane { flex: 1 1 480px; }
 #histogram { position: relative; width: 100%; height: 520px; border: 1px solid #333; }
@@ -356,7 +378,7 @@ std::string report_html(const AnalysisImage& input, const ImageAnalysis& a, std:
 <div id="image-wrap" data-selected-pixels="0"><img id="image" alt="analysed image" src="{image}"><canvas id="overlay"></canvas></div>
 <p class="hint">Click a region in the image, or pick one below.</p>
 <div id="region-list"></div>
-<h2>Regions by size</h2>
+{segments}<h2>Regions by size</h2>
 {region_table}
 <h2>Illuminant</h2>
 <div id="illuminant">{illuminant}</div>
@@ -379,6 +401,10 @@ Colour: <select id="colour-mode"><option value="own">own colour</option><option 
       fmt::arg("numbers", beside_files ? R"(Numbers: <a href="analysis.json">analysis.json</a>, plots in <a href="plots/">plots/</a>.)"
                                        : "Numbers: the analysis's data (analysis.json's content)."),
       fmt::arg("notes", notes),
+      fmt::arg("segments", a.segmentation ? fmt::format("<h2>Segments</h2>\n<img id=\"segments\" alt=\"segment map\" src=\"{}\">\n"
+                                                        "<p class=\"hint\">Segment k in a colour of its own, unassigned pixels dark grey.</p>\n",
+                                                        segment_map_png(a, d))
+                                          : std::string()),
       fmt::arg("image", image_png(input, layer, a, d)), fmt::arg("illuminant", illuminant), fmt::arg("legend", legend),
       fmt::arg("unit", escape_html(unit.description)), fmt::arg("region_table", region_table),
       fmt::arg("data", json_script_safe(data.dump(-1, ' ', false, kReplaceInvalidUtf8))), fmt::arg("bundle", script_safe(std::string(viewer_bundle()))));
