@@ -116,7 +116,7 @@ const scene = new THREE.Scene();
 scene.background = new THREE.Color(0x1c1c1c);
 const camera = new THREE.PerspectiveCamera(35, 1, 0.01, 100);
 camera.up.set(0, 0, 1); // blue up: the cube stands on its red-green face
-camera.position.set(2.6, -1.6, 1.6);
+camera.position.set(3.02, -2.02, 1.82); // far enough back that the axes' names at the edges' ends stay in view
 const controls = new OrbitControls(camera, renderer.domElement);
 controls.target.set(0.5, 0.5, 0.5);
 controls.update(); // aims the camera at the target
