@@ -422,21 +422,26 @@ AnalysisImage read_analysis_image(const std::filesystem::path& file, const std::
   return analysis_image_of(read_raw(file), file.string(), input_transfer, declared);
 }
 
-AnalysisImage read_analysis_pixels(const std::string& name, int width, int height, std::vector<float> rgb, int integer_bits,
-                                   const std::string& input_transfer) {
+AnalysisImage read_analysis_pixels(const std::string& name, int width, int height, std::vector<float> values, int integer_bits,
+                                   const std::string& input_transfer, bool alpha) {
   const std::optional<ToneCurve> declared = parse_input_transfer(input_transfer);
   if (width < 1 || height < 1) throw InputError(fmt::format("{}: image has no pixels", name));
-  if (rgb.size() != static_cast<std::size_t>(width) * static_cast<std::size_t>(height) * 3)
-    throw InputError(fmt::format("{}: {} values for {} x {} pixels of R, G, B", name, rgb.size(), width, height));
+  const int channels = alpha ? 4 : 3;
+  if (values.size() != static_cast<std::size_t>(width) * static_cast<std::size_t>(height) * static_cast<std::size_t>(channels))
+    throw InputError(fmt::format("{}: {} values for {} x {} pixels of R, G, B{}", name, values.size(), width, height, alpha ? ", A" : ""));
   if (integer_bits != 0 && integer_bits != 8 && integer_bits != 16 && integer_bits != 32)
     throw InputError(fmt::format("{}: integer samples of {} bits; 8, 16 or 32 (or float)", name, integer_bits));
   RawImage raw;
   raw.width = width;
   raw.height = height;
-  raw.channels = 3;
+  raw.channels = channels;
   raw.names = {"R", "G", "B"};
+  if (alpha) {
+    raw.names.push_back("A");
+    raw.alpha = 3;
+  }
   raw.format = "array";
-  raw.values = std::move(rgb);
+  raw.values = std::move(values);
   if (integer_bits > 0) {
     raw.encoding.integer = true;
     raw.encoding.bits = integer_bits;

@@ -31,13 +31,13 @@ std::optional<ToneCurve> parse_input_transfer(const std::string& text);
 AnalysisImage read_analysis_image(const std::filesystem::path& file, const std::string& input_transfer = "auto",
                                   const RawOptions& raw = {});
 
-// The same analysis image from R, G, B already in memory (an array: [y][x][channel], `width` × `height` × 3 values),
-// named `name` in messages: `integer_bits` 8, 16 or 32 for integer samples given as their stored integers (as an
-// integer file's are read), 0 for float. Read as a file of those values would be, without the metadata a file can
-// carry: under "auto", integer samples are sRGB (a picture) and float ones linear. InputError naming `name` for a
-// size that does not match or other bits.
-AnalysisImage read_analysis_pixels(const std::string& name, int width, int height, std::vector<float> rgb, int integer_bits,
-                                   const std::string& input_transfer = "auto");
+// The same analysis image from R, G, B (and, with `alpha`, A) already in memory (an array: [y][x][channel], `width` ×
+// `height` × 3 or 4 values), named `name` in messages: `integer_bits` 8, 16 or 32 for integer samples given as their
+// stored integers (as an integer file's are read), 0 for float. Read as a file of those values would be, without the
+// metadata a file can carry: under "auto", integer samples are sRGB (a picture) and float ones linear; an alpha of 0
+// sets its pixel aside, as a file's does. InputError naming `name` for a size that does not match or other bits.
+AnalysisImage read_analysis_pixels(const std::string& name, int width, int height, std::vector<float> values, int integer_bits,
+                                   const std::string& input_transfer = "auto", bool alpha = false);
 
 // The frame of a camera measurement (chromatrace calibrate): one channel (a monochrome camera) or R, G, B (an alpha
 // channel aside), each as stored: integer files in their stored integers, the black level not subtracted. The

@@ -157,12 +157,13 @@ Analysis analyze_file(const std::string& path, const AnalyzeArgs& options) {
 // The camera's noise is in its digital numbers, which an array holds only as linear values.
 bool camera_config_allowed_for_array(const AnalyzeArgs& args) { return args.camera_config.empty() || args.input_transfer == "linear"; }
 
-// An H × W × 3 array of uint8, uint16, uint32 (their stored integers) or float32/float64, as the image named `name`.
+// An H × W × 3 (R, G, B) or × 4 (R, G, B, A) array of uint8, uint16, uint32 (their stored integers) or
+// float32/float64, as the image named `name`.
 // One copy, into the analyzer's own float image (which it sets aside pixels in), whatever the array's strides.
 Analysis analyze_array(const py::array& array, const std::string& name, const AnalyzeArgs& options) {
   const AnalyzeArgs args = checked(options);
-  if (array.ndim() != 3 || array.shape(2) != 3)
-    throw InputError(fmt::format("{}: an image array is height × width × 3 (R, G, B), got shape ({})", name,
+  if (array.ndim() != 3 || (array.shape(2) != 3 && array.shape(2) != 4))
+    throw InputError(fmt::format("{}: an image array is height × width × 3 (R, G, B) or × 4 (R, G, B, A), got shape ({})", name,
                                  fmt::join(std::vector<py::ssize_t>(array.shape(), array.shape() + array.ndim()), ", ")));
   const py::dtype type = array.dtype();
   const std::string type_name = type.attr("name").cast<std::string>();
@@ -175,18 +176,19 @@ Analysis analyze_array(const py::array& array, const std::string& name, const An
   if (!camera_config_allowed_for_array(args))
     throw InputError(fmt::format("--camera-config: the camera's noise is in its digital numbers: give them as {} with --input-transfer linear (encoding=\"linear\")", name));
   const auto height = static_cast<int>(array.shape(0)), width = static_cast<int>(array.shape(1));
+  const int channels = static_cast<int>(array.shape(2));
   const std::array<py::ssize_t, 3> strides = {array.strides(0), array.strides(1), array.strides(2)};
   const auto* base = static_cast<const std::uint8_t*>(array.data());
   py::gil_scoped_release release;
-  std::vector<float> rgb(static_cast<std::size_t>(width) * static_cast<std::size_t>(height) * 3);
+  std::vector<float> values(static_cast<std::size_t>(width) * static_cast<std::size_t>(height) * static_cast<std::size_t>(channels));
   const auto copy = [&]<typename T>(T) {
     std::size_t i = 0;
     for (int y = 0; y < height; ++y)
       for (int x = 0; x < width; ++x)
-        for (int c = 0; c < 3; ++c) {
+        for (int c = 0; c < channels; ++c) {
           T v;
           std::memcpy(&v, base + y * strides[0] + x * strides[1] + c * strides[2], sizeof(T));
-          rgb[i++] = static_cast<float>(v);
+          values[i++] = static_cast<float>(v);
         }
   };
   if (kind == 'u' && bits == 8) copy(std::uint8_t{});
@@ -194,7 +196,8 @@ Analysis analyze_array(const py::array& array, const std::string& name, const An
   else if (kind == 'u') copy(std::uint32_t{});
   else if (type.itemsize() == 4) copy(float{});
   else copy(double{});
-  return analyse(analyzer::read_analysis_pixels(name, width, height, std::move(rgb), bits, args.input_transfer), args, true);
+  return analyse(analyzer::read_analysis_pixels(name, width, height, std::move(values), bits, args.input_transfer, channels == 4), args,
+                 true);
 }
 
 // A height × width array of whole numbers (bool, integers, or floats holding whole numbers) as a label image.

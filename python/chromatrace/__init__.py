@@ -162,8 +162,9 @@ def analyze(image: Any, *, encoding: str = "auto", layer: str = "final", labels:
             segment_dark: float | None = None) -> Analysis:
     """Analyses an image's colour histograms, as `chromatrace analyze IMAGE` does.
 
-    image: a path (PNG, TIFF, EXR, JPEG, camera raw …) or a height x width x 3 array of R, G, B: uint8, uint16 or
-        uint32 hold their stored integers (as an integer file's), float32/float64 the values themselves.
+    image: a path (PNG, TIFF, EXR, JPEG, camera raw …) or a height x width x 3 array of R, G, B (x 4 with an alpha,
+        whose 0 sets a pixel aside, as a file's does): uint8, uint16 or uint32 hold their stored integers (as an
+        integer file's), float32/float64 the values themselves.
     encoding: what R, G, B hold (--input-transfer): "auto", "linear", "srgb" or "gamma=G". Under "auto" an
         integer array is sRGB and a float array linear, as files without metadata are taken.
     layer: the layer of a simulator's EXR (--layer); arrays have only "final".

@@ -71,6 +71,25 @@ def test_an_array_of_any_layout_or_type_is_read_as_its_values(chromatrace):
     assert chromatrace.analyze(base[::-1, :, ::-1]).data == flipped  # negative strides
 
 
+def test_an_alpha_channel_sets_pixels_aside_as_a_files_does(chromatrace, tmp_path):
+    pixels = read_pixels(DATA / "photos" / "smarties.png")
+    alpha = np.full(pixels.shape[:2] + (1,), 255, np.uint8)
+    alpha[:100, :150] = 0
+    rgba = np.ascontiguousarray(np.concatenate([pixels, alpha], axis=2))
+    path = tmp_path / "rgba.png"
+    out = oiio.ImageOutput.create(str(path))
+    spec = oiio.ImageSpec(rgba.shape[1], rgba.shape[0], 4, oiio.UINT8)
+    spec.alpha_channel = 3
+    out.open(str(path), spec)
+    out.write_image(rgba)
+    out.close()
+    expected, _ = command_analysis(path, tmp_path / "command")
+    got = chromatrace.analyze(rgba, name=str(path))
+    assert without_curve_source(got.data) == without_curve_source(expected)
+    assert got.region(0)["valid_pixels"] == rgba.shape[0] * rgba.shape[1] - 100 * 150
+    assert "alpha channel A: 15000 fully transparent pixels left out of every region" in got.data["notes"]
+
+
 def test_labels_and_masks_as_arrays_are_the_files_regions(chromatrace, tmp_path):
     photo = DATA / "photos" / "smarties.png"
     pixels = read_pixels(photo)
@@ -113,7 +132,8 @@ def test_refusals_raise_the_commands_message(chromatrace, tmp_path):
         assert isinstance(raised.value, ValueError)
         if command is not None:
             assert str(raised.value) == command_error(*command)
-    with pytest.raises(chromatrace.InputError, match=r"^array: an image array is height × width × 3 \(R, G, B\), got shape \(4, 4\)$"):
+    with pytest.raises(chromatrace.InputError,
+                       match=r"^array: an image array is height × width × 3 \(R, G, B\) or × 4 \(R, G, B, A\), got shape \(4, 4\)$"):
         chromatrace.analyze(np.zeros((4, 4), np.uint8))
     with pytest.raises(chromatrace.InputError, match="^array: samples of type int16; uint8, uint16, uint32, float32 or float64$"):
         chromatrace.analyze(np.zeros((4, 4, 3), np.int16))
