@@ -120,8 +120,11 @@ Series load_series(const std::filesystem::path& file, int threads) {
   series.base = root["base"].non_empty_string();
   const std::filesystem::path series_dir = file.parent_path();
   const std::filesystem::path base_file = (series_dir / series.base).lexically_normal();
-  if (!std::filesystem::is_regular_file(base_file))
-    root["base"].fail(fmt::format("{}: no such scene file", base_file.string()));
+  // The overload that reports rather than throws: a name the system refuses (too long, say) is bad input too.
+  std::error_code error;
+  if (!std::filesystem::is_regular_file(base_file, error))
+    root["base"].fail(fmt::format("{}: {}", base_file.string(),
+                                  error && error != std::errc::no_such_file_or_directory ? error.message() : "no such scene file"));
   try {
     series.base_scene = load_scene(base_file);
   } catch (const InputError& e) {

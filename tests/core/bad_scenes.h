@@ -52,6 +52,8 @@ inline const std::vector<BadScene>& bad_scenes() {
       {"series_bad_variant.json", "variants[1] \"rough\": materials.plastic.roughness: must be in [0, 1], got 1.5"},
       {"series_cycle.json", "variants[0].extends: a cycle of extends: a → c → b → a"},
       {"series_missing_base.json", "base: {scenes}/no_such_scene.json: no such scene file"},
+      // A name the system refuses is named as bad input, not thrown as a filesystem error (found by fuzz_series).
+      {"series_base_name_too_long.json", "base: {scenes}/" + std::string(300, 'n') + ".json: File name too long"},
       {"series_unknown_structure.json",
        "variants[0].expect.image[1]: unknown structure \"banana\" (the analyzer's classes: none, clipped, "
        "mixed, point, linear, thickened-line, L, skewed-T, fork, gamma, curved, thickened, volume, P, superposed, "
