@@ -31,6 +31,12 @@ def longest_stall_during(call):
     return span[0], stall
 
 
+def test_the_measure_sees_a_call_that_holds_the_gil():
+    values = np.random.default_rng(1).uniform(size=2_000_000).tolist()
+    duration, stall = longest_stall_during(lambda: sorted(values))  # one C call that never lets the GIL go
+    assert stall > 0.5 * duration, (stall, duration)
+
+
 def test_other_threads_run_while_the_module_works(chromatrace, tmp_path):
     rng = np.random.default_rng(2)
     image = rng.uniform(0.01, 1.0, size=(1500, 2000, 3)).astype(np.float32)
