@@ -41,6 +41,7 @@
 #include "core/error.h"
 #include "core/file_io.h"
 #include "core/json_input.h"
+#include "core/limits.h"
 #include "core/parallel.h"
 #include "core/spectral_exr.h"
 #include "plot/png.h"
@@ -175,6 +176,8 @@ Analysis analyze_array(const py::array& array, const std::string& name, const An
   if (bits == 64) throw InputError(fmt::format("{}: samples of type uint64; uint8, uint16, uint32, float32 or float64", name));
   if (!camera_config_allowed_for_array(args))
     throw InputError(fmt::format("--camera-config: the camera's noise is in its digital numbers: give them as {} with --input-transfer linear (encoding=\"linear\")", name));
+  // The file readers' limits, before any memory is taken: a broadcast view costs NumPy nothing at any size.
+  check_image_size(name, array.shape(1), array.shape(0), static_cast<int>(array.shape(2)));
   const auto height = static_cast<int>(array.shape(0)), width = static_cast<int>(array.shape(1));
   const int channels = static_cast<int>(array.shape(2));
   const std::array<py::ssize_t, 3> strides = {array.strides(0), array.strides(1), array.strides(2)};
@@ -202,6 +205,8 @@ Analysis analyze_array(const py::array& array, const std::string& name, const An
 
 // A height × width array of whole numbers (bool, integers, or floats holding whole numbers) as a label image.
 analyzer::LabelImage label_image(const py::object& array, const std::string& what) {
+  if (const py::array given = py::array::ensure(array); given && given.ndim() == 2)
+    check_image_size(what, given.shape(1), given.shape(0), 1);
   auto a = py::array_t<std::int64_t, py::array::c_style | py::array::forcecast>::ensure(array);
   if (!a || a.ndim() != 2) throw InputError(fmt::format("{}: expected a height × width array", what));
   const py::array original = py::array::ensure(array);
@@ -426,6 +431,8 @@ py::dict read_raw_mosaic(const std::filesystem::path& path) {
 using ArrayFrame = std::tuple<std::string, double, py::object>;
 calibrate::Frame frame_of(const ArrayFrame& item) {
   const auto& [name, exposure_s, array] = item;
+  if (const py::array given = py::array::ensure(array); given && given.ndim() >= 2)
+    check_image_size(name, given.shape(1), given.shape(0), given.ndim() == 3 ? static_cast<int>(given.shape(2)) : 1);
   const auto a = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(array);
   if (!a || (a.ndim() != 2 && !(a.ndim() == 3 && a.shape(2) == 3)))
     throw InputError(fmt::format("{}: a frame is a height × width array (one channel) or height × width × 3 (R, G, B)", name));

@@ -137,6 +137,11 @@ def test_refusals_raise_the_commands_message(chromatrace, tmp_path):
         chromatrace.analyze(np.zeros((4, 4), np.uint8))
     with pytest.raises(chromatrace.InputError, match="^array: samples of type int16; uint8, uint16, uint32, float32 or float64$"):
         chromatrace.analyze(np.zeros((4, 4, 3), np.int16))
+    # A broadcast view is any size for free; the file readers' limits hold before any memory is taken.
+    with pytest.raises(chromatrace.InputError, match=r"^array: image of 70000x60000 pixels, more than the limit of 2\^30"):
+        chromatrace.analyze(np.broadcast_to(np.uint8(7), (60000, 70000, 3)))
+    with pytest.raises(chromatrace.InputError, match=r"^array: image of 20000x15000 pixels, 3 channels: needs 3.6 GB as floats"):
+        chromatrace.analyze(np.broadcast_to(np.uint8(7), (15000, 20000, 3)))
     with pytest.raises(chromatrace.InputError, match="^array: no valid pixel: 0 transparent, 16 negative, 0 NaN or infinite$"):
         chromatrace.analyze(-np.ones((4, 4, 3), np.float32))
 
