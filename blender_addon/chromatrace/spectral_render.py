@@ -9,8 +9,8 @@ What it guarantees:
 - Everything it changes (colours, Cycles and colour-management settings, passes, light groups, object
   indices, the world's strength) goes through a Journal and is put back in a `finally`, whether the render
   succeeds, fails or is cancelled (closing the generator). It never saves the .blend.
-- Each finished Cycles render is read back (`chromatrace info`: to the end of its pixel data, at the render's
-  size, with the channels assemble takes from it) and only then moved into a cache directory keyed by a hash of
+- Each finished Cycles render is read back (to the end of its pixel data, at the render's size, with the channels
+  assemble takes from it: with Blender's own OpenImageIO in this process where it imports, else `chromatrace info`) and only then moved into a cache directory keyed by a hash of
   everything that decides its pixels (cache.py); one that does not read (a full disk) fails the run and is
   removed. A run that was killed resumes with the renders still missing; a cached render that does not read
   back is rendered again, with a warning. The final EXR is written atomically by `chromatrace assemble`.
@@ -25,7 +25,7 @@ import time
 import bpy
 
 from . import blender_compat, cache, components, cycles_setup, manifest, materials, node_resolution, node_rules
-from . import render_setup, scene_parts
+from . import readback, render_setup, scene_parts
 from .bands import band_groups, describe_band_range, group_samples
 from .cache_description import cache_description
 from .camera_math import camera_description
@@ -216,10 +216,14 @@ class SpectralRender:
     def _unreadable(self, path, channels):
         """Why a Cycles render file cannot be assembled, or None: it must read to the end of its pixel data, be of
         the render's size and hold `channels`."""
-        try:
-            info = self.tool.image_info(path)
-        except (BadInput, RuntimeError) as e:
-            return str(e)
+        info = readback.read_back(path)  # in this process, with Blender's own OpenImageIO, where it imports
+        if isinstance(info, str):
+            return info
+        if info is None:
+            try:
+                info = self.tool.image_info(path)
+            except (BadInput, RuntimeError) as e:
+                return str(e)
         size = [info["width"], info["height"]]
         if size != self._resolution():
             return f"{path}: {size[0]}x{size[1]} pixels, not the render's {'x'.join(map(str, self._resolution()))}"
