@@ -297,15 +297,24 @@ py::dict read_spectral_exr(const std::filesystem::path& path) {
   return out;
 }
 
+// Bands by their edges, or by their centres (core's Bands::from_centres: each reaches halfway to its neighbours).
 void write_spectral_exr(const std::filesystem::path& path, const py::object& total, const std::vector<double>& band_edges_nm,
-                        bool reflective, const std::vector<std::pair<std::string, py::object>>& components,
+                        const std::vector<double>& wavelengths_nm, bool reflective, const std::vector<std::pair<std::string, py::object>>& components,
                         const py::object& object_ids, const std::map<std::int32_t, std::string>& object_names,
                         const std::map<std::string, std::string>& attributes) {
   const auto cube = float_array(total, 3, "spectral");
   SpectralExrLayout layout;
   layout.height = static_cast<int>(cube.shape(0));
   layout.width = static_cast<int>(cube.shape(1));
-  layout.bands = Bands::from_edges(band_edges_nm, "band_edges_nm");
+  if (!band_edges_nm.empty()) {
+    layout.bands = Bands::from_edges(band_edges_nm, "band_edges_nm");
+  } else if (wavelengths_nm.empty()) {
+    throw InputError("wavelengths_nm: give the bands' centres (or band_edges_nm)");
+  } else {
+    if (wavelengths_nm.size() != static_cast<std::size_t>(cube.shape(2)))
+      throw InputError(fmt::format("wavelengths_nm: {} centres for {} bands in the array", wavelengths_nm.size(), cube.shape(2)));
+    layout.bands = Bands::from_centres(wavelengths_nm, "wavelengths_nm");
+  }
   if (static_cast<std::size_t>(cube.shape(2)) != layout.bands.size())
     throw InputError(fmt::format("spectral: {} bands in the array, {} in band_edges_nm", cube.shape(2), layout.bands.size()));
   layout.reflective = reflective;
@@ -553,7 +562,8 @@ PYBIND11_MODULE(_chromatrace, m) {
   m.def("analyze_file", &analyze_file, py::arg("path"), py::arg("args"));
   m.def("analyze_array", &analyze_array, py::arg("array"), py::arg("name"), py::arg("args"));
   m.def("read_spectral_exr", &read_spectral_exr, py::arg("path"));
-  m.def("write_spectral_exr", &write_spectral_exr, py::arg("path"), py::arg("spectral"), py::arg("band_edges_nm"), py::arg("reflective"),
+  m.def("write_spectral_exr", &write_spectral_exr, py::arg("path"), py::arg("spectral"), py::arg("band_edges_nm"),
+        py::arg("wavelengths_nm"), py::arg("reflective"),
         py::arg("components"), py::arg("object_ids"), py::arg("object_names"), py::arg("attributes"));
   m.def("read_image_channels", &read_image_channels, py::arg("path"));
   m.def("read_raw_mosaic", &read_raw_mosaic, py::arg("path"));

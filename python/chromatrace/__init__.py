@@ -204,23 +204,6 @@ def read_spectral_exr(path: str | os.PathLike) -> dict:
     return _chromatrace.read_spectral_exr(os.fspath(path))
 
 
-def _band_edges(wavelengths_nm: Sequence[float] | None, band_edges_nm: Sequence[float] | None, bands: int) -> list[float]:
-    if band_edges_nm is not None:
-        return [float(v) for v in band_edges_nm]
-    if wavelengths_nm is None:
-        raise InputError("wavelengths_nm: give the bands' centres (or band_edges_nm)")
-    c = [float(v) for v in wavelengths_nm]
-    if len(c) != bands:
-        raise InputError(f"wavelengths_nm: {len(c)} centres for {bands} bands in the array")
-    if len(c) == 1:
-        raise InputError("wavelengths_nm: one band needs its band_edges_nm")
-    if any(b <= a for a, b in zip(c, c[1:])):
-        raise InputError("wavelengths_nm: must increase")
-    # Each band reaches halfway to its neighbours; the outer ones as far out as in.
-    mid = [(a + b) / 2 for a, b in zip(c, c[1:])]
-    return [c[0] - (mid[0] - c[0])] + mid + [c[-1] + (c[-1] - mid[-1])]
-
-
 def write_spectral_exr(path: str | os.PathLike, spectral: Any, wavelengths_nm: Sequence[float] | None = None, *,
                        band_edges_nm: Sequence[float] | None = None, reflective: bool = False,
                        components: Mapping[str, Any] | None = None, object_ids: Any = None,
@@ -236,9 +219,9 @@ def write_spectral_exr(path: str | os.PathLike, spectral: Any, wavelengths_nm: S
     cube = np.asarray(spectral)
     if cube.ndim != 3:
         raise InputError(f"spectral: expected height x width x bands, got shape {cube.shape}")
-    edges = _band_edges(wavelengths_nm, band_edges_nm, cube.shape[2])
-    _chromatrace.write_spectral_exr(os.fspath(path), cube, edges, reflective, list((components or {}).items()), object_ids,
-                                    dict(object_names or {}), dict(attributes or {}))
+    _chromatrace.write_spectral_exr(os.fspath(path), cube, [float(v) for v in band_edges_nm or []],
+                                    [float(v) for v in wavelengths_nm or []], reflective, list((components or {}).items()),
+                                    object_ids, dict(object_names or {}), dict(attributes or {}))
 
 
 # ----------------------------------------------------------------------------------------------------------------
@@ -308,7 +291,7 @@ def _capture_from_exr(path: str, report: dict) -> Capture:
         return np.ascontiguousarray(values[:, :, [index[k] for k in keys]])
 
     layers = sorted({n.rsplit(".", 1)[0] for n in names if "." in n and n.rsplit(".", 1)[1] in ("R", "G", "B")})
-    components = {l: rgb(l + ".") for l in layers if l not in ("linear", "display") and rgb(l + ".") is not None}
+    components = {l: layer for l in layers if l not in ("linear", "display") and (layer := rgb(l + ".")) is not None}
     ids = values[:, :, index["object_id"]].astype(np.int32) if "object_id" in index else None
     return Capture(rgb=rgb(""), signal=str(attributes.get("chromatrace.signal", "")), linear=rgb("linear."),
                    display=rgb("display."), components=components, object_ids=ids,
