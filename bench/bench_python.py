@@ -13,7 +13,8 @@
 3. With --blender EXE: what the Blender add-on's command calls cost, the question before it calls the module in
    process. The batch renders the paper box (64 x 64, 16 samples: a preview) with CHROMATRACE_EXE pointing at a
    wrapper that times each call; printed per subcommand beside the batch's wall time and a bare start of the full
-   program (`scene-bands --help`).
+   program (`scene-bands --help`). Then the read-back of each cached Cycles render, at 64 and 128 pixels, both ways
+   side by side: in the process with OpenImageIO's Python module, and as a `chromatrace info` process.
 
 Usage: CHROMATRACE_EXE=build/cli/chromatrace PYTHONPATH=build/python python3 bench/bench_python.py [--repeats N]
        [--blender blender]
@@ -149,6 +150,35 @@ def blender_calls(blender, work):
     print(f"a bare start of the full program (scene-bands --help): {bare:.3f} s; {count} starts: {count * bare:.2f} s")
 
 
+def readback_side_by_side(blender, work, sizes=(64, 128), repeats=3):
+    """The add-on's read-back of each Cycles render, both ways side by side on the same files, at two sizes: in the
+    process with OpenImageIO's Python module (blender_addon/chromatrace/readback.py, as Blender's own Python runs
+    it) against a `chromatrace info --json` process, best of N each."""
+    sys.path.insert(0, str(SOURCE / "blender_addon"))
+    from chromatrace import readback  # the add-on's module; it needs no Blender where OpenImageIO imports
+    print(f"{'size':>9} {'renders':>7} {'in process (s)':>15} {'info process (s)':>17} {'ratio':>7}")
+    for size in sizes:
+        cache = work / f"cache-{size}"
+        subprocess.run([blender, "--background", "--factory-startup", "--python", str(SOURCE / "blender_addon/batch.py"), "--",
+                        "--scene", str(SOURCE / "scenes/paper/box.json"), "--out", str(work / f"box-{size}.exr"),
+                        "--resolution", f"{size}x{size}", "--samples", "16", "--cache-dir", str(cache), "--keep-cache",
+                        "--quiet"], check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        files = sorted(str(p) for p in cache.rglob("*.exr"))
+        inside = outside = 0.0
+        for f in files:
+            best = [float("inf"), float("inf")]
+            for _ in range(repeats):
+                start = time.perf_counter()
+                info = readback.read_back(f)
+                best[0] = min(best[0], time.perf_counter() - start)
+                assert isinstance(info, dict), info
+                best[1] = min(best[1], _timed([EXE, "info", f, "--json"]))
+            inside += best[0]
+            outside += best[1]
+        print(f"{size:>4} x{size:<4} {len(files):>7} {inside / len(files):>15.4f} {outside / len(files):>17.4f} "
+              f"{outside / inside:>6.0f}x")
+
+
 def _timed(args):
     start = time.perf_counter()
     subprocess.run(args, check=True, stdout=subprocess.DEVNULL)
@@ -168,6 +198,7 @@ def main():
             memory(Path(scratch))
         if args.blender:
             blender_calls(args.blender, Path(scratch))
+            readback_side_by_side(args.blender, Path(scratch))
 
 
 if __name__ == "__main__":
