@@ -39,6 +39,16 @@ std::optional<double> recorded_exposure(const std::filesystem::path& file, std::
   return std::nullopt;
 }
 
+// Digital numbers are whole: a frame scaled to 0–1, or processed, would give a gain in its own units and no
+// quantisation to judge the dark noise by. InputError naming the first finite value that is not.
+void check_whole_numbers(const std::string& name, const std::string& channel, const auto& plane, int width) {
+  for (std::size_t i = 0; i < plane.size(); ++i)
+    if (std::isfinite(plane[i]) && plane[i] != std::round(plane[i]))
+      throw InputError(fmt::format("{}: channel {} holds {} at pixel ({}, {}), not a whole number: calibration needs the camera's "
+                                   "digital numbers (a frame scaled to 0–1 or processed is not)",
+                                   name, channel, plane[i], i % static_cast<std::size_t>(width), i / static_cast<std::size_t>(width)));
+}
+
 Plane plane_of(int width, int height, const std::string& file, std::size_t count, auto value) {
   Plane p{width, height, std::vector<double>(count)};
   for (std::size_t i = 0; i < count; ++i) {
@@ -94,15 +104,8 @@ Frame read_linear_frame(const std::filesystem::path& file, const std::string& in
   const std::size_t n = static_cast<std::size_t>(image.width) * static_cast<std::size_t>(image.height);
   for (std::size_t c = 0; c < image.planes.size(); ++c) {
     const std::vector<float>& plane = image.planes[c];
-    // A float file that is not the simulator's holds digital numbers only when they are whole: a frame scaled to
-    // 0–1, or processed, would give a gain in its own units and no quantisation to judge the dark noise by.
-    if (!e.integer && e.metadata.empty())
-      for (std::size_t i = 0; i < n; ++i)
-        if (std::isfinite(plane[i]) && plane[i] != std::round(plane[i]))
-          throw InputError(fmt::format("{}: channel {} holds {} at pixel ({}, {}), not a whole number: calibration needs the camera's "
-                                       "digital numbers (a frame scaled to 0–1 or processed is not)",
-                                       name, image.channels[c], plane[i], i % static_cast<std::size_t>(image.width),
-                                       i / static_cast<std::size_t>(image.width)));
+    // A float file that is not the simulator's holds digital numbers only when they are whole.
+    if (!e.integer && e.metadata.empty()) check_whole_numbers(name, image.channels[c], plane, image.width);
     f.channel_names.push_back(image.channels.size() == 1 ? image.channels[c] : std::string(1, "RGB"[c]));
     f.channels.push_back(plane_of(image.width, image.height, name, n, [&](std::size_t i) { return plane[i]; }));
   }
@@ -140,11 +143,7 @@ Frame frame_in_memory(const std::string& name, double exposure_s, int width, int
     const std::vector<double>& plane = planes[c];
     if (width < 1 || height < 1 || plane.size() != n)
       throw InputError(fmt::format("{}: {} values for {} x {} pixels", name, plane.size(), width, height));
-    for (std::size_t i = 0; i < n; ++i)
-      if (std::isfinite(plane[i]) && plane[i] != std::round(plane[i]))
-        throw InputError(fmt::format("{}: channel {} holds {} at pixel ({}, {}), not a whole number: calibration needs the camera's "
-                                     "digital numbers (a frame scaled to 0–1 or processed is not)",
-                                     name, c, plane[i], i % static_cast<std::size_t>(width), i / static_cast<std::size_t>(width)));
+    check_whole_numbers(name, std::to_string(c), plane, width);
     f.channel_names.push_back(planes.size() == 1 ? "Y" : std::string(1, "RGB"[c]));
     f.channels.push_back(plane_of(width, height, name, n, [&](std::size_t i) { return static_cast<float>(plane[i]); }));
   }
