@@ -70,11 +70,16 @@ print(before, resource.getrusage(resource.RUSAGE_SELF).ru_maxrss, len(a.regions)
 """
 
 
-def child_peak_kib(args):
-    """Runs `args` in a child process; its stdout and its peak resident memory (KiB)."""
+def child_peak_kib(args, stdout=None):
+    """Runs `args` in a child process (its stdout into the file `stdout`, if given); its peak resident memory (KiB)."""
+    fd = os.open(stdout, os.O_WRONLY | os.O_CREAT | os.O_TRUNC) if stdout else None
     pid = os.fork()
     if pid == 0:
+        if fd is not None:
+            os.dup2(fd, 1)
         os.execvp(args[0], args)
+    if fd is not None:
+        os.close(fd)
     # The child's own rusage, not the sum over every child so far.
     _, status, usage = os.wait4(pid, 0)
     assert os.waitstatus_to_exitcode(status) == 0, args
@@ -98,21 +103,14 @@ def memory(work):
     del big
     command = child_peak_kib([EXE, "analyze", str(path), "-o", str(work / "big"), "--no-plots", "--no-report", "--quiet"])
     result = work / "module.txt"
-    fd = os.open(result, os.O_WRONLY | os.O_CREAT | os.O_TRUNC)
-    pid = os.fork()
-    if pid == 0:
-        os.dup2(fd, 1)
-        os.execvp(sys.executable, [sys.executable, "-c", MODULE_CHILD, str(path)])
-    os.close(fd)
-    _, status, usage = os.wait4(pid, 0)
-    assert os.waitstatus_to_exitcode(status) == 0
-    before, after, _ = map(int, result.read_text().split())
+    module = child_peak_kib([sys.executable, "-c", MODULE_CHILD, str(path)], stdout=result)
+    before, _, _ = map(int, result.read_text().split())
     mib = lambda k: k / 1024
     print(f"24-megapixel 8-bit image ({6000 * 4000 * 3 / 2**20:.0f} MiB as uint8, {6000 * 4000 * 12 / 2**20:.0f} MiB as float):")
     print(f"  command, from a TIFF:          peak {mib(command):8.0f} MiB")
-    print(f"  module, from a NumPy array:    peak {mib(usage.ru_maxrss):8.0f} MiB; before the call {mib(before):.0f} MiB "
-          f"(Python, NumPy, OpenImageIO, the array); the analysis took {mib(usage.ru_maxrss - before):.0f} MiB")
-    print(f"  the analysis's memory, module / command: {(usage.ru_maxrss - before) / command:.2f}")
+    print(f"  module, from a NumPy array:    peak {mib(module):8.0f} MiB; before the call {mib(before):.0f} MiB "
+          f"(Python, NumPy, OpenImageIO, the array); the analysis took {mib(module - before):.0f} MiB")
+    print(f"  the analysis's memory, module / command: {(module - before) / command:.2f}")
 
 
 WRAPPER = """#!/bin/sh
