@@ -164,9 +164,18 @@ void check_comparable(const Render& a, const Render& b) {
                                      "different scenes)",
                                      b.file, id, other, name, a.file));
     }
-    throw InputError(fmt::format("{}: attribute chromatrace.objects: more objects than in {} (incomparable: "
-                                 "different scenes)",
-                                 b.file, a.file));
+    // B's further ids may be its scene's lights that A's render has no ids for: Blender's light objects, which
+    // Cycles does not index, exported as the scene file's lights (docs/compare.md).
+    std::set<std::string> lights;
+    if (sb.is_object() && sb.contains("lights") && sb["lights"].is_array())
+      for (const json& light : sb["lights"])
+        if (light.is_object() && light.contains("name") && light["name"].is_string())
+          lights.insert(light["name"].get<std::string>());
+    for (const auto& [id, name] : b.info.object_names)
+      if (!a.info.object_names.count(id) && !lights.count(name))
+        throw InputError(fmt::format("{}: attribute chromatrace.objects: more objects than in {} (incomparable: "
+                                     "different scenes)",
+                                     b.file, a.file));
   }
   const json ca = parse_meta(a.info, "chromatrace.camera"), cb = parse_meta(b.info, "chromatrace.camera");
   if (ca.is_object() && cb.is_object()) {

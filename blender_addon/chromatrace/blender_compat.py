@@ -10,11 +10,15 @@ running Blender has wherever its API can say so; the rest of the add-on asks her
 - The Smith masking of Cycles' GGX: separable up to 3.x, height-correlated from 4.0.
 - Multiscatter GGX: a random walk shared by the colour channels up to 3.x, a per-channel albedo scaling from 4.0.
 - The linear Rec.709 colour space: "Linear" up to 3.x, "Linear Rec.709" from 4.0.
+- A light's power: an area light of P W and area A emits P/(4A) up to 3.x, P/(πA) from 4.0 (P/π where not
+  normalised); a point light of radius r emits P/(4π·πr²) in every version (light_radiance_per_watt).
 - Principled BSDF: version 1 up to 3.x (Specular, Sheen and Clearcoat weights, tints as factors of the base
   colour's hue), version 2 from 4.0 (Specular IOR Level, Coat and Sheen Weight, tints as colours, which Cycles
   layers by their strongest channel); the node rules read whichever inputs the node has
   (node_rules.node_issues).
 """
+
+import math
 
 import bpy
 
@@ -75,3 +79,20 @@ def linear_rec709(image):
     """The name of linear Rec.709 (linear sRGB) among the colour spaces the running Blender offers an image."""
     names = image.colorspace_settings.bl_rna.properties["name"].enum_items.keys()
     return "Linear Rec.709" if "Linear Rec.709" in names else "Linear"
+
+
+def light_radiance_per_watt(light, area):
+    """The radiance (in Cycles' units, those of an Emission shader of strength 1) that one watt of `light`'s power
+    gives its surface: an area light of `area` m² (its size times its object's scale), or a point light's sphere.
+    No API reports it, so the version decides; measured on 3.4, 4.5 and 5.3 against an emitting mesh of the light's
+    shape (tests/blender/test_light_export.py). A 4.x light's Exposure multiplies it by 2^exposure."""
+    normalised = getattr(light, "normalize", True)
+    exposure = 2.0 ** float(getattr(light, "exposure", 0.0))
+    if light.type == "AREA":
+        if bpy.app.version < (4, 0, 0):
+            return exposure * 0.25 / area
+        return exposure / (math.pi * (area if normalised else 1.0))
+    if light.type == "POINT":
+        r = float(light.shadow_soft_size)
+        return exposure / (math.pi * (4.0 * math.pi * r * r if normalised else 1.0))
+    raise ValueError(f"no radiance per watt for a {light.type} light")

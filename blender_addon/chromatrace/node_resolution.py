@@ -215,6 +215,19 @@ def input_source(scene, material, spectral_input):
     return rgb_source({"rgb": rgb}, emitted=spectral_input.role == "emission"), factor
 
 
+def _flat_if_grey(spectral_input):
+    """A light's node colour that is an RGB grey as a flat factor (the FILTER role), else as it is."""
+    rgb = spectral_input.current_rgb
+    if spectral_input.role == "emission" and spectral_input.source is None and rgb is not None and max(rgb) == min(rgb):
+        return spectral_input._replace(role=FILTER)
+    return spectral_input
+
+
+def light_temperature(light):
+    """The Temperature (K) a light's colour is multiplied by (Blender 4.5 and later), or None when it is off."""
+    return float(light.temperature) if getattr(light, "use_temperature", False) else None
+
+
 def owner_inputs(scene, kind, thing, walk):
     """[(SpectralInput, source, scale)] of one material, light object or world; BadInput when one fails."""
     found = []
@@ -227,10 +240,22 @@ def owner_inputs(scene, kind, thing, walk):
     if kind == "light":
         light = thing.data
         settings = light.chromatrace
-        # Where the light's nodes give its colour (a Blackbody node, a colour), its own colour multiplies that: a
-        # filter, whose white is flat. Otherwise its colour is what it emits, relative to D65.
+        # Where the light's nodes give its colour (a Blackbody node, a colour that is not a grey, a texture), its own
+        # colour multiplies that: a filter, whose white is flat. Otherwise its colour is what it emits, relative to
+        # D65, and a grey in its nodes (the white Emission node Blender 5 gives every new light) is a flat factor.
+        leaves = [_flat_if_grey(leaf) for leaf in leaves]
         emitted = not any(leaf.role == "emission" for leaf in leaves)
-        if settings.emission.kind == "RGB" and settings.emission.use_current_colour:
+        temperature = light_temperature(light)
+        if settings.emission.kind == "RGB" and settings.emission.use_current_colour and temperature is not None:
+            # Cycles multiplies the colour by the Blackbody colour of the light's Temperature: Planck's law at it,
+            # as a Blackbody node is (render_setup switches the Temperature off for the spectral renders).
+            rgb = tuple(light.color)
+            if max(rgb) != min(rgb):
+                raise BadInput(f"{what}: its colour {tuple(round(c, 4) for c in rgb)} tints its Temperature "
+                               f"({temperature:g} K); a temperature is Planck's law, which only a grey colour "
+                               "scales: make the colour grey, or switch the Temperature off and give the spectrum")
+            source, scale = {"blackbody_k": temperature}, settings.emission_scale * max(0.0, rgb[0])
+        elif settings.emission.kind == "RGB" and settings.emission.use_current_colour:
             rgb, factor = rgb_for_upsampling(tuple(light.color))
             source = rgb_source(resolve(scene, settings.emission, rgb, what), emitted=emitted)
             scale = settings.emission_scale * factor

@@ -13,16 +13,11 @@ from .errors import BadInput
 def plan_open_scene(scene, tool, target, work, scene_file=None, edge_step=None, **request):
     """Planned (planning.py) for `scene`. `request`: the render's Request settings the pilots keep (resolution,
     device, on_mixing_nodes, on_world). BadInput when the scene cannot be planned."""
+    approximations = []
     if not scene_file:
-        # The plan's model reads a scene file; Blender's own light objects (and the colours of its nodes) have none.
-        lamps = sorted(ob.name for ob in scene.objects if ob.type == "LIGHT" and not ob.hide_render)
-        if lamps:
-            raise BadInput(f"Blender light objects ({', '.join(lamps)}) cannot be planned yet (chromatrace plan reads "
-                           "a scene file, whose lights are emitting quads or spheres); give a band plan made by "
-                           "chromatrace plan on a scene file instead")
         scene_file = os.path.join(work, "scene.json")
         try:
-            scene_export.export_scene(scene, scene_file, tool, log=lambda message: None)
+            scene_export.export_scene(scene, scene_file, tool, log=lambda message: None, approximations=approximations)
         except BadInput as e:
             raise BadInput(f"the scene could not be written as a scene file to plan: {e}") from None
     base = spectral_render.Request.from_scene(scene, **{k: v for k, v in request.items() if v is not None})
@@ -36,7 +31,9 @@ def plan_open_scene(scene, tool, target, work, scene_file=None, edge_step=None, 
         pilot.log = lambda message: None
         spectral_render.SpectralRender(scene, pilot, tool).run()
 
-    return planning.plan_render(scene_file, target, work, render_pilot, tool, edge_step)
+    planned = planning.plan_render(scene_file, target, work, render_pilot, tool, edge_step)
+    planned.approximations = approximations  # what the plan's scene file holds only approximately: said as notes
+    return planned
 
 
 def pilot_resolution(scene, request):

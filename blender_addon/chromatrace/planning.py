@@ -38,6 +38,7 @@ class Planned:
     def __init__(self, bands_file, report):
         self.bands_file = bands_file
         self.report = report
+        self.approximations = []  # what the scene file planned on holds only approximately (scene_export)
 
     @property
     def max_bounces(self):
@@ -50,8 +51,9 @@ class Planned:
     @property
     def notes(self):
         """What the plan's model could not hold (an image texture seen as a few colours, a camera whose
-        curves end early, ...): said beside the prediction, which they make less certain."""
-        return list(self.report.get("notes", []))
+        curves end early, ...), and what the open scene's file holds only approximately: said beside the prediction,
+        which they make less certain."""
+        return list(self.approximations) + list(self.report.get("notes", []))
 
     def summary(self):
         cycles = self.report["prediction"]["cycles"]

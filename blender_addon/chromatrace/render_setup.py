@@ -65,6 +65,9 @@ def apply_settings(journal, scene, request, plan, resolution):
                        resolution, plan.passes)
     plan.device = cycles_setup.select_device(journal, scene, _cycles_preferences(), request.device)
     _set_world(journal, scene.world, plan)
+    for ob in plan.lights:  # its Temperature is in the light's spectrum (node_resolution.owner_inputs)
+        if node_resolution.light_temperature(ob.data) is not None:
+            journal.set(ob.data, "use_temperature", False)
     for spectral_input, _key, _scale, _owner in plan.inputs:
         node = spectral_input.replace
         if node is not None and node.as_pointer() not in plan.replaced:

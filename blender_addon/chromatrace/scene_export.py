@@ -12,8 +12,9 @@ import math
 import os
 
 import bpy
+from mathutils import Vector
 
-from . import blender_compat, materials, ply
+from . import blender_compat, materials, ply, scene_parts
 from .errors import BadInput
 from .floats import short_float
 from .geometry_digest import camera_digest, object_digest
@@ -28,7 +29,65 @@ def _reflectance_rgb(material):
     return tuple(node.outputs[0].default_value[:3]) if node else tuple(material.diffuse_color[:3])
 
 
-def _material_entry(material, out_dir, log):
+def _texture_file(source, texture_dir, out_dir):
+    """A scene-format texture source with its file relative to the scene file; an image packed into the .blend is
+    written out into `texture_dir` first (its bytes as packed: the file it was)."""
+    source = dict(source)
+    path = source["texture"]
+    if path.startswith("packed:"):
+        image = bpy.data.images[path[len("packed:"):]]
+        extension = os.path.splitext(image.filepath)[1] or {"OPEN_EXR": ".exr", "PNG": ".png", "JPEG": ".jpg",
+                                                             "TIFF": ".tif", "HDR": ".hdr"}.get(image.file_format, "")
+        safe = "".join(ch if ch.isalnum() or ch in "-_." else "_" for ch in image.name)
+        os.makedirs(texture_dir, exist_ok=True)
+        path = os.path.join(texture_dir, safe + (extension if not safe.endswith(extension) else ""))
+        with open(path + ".partial", "wb") as f:
+            f.write(image.packed_file.data)
+        os.replace(path + ".partial", path)
+    source["texture"] = os.path.relpath(path, out_dir)
+    return source
+
+
+# Shader nodes whose material a scene file holds exactly (as `lambert`), with the inputs that must be 0 for it.
+_LAMBERTIAN = {"ShaderNodeBsdfDiffuse": ("Roughness",)}
+
+
+def _node_material_entry(scene, material, texture_dir, out_dir, approximate):
+    """A material of the node-tree model as a scene-format material, from the colours the spectral render gives
+    it (materials.spectral_inputs). A Diffuse BSDF of roughness 0 (or no nodes: the viewport colour, which Cycles
+    renders diffusely) is `lambert` of its colour or texture, exactly. Any other tree is `lambert` of its first
+    reflectance colour (a Principled BSDF's base colour), which `approximate` says. BadInput for a tree that emits:
+    a scene file's emitters are lights."""
+    from . import node_resolution
+    what = f"material \"{material.name}\""
+    walk = materials.walk_material(material)
+    inputs = materials.spectral_inputs(material, walk)
+    if any(i.role == "emission" for i in inputs):
+        raise BadInput(f"{what}: its nodes emit light, which a scene file holds only as a light (a quad or a "
+                       "sphere): set the object's chromatrace role to Light, or make it a Blender area light")
+    reflectances = [i for i in inputs if i.role == "reflectance"]
+    if reflectances:
+        first = reflectances[0]
+        if first.attribute == "image" and first.source is not None:
+            source = _texture_file(first.source, texture_dir, out_dir)
+        else:
+            source, _scale = node_resolution.node_source(first, what)
+    else:  # only spectrally flat colours (a glossy's grey): their grey, or black
+        greys = [i.current_rgb[0] for i in inputs if i.role == "interface"]
+        source = {"constant": max(0.0, min(1.0, greys[0])) if greys else 0.0}
+    shaders = [node for _path, node in walk.shaders]
+    exact = len(reflectances) == len(inputs) <= 1 and all(
+        node.bl_idname in _LAMBERTIAN and all(node.inputs[k].default_value == 0.0 and not node.inputs[k].is_linked
+                                              for k in _LAMBERTIAN[node.bl_idname]) for node in shaders)
+    if not exact:
+        kinds = sorted({node.bl_label for node in shaders}) or ["no shader"]
+        approximate(f"{what}: its nodes ({', '.join(kinds)}) are written as a Lambertian material of "
+                    f"{'its colour ' + first.label if reflectances else 'their grey'}; the scene file holds them "
+                    "only approximately")
+    return {"type": "lambert", "reflectance": source}
+
+
+def _material_entry(material, out_dir):
     s = material.chromatrace
     reflectance = _spectrum_ref(s.reflectance, _reflectance_rgb(material), out_dir)
     if s.model == "DICHROMATIC":
@@ -39,8 +98,6 @@ def _material_entry(material, out_dir, log):
         return entry
     if s.model == "MIRROR":
         return {"type": "mirror", "reflectance": reflectance}
-    if s.model == "NODES":
-        log(f"material \"{material.name}\": its node tree is written as a Lambertian material")
     return {"type": "lambert", "reflectance": reflectance}
 
 
@@ -97,7 +154,7 @@ def _mesh_shape(ob, depsgraph, mesh_dir, out_dir):
     return {"type": "mesh", "file": os.path.relpath(path, out_dir)}
 
 
-def _environment(world, out_dir, log):
+def _environment(world, out_dir, texture_dir, log):
     """The scene format's environment from Blender's world: a Background's colour from an Environment Texture (its
     default vector, or a Mapping node that only turns it about Z) or a constant colour, × its strength; None for
     no world or a dark one. Anything else is said and left out."""
@@ -133,11 +190,7 @@ def _environment(world, out_dir, log):
         return None
     from .colour_walk import texture_source
     source = texture_source(node.image)
-    if source["texture"].startswith("packed:"):
-        log(f"world \"{world.name}\": its image is packed into the .blend; unpack it to export the environment")
-        return None
-    source["texture"] = os.path.relpath(source["texture"], out_dir)
-    entry["radiance"] = source
+    entry["radiance"] = _texture_file(source, texture_dir, out_dir)
     vector = node.inputs["Vector"]
     if vector.is_linked:
         mapping = vector.links[0].from_node
@@ -168,6 +221,77 @@ def _light_quad(ob):
     return {"type": "quad", "corner": list(p[0]), "edge1": list(p[1] - p[0]), "edge2": list(p[3] - p[0])}
 
 
+def _light_node_strength(ob):
+    """The Strength of the Emission node a light's node tree ends in (1 without a tree); BadInput for a tree that
+    is more than that, whose light a scene file's one spectrum and scale cannot hold."""
+    light = ob.data
+    if not blender_compat.uses_nodes(light):
+        return 1.0
+    output = light.node_tree.get_output_node("CYCLES")
+    surface = output.inputs["Surface"] if output is not None else None
+    links = [l for l in surface.links if l.is_valid and not l.is_muted] if surface is not None else []
+    node = links[0].from_node if links else None
+    if node is None or node.bl_idname != "ShaderNodeEmission" or node.inputs["Strength"].is_linked:
+        raise BadInput(f"light \"{ob.name}\": its node tree is more than an Emission node of constant strength, "
+                       "which a scene file's light (one spectrum and a scale) cannot hold")
+    return float(node.inputs["Strength"].default_value)
+
+
+def _light_spectrum(scene, ob):
+    """(radiance source, scale) of a Blender light as the spectral render emits it (node_resolution.owner_inputs):
+    the product of its colours' spectra, where all but one of them are flat; BadInput otherwise."""
+    from . import node_resolution
+    inputs = node_resolution.owner_inputs(scene, "light", ob, materials.walk_light(ob.data))
+    shaped = [(source, scale) for _input, source, scale in inputs if "constant" not in source]
+    scale = math.prod(scale * source.get("constant", 1.0) for _input, source, scale in inputs)
+    if len(shaped) > 1:
+        raise BadInput(f"light \"{ob.name}\": its colour and its nodes' colours make a product of spectra, which a "
+                       "scene file's light cannot hold; make all but one of them grey")
+    return (shaped[0][0] if shaped else {"constant": 1.0}), scale
+
+
+def _blender_light(scene, ob, approximate):
+    """A Blender light object as a scene-format light, emitting what Cycles' spectral render of it emits: an area
+    light (square or rectangle) as a one-sided quad facing its −Z, a point light of some radius as a sphere. The
+    rest (sun, spot, disk, a spread below 180°, a point without radius) has no scene-format shape: BadInput."""
+    light, what = ob.data, f"light \"{ob.name}\""
+    m = ob.matrix_world
+    if light.type == "AREA":
+        if light.shape not in ("SQUARE", "RECTANGLE"):
+            raise BadInput(f"{what}: a {light.shape.lower()} area light has no scene-format shape (quads and spheres "
+                           "only); make it a square or a rectangle")
+        if getattr(light, "spread", math.pi) < math.pi - 1e-6:
+            raise BadInput(f"{what}: its spread of {math.degrees(light.spread):g} degrees focuses its light, which a "
+                           "scene file's quad (a diffuse emitter) cannot; set the spread to 180")
+        sx = light.size
+        sy = light.size if light.shape == "SQUARE" else light.size_y
+        corner = m @ Vector((-sx / 2, -sy / 2, 0.0))
+        edge1, edge2 = m.to_3x3() @ Vector((0.0, sy, 0.0)), m.to_3x3() @ Vector((sx, 0.0, 0.0))  # normal: −Z
+        area = edge1.cross(edge2).length
+        if area <= 0.0:
+            raise BadInput(f"{what}: its size is 0")
+        shape = {"type": "quad", "corner": [short_float(c) for c in corner], "edge1": [short_float(c) for c in edge1],
+                 "edge2": [short_float(c) for c in edge2]}
+    elif light.type == "POINT":
+        if light.shadow_soft_size <= 0.0:
+            raise BadInput(f"{what}: a point light of radius 0 has no surface; give it a radius (a sphere light)")
+        area = None
+        if bpy.app.version < (4, 0, 0) or getattr(light, "use_soft_falloff", False):
+            approximate(f"{what}: this Cycles lights each point as if the point light of radius "
+                        f"{light.shadow_soft_size:g} m were a disk facing it (Soft Falloff), which gives d²/(d² + r²) "
+                        "of the light of the sphere the scene file has, at distance d: within 1 % beyond 10 radii")
+        shape = {"type": "sphere", "center": [short_float(c) for c in m.translation],
+                 "radius": short_float(light.shadow_soft_size)}
+    else:
+        raise BadInput(f"{what}: a {light.type.lower()} light has no scene-format shape; use an area light (square "
+                       "or rectangle), a point light with a radius, or an emitting mesh")
+    source, scale = _light_spectrum(scene, ob)
+    watts = float(light.energy) * _light_node_strength(ob)
+    scale *= watts * blender_compat.light_radiance_per_watt(light, area)
+    return {"name": ob.chromatrace.scene_name or ob.name, "shape": shape, "radiance": source,
+            "scale": short_float(scale), "group": getattr(ob, "lightgroup", "") or scene_parts.group_name(ob.name)}
+
+
 def _camera(scene):
     ob = scene.camera
     if ob is None:
@@ -185,10 +309,20 @@ def _camera(scene):
             "fov_axis": "horizontal", "resolution": resolution, "sensor_width_mm": d["sensor_width_mm"]}
 
 
-def export_scene(scene, path, tool, log=print):
+def export_scene(scene, path, tool, log=print, approximations=None):
+    """Writes `scene` to the scene file `path` (meshes and unpacked textures in folders beside it), checked by
+    `chromatrace check-scene`; returns the document. What the file holds only approximately or leaves out (a node
+    tree as a Lambertian material, a world it cannot write) is logged and, when given, appended to
+    `approximations`."""
     out_dir = os.path.dirname(os.path.abspath(path))
     stem = os.path.splitext(os.path.basename(path))[0]
     mesh_dir = os.path.join(out_dir, f"{stem}_meshes")
+    texture_dir = os.path.join(out_dir, f"{stem}_textures")
+
+    def approximate(message):
+        log(message)
+        if approximations is not None:
+            approximations.append(message)
     s = scene.chromatrace
     source_dir = os.path.dirname(s.source_file) if s.source_file else out_dir
     depsgraph = bpy.context.evaluated_depsgraph_get()
@@ -203,8 +337,12 @@ def export_scene(scene, path, tool, log=print):
     ordered = sorted(candidates, key=lambda o: (o.pass_index == 0, o.pass_index, o.name))
     objects = [ob for ob in ordered if ob.chromatrace.role == "OBJECT"]
     lights = [ob for ob in ordered if ob.chromatrace.role == "LIGHT"]
-    if any(ob.type == "LIGHT" and not ob.hide_render for ob in scene.objects):
-        log("Blender light objects are not written: chromatrace lights are emitting quads or spheres")
+    blender_lights = sorted((ob for ob in scene.objects if ob.type == "LIGHT" and not ob.hide_render),
+                            key=lambda ob: ob.name)
+    portals = [ob.name for ob in blender_lights if getattr(getattr(ob.data, "cycles", None), "is_portal", False)]
+    if portals:
+        approximate(f"portals are not lights and are not written: {', '.join(portals)}")
+    blender_lights = [ob for ob in blender_lights if ob.name not in portals]
 
     materials, names = {}, {}
 
@@ -212,7 +350,8 @@ def export_scene(scene, path, tool, log=print):
         if material.name not in names:
             name = material.chromatrace.scene_name or material.name
             names[material.name] = name
-            materials[name] = _material_entry(material, out_dir, log)
+            materials[name] = (_node_material_entry(scene, material, texture_dir, out_dir, approximate)
+                               if material.chromatrace.model == "NODES" else _material_entry(material, out_dir))
         return names[material.name]
 
     object_entries = []
@@ -242,6 +381,7 @@ def export_scene(scene, path, tool, log=print):
                 raise BadInput(f"light \"{ob.name}\": material \"{ob.chromatrace.light_material}\" not found")
             entry["material"] = material_name(reflect)
         light_entries.append(entry)
+    light_entries += [_blender_light(scene, ob, approximate) for ob in blender_lights]
     # Scene materials that no object uses (kept by a fake user since import).
     for material in bpy.data.materials:
         if material.use_fake_user and material.chromatrace.scene_name and material.chromatrace.model != "NODES":
@@ -250,7 +390,7 @@ def export_scene(scene, path, tool, log=print):
     document["materials"] = materials
     document["objects"] = object_entries
     document["lights"] = light_entries
-    environment = _environment(scene.world, out_dir, log)
+    environment = _environment(scene.world, out_dir, texture_dir, approximate)
     if environment is not None:
         document["environment"] = environment
     document["camera"] = _camera(scene)

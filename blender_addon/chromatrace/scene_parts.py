@@ -41,7 +41,8 @@ def scene_parts(scene):
     return view_layer, objects, used_materials(objects), lights
 
 
-def _group_name(name):
+def group_name(name):
+    """A light group's name from an object's: letters, digits, _ and - only."""
     return re.sub(r"[^A-Za-z0-9_-]", "_", name) or "group"
 
 
@@ -58,7 +59,7 @@ def light_groups(scene, families, view_layer, objects, emitters, world):
             slot.material is not None and slot.material.name in emitters for slot in ob.material_slots)
         if not emits:
             continue
-        group = ob.lightgroup or _group_name(ob.name)
+        group = ob.lightgroup or group_name(ob.name)
         assignments[ob.name] = group
         if group not in groups:
             groups.append(group)

@@ -6,6 +6,8 @@
     python3 cross_validate.py filter-glossy SCENE.json  # Cycles' default Filter Glossy and Clamp Indirect left on: must fail
     python3 cross_validate.py reflectance SCENE.json OBJECT  # OBJECT's reflectance changed for Cycles: must fail there
     python3 cross_validate.py turned SCENE.json  # the environment turned 90° more for Cycles: must fail
+    python3 cross_validate.py agree-blend MODE  # make_artist_scene.py MODE's .blend rendered by Cycles, and the
+                                                # scene file it exports rendered by the tracer: must agree
 
 Environment: CHROMATRACE_EXE, BLENDER (the executable), BLENDER_VERSION (its version: the scene's GGX masking is
 Cycles' in that version, tests/blender/scene_for_blender.py), and optionally CROSS_SIZE (32x32), CROSS_BANDS
@@ -48,8 +50,9 @@ def render_tracer(scene, out, seed=1):
 def render_cycles(scene, out, work, env_extra=None):
     env = dict(os.environ, CHROMATRACE_EXE=EXE)
     env.update(env_extra or {})
+    source = "--blend" if scene.endswith(".blend") else "--scene"
     _, seconds = run([BLENDER, "--background", "--factory-startup", "--python",
-                      os.path.join(SOURCE, "blender_addon", "batch.py"), "--", "--scene", scene, "--out", out,
+                      os.path.join(SOURCE, "blender_addon", "batch.py"), "--", source, scene, "--out", out,
                       "--samples", SPP, "--resolution", SIZE, "--bands", BANDS, "--components", "paths,lights",
                       "--seed", "7", "--cache-dir", os.path.join(work, "cache"), "-q"], env)
     return seconds
@@ -85,19 +88,38 @@ def check(condition, message):
         sys.exit("FAIL: " + message)
 
 
+def blend_and_export(mode, work):
+    """make_artist_scene.py's MODE as a .blend, and the scene file Export writes of it (what it holds only
+    approximately printed)."""
+    blend, scene = os.path.join(work, f"{mode}.blend"), os.path.join(work, "exported.json")
+    here = os.path.dirname(os.path.abspath(__file__))
+    run([BLENDER, "--background", "--factory-startup", "--python", os.path.join(here, "make_artist_scene.py"), "--",
+         mode, blend])
+    result, _ = run([BLENDER, blend, "--background", "--factory-startup", "--python-exit-code", "1", "--python",
+                     os.path.join(here, "export_blend.py"), "--", scene],
+                    dict(os.environ, CHROMATRACE_EXE=EXE, CHROMATRACE_SOURCE_DIR=SOURCE))
+    sys.stderr.write("".join(line + "\n" for line in result.stdout.splitlines() if line.startswith("approximately:")))
+    return blend, scene
+
+
 def main():
-    case, scene = sys.argv[1], os.path.abspath(sys.argv[2])
+    case, scene = sys.argv[1], sys.argv[2]
     work = tempfile.mkdtemp(prefix="cross_validate_")
     try:
         tracer, cycles = os.path.join(work, "tracer.exr"), os.path.join(work, "cycles.exr")
-        scene = scene_copy(scene, work, name="scene.json")  # both renderers render this one
+        blend = None
+        if case == "agree-blend":  # Cycles renders the .blend, the tracer the scene file exported from it
+            blend, scene = blend_and_export(scene, work)
+            case = "agree"
+        else:
+            scene = scene_copy(os.path.abspath(scene), work, name="scene.json")  # both renderers render this one
         point = case == "agree-point"
         if point:  # point pixels: Cycles' narrow Gaussian against the tracer's pixel centres
             scene = scene_copy(scene, work, lambda d: d.setdefault("render", {}).update(pixel_filter="point"))
             case = "agree"
         t_seconds = render_tracer(scene, tracer)
         if case == "agree":
-            c_seconds = render_cycles(scene, cycles, work)
+            c_seconds = render_cycles(blend or scene, cycles, work)
             doc = compare(cycles, tracer, os.path.join(work, "compare"))
             # Every component family the issue names is compared.
             expected = {"total", "emission", "diffuse_direct", "diffuse_indirect", "glossy_direct", "glossy_indirect"}

@@ -11,6 +11,8 @@
         seen from above by an orthographic camera; no lights
     blender -b --factory-startup --python make_artist_scene.py -- blackbody OUT.blend KELVIN
         a grey diffuse plane under an area light whose node tree's colour is a Blackbody node at KELVIN, no world
+    blender -b --factory-startup --python make_artist_scene.py -- lights OUT.blend
+        Blender's light objects in each power convention (blender_lights_scene) over a textured floor and a box
     blender -b --factory-startup --python make_artist_scene.py -- grey_floor OUT.blend (hdri | R,G,B)
         a large diffuse floor whose colour is an Image Texture node of a 2×2 float image of greys (R = G = B: 0.25
         and 0.6), packed into the .blend, seen at a slant by a perspective camera with the sky above the horizon;
@@ -245,8 +247,62 @@ def textured_scene(out):
     look_down(bpy.context.scene.camera, 5.0, 3.0)
 
 
+def blender_lights_scene():
+    """Blender's own light objects in each power convention, out of the camera's view, over a textured floor and a
+    grey box: a rectangular area light whose node tree's colour is a Blackbody node (3500 K), a point light of
+    radius 0.05 m with an RGB colour (Soft Falloff off where the light has it), and a square area light with its
+    Temperature (Blender 4.5+: 5000 K, Exposure 1, not normalised; a white colour before)."""
+    bpy.ops.mesh.primitive_plane_add(size=8.0, location=(0.0, 0.0, 0.0))
+    floor = bpy.context.object
+    floor.name = "floor"
+    checker = [v for i in range(16) for v in ((0.7, 0.6, 0.35, 1.0) if (i + i // 4) % 2 else (0.2, 0.35, 0.6, 1.0))]
+    floor.data.materials.append(diffuse_image_material("tiles", packed_float_image("tiles", 4, 4, checker, OUT)))
+    bpy.ops.mesh.primitive_cube_add(size=0.6, location=(0.3, 0.8, 0.3))
+    box = bpy.context.object
+    box.name = "box"
+    grey = bpy.data.materials.new("grey")
+    grey.use_nodes = True
+    nodes = grey.node_tree.nodes
+    nodes.remove(nodes["Principled BSDF"])
+    diffuse = nodes.new("ShaderNodeBsdfDiffuse")
+    diffuse.inputs["Color"].default_value = (0.5, 0.5, 0.5, 1.0)
+    grey.node_tree.links.new(diffuse.outputs[0], nodes["Material Output"].inputs["Surface"])
+    box.data.materials.append(grey)
+
+    area = area_light_with_blackbody(3500.0, (-0.6, 0.9, 1.6), size=1.0, power=120.0)
+    area.data.shape = "RECTANGLE"
+    area.data.size_y = 0.5
+    area.rotation_euler = (math.radians(20.0), 0.0, math.radians(30.0))
+
+    point = bpy.data.lights.new("Point", "POINT")
+    point.energy, point.shadow_soft_size, point.color = 60.0, 0.05, (1.0, 0.8, 0.6)
+    if hasattr(point, "use_soft_falloff"):
+        point.use_soft_falloff = False
+    ob = bpy.data.objects.new("Point", point)
+    ob.location = (1.4, -0.2, 1.2)
+    bpy.context.scene.collection.objects.link(ob)
+
+    square = bpy.data.lights.new("Square", "AREA")
+    square.size, square.energy = 0.6, 40.0
+    if hasattr(square, "use_temperature"):
+        square.use_temperature, square.temperature = True, 5000.0
+        square.exposure, square.normalize = 1.0, False
+    ob = bpy.data.objects.new("Square", square)
+    ob.location = (0.8, 2.0, 1.4)
+    ob.rotation_euler = (math.radians(-35.0), 0.0, 0.0)
+    bpy.context.scene.collection.objects.link(ob)
+
+    camera = bpy.context.scene.camera
+    camera.data.type = "PERSP"
+    camera.data.lens = 35.0
+    camera.location = (0.0, -2.4, 1.5)
+    camera.rotation_euler = (math.radians(52.0), 0.0, 0.0)
+    bpy.context.scene.world = None
+
+
 argv = sys.argv[sys.argv.index("--") + 1:]
 mode, out = argv[0], argv[1]
+OUT = out
 if mode != "studio":
     clear_defaults()
 bpy.context.scene.render.engine = "CYCLES"
@@ -261,6 +317,8 @@ elif mode == "grey_floor":
     grey_floor_scene(out, argv[2])
 elif mode == "blackbody":
     blackbody_scene(float(argv[2]))
+elif mode == "lights":
+    blender_lights_scene()
 else:
     raise SystemExit(f"unknown mode {mode}")
 bpy.ops.wm.save_as_mainfile(filepath=os.path.abspath(out))

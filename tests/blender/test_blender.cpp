@@ -1086,14 +1086,16 @@ TEST_F(ArtistScene, BlackbodyLightBandShapeIsPlancksLaw) {
     const std::string k = std::to_string(static_cast<int>(kelvin));
     const fs::path blend = make({"blackbody", k}, "blackbody" + k + ".blend");
     if (kelvin == 3000.0) {
-      // Blender's own lights have no scene file for the plan to read: --plan refuses by name, rendering nothing.
-      const CommandResult refused = batch({"--blend", blend.string(), "--out", dir_.file("planned.exr").string(),
-                                           "--plan", "1"});
-      EXPECT_EQ(refused.exit_code, 2) << refused.err;
-      EXPECT_NE(refused.err.find("--plan: " + blend.string() + ": Blender light objects (Area) cannot be planned yet"),
-                std::string::npos)
-          << refused.err;
-      EXPECT_FALSE(fs::exists(dir_.file("planned.exr")));
+      // Blender's own lights are written to the plan's scene file as the light they are (scene_export): a .blend lit
+      // by an area light is planned, and the render keeps the plan in its header.
+      const fs::path planned = dir_.file("planned.exr");
+      const CommandResult r = batch({"--blend", blend.string(), "--out", planned.string(), "--plan", "1",
+                                     "--resolution", "24x24", "--components", "none"},
+                                    "cache-planned");
+      ASSERT_EQ(r.exit_code, 0) << r.err;
+      EXPECT_NE(r.err.find("chromatrace: plan for a mean ΔE00 of 1:"), std::string::npos) << r.err;
+      SpectralExrReader reader(planned);
+      EXPECT_TRUE(reader.info().metadata.count("chromatrace.plan")) << "no chromatrace.plan in the header";
     }
     const json plan = explain(blend);
     const json& area = *owner(plan, "light", "Area");

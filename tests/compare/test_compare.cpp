@@ -37,6 +37,8 @@ struct Synthetic {
   int width = kW;
   double camera_x = 0.0;
   double slope = 0.001;  // relative change of every spectrum per nm about 580 nm (0: flat within each 40 nm bin)
+  std::string extra;       // a third name with id 3 and no pixels, when not empty
+  bool extra_is_light = false;  // and it is one of the scene's lights (else an object)
 };
 
 // Band b of object o's diffuse_direct and glossy_direct.
@@ -51,10 +53,14 @@ void write_render(const fs::path& file, const Synthetic& s) {
   layout.components = {"diffuse_direct", "glossy_direct"};
   layout.object_ids = true;
   layout.object_names = {{1, "wall"}, {2, "ball"}};
-  const json scene = {{"format", "chromatrace-scene/1"},
-                      {"name", s.scene_name},
-                      {"materials", {{"wall", {{"type", "lambert"}}}, {"ball", {{"type", "dichromatic"}}}}},
-                      {"objects", {{{"name", "wall"}, {"material", "wall"}}, {{"name", "ball"}, {"material", "ball"}}}}};
+  json scene = {{"format", "chromatrace-scene/1"},
+                {"name", s.scene_name},
+                {"materials", {{"wall", {{"type", "lambert"}}}, {"ball", {{"type", "dichromatic"}}}}},
+                {"objects", {{{"name", "wall"}, {"material", "wall"}}, {{"name", "ball"}, {"material", "ball"}}}}};
+  if (!s.extra.empty()) {
+    layout.object_names[3] = s.extra;
+    scene[s.extra_is_light ? "lights" : "objects"].push_back({{"name", s.extra}, {"material", "wall"}});
+  }
   layout.attributes["chromatrace.scene"] = scene.dump();
   layout.attributes["chromatrace.camera"] =
       json{{"position", {s.camera_x, -3.5, 1}}, {"look_at", {s.camera_x, 0, 1}}, {"up", {0, 0, 1}},
@@ -260,6 +266,29 @@ TEST_F(Compare, IncomparableInputsExit2NamingTheFileAndWhatDiffers) {
   EXPECT_EQ(cam.exit_code, 2);
   EXPECT_NE(cam.err.find("--camera"), std::string::npos) << cam.err;
   for (const char* o : {"o1", "o2", "o3"}) EXPECT_FALSE(fs::exists(dir_.file(o)));
+}
+
+// Cycles gives Blender's light objects no id; the scene file exported from the .blend has them as lights, which
+// the tracer's render names after the objects. Such ids of B's scene's lights are compared (they hold no pixels),
+// any other id A lacks is another scene.
+TEST_F(Compare, IdsThatOnlyBsSceneLightsHaveAreComparable) {
+  Synthetic a, lamp, chair;
+  lamp.extra = chair.extra = "lamp";
+  lamp.extra_is_light = true;
+  lamp.seed = chair.seed = 2;
+  const std::string fa = render("a.exr", a).string(), fl = render("lamp.exr", lamp).string();
+  const auto r = run({fa, fl, "-o", dir_.file("out").string()});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(result("out")["verdict"]["agree"]);
+  const std::string fc = render("chair.exr", chair).string();
+  const auto refused = run({fa, fc, "-o", dir_.file("out2").string()});
+  EXPECT_EQ(refused.exit_code, 2);
+  EXPECT_NE(refused.err.find(fc + ": attribute chromatrace.objects: more objects than in " + fa), std::string::npos)
+      << refused.err;
+  // Nor the other way round: A's lights are not B's to lack.
+  const auto reversed = run({fl, fa, "-o", dir_.file("out3").string()});
+  EXPECT_EQ(reversed.exit_code, 2);
+  EXPECT_NE(reversed.err.find("id 3 is no object"), std::string::npos) << reversed.err;
 }
 
 TEST_F(Compare, IdenticalRendersHaveZeroDeltaE) {
