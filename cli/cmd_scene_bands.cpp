@@ -62,6 +62,10 @@ Json material_entry(const Material& material, const Bands& bands) {
           return {{"type", "lambert"}, {"reflectance", averages(m.reflectance.spectrum, bands)}};
         } else if constexpr (std::is_same_v<M, MirrorMaterial>) {
           return {{"type", "mirror"}, {"reflectance", averages(m.reflectance.spectrum, bands)}};
+        } else if constexpr (std::is_same_v<M, PrincipledMaterial>) {
+          return {{"type", "principled"}, {"version", m.version},
+                  {"base_color", averages(m.base_color.spectrum, bands)}, {"roughness", m.roughness},
+                  {"ior", m.effective_ior()}, {"distribution", m.multiscatter ? "multiscatter-ggx" : "ggx"}};
         } else {
           Json entry = {{"type", "dichromatic"}, {"diffuse", averages(m.diffuse.spectrum, bands)}, {"specular", m.specular}};
           if (const auto* ggx = std::get_if<DichromaticMaterial::Ggx>(&m.lobe)) {

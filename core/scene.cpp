@@ -256,6 +256,7 @@ class SceneReader {
   Environment environment(const JsonNode& node);
   void check_texture_coordinates(const JsonNode& objects) const;
   Material material(const std::string& name, const JsonNode& node);
+  PrincipledMaterial principled(const JsonNode& node);
   std::size_t material_index(const JsonNode& node) const;
   Shape object_shape(const JsonNode& node) const;
   LightShape light_shape(const JsonNode& node) const;
@@ -449,7 +450,8 @@ SpectrumRef SceneReader::reflectance(const JsonNode& node) {
 }
 
 Material SceneReader::material(const std::string& name, const JsonNode& node) {
-  const std::string type = node["type"].choice({"lambert", "dichromatic", "mirror"});
+  const std::string type = node["type"].choice({"lambert", "dichromatic", "mirror", "principled"});
+  if (type == "principled") return {name, principled(node)};
   if (type == "lambert") {
     node.expect_object({"type", "reflectance"});
     return {name, LambertMaterial{reflectance(node["reflectance"])}};
@@ -488,6 +490,39 @@ Material SceneReader::material(const std::string& name, const JsonNode& node) {
                     "reflect more light than it receives",
                     body, dichromatic.specular));
   return {name, std::move(dichromatic)};
+}
+
+PrincipledMaterial SceneReader::principled(const JsonNode& node) {
+  node.expect_object({"type", "version", "base_color", "roughness", "ior", "specular_ior_level", "specular",
+                      "distribution"});
+  PrincipledMaterial m;
+  if (const auto version = node.find("version")) m.version = static_cast<int>(version->integer_in(1, 2));
+  m.base_color = reflectance(node["base_color"]);
+  if (const auto roughness = node.find("roughness")) m.roughness = roughness->number_in(0.0, 1.0);
+  for (const char* key : m.version == 2 ? std::vector<const char*>{"specular"}
+                                        : std::vector<const char*>{"ior", "specular_ior_level"})
+    if (const auto other = node.find(key))
+      other->fail(fmt::format("applies only to \"version\": {}", m.version == 2 ? 1 : 2));
+  if (m.version == 2) {
+    if (const auto ior = node.find("ior")) m.ior = ior->number_in(1.0, 10.0);
+    if (const auto level = node.find("specular_ior_level")) m.specular_ior_level = level->number_in(0.0, 1.0);
+  } else {
+    if (const auto specular = node.find("specular")) m.specular = specular->number_in(0.0, 1.0);
+  }
+  if (const auto distribution = node.find("distribution")) {
+    m.multiscatter = distribution->choice({"ggx", "multiscatter-ggx"}) == "multiscatter-ggx";
+    if (m.multiscatter && m.version == 1)
+      distribution->fail("Blender 3.x's Multiscatter GGX is a random walk the tracer does not hold; version 1 "
+                         "takes \"ggx\"");
+  } else if (m.version == 1) {
+    m.multiscatter = false;  // Blender 3.x's default
+  }
+  // Below this Cycles makes the interface a perfect mirror (alpha² at its threshold), which the tracer's principled
+  // lobe does not hold.
+  if (m.roughness < 0.02 && m.effective_ior() > 1.0)
+    node["roughness"].fail(fmt::format("{} is below 0.02, where Cycles' interface becomes a perfect mirror, which "
+                                       "a principled material does not hold", m.roughness));
+  return m;
 }
 
 std::size_t SceneReader::material_index(const JsonNode& node) const {
@@ -580,6 +615,7 @@ void SceneReader::check_texture_coordinates(const JsonNode& objects) const {
     if (const auto* m = std::get_if<LambertMaterial>(&material.model); m && m->reflectance.texture) textured = "reflectance";
     if (const auto* m = std::get_if<DichromaticMaterial>(&material.model); m && m->diffuse.texture) textured = "diffuse";
     if (const auto* m = std::get_if<MirrorMaterial>(&material.model); m && m->reflectance.texture) textured = "reflectance";
+    if (const auto* m = std::get_if<PrincipledMaterial>(&material.model); m && m->base_color.texture) textured = "base_color";
     if (textured.empty()) continue;
     nodes[i]["shape"]["file"].fail(fmt::format(
         "{} has no texture coordinates (vertex properties u, v or s, t), but object \"{}\" has material \"{}\" "
@@ -653,18 +689,32 @@ std::vector<NamedSpectrum> SceneReader::read_spectra(const JsonNode& root) {
 }  // namespace
 
 const char* material_type_name(const Material& material) {
-  static constexpr const char* names[] = {"lambert", "dichromatic", "mirror"};
+  static constexpr const char* names[] = {"lambert", "dichromatic", "mirror", "principled"};
   return names[material.model.index()];
 }
 
 const SpectrumRef& Material::reflectance_spectrum() const {
   if (const auto* d = std::get_if<DichromaticMaterial>(&model)) return d->diffuse;
   if (const auto* m = std::get_if<MirrorMaterial>(&model)) return m->reflectance;
+  if (const auto* p = std::get_if<PrincipledMaterial>(&model)) return p->base_color;
   return std::get<LambertMaterial>(model).reflectance;
 }
 
 const char* Material::reflectance_key() const {
+  if (std::holds_alternative<PrincipledMaterial>(model)) return "base_color";
   return std::holds_alternative<DichromaticMaterial>(model) ? "diffuse" : "reflectance";
+}
+
+double PrincipledMaterial::effective_ior() const {
+  if (version == 1) {
+    // F0 = 0.08 · specular, and the IOR whose normal-incidence Fresnel that is.
+    const double root = std::sqrt(0.08 * specular);
+    return root > 0.0 ? (1.0 + root) / (1.0 - root) : 1.0;
+  }
+  if (specular_ior_level == 0.5) return ior;
+  const double f0 = std::clamp(std::pow((ior - 1.0) / (ior + 1.0), 2) * 2.0 * specular_ior_level, 0.0, 0.99);
+  const double root = std::sqrt(f0);
+  return (1.0 + root) / (1.0 - root);
 }
 
 const Material* Scene::find_material(std::string_view name) const { return find_by_name(materials, name); }

@@ -83,9 +83,28 @@ struct MirrorMaterial {
   SpectrumRef reflectance;
 };
 
+// Blender's Principled BSDF as Cycles evaluates it, for an opaque dielectric (no metal, transmission, coat, sheen,
+// subsurface or emission; white specular tint): a GGX interface with the dielectric Fresnel over a diffuse base
+// (docs/scene-format.md, "principled"). Version 2 (Blender 4.0 on): Lambert base attenuated by the interface's
+// albedo at the view angle, height-correlated masking, Fresnel of `ior` (scaled by specular_ior_level), Multiscatter
+// GGX's energy compensation unless distribution is plain GGX. Version 1 (Blender 3.x): Burley's diffuse with
+// retro-reflection added to single-scatter GGX with separable masking and F0 = 0.08 · specular.
+struct PrincipledMaterial {
+  SpectrumRef base_color;
+  double roughness = 0.5;
+  int version = 2;
+  double ior = 1.5;                 // version 2
+  double specular_ior_level = 0.5;  // version 2
+  double specular = 0.5;            // version 1
+  bool multiscatter = true;         // version 2 only: Multiscatter GGX (Blender's default) or plain GGX
+  // The interface's IOR after the Specular IOR Level (v2) or from F0 = 0.08 · specular (v1); 1 when it reflects
+  // nothing (no specular lobe).
+  double effective_ior() const;
+};
+
 struct Material {
   std::string name;
-  std::variant<LambertMaterial, DichromaticMaterial, MirrorMaterial> model;
+  std::variant<LambertMaterial, DichromaticMaterial, MirrorMaterial, PrincipledMaterial> model;
 
   // The one spectrum that colours what the material reflects: a Lambert or mirror material's reflectance, a
   // dichromatic material's diffuse (body) reflectance (its specular lobe is flat). reflectance_key() names its
@@ -94,7 +113,7 @@ struct Material {
   const char* reflectance_key() const;
 };
 
-// "lambert", "dichromatic" or "mirror".
+// "lambert", "dichromatic", "mirror" or "principled".
 const char* material_type_name(const Material& material);
 
 // ---- Lights and objects ------------------------------------------------------------------------------

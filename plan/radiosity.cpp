@@ -11,6 +11,7 @@
 
 #include "core/random.h"
 #include "reference_tracer/accel.h"
+#include "reference_tracer/principled.h"
 
 namespace ct::plan {
 
@@ -318,6 +319,11 @@ SceneSurfaces scene_surfaces(const Scene& scene, const std::vector<TriangleMesh>
       s.glossy = s.diffuse;
       s.diffuse = zero;
       mirror = true;
+    } else if (auto* p = std::get_if<PrincipledMaterial>(&m.model)) {
+      // The interface reflects its average Fresnel, spectrally flat, beside the base's colour (which Cycles dims
+      // by a few per cent under it: the model keeps it whole).
+      ks = rt::average_fresnel_dielectric(p->effective_ior());
+      s.glossy = one;
     }
     s.albedo.v.resize(albedo.size());
     for (std::size_t i = 0; i < albedo.size(); ++i) {

@@ -32,7 +32,8 @@ LobeValues evaluate(const TracerMaterial& m, const Vec3& wo, const Vec3& wi) {
   const double pg = m.glossy_probability;
   if (m.diffuse) {
     const LambertLobe lambert;
-    v.diffuse = lambert.eval(wo, wi);
+    const auto* principled = std::get_if<PrincipledLobe>(&m.glossy);
+    v.diffuse = principled ? principled->diffuse(wo, wi) : lambert.eval(wo, wi);
     v.pdf += (1.0 - pg) * lambert.pdf(wo, wi);
   }
   std::visit(

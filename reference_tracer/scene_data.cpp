@@ -79,6 +79,15 @@ TracerMaterial make_material(const Material& material, TextureSet& textures) {
     const double body = textures.mean(m.diffuse);
     m.glossy_probability = m.specular_weight > 0.0 ? m.specular_weight / (m.specular_weight + body) : 0.0;
     if (body <= 0.0 && m.specular_weight > 0.0) m.glossy_probability = 1.0;
+  } else if (const auto* principled = std::get_if<PrincipledMaterial>(&material.model)) {
+    m.diffuse = textures.input(principled->base_color, &principled->base_color.spectrum);
+    m.specular_weight = 1.0;  // the lobe carries its Fresnel
+    m.glossy = rt::PrincipledLobe(principled->version, principled->roughness, principled->effective_ior(),
+                                  principled->multiscatter);
+    // The lobe's share of the light at normal incidence beside the base's, as the chance of sampling it.
+    const double interface = average_fresnel_dielectric(principled->effective_ior());
+    const double body = textures.mean(m.diffuse);
+    m.glossy_probability = interface > 0.0 ? std::max(0.1, interface / (interface + body)) : 0.0;
   } else {
     const auto& mirror = std::get<MirrorMaterial>(material.model);
     m.specular = textures.input(mirror.reflectance, &mirror.reflectance.spectrum);

@@ -15,6 +15,7 @@
 #include "reference_tracer/accel.h"
 #include "reference_tracer/bsdf.h"
 #include "reference_tracer/lanes.h"
+#include "reference_tracer/principled.h"
 
 namespace ct::rt {
 
@@ -43,7 +44,7 @@ struct TracerMaterial {
   ColourInput diffuse;   // none: no diffuse term
   ColourInput specular;  // none: flat specular_weight
   double specular_weight = 0.0;
-  std::variant<std::monostate, GgxLobe, PhongLobe, MirrorLobe> glossy;
+  std::variant<std::monostate, GgxLobe, PhongLobe, MirrorLobe, PrincipledLobe> glossy;
   double glossy_probability = 0.0;  // chance of sampling the glossy lobe rather than the diffuse one
 
   bool is_delta() const { return std::holds_alternative<MirrorLobe>(glossy); }

@@ -81,6 +81,11 @@ def linear_rec709(image):
     return "Linear Rec.709" if "Linear Rec.709" in names else "Linear"
 
 
+def principled_version():
+    """The Principled BSDF's version in the running Blender: 2 from 4.0 (Specular IOR Level, layered), 1 before."""
+    return 2 if bpy.app.version >= (4, 0, 0) else 1
+
+
 def light_radiance_per_watt(light, area):
     """The radiance (in Cycles' units, those of an Emission shader of strength 1) that one watt of `light`'s power
     gives its surface: an area light of `area` m² (its size times its object's scale), or a point light's sphere.

@@ -11,7 +11,8 @@ from .errors import BadInput
 
 REFLECTANCE_NODE = "ct_reflectance"
 EMISSION_NODE = "ct_emission"
-MANAGED_MODELS = ("LAMBERT", "DICHROMATIC", "MIRROR", "NONE")
+MANAGED_MODELS = ("LAMBERT", "DICHROMATIC", "MIRROR", "PRINCIPLED", "NONE")
+PRINCIPLED_NODE = "ct_principled"
 
 _TRANSMISSION_NODES = ("ShaderNodeBsdfGlass", "ShaderNodeBsdfRefraction")
 # A colour the spectral render sets: target.attribute gets the band values (× scale), keeping alpha. Roles:
@@ -39,7 +40,7 @@ def build_material_nodes(material):
     nodes.clear()
     output = _new(nodes, "ShaderNodeOutputMaterial", "ct_output", (600, 0))
     shader = None
-    if s.model in ("LAMBERT", "DICHROMATIC", "MIRROR"):
+    if s.model in ("LAMBERT", "DICHROMATIC", "MIRROR", "PRINCIPLED"):
         if s.reflectance.kind == "TEXTURE":
             colour = _new(nodes, "ShaderNodeTexImage", REFLECTANCE_NODE, (-500, 100))
             colour.image = load_image(s.reflectance.texture_path, s.reflectance.texture_colour_space)
@@ -64,6 +65,11 @@ def build_material_nodes(material):
             links.new(diffuse.outputs[0], add.inputs[0])
             links.new(glossy.outputs[0], add.inputs[1])
             shader = add
+        if s.model == "PRINCIPLED":
+            principled = _new(nodes, "ShaderNodeBsdfPrincipled", PRINCIPLED_NODE, (-100, 100))
+            set_principled(principled, s)
+            links.new(colour.outputs[0], principled.inputs["Base Color"])
+            shader = principled
         if s.model == "MIRROR":
             glossy = _new(nodes, "ShaderNodeBsdfGlossy", "ct_mirror", (-100, 100))
             glossy.distribution = "GGX"
@@ -97,6 +103,18 @@ def build_material_nodes(material):
             shader = add
     if shader is not None:
         links.new(shader.outputs[0], output.inputs["Surface"])
+
+
+def set_principled(node, s):
+    """A Principled BSDF node set as the scene format's principled material of `s` (the node's version is the
+    running Blender's: 2 from 4.0, with IOR and Specular IOR Level; 1 before, with Specular)."""
+    node.distribution = s.distribution if "Specular IOR Level" in node.inputs else "GGX"
+    node.inputs["Roughness"].default_value = s.roughness
+    if "Specular IOR Level" in node.inputs:
+        node.inputs["IOR"].default_value = s.ior
+        node.inputs["Specular IOR Level"].default_value = s.specular_ior_level
+    else:
+        node.inputs["Specular"].default_value = s.principled_specular
 
 
 def load_image(path, colour_space="auto"):

@@ -151,6 +151,8 @@ MODEL_ITEMS = [
     ("LAMBERT", "Lambert", "f = R(λ)/π: a Diffuse BSDF"),
     ("DICHROMATIC", "Dichromatic", "Lambertian body plus a spectrally flat GGX interface lobe (Shafer's model)"),
     ("MIRROR", "Mirror", "A perfect mirror scaled by R(λ)"),
+    ("PRINCIPLED", "Principled", "Blender's Principled BSDF as an opaque dielectric: base colour R(λ) under a "
+                                 "spectrally flat interface"),
     ("NONE", "No reflection", "Reflects nothing (an emitter only)"),
 ]
 
@@ -166,6 +168,16 @@ class CHROMATRACE_PG_material(bpy.types.PropertyGroup):
                        default="ggx", update=_rebuild_nodes)
     roughness: FloatProperty(name="Roughness", min=0.0, max=1.0, default=0.15, update=_rebuild_nodes)
     exponent: FloatProperty(name="Exponent", min=0.0, default=50.0)
+    ior: FloatProperty(name="IOR", min=1.0, max=10.0, default=1.5, update=_rebuild_nodes,
+                       description="The Principled BSDF's IOR (Blender 4.0 and later)")
+    specular_ior_level: FloatProperty(name="Specular IOR Level", min=0.0, max=1.0, default=0.5,
+                                      update=_rebuild_nodes,
+                                      description="The Principled BSDF's Specular IOR Level (Blender 4.0 and later)")
+    principled_specular: FloatProperty(name="Specular", min=0.0, max=1.0, default=0.5, update=_rebuild_nodes,
+                                       description="The Principled BSDF's Specular (Blender 3.x): F0 = 0.08 × it")
+    distribution: EnumProperty(name="Distribution", items=[
+        ("MULTI_GGX", "Multiscatter GGX", "GGX with Cycles' energy compensation (Blender 4.0 and later)"),
+        ("GGX", "GGX", "Single-scatter GGX")], default="MULTI_GGX", update=_rebuild_nodes)
     emissive: BoolProperty(name="Emits light", default=False, update=_rebuild_nodes)
     emission: PointerProperty(type=CHROMATRACE_PG_spectrum, name="Emission")
     emission_scale: FloatProperty(name="Scale", min=0.0, default=1.0, update=_rebuild_nodes,

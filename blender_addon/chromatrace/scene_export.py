@@ -51,6 +51,57 @@ def _texture_file(source, texture_dir, out_dir):
 # Shader nodes whose material a scene file holds exactly (as `lambert`), with the inputs that must be 0 for it.
 _LAMBERTIAN = {"ShaderNodeBsdfDiffuse": ("Roughness",)}
 
+# A Principled BSDF's inputs that must hold these values for a scene file's `principled` material (an opaque
+# dielectric), by version: 2 from Blender 4.0 (it has Specular IOR Level), 1 before. Inputs a Blender lacks are
+# skipped. The base colour, roughness and IOR (v2) or Specular (v1) are read, and must not be linked.
+_PRINCIPLED_FIXED = {
+    2: {"Metallic": 0.0, "Transmission Weight": 0.0, "Coat Weight": 0.0, "Sheen Weight": 0.0,
+        "Subsurface Weight": 0.0, "Emission Strength": 0.0, "Anisotropic": 0.0, "Alpha": 1.0,
+        "Specular Tint": (1.0, 1.0, 1.0), "Diffuse Roughness": 0.0, "Thin Film Thickness": 0.0},
+    1: {"Metallic": 0.0, "Transmission": 0.0, "Clearcoat": 0.0, "Sheen": 0.0, "Subsurface": 0.0,
+        "Emission Strength": 0.0, "Anisotropic": 0.0, "Alpha": 1.0, "Specular Tint": 0.0},
+}
+# Colour inputs the walk reports beside the base colour, which the values above leave without effect.
+_PRINCIPLED_TINTS = ("Specular Tint", "Coat Tint", "Sheen Tint", "Subsurface Color")
+
+
+def _principled_entry(material, walk, base, approximate):
+    """The material as a scene file's `principled` (docs/scene-format.md) when its tree is one Principled BSDF that
+    is an opaque dielectric with a smooth enough interface, else None with the reason."""
+    shaders = [node for _path, node in walk.shaders]
+    if len(shaders) != 1 or shaders[0].bl_idname != "ShaderNodeBsdfPrincipled":
+        return None, None
+    node = shaders[0]
+    version = 2 if "Specular IOR Level" in node.inputs else 1
+    for name, wanted in _PRINCIPLED_FIXED[version].items():
+        socket = node.inputs.get(name)
+        if socket is None or (name == "Emission Strength" and max(node.inputs[
+                "Emission Color" if "Emission Color" in node.inputs else "Emission"].default_value[:3]) == 0.0):
+            continue
+        value = socket.default_value
+        value = tuple(value[:3]) if isinstance(wanted, tuple) else value
+        if socket.is_linked or value != wanted:
+            return None, f"its Principled BSDF's {name} is {'linked' if socket.is_linked else value}, not {wanted}"
+    numbers = ("Roughness", "IOR", "Specular IOR Level") if version == 2 else ("Roughness", "Specular")
+    for name in numbers + ("Normal",):
+        if node.inputs[name].is_linked:
+            return None, f"its Principled BSDF's {name} is linked"
+    roughness = node.inputs["Roughness"].default_value
+    if roughness < 0.02:
+        return None, f"its Principled BSDF's Roughness {roughness:g} is below 0.02, where Cycles makes a mirror"
+    entry = {"type": "principled", "version": version, "base_color": base, "roughness": short_float(roughness)}
+    if version == 2:
+        entry["ior"] = short_float(node.inputs["IOR"].default_value)
+        entry["specular_ior_level"] = short_float(node.inputs["Specular IOR Level"].default_value)
+        entry["distribution"] = "multiscatter-ggx" if node.distribution == "MULTI_GGX" else "ggx"
+    else:
+        entry["specular"] = short_float(node.inputs["Specular"].default_value)
+        entry["distribution"] = "ggx"
+        if node.distribution == "MULTI_GGX" and roughness > 0.075:
+            approximate(f"material \"{material.name}\": its Principled BSDF's Multiscatter GGX (Blender 3.x's random "
+                        "walk) is written as single-scatter GGX, which reflects a little less at high roughness")
+    return entry, None
+
 
 def _node_material_entry(scene, material, texture_dir, out_dir, approximate):
     """A material of the node-tree model as a scene-format material, from the colours the spectral render gives
@@ -66,6 +117,16 @@ def _node_material_entry(scene, material, texture_dir, out_dir, approximate):
         raise BadInput(f"{what}: its nodes emit light, which a scene file holds only as a light (a quad or a "
                        "sphere): set the object's chromatrace role to Light, or make it a Blender area light")
     reflectances = [i for i in inputs if i.role == "reflectance"]
+    bases = [i for i in reflectances if not i.label.endswith(tuple("/" + t for t in _PRINCIPLED_TINTS))]
+    if len(bases) == 1:
+        base = (_texture_file(bases[0].source, texture_dir, out_dir)
+                if bases[0].attribute == "image" and bases[0].source is not None
+                else node_resolution.node_source(bases[0], what)[0])
+        entry, reason = _principled_entry(material, walk, base, approximate)
+        if entry is not None:
+            return entry
+    else:
+        reason = None
     if reflectances:
         first = reflectances[0]
         if first.attribute == "image" and first.source is not None:
@@ -82,8 +143,8 @@ def _node_material_entry(scene, material, texture_dir, out_dir, approximate):
     if not exact:
         kinds = sorted({node.bl_label for node in shaders}) or ["no shader"]
         approximate(f"{what}: its nodes ({', '.join(kinds)}) are written as a Lambertian material of "
-                    f"{'its colour ' + first.label if reflectances else 'their grey'}; the scene file holds them "
-                    "only approximately")
+                    f"{'its colour ' + first.label if reflectances else 'their grey'}"
+                    + (f" ({reason})" if reason else "") + "; the scene file holds them only approximately")
     return {"type": "lambert", "reflectance": source}
 
 
@@ -98,6 +159,15 @@ def _material_entry(material, out_dir):
         return entry
     if s.model == "MIRROR":
         return {"type": "mirror", "reflectance": reflectance}
+    if s.model == "PRINCIPLED":
+        entry = {"type": "principled", "version": blender_compat.principled_version(), "base_color": reflectance,
+                 "roughness": short_float(s.roughness)}
+        if entry["version"] == 2:
+            entry.update(ior=short_float(s.ior), specular_ior_level=short_float(s.specular_ior_level),
+                         distribution="multiscatter-ggx" if s.distribution == "MULTI_GGX" else "ggx")
+        else:
+            entry.update(specular=short_float(s.principled_specular), distribution="ggx")
+        return entry
     return {"type": "lambert", "reflectance": reflectance}
 
 

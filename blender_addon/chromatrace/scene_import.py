@@ -40,7 +40,15 @@ def _material(name, entry, scene_dir):
     s = material.chromatrace
     s.scene_name = name
     kind = entry["type"]
-    if kind == "dichromatic":
+    if kind == "principled":
+        _spectrum(s.reflectance, entry["base_color"], scene_dir)
+        s.roughness = entry.get("roughness", 0.5)
+        s.ior = entry.get("ior", 1.5)
+        s.specular_ior_level = entry.get("specular_ior_level", 0.5)
+        s.principled_specular = entry.get("specular", 0.5)
+        default = "multiscatter-ggx" if entry.get("version", 2) == 2 else "ggx"
+        s.distribution = "MULTI_GGX" if entry.get("distribution", default) == "multiscatter-ggx" else "GGX"
+    elif kind == "dichromatic":
         _spectrum(s.reflectance, entry["diffuse"], scene_dir)
         s.specular = entry["specular"]
         s.lobe = entry.get("lobe", "ggx")
@@ -170,6 +178,17 @@ def _ensure_lightgroup(view_layer, group):
         view_layer.lightgroups.add(name=group)
 
 
+def _refuse_other_principled(document, path):
+    """Refuses, before anything is added to the scene, a principled material of the other Principled BSDF version
+    than this Blender's: its node would be another BSDF."""
+    here = blender_compat.principled_version()
+    for name, entry in document["materials"].items():
+        if entry["type"] == "principled" and entry.get("version", 2) != here:
+            raise BadInput(f"{path}: materials.{name}.version: {entry.get('version', 2)}, but Blender "
+                           f"{bpy.app.version_string}'s Principled BSDF is version {here}: Cycles would render another "
+                           "material")
+
+
 def _refuse_other_masking(document, path, option):
     """Refuses, before anything is added to the scene, a GGX material whose masking is not this Cycles': Cycles
     would render another material. `option` names what renders it with Cycles' masking instead."""
@@ -205,6 +224,7 @@ def import_scene(path, scene, tool, log=print, ggx_masking="scene", warn=None, m
     if ggx_masking == "cycles":
         _use_cycles_masking(document, warn or log, masking_option)
     _refuse_other_masking(document, path, masking_option)
+    _refuse_other_principled(document, path)
     scene_dir = os.path.dirname(os.path.abspath(path))
     s = scene.chromatrace
     s.scene_name = document.get("name", "")

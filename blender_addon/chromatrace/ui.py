@@ -153,12 +153,21 @@ class CHROMATRACE_PT_material(_Panel, bpy.types.Panel):
         row.operator("chromatrace.build_material", text="", icon="FILE_REFRESH")
         if s.model != "NONE":
             box = layout.box()
-            box.label(text="Reflectance" if s.model != "DICHROMATIC" else "Diffuse reflectance")
+            box.label(text={"DICHROMATIC": "Diffuse reflectance", "PRINCIPLED": "Base colour"}.get(s.model, "Reflectance"))
             s.reflectance.draw(box.column())
         if s.model == "DICHROMATIC":
             layout.prop(s, "specular")
             layout.prop(s, "lobe")
             layout.prop(s, "roughness" if s.lobe == "ggx" else "exponent")
+        if s.model == "PRINCIPLED":
+            from .blender_compat import principled_version
+            layout.prop(s, "roughness")
+            if principled_version() == 2:
+                layout.prop(s, "ior")
+                layout.prop(s, "specular_ior_level")
+                layout.prop(s, "distribution")
+            else:
+                layout.prop(s, "principled_specular")
         layout.prop(s, "emissive")
         if s.emissive:
             box = layout.box()

@@ -13,6 +13,8 @@
         a grey diffuse plane under an area light whose node tree's colour is a Blackbody node at KELVIN, no world
     blender -b --factory-startup --python make_artist_scene.py -- lights OUT.blend
         Blender's light objects in each power convention (blender_lights_scene) over a textured floor and a box
+    blender -b --factory-startup --python make_artist_scene.py -- principled OUT.blend
+        Principled BSDFs as an artist leaves them (principled_scene) under an area light
     blender -b --factory-startup --python make_artist_scene.py -- grey_floor OUT.blend (hdri | R,G,B)
         a large diffuse floor whose colour is an Image Texture node of a 2×2 float image of greys (R = G = B: 0.25
         and 0.6), packed into the .blend, seen at a slant by a perspective camera with the sky above the horizon;
@@ -300,6 +302,47 @@ def blender_lights_scene():
     bpy.context.scene.world = None
 
 
+def principled(name, base, roughness, ior=None):
+    """A material of Blender's default Principled BSDF with this base colour and roughness (and IOR when given)."""
+    material = bpy.data.materials.new(name)
+    material.use_nodes = True
+    node = material.node_tree.nodes["Principled BSDF"]
+    node.inputs["Base Color"].default_value = (*base, 1.0)
+    node.inputs["Roughness"].default_value = roughness
+    if ior is not None:
+        node.inputs["IOR"].default_value = ior
+    return material
+
+
+def principled_scene():
+    """Principled BSDFs as an artist leaves them (only the base colour, roughness and IOR set) under a rectangular
+    area light: a floor (roughness 0.5), a red sphere (0.25), a blue sphere (0.1, IOR 1.6) and a white box (0.7)."""
+    bpy.ops.mesh.primitive_plane_add(size=8.0, location=(0.0, 0.0, 0.0))
+    bpy.context.object.name = "floor"
+    bpy.context.object.data.materials.append(principled("floor", (0.45, 0.42, 0.38), 0.5))
+    for name, location, base, roughness, ior in (("red ball", (-0.5, 0.6, 0.35), (0.7, 0.08, 0.05), 0.25, None),
+                                                 ("blue ball", (0.45, 0.9, 0.3), (0.05, 0.15, 0.6), 0.1, 1.6)):
+        bpy.ops.mesh.primitive_uv_sphere_add(radius=location[2], location=location, segments=64, ring_count=32)
+        bpy.ops.object.shade_smooth()
+        bpy.context.object.name = name
+        bpy.context.object.data.materials.append(principled(name, base, roughness, ior))
+    bpy.ops.mesh.primitive_cube_add(size=0.5, location=(0.2, 1.7, 0.25))
+    bpy.context.object.name = "box"
+    bpy.context.object.data.materials.append(principled("box", (0.8, 0.8, 0.8), 0.7))
+    area = bpy.data.lights.new("Lamp", "AREA")
+    area.shape, area.size, area.size_y, area.energy = "RECTANGLE", 1.2, 0.6, 150.0
+    ob = bpy.data.objects.new("Lamp", area)
+    ob.location = (-0.3, 1.2, 2.2)
+    ob.rotation_euler = (math.radians(15.0), 0.0, 0.0)
+    bpy.context.scene.collection.objects.link(ob)
+    camera = bpy.context.scene.camera
+    camera.data.type = "PERSP"
+    camera.data.lens = 35.0
+    camera.location = (0.0, -2.0, 1.6)
+    camera.rotation_euler = (math.radians(55.0), 0.0, 0.0)
+    bpy.context.scene.world = None
+
+
 argv = sys.argv[sys.argv.index("--") + 1:]
 mode, out = argv[0], argv[1]
 OUT = out
@@ -319,6 +362,8 @@ elif mode == "blackbody":
     blackbody_scene(float(argv[2]))
 elif mode == "lights":
     blender_lights_scene()
+elif mode == "principled":
+    principled_scene()
 else:
     raise SystemExit(f"unknown mode {mode}")
 bpy.ops.wm.save_as_mainfile(filepath=os.path.abspath(out))

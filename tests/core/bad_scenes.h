@@ -30,6 +30,13 @@ inline const std::vector<BadScene>& bad_scenes() {
        "line 3, column 56: syntax error while parsing object - unexpected string literal; expected '}'"},
       {"unknown_spectrum.json", "materials.wall.reflectance: unknown spectrum \"whte\" (spectra: white)"},
       {"roughness_out_of_range.json", "materials.red_plastic.roughness: must be in [0, 1], got 1.5"},
+      {"principled_mirror_roughness.json",
+       "materials.plastic.roughness: 0.01 is below 0.02, where Cycles' interface becomes a perfect mirror, which a "
+       "principled material does not hold"},
+      {"principled_v1_multiscatter.json",
+       "materials.plastic.distribution: Blender 3.x's Multiscatter GGX is a random walk the tracer does not hold; "
+       "version 1 takes \"ggx\""},
+      {"principled_v2_specular.json", "materials.plastic.specular: applies only to \"version\": 1"},
       {"unknown_masking.json",
        "materials.red_plastic.masking: must be one of \"separable\", \"height-correlated\", got \"smith\""},
       {"duplicate_key.json", "materials.wall.reflectance: key appears twice in one object"},

@@ -97,7 +97,7 @@ TEST(Scene, TypeAndRangeErrors) {
   EXPECT_EQ(error_of({{"camera", {{"look_at", {0, -3, 0}}}}}),
             "test.json: camera: the default up [0, 0, 1] is parallel to the viewing direction; give \"up\"");
   EXPECT_EQ(error_of({{"materials", {{"wall", {{"type", "glass"}}}}}}),
-            "test.json: materials.wall.type: must be one of \"lambert\", \"dichromatic\", \"mirror\", got \"glass\"");
+            "test.json: materials.wall.type: must be one of \"lambert\", \"dichromatic\", \"mirror\", \"principled\", got \"glass\"");
   EXPECT_EQ(error_of({{"materials", {{"plastic", {{"exponent", 20}}}}}}),
             "test.json: materials.plastic.exponent: applies only to \"lobe\": \"phong\"");
   EXPECT_EQ(error_of({{"materials", {{"wall", {{"reflectance", {{"constant", -0.1}}}}}}}}),
