@@ -3,7 +3,7 @@
 """Benchmark: a spectral Cycles render planned for a colour-error target against one plain RGB Cycles render.
 
     CHROMATRACE_EXE=build/cli/chromatrace python3 bench/bench_plan_cycles.py [--resolution 96] [--samples 256]
-        [--reference-spp 8192] [--target 1] [--light d65|f11|both] [--scene box|textured|both]
+        [--reference-spp 8192] [--target 1] [--light d65|f11|both] [--scene box|textured|artist|both|all]
         [--blender blender [--blender build/tests/blender/blender-4.5 ...]]
 
 Each --blender is run in turn (a Blender binary, or a bpy module behind tests/blender/bpy_blender.py, as the
@@ -16,6 +16,11 @@ For two scenes, each under a smooth light (D65) and under CIE F11 (three narrow 
 - the textured scene (scenes/textured/textured.json: image textures, a glossy ball, an HDRI sky, whose RGB texels
   are relative to D65), and the same scene lit instead by an F11 panel overhead (a 6 m square 3 m up, of the HDRI's
   mean luminance; Blender's world takes no measured spectrum).
+
+And an artist's scene, under its own light: a .blend made by each Blender (tests/blender/make_artist_scene.py
+artist: Principled BSDFs, a packed image texture, Blender's studio HDRI as the world and an area light coloured by a
+Blackbody node), rendered from the .blend as an artist renders it, and its reference rendered by the tracer from the
+scene file the add-on's Export writes of it (which holds all of it exactly, blender.cross_validate.principled).
 
 For each:
 
@@ -32,6 +37,9 @@ For each:
    image's mean ΔE00 (CIE 1931 observer) and the worst object's. The reference's own noise is in what compare
    measures; the plan's prediction against it (the header's chromatrace.plan: its prediction, and the tracer's noise
    at one sample over √(reference paths), in quadrature) is printed beside it.
+
+A second plain render has the samples of the planned render's largest band group: a plain render as noisy as the
+planned one, whose ratio separates the spectral render's own cost from the samples the target asks for.
 
 Prints, per Blender and light, the CPU ratio planned spectral / plain RGB with and without the planning, the
 predicted and measured mean ΔE00 and the worst object's. Not a test: the machine is shared, so read the figures as
@@ -115,6 +123,30 @@ def scene_for(scene_name, light, work, masking):
     return path
 
 
+# A plain RGB Cycles render of the open .blend as bench_blender.PLAIN renders an imported scene.
+PLAIN_BLEND = PLAIN.replace("""for c in (bpy.data.objects, bpy.data.meshes, bpy.data.materials, bpy.data.lights, bpy.data.cameras):
+    for item in list(c):
+        c.remove(item)
+scene = bpy.context.scene
+scene_import.import_scene({box!r}, scene, tool.Tool(tool.find_executable()), lambda m: None)
+""", "scene = bpy.context.scene\n")
+
+
+def artist_blend(blender_exe, out_dir):
+    """make_artist_scene.py's artist .blend made by this Blender, and the scene file Export writes of it."""
+    blend, scene = os.path.join(out_dir, "artist.blend"), os.path.join(out_dir, "artist.json")
+    if not os.path.exists(scene):
+        here = os.path.join(ROOT, "tests", "blender")
+        run([blender_exe, "--background", "--factory-startup", "--python", os.path.join(here, "make_artist_scene.py"),
+             "--", "artist", blend])
+        said = run([blender_exe, blend, "--background", "--factory-startup", "--python-exit-code", "1", "--python",
+                    os.path.join(here, "export_blend.py"), "--", scene],
+                   env=dict(os.environ, CHROMATRACE_SOURCE_DIR=ROOT))
+        if "approximately:" in said.stdout:
+            sys.exit("the artist's scene was exported approximately:\n" + said.stdout)
+    return blend, scene
+
+
 def run(cmd, **kw):
     r = subprocess.run(cmd, capture_output=True, text=True, **kw)
     if r.returncode:
@@ -130,7 +162,14 @@ def header_plan(exe, exr):
 def bench(scene_name, light, args, work, blender_exe, version, references):
     exe = os.environ["CHROMATRACE_EXE"]
     masking = "height-correlated" if int(version.split(".")[0]) >= 4 else "separable"
-    scene = scene_for(scene_name, light, work, masking)
+    out_dir = os.path.join(work, version)
+    os.makedirs(out_dir, exist_ok=True)
+    blend = None
+    if scene_name == "artist":  # its reference is of its export, which holds this Blender's Principled BSDF
+        blend, scene = artist_blend(blender_exe, out_dir)
+        masking = f"principled-v{2 if int(version.split('.')[0]) >= 4 else 1}"  # one reference per Principled BSDF
+    else:
+        scene = scene_for(scene_name, light, work, masking)
     case = f"{scene_name}-{light}"
     res = f"{args.resolution}x{args.resolution}"
     with open(scene) as f:
@@ -144,11 +183,10 @@ def bench(scene_name, light, args, work, blender_exe, version, references):
              str(args.reference_spp), "--max-bounces", str(scene_bounces), "--seed", "7", "-q"])
         references[reference] = _children_cpu() - start_cpu
 
-    out_dir = os.path.join(work, version)
-    os.makedirs(out_dir, exist_ok=True)
     blender = [blender_exe, "--background", "--factory-startup"]
     spectral_exr = os.path.join(out_dir, f"{case}-cycles.exr")
-    spectral = run(blender + ["--python", os.path.join(ROOT, "blender_addon", "batch.py"), "--", "--scene", scene,
+    source = ["--blend", blend] if blend else ["--scene", scene]
+    spectral = run(blender + ["--python", os.path.join(ROOT, "blender_addon", "batch.py"), "--", *source,
                               "--out", spectral_exr, "--resolution", res, "--plan", repr(args.target),
                               "--plan-edge-step", "5", "--components", "paths",
                               "--cache-dir", os.path.join(out_dir, f"{case}-cache")],
@@ -168,13 +206,21 @@ def bench(scene_name, light, args, work, blender_exe, version, references):
     worst_predicted = (f"{math.hypot(worst_plan['mean_de00'], reference_noise * worst_plan['noise_to_image_noise']):.2f} "
                        f"({worst_plan['name']})") if worst_plan else "-"
 
-    plain = run(blender + ["--python-expr", PLAIN.format(root=ROOT, box=scene, samples=args.samples,
-                                                          res=args.resolution,
-                                                          out=os.path.join(out_dir, f"{case}-rgb.exr"))])
+    script = (PLAIN_BLEND if blend else PLAIN).format(root=ROOT, box=scene, samples=args.samples,
+                                                       res=args.resolution, out=os.path.join(out_dir, f"{case}-rgb.exr"))
+    plain = run(([blender_exe, blend, "--background", "--factory-startup"] if blend else blender)
+                + ["--python-expr", script])
     found = re.search(r"PLAIN_RENDER_SECONDS ([0-9.]+) ([0-9.]+)", plain.stdout)
     if not found:
         sys.exit("plain RGB render printed no timing:\n" + plain.stdout[-400:] + plain.stderr[-800:])
     plain_cpu = float(found.group(2))
+    # And a plain render as noisy as the planned one: the samples of its largest band group.
+    equal_samples = max(plan["cycles_samples"])
+    script = (PLAIN_BLEND if blend else PLAIN).format(root=ROOT, box=scene, samples=equal_samples,
+                                                       res=args.resolution, out=os.path.join(out_dir, f"{case}-rgb-equal.exr"))
+    plain = run(([blender_exe, blend, "--background", "--factory-startup"] if blend else blender)
+                + ["--python-expr", script])
+    equal_cpu = float(re.search(r"PLAIN_RENDER_SECONDS ([0-9.]+) ([0-9.]+)", plain.stdout).group(2))
 
     compare_dir = os.path.join(out_dir, f"{case}-compare")
     run([exe, "compare", spectral_exr, reference, "-o", compare_dir, "--colour", "own", "-q"])
@@ -192,11 +238,14 @@ def bench(scene_name, light, args, work, blender_exe, version, references):
     print(f"  plain RGB Cycles render ({args.samples} samples): {plain_cpu:.2f} s CPU")
     print(f"  ratio planned spectral / plain RGB: {spectral_cpu / plain_cpu:.2f}x CPU "
           f"({(spectral_cpu + planning_cpu) / plain_cpu:.2f}x with the planning)")
+    print(f"  plain RGB Cycles render at the planned groups' largest samples ({equal_samples}): {equal_cpu:.2f} s CPU; "
+          f"ratio planned spectral / it: {spectral_cpu / equal_cpu:.2f}x")
     print(f"  mean dE00 against the 5 nm reference ({args.reference_spp} paths per pixel, "
           f"{references[reference]:.0f} s CPU): measured {mean_de:.2f}, predicted {predicted:.2f} "
           f"({low:.2f}-{high:.2f}); without the reference's noise predicted {plan['predicted_mean_de00']:.2f}; "
           f"worst object {worst} {worst_de:.2f}, predicted {worst_predicted}")
     return dict(ratio=spectral_cpu / plain_cpu, with_planning=(spectral_cpu + planning_cpu) / plain_cpu,
+                equal=spectral_cpu / equal_cpu,
                 measured=mean_de, predicted=predicted, low=low, high=high, worst=f"{worst_de:.2f} ({worst})",
                 worst_predicted=worst_predicted,
                 samples=",".join(map(str, plan["cycles_samples"])))
@@ -209,7 +258,8 @@ def main():
     p.add_argument("--reference-spp", type=int, default=8192)
     p.add_argument("--target", type=float, default=1.0, help="the plan's mean dE00")
     p.add_argument("--light", choices=("d65", "f11", "both"), default="both")
-    p.add_argument("--scene", choices=("box", "textured", "both"), default="both")
+    p.add_argument("--scene", choices=("box", "textured", "artist", "both", "all"), default="both",
+                   help="both: the box and the textured scene; all: the artist's too")
     p.add_argument("--blender", action="append", help="a Blender (repeatable; default: blender)")
     args = p.parse_args()
     if not os.environ.get("CHROMATRACE_EXE"):
@@ -220,16 +270,18 @@ def main():
         results, references = [], {}
         for blender_exe in args.blender or ["blender"]:
             version = blender_version(blender_exe)
-            for scene_name in (("box", "textured") if args.scene == "both" else (args.scene,)):
-                for light in (("d65", "f11") if args.light == "both" else (args.light,)):
+            scenes = {"both": ("box", "textured"), "all": ("box", "textured", "artist")}.get(args.scene, (args.scene,))
+            for scene_name in scenes:
+                for light in ("own",) if scene_name == "artist" else (
+                        ("d65", "f11") if args.light == "both" else (args.light,)):
                     results.append((version, scene_name, light,
                                     bench(scene_name, light, args, work, blender_exe, version, references)))
         print(f"\nload average at the end {os.getloadavg()[0]:.1f}")
-        print("\nBlender  scene     light  samples per group  CPU / plain  with planning  mean dE00 measured  "
-              "predicted (range)      worst object measured, predicted")
+        print("\nBlender  scene     light  samples per group  CPU / plain  with planning  / plain at planned samples  "
+              "mean dE00 measured  predicted (range)      worst object measured, predicted")
         for version, scene_name, light, r in results:
             print(f"{version:8s} {scene_name:9s} {light.upper():5s}  {r['samples']:17s}  {r['ratio']:10.2f}x  "
-                  f"{r['with_planning']:12.2f}x"
+                  f"{r['with_planning']:12.2f}x  {r['equal']:24.2f}x"
                   f"  {r['measured']:17.2f}  {r['predicted']:.2f} ({r['low']:.2f}-{r['high']:.2f})  {r['worst']}, {r['worst_predicted']}")
 
 

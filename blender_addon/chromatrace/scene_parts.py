@@ -65,7 +65,7 @@ def light_groups(scene, families, view_layer, objects, emitters, world):
             groups.append(group)
     world_group = None
     if world["status"] == "lit":
-        world_group = scene.world.lightgroup or "world"
+        world_group = scene.world.lightgroup or "environment"  # the scene format's default, as Export writes it
         if world_group not in groups:
             groups.append(world_group)
     return groups, assignments, world_group

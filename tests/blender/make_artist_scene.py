@@ -15,6 +15,9 @@
         Blender's light objects in each power convention (blender_lights_scene) over a textured floor and a box
     blender -b --factory-startup --python make_artist_scene.py -- principled OUT.blend
         Principled BSDFs as an artist leaves them (principled_scene) under an area light
+    blender -b --factory-startup --python make_artist_scene.py -- artist OUT.blend
+        Principled BSDFs, a packed image texture, an HDRI world and a Blackbody area light, all of which Export
+        writes exactly (artist_scene): bench/bench_plan_cycles.py's artist's scene
     blender -b --factory-startup --python make_artist_scene.py -- grey_floor OUT.blend (hdri | R,G,B)
         a large diffuse floor whose colour is an Image Texture node of a 2×2 float image of greys (R = G = B: 0.25
         and 0.6), packed into the .blend, seen at a slant by a perspective camera with the sky above the horizon;
@@ -343,6 +346,46 @@ def principled_scene():
     bpy.context.scene.world = None
 
 
+def artist_scene(out):
+    """An artist's scene that Export writes exactly: Principled BSDFs left at Blender's defaults but for their base
+    colour and roughness (a floor whose base colour is an Image Texture of a 4×4 float image packed into the .blend,
+    a red and a blue ball, a white box), Blender's studio HDRI courtyard.exr as the world (strength 0.5), and a
+    rectangular area light coloured by a Blackbody node at 3200 K."""
+    bpy.ops.mesh.primitive_plane_add(size=8.0, location=(0.0, 0.0, 0.0))
+    floor = bpy.context.object
+    floor.name = "floor"
+    checker = [v for i in range(16) for v in ((0.6, 0.5, 0.3, 1.0) if (i + i // 4) % 2 else (0.2, 0.3, 0.5, 1.0))]
+    tiles = principled("tiles", (0.8, 0.8, 0.8), 0.6)
+    texture = tiles.node_tree.nodes.new("ShaderNodeTexImage")
+    texture.image = packed_float_image("tiles", 4, 4, checker, out)
+    texture.interpolation = "Closest"
+    tiles.node_tree.links.new(texture.outputs["Color"], tiles.node_tree.nodes["Principled BSDF"].inputs["Base Color"])
+    floor.data.materials.append(tiles)
+    for name, location, base, roughness in (("red ball", (-0.6, 0.5, 0.4), (0.7, 0.08, 0.05), 0.3),
+                                            ("blue ball", (0.5, 0.9, 0.35), (0.05, 0.15, 0.6), 0.15)):
+        bpy.ops.mesh.primitive_uv_sphere_add(radius=location[2], location=location, segments=64, ring_count=32)
+        bpy.ops.object.shade_smooth()
+        bpy.context.object.name = name
+        bpy.context.object.data.materials.append(principled(name, base, roughness))
+    bpy.ops.mesh.primitive_cube_add(size=0.5, location=(0.3, 1.8, 0.25))
+    bpy.context.object.name = "box"
+    bpy.context.object.data.materials.append(principled("box", (0.8, 0.8, 0.8), 0.5))
+    lamp = area_light_with_blackbody(3200.0, (-0.4, 1.0, 2.4), size=1.2, power=200.0)
+    lamp.data.shape, lamp.data.size_y = "RECTANGLE", 0.6
+    world = bpy.context.scene.world
+    world.use_nodes = True
+    environment = world.node_tree.nodes.new("ShaderNodeTexEnvironment")
+    environment.image = bpy.data.images.load(os.path.join(STUDIO_WORLDS, "courtyard.exr"))
+    background = world.node_tree.nodes["Background"]
+    world.node_tree.links.new(environment.outputs["Color"], background.inputs["Color"])
+    background.inputs["Strength"].default_value = 0.5
+    camera = bpy.context.scene.camera
+    camera.data.type = "PERSP"
+    camera.data.lens = 35.0
+    camera.location = (0.0, -2.2, 1.5)
+    camera.rotation_euler = (math.radians(60.0), 0.0, 0.0)
+
+
 argv = sys.argv[sys.argv.index("--") + 1:]
 mode, out = argv[0], argv[1]
 OUT = out
@@ -364,6 +407,8 @@ elif mode == "lights":
     blender_lights_scene()
 elif mode == "principled":
     principled_scene()
+elif mode == "artist":
+    artist_scene(out)
 else:
     raise SystemExit(f"unknown mode {mode}")
 bpy.ops.wm.save_as_mainfile(filepath=os.path.abspath(out))
