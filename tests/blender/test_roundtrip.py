@@ -184,5 +184,29 @@ try:
 except Exception as e:  # BadInput
     expect(f"materials.{first}.version: {3 - version}, but Blender" in str(e), f"refusal does not name the version: {e}")
 
+# An artist's Principled BSDF that is not an opaque dielectric (metal) is written as a Lambertian material of its base
+# colour, and Export says so and why; an opaque one is written as the scene format's principled material.
+scene = fresh_scene()
+scene_import.import_scene(scene_file("cornell_box", "cornell_box.json"), scene, TOOL, print)
+for name, metallic in (("steel", 1.0), ("plastic", 0.0)):
+    bpy.ops.mesh.primitive_uv_sphere_add(radius=0.1, location=(0.3, 0.3, 0.1))
+    ball = bpy.context.object
+    ball.name = name
+    material = bpy.data.materials.new(name)
+    material.use_nodes = True
+    material.node_tree.nodes["Principled BSDF"].inputs["Metallic"].default_value = metallic
+    ball.data.materials.append(material)
+approximations = []
+artist = os.path.join(WORK, "artist", "scene.json")
+os.makedirs(os.path.dirname(artist))
+written = scene_export.export_scene(scene, artist, TOOL, print, approximations=approximations)
+expect(written["materials"]["steel"]["type"] == "lambert", f"the metal is not written as lambert: {written['materials']['steel']}")
+expect(any('material "steel"' in line and "Metallic is 1.0, not 0.0" in line for line in approximations),
+       f"Export does not say why the metal is approximate: {approximations}")
+expect(written["materials"]["plastic"]["type"] == "principled"
+       and written["materials"]["plastic"]["version"] == (2 if bpy.app.version >= (4, 0, 0) else 1),
+       f"the opaque Principled BSDF is not written as principled: {written['materials']['plastic']}")
+expect(not any('material "plastic"' in line for line in approximations), f"the plastic was said approximate: {approximations}")
+
 shutil.rmtree(WORK, ignore_errors=True)
 finish("round trip")
