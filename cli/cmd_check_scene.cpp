@@ -91,7 +91,7 @@ Json scene_summary(const Scene& scene, const plan::RenderRequest& settings) {
     extent.extend(bounds(mesh));
   }
   Json materials = Json::object();
-  for (const char* type : {"lambert", "dichromatic", "mirror"}) {
+  for (const char* type : {"lambert", "dichromatic", "mirror", "principled"}) {
     const auto n = std::count_if(scene.materials.begin(), scene.materials.end(),
                                  [&](const Material& m) { return std::string_view(material_type_name(m)) == type; });
     if (n > 0) materials[type] = n;

@@ -84,7 +84,8 @@ TracerMaterial make_material(const Material& material, TextureSet& textures) {
     m.specular_weight = 1.0;  // the lobe carries its Fresnel
     m.glossy = rt::PrincipledLobe(principled->version, principled->roughness, principled->effective_ior(),
                                   principled->multiscatter);
-    // The lobe's share of the light at normal incidence beside the base's, as the chance of sampling it.
+    // The interface's hemispherical average Fresnel beside the base's mean, as the chance of sampling it (at least
+    // one in ten, for the highlight's indirect light).
     const double interface = average_fresnel_dielectric(principled->effective_ior());
     const double body = textures.mean(m.diffuse);
     m.glossy_probability = interface > 0.0 ? std::max(0.1, interface / (interface + body)) : 0.0;

@@ -90,7 +90,7 @@ def light_radiance_per_watt(light, area):
     """The radiance (in Cycles' units, those of an Emission shader of strength 1) that one watt of `light`'s power
     gives its surface: an area light of `area` m² (its size times its object's scale), or a point light's sphere.
     No API reports it, so the version decides; measured on 3.4, 4.5 and 5.3 against an emitting mesh of the light's
-    shape (tests/blender/test_light_export.py). A 4.x light's Exposure multiplies it by 2^exposure."""
+    shape; blender.cross_validate.blender_lights holds it (tests/blender/cross_validate.py). A 4.x light's Exposure multiplies it by 2^exposure."""
     normalised = getattr(light, "normalize", True)
     exposure = 2.0 ** float(getattr(light, "exposure", 0.0))
     if light.type == "AREA":
