@@ -155,9 +155,13 @@ PathTracer::PathTracer(const TracerScene& scene, TracerSettings settings, LayerP
   for (const TracerLight& light : scene.lights()) table(light.radiance.spectrum);
   if (scene.environment()) table(scene.environment()->radiance.spectrum);
   if (settings_.mode == SpectralMode::Bands) {
-    // Each texel colour's spectrum in the form an {"rgb"} spectrum has (1 nm samples), averaged over each band.
-    for (const TracerTexture& texture : scene.textures())
-      texture_bands_.push_back(palette_band_averages(texture.spectra, settings_.bands, settings_.threads));
+    // Each texel colour's spectrum in the form an {"rgb"} spectrum has (1 nm samples), averaged over each band
+    // (texel_values, when first met).
+    for (const TracerTexture& texture : scene.textures()) {
+      const std::size_t entries = texture.spectra.palette.size();
+      texture_bands_.push_back({std::unique_ptr<double[]>(new double[entries * settings_.bands.size()]),
+                                std::make_unique<std::atomic<std::uint8_t>[]>(entries)});
+    }
   }
 }
 
@@ -166,9 +170,22 @@ Lanes PathTracer::texel_values(const ColourInput& in, std::size_t texel, const C
   const TracerTexture& texture = scene_.textures()[static_cast<std::size_t>(in.texture)];
   const std::uint32_t entry = texture.spectra.palette_of[texel];
   if (chunk) {
-    const std::vector<double>& table = texture_bands_[static_cast<std::size_t>(in.texture)];
-    const std::size_t offset = static_cast<std::size_t>(entry) * settings_.bands.size() + static_cast<std::size_t>(chunk->first_band);
-    return Eigen::Map<const Eigen::ArrayXd>(table.data() + offset, chunk->count) * in.scale;
+    const TextureBands& table = texture_bands_[static_cast<std::size_t>(in.texture)];
+    const std::size_t nb = settings_.bands.size();
+    double* row = table.values.get() + static_cast<std::size_t>(entry) * nb;
+    std::atomic<std::uint8_t>& state = table.state[entry];
+    if (state.load(std::memory_order_acquire) != 2) {
+      std::uint8_t expected = 0;
+      if (state.compare_exchange_strong(expected, 1, std::memory_order_acq_rel)) {
+        tabulated_band_averages(texture.spectra.palette[entry], settings_.bands, row);
+        state.store(2, std::memory_order_release);
+      } else if (expected != 2) {  // another thread is computing it: the same values, computed here too
+        std::vector<double> own(nb);
+        tabulated_band_averages(texture.spectra.palette[entry], settings_.bands, own.data());
+        return Eigen::Map<const Eigen::ArrayXd>(own.data() + chunk->first_band, chunk->count) * in.scale;
+      }
+    }
+    return Eigen::Map<const Eigen::ArrayXd>(row + chunk->first_band, chunk->count) * in.scale;
   }
   const ScaledSigmoid& s = texture.spectra.palette[entry];
   Lanes out(wavelengths.size());

@@ -13,7 +13,9 @@
 // with none (the camera sees an emitter) is "emission". Each contribution also goes to its light's group
 // and to bounce.<k>, k = number of scattering events. Each family of components sums to the total.
 
+#include <atomic>
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -112,8 +114,14 @@ class PathTracer {
   std::vector<Chunk> chunks_;
   // Band averages of every spectrum the tracer uses, for `bands` mode.
   std::vector<std::pair<const PiecewiseLinearSpectrum*, std::vector<double>>> band_tables_;
-  // Per texture, the band averages of each palette entry (palette-major), for `bands` mode.
-  std::vector<std::vector<double>> texture_bands_;
+  // Per texture, the band averages of each palette entry (palette-major), for `bands` mode, each computed the first
+  // time a path meets its colour: a small render meets few of an HDRI's hundreds of thousands of colours. The values
+  // are a function of the entry alone, so the image is the same whichever thread computes them.
+  struct TextureBands {
+    std::unique_ptr<double[]> values;                    // not initialised: pages are touched only where used
+    std::unique_ptr<std::atomic<std::uint8_t>[]> state;  // per entry: 0 not computed, 1 being computed, 2 ready
+  };
+  std::vector<TextureBands> texture_bands_;
 };
 
 }  // namespace ct::rt
