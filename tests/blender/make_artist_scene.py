@@ -83,6 +83,23 @@ def look_down(camera, height, ortho_scale):
     camera.data.ortho_scale = ortho_scale
 
 
+def look_ahead(camera, location, pitch_deg):
+    """A 35 mm perspective camera at `location`, looking along +Y tilted down to `pitch_deg` from straight down."""
+    camera.data.type = "PERSP"
+    camera.data.lens = 35.0
+    camera.location = location
+    camera.rotation_euler = (math.radians(pitch_deg), 0.0, 0.0)
+
+
+def link_light(name, data, location, pitch_deg=0.0):
+    """A light object of `data` at `location`, turned `pitch_deg` about X, in the scene."""
+    ob = bpy.data.objects.new(name, data)
+    ob.location = location
+    ob.rotation_euler = (math.radians(pitch_deg), 0.0, 0.0)
+    bpy.context.scene.collection.objects.link(ob)
+    return ob
+
+
 def clear_defaults():
     for name in ("Cube", "Light"):
         ob = bpy.data.objects.get(name)
@@ -115,18 +132,23 @@ def library_scene(only):
         bpy.context.scene.world = None
 
 
+def grey_diffuse(name="grey", grey=0.5):
+    """A material whose node tree is a Diffuse BSDF of this grey."""
+    material = bpy.data.materials.new(name)
+    material.use_nodes = True
+    nodes = material.node_tree.nodes
+    nodes.remove(nodes["Principled BSDF"])
+    diffuse = nodes.new("ShaderNodeBsdfDiffuse")
+    diffuse.inputs["Color"].default_value = (grey, grey, grey, 1.0)
+    material.node_tree.links.new(diffuse.outputs[0], nodes["Material Output"].inputs["Surface"])
+    return material
+
+
 def blackbody_scene(kelvin):
     bpy.ops.mesh.primitive_plane_add(size=4.0, location=(0.0, 0.0, 0.0))
     plane = bpy.context.object
     plane.name = "plane"
-    grey = bpy.data.materials.new("grey")
-    grey.use_nodes = True
-    nodes = grey.node_tree.nodes
-    nodes.remove(nodes["Principled BSDF"])
-    diffuse = nodes.new("ShaderNodeBsdfDiffuse")
-    diffuse.inputs["Color"].default_value = (0.5, 0.5, 0.5, 1.0)
-    grey.node_tree.links.new(diffuse.outputs[0], nodes["Material Output"].inputs["Surface"])
-    plane.data.materials.append(grey)
+    plane.data.materials.append(grey_diffuse())
     area_light_with_blackbody(kelvin, (0.0, 0.0, 1.5), size=1.0, power=100.0)
     look_down(bpy.context.scene.camera, 5.0, 3.0)
     bpy.context.scene.world = None
@@ -265,14 +287,7 @@ def blender_lights_scene():
     bpy.ops.mesh.primitive_cube_add(size=0.6, location=(0.3, 0.8, 0.3))
     box = bpy.context.object
     box.name = "box"
-    grey = bpy.data.materials.new("grey")
-    grey.use_nodes = True
-    nodes = grey.node_tree.nodes
-    nodes.remove(nodes["Principled BSDF"])
-    diffuse = nodes.new("ShaderNodeBsdfDiffuse")
-    diffuse.inputs["Color"].default_value = (0.5, 0.5, 0.5, 1.0)
-    grey.node_tree.links.new(diffuse.outputs[0], nodes["Material Output"].inputs["Surface"])
-    box.data.materials.append(grey)
+    box.data.materials.append(grey_diffuse())
 
     area = area_light_with_blackbody(3500.0, (-0.6, 0.9, 1.6), size=1.0, power=120.0)
     area.data.shape = "RECTANGLE"
@@ -283,25 +298,16 @@ def blender_lights_scene():
     point.energy, point.shadow_soft_size, point.color = 60.0, 0.05, (1.0, 0.8, 0.6)
     if hasattr(point, "use_soft_falloff"):
         point.use_soft_falloff = False
-    ob = bpy.data.objects.new("Point", point)
-    ob.location = (1.4, -0.2, 1.2)
-    bpy.context.scene.collection.objects.link(ob)
+    link_light("Point", point, (1.4, -0.2, 1.2))
 
     square = bpy.data.lights.new("Square", "AREA")
     square.size, square.energy = 0.6, 40.0
     if hasattr(square, "use_temperature"):
         square.use_temperature, square.temperature = True, 5000.0
         square.exposure, square.normalize = 1.0, False
-    ob = bpy.data.objects.new("Square", square)
-    ob.location = (0.8, 2.0, 1.4)
-    ob.rotation_euler = (math.radians(-35.0), 0.0, 0.0)
-    bpy.context.scene.collection.objects.link(ob)
+    link_light("Square", square, (0.8, 2.0, 1.4), -35.0)
 
-    camera = bpy.context.scene.camera
-    camera.data.type = "PERSP"
-    camera.data.lens = 35.0
-    camera.location = (0.0, -2.4, 1.5)
-    camera.rotation_euler = (math.radians(52.0), 0.0, 0.0)
+    look_ahead(bpy.context.scene.camera, (0.0, -2.4, 1.5), 52.0)
     bpy.context.scene.world = None
 
 
@@ -334,15 +340,8 @@ def principled_scene():
     bpy.context.object.data.materials.append(principled("box", (0.8, 0.8, 0.8), 0.7))
     area = bpy.data.lights.new("Lamp", "AREA")
     area.shape, area.size, area.size_y, area.energy = "RECTANGLE", 1.2, 0.6, 150.0
-    ob = bpy.data.objects.new("Lamp", area)
-    ob.location = (-0.3, 1.2, 2.2)
-    ob.rotation_euler = (math.radians(15.0), 0.0, 0.0)
-    bpy.context.scene.collection.objects.link(ob)
-    camera = bpy.context.scene.camera
-    camera.data.type = "PERSP"
-    camera.data.lens = 35.0
-    camera.location = (0.0, -2.0, 1.6)
-    camera.rotation_euler = (math.radians(55.0), 0.0, 0.0)
+    link_light("Lamp", area, (-0.3, 1.2, 2.2), 15.0)
+    look_ahead(bpy.context.scene.camera, (0.0, -2.0, 1.6), 55.0)
     bpy.context.scene.world = None
 
 
@@ -379,11 +378,7 @@ def artist_scene(out):
     background = world.node_tree.nodes["Background"]
     world.node_tree.links.new(environment.outputs["Color"], background.inputs["Color"])
     background.inputs["Strength"].default_value = 0.5
-    camera = bpy.context.scene.camera
-    camera.data.type = "PERSP"
-    camera.data.lens = 35.0
-    camera.location = (0.0, -2.2, 1.5)
-    camera.rotation_euler = (math.radians(60.0), 0.0, 0.0)
+    look_ahead(bpy.context.scene.camera, (0.0, -2.2, 1.5), 60.0)
 
 
 argv = sys.argv[sys.argv.index("--") + 1:]
