@@ -123,13 +123,16 @@ def scene_for(scene_name, light, work, masking):
     return path
 
 
-# A plain RGB Cycles render of the open .blend as bench_blender.PLAIN renders an imported scene.
-PLAIN_BLEND = PLAIN.replace("""for c in (bpy.data.objects, bpy.data.meshes, bpy.data.materials, bpy.data.lights, bpy.data.cameras):
+# A plain RGB Cycles render of the open .blend as bench_blender.PLAIN renders an imported scene: PLAIN without its
+# import.
+_IMPORT = """for c in (bpy.data.objects, bpy.data.meshes, bpy.data.materials, bpy.data.lights, bpy.data.cameras):
     for item in list(c):
         c.remove(item)
 scene = bpy.context.scene
 scene_import.import_scene({box!r}, scene, tool.Tool(tool.find_executable()), lambda m: None)
-""", "scene = bpy.context.scene\n")
+"""
+assert _IMPORT in PLAIN, "bench_blender.PLAIN no longer imports the scene as this bench expects"
+PLAIN_BLEND = PLAIN.replace(_IMPORT, "scene = bpy.context.scene\n")
 
 
 def artist_blend(blender_exe, out_dir):

@@ -73,10 +73,11 @@ def _principled_entry(material, walk, base, approximate):
         return None, None
     node = shaders[0]
     version = 2 if "Specular IOR Level" in node.inputs else 1
+    emission = node.inputs.get("Emission Color") or node.inputs.get("Emission")
     for name, wanted in _PRINCIPLED_FIXED[version].items():
         socket = node.inputs.get(name)
-        if socket is None or (name == "Emission Strength" and max(node.inputs[
-                "Emission Color" if "Emission Color" in node.inputs else "Emission"].default_value[:3]) == 0.0):
+        if socket is None or (name == "Emission Strength" and not emission.is_linked
+                              and max(emission.default_value[:3]) == 0.0):  # a black emission emits nothing
             continue
         value = socket.default_value
         value = tuple(value[:3]) if isinstance(wanted, tuple) else value
@@ -116,23 +117,22 @@ def _node_material_entry(scene, material, texture_dir, out_dir, approximate):
     if any(i.role == "emission" for i in inputs):
         raise BadInput(f"{what}: its nodes emit light, which a scene file holds only as a light (a quad or a "
                        "sphere): set the object's chromatrace role to Light, or make it a Blender area light")
+
+    def colour(spectral_input):  # its image texture (written out if packed), or its colour's spectrum
+        if spectral_input.attribute == "image" and spectral_input.source is not None:
+            return _texture_file(spectral_input.source, texture_dir, out_dir)
+        return node_resolution.node_source(spectral_input, what)[0]
+
     reflectances = [i for i in inputs if i.role == "reflectance"]
     bases = [i for i in reflectances if not i.label.endswith(tuple("/" + t for t in _PRINCIPLED_TINTS))]
+    reason = None
     if len(bases) == 1:
-        base = (_texture_file(bases[0].source, texture_dir, out_dir)
-                if bases[0].attribute == "image" and bases[0].source is not None
-                else node_resolution.node_source(bases[0], what)[0])
-        entry, reason = _principled_entry(material, walk, base, approximate)
+        entry, reason = _principled_entry(material, walk, colour(bases[0]), approximate)
         if entry is not None:
             return entry
-    else:
-        reason = None
     if reflectances:
         first = reflectances[0]
-        if first.attribute == "image" and first.source is not None:
-            source = _texture_file(first.source, texture_dir, out_dir)
-        else:
-            source, _scale = node_resolution.node_source(first, what)
+        source = colour(first)
     else:  # only spectrally flat colours (a glossy's grey): their grey, or black
         greys = [i.current_rgb[0] for i in inputs if i.role == "interface"]
         source = {"constant": max(0.0, min(1.0, greys[0])) if greys else 0.0}
