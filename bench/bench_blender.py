@@ -45,7 +45,7 @@ scene = bpy.context.scene
 scene_import.import_scene({box!r}, scene, tool.Tool(tool.find_executable()), lambda m: None)
 journal = Journal()
 passes = {{"Emit", "DiffDir", "DiffInd", "DiffCol", "GlossDir", "GlossInd", "GlossCol", "IndexOB"}}
-cycles_setup.apply(journal, scene, scene.view_layers[0], {samples}, 1, False, ({res}, {res}), passes)
+cycles_setup.apply(journal, scene, scene.view_layers[0], {samples}, {seed}, False, ({res}, {res}), passes)
 cycles_setup.set_bounces(journal, scene, 7)
 scene.render.filepath = {out!r}
 start, start_cpu = time.monotonic(), time.process_time()
@@ -90,7 +90,7 @@ def main():
 
     start, start_cpu = time.monotonic(), _children_cpu()
     plain = subprocess.run(blender + ["--python-expr", PLAIN.format(
-        root=ROOT, box=scene, samples=args.samples, res=args.resolution, out=os.path.join(work, "rgb.exr"))],
+        root=ROOT, box=scene, samples=args.samples, seed=1, res=args.resolution, out=os.path.join(work, "rgb.exr"))],
         capture_output=True, text=True)
     plain_wall, plain_cpu = time.monotonic() - start, _children_cpu() - start_cpu
     found = re.search(r"PLAIN_RENDER_SECONDS ([0-9.]+) ([0-9.]+)", plain.stdout)

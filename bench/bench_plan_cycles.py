@@ -41,6 +41,13 @@ For each:
 A second plain render has the samples of the planned render's largest band group: a plain render as noisy as the
 planned one, whose ratio separates the spectral render's own cost from the samples the target asks for.
 
+A third, the first's twin with seed 2, gives the plain render's own noise (bench_plain_noise: the ΔE00 between the two
+over √2, over the image and per object). From it the floor of an unbiased planned render: every band group is a
+Cycles render no less noisy than the plain render at equal samples (the plan's predicted noise over the plain
+render's is printed to check it), so each group needs at least the samples at which the plain render's own noise
+meets the target, for the mean (with the bands' error) and for the worst object's limit; the planned groups' CPU at
+those samples, over the plain render's, is the least an unbiased spectral render can cost here.
+
 Prints, per Blender and light, the CPU ratio planned spectral / plain RGB with and without the planning, the
 predicted and measured mean ΔE00 and the worst object's. Not a test: the machine is shared, so read the figures as
 ratios from one run.
@@ -162,6 +169,46 @@ def header_plan(exe, exr):
     return json.loads(info["metadata"]["chromatrace.plan"])
 
 
+def plain_noise_of(plain_exr, scene, reference, exe):
+    """One plain render's Monte Carlo noise in ΔE00 (bench_plain_noise on two seeds): {"image": n, objects: {name: n}}."""
+    names = json.loads(run([exe, "info", reference, "--json"]).stdout)["object_ids"]["names"]
+    with open(scene) as f:
+        lights = {light.get("name") for light in json.load(f).get("lights", [])}
+    emitters = ",".join(i for i, name in names.items() if name in lights)
+    tool = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(exe))), "bench", "bench_plain_noise")
+    said = run([tool, *plain_exr, "--emitters", emitters]).stdout.split("\n")
+    noise = {"image": float(said[0].split()[1]), "objects": {}}
+    for line in said[1:]:
+        if line.startswith("object "):
+            _, object_id, pixels, n = line.split()
+            if int(pixels) >= 16 and names.get(object_id) not in lights:
+                noise["objects"][names.get(object_id, object_id)] = float(n)
+    return noise
+
+
+def floor_of(plan, plain_noise, args, spectral_cpu, plain_cpu):
+    """What an unbiased planned render costs at the least, from this run's measurements (docs/plan.md, "What sets the
+    floor"). Each band group is a Cycles render, no less noisy than the plain render at equal samples (printed: the
+    plan's predicted noise over the plain render's at the planned samples), so each group needs at least the samples
+    N at which the plain render's own noise meets the target: the image's mean in quadrature with the bands' and
+    bounces' predicted error, and every object's limit (2 × the target) with the object's noise alone. The planned
+    groups' CPU scaled to N (a lower bound where a group has a fixed cost and N is below its samples), over the plain
+    render's."""
+    samples = plan["cycles_samples"]
+    mean_samples = sum(samples) / len(samples)
+    bands = plan.get("predicted_bands_mean_de00", 0.0)
+    budget = max(args.target ** 2 - bands ** 2, 1e-9)
+    worst_name, worst = max(plain_noise["objects"].items(), key=lambda item: item[1])
+    need_mean = args.samples * plain_noise["image"] ** 2 / budget
+    need_object = args.samples * worst ** 2 / (2 * args.target) ** 2
+    need = max(need_mean, need_object)
+    noisier = None
+    if "predicted_noise_mean_de00" in plan:  # the plan's noise over the plain render's at the planned samples
+        noisier = plan["predicted_noise_mean_de00"] / (plain_noise["image"] * math.sqrt(args.samples / mean_samples))
+    return dict(need_mean=need_mean, need_object=need_object, worst_name=worst_name, worst=worst, samples=need,
+                ratio=spectral_cpu * need / mean_samples / plain_cpu, noisier=noisier, groups=len(samples))
+
+
 def bench(scene_name, light, args, work, blender_exe, version, references):
     exe = os.environ["CHROMATRACE_EXE"]
     masking = "height-correlated" if int(version.split(".")[0]) >= 4 else "separable"
@@ -209,21 +256,24 @@ def bench(scene_name, light, args, work, blender_exe, version, references):
     worst_predicted = (f"{math.hypot(worst_plan['mean_de00'], reference_noise * worst_plan['noise_to_image_noise']):.2f} "
                        f"({worst_plan['name']})") if worst_plan else "-"
 
-    script = (PLAIN_BLEND if blend else PLAIN).format(root=ROOT, box=scene, samples=args.samples,
-                                                       res=args.resolution, out=os.path.join(out_dir, f"{case}-rgb.exr"))
-    plain = run(([blender_exe, blend, "--background", "--factory-startup"] if blend else blender)
-                + ["--python-expr", script])
-    found = re.search(r"PLAIN_RENDER_SECONDS ([0-9.]+) ([0-9.]+)", plain.stdout)
-    if not found:
-        sys.exit("plain RGB render printed no timing:\n" + plain.stdout[-400:] + plain.stderr[-800:])
-    plain_cpu = float(found.group(2))
+    def plain_render(samples, seed, out):
+        script = (PLAIN_BLEND if blend else PLAIN).format(root=ROOT, box=scene, samples=samples, seed=seed,
+                                                           res=args.resolution, out=out)
+        plain = run(([blender_exe, blend, "--background", "--factory-startup"] if blend else blender)
+                    + ["--python-expr", script])
+        found = re.search(r"PLAIN_RENDER_SECONDS ([0-9.]+) ([0-9.]+)", plain.stdout)
+        if not found:
+            sys.exit("plain RGB render printed no timing:\n" + plain.stdout[-400:] + plain.stderr[-800:])
+        return float(found.group(2))
+
+    plain_exr = [os.path.join(out_dir, f"{case}-rgb-{seed}.exr") for seed in (1, 2)]
+    # Its noise from the difference of two seeds; its cost the cheaper of the two (the same work: the machine's noise).
+    plain_cpu = min(plain_render(args.samples, 1, plain_exr[0]), plain_render(args.samples, 2, plain_exr[1]))
+    plain_noise = plain_noise_of(plain_exr, scene, reference, exe)
     # And a plain render as noisy as the planned one: the samples of its largest band group.
     equal_samples = max(plan["cycles_samples"])
-    script = (PLAIN_BLEND if blend else PLAIN).format(root=ROOT, box=scene, samples=equal_samples,
-                                                       res=args.resolution, out=os.path.join(out_dir, f"{case}-rgb-equal.exr"))
-    plain = run(([blender_exe, blend, "--background", "--factory-startup"] if blend else blender)
-                + ["--python-expr", script])
-    equal_cpu = float(re.search(r"PLAIN_RENDER_SECONDS ([0-9.]+) ([0-9.]+)", plain.stdout).group(2))
+    equal_cpu = plain_render(equal_samples, 1, os.path.join(out_dir, f"{case}-rgb-equal.exr"))
+    floor = floor_of(plan, plain_noise, args, spectral_cpu, plain_cpu)
 
     compare_dir = os.path.join(out_dir, f"{case}-compare")
     run([exe, "compare", spectral_exr, reference, "-o", compare_dir, "--colour", "own", "-q"])
@@ -247,11 +297,19 @@ def bench(scene_name, light, args, work, blender_exe, version, references):
           f"{references[reference]:.0f} s CPU): measured {mean_de:.2f}, predicted {predicted:.2f} "
           f"({low:.2f}-{high:.2f}); without the reference's noise predicted {plan['predicted_mean_de00']:.2f}; "
           f"worst object {worst} {worst_de:.2f}, predicted {worst_predicted}")
+    print(f"  plain RGB render's own noise at {args.samples} samples (seeds 1 and 2): mean dE00 {plain_noise['image']:.2f}, "
+          f"worst object {floor['worst_name']} {floor['worst']:.2f}; the plan's noise over it at the planned samples "
+          + (f"{floor['noisier']:.2f}" if floor["noisier"] else "-"))
+    print(f"  floor: the plain render's noise meets the mean at {floor['need_mean']:.0f} samples and "
+          f"{floor['worst_name']}'s limit at {floor['need_object']:.0f}; {floor['groups']} groups of "
+          f"{floor['samples']:.0f} samples cost at least {floor['ratio']:.2f}x the plain render")
     return dict(ratio=spectral_cpu / plain_cpu, with_planning=(spectral_cpu + planning_cpu) / plain_cpu,
                 equal=spectral_cpu / equal_cpu,
                 measured=mean_de, predicted=predicted, low=low, high=high, worst=f"{worst_de:.2f} ({worst})",
                 worst_predicted=worst_predicted,
-                samples=",".join(map(str, plan["cycles_samples"])))
+                samples=",".join(map(str, plan["cycles_samples"])), plain_noise=plain_noise["image"],
+                plain_worst=f"{floor['worst']:.2f} ({floor['worst_name']})", floor=floor["ratio"],
+                floor_samples=floor["samples"])
 
 
 def main():
@@ -286,6 +344,11 @@ def main():
             print(f"{version:8s} {scene_name:9s} {light.upper():5s}  {r['samples']:17s}  {r['ratio']:10.2f}x  "
                   f"{r['with_planning']:12.2f}x  {r['equal']:24.2f}x"
                   f"  {r['measured']:17.2f}  {r['predicted']:.2f} ({r['low']:.2f}-{r['high']:.2f})  {r['worst']}, {r['worst_predicted']}")
+        print("\nBlender  scene     light  plain render's noise: mean, worst object   samples a group needs at the least  "
+              "floor / plain")
+        for version, scene_name, light, r in results:
+            print(f"{version:8s} {scene_name:9s} {light.upper():5s}  {r['plain_noise']:.2f}, {r['plain_worst']:27s}  "
+                  f"{r['floor_samples']:34.0f}  {r['floor']:12.2f}x")
 
 
 if __name__ == "__main__":

@@ -16,6 +16,8 @@
 #include "cli/command.h"
 #include "cli/options.h"
 #include "core/band_plan.h"
+#include "core/cie.h"
+#include "core/colour.h"
 #include "core/error.h"
 #include "core/json_input.h"
 #include "core/scene.h"
@@ -30,13 +32,36 @@ struct SceneBandsOptions {
 
 Json averages(const PiecewiseLinearSpectrum& spectrum, const Bands& bands) { return band_averages(spectrum, bands); }
 
-// Band averages, plus the largest sample (so a caller can check a reflectance against 1 before rendering).
+// The spectrum's colour in linear sRGB (D65 white), both ways an RGB renderer could show it: as a reflectance under
+// D65 (the perfect white is [1, 1, 1]), and as an emitted radiance relative to D65 of the flat spectrum 1's luminance
+// (the convention of an emitted {"rgb"}: D65 of that luminance is [1, 1, 1]), so that a source given as
+// {"rgb": c} comes back as c, up to the upsampling's accuracy.
+Json linear_srgb(const Vec3d& xyz) {
+  const Vec3d rgb = xyz_to_linear_srgb(xyz);
+  return Json::array({rgb[0], rgb[1], rgb[2]});
+}
+
+Json reflected_srgb(const PiecewiseLinearSpectrum& spectrum) {
+  return linear_srgb(reflectance_to_xyz(spectrum, cie::illuminant("D65")));
+}
+
+Json emitted_srgb(const PiecewiseLinearSpectrum& spectrum) {
+  static const double flat_luminance = spectrum_to_xyz(PiecewiseLinearSpectrum::constant(1.0))[1];
+  Vec3d xyz = spectrum_to_xyz(spectrum);
+  for (double& c : xyz) c /= flat_luminance;
+  return linear_srgb(xyz);
+}
+
+// Band averages, plus the largest sample (so a caller can check a reflectance against 1 before rendering), and its
+// colour in linear sRGB (what the Blender add-on shows in Blender's viewport and a plain RGB render).
 Json spectrum_entry(const PiecewiseLinearSpectrum& spectrum, const Bands& bands) {
   const auto& values = spectrum.values();
   const auto peak = std::max_element(values.begin(), values.end());
   return {{"bands", averages(spectrum, bands)},
           {"max", *peak},
-          {"max_nm", spectrum.wavelengths()[static_cast<std::size_t>(peak - values.begin())]}};
+          {"max_nm", spectrum.wavelengths()[static_cast<std::size_t>(peak - values.begin())]},
+          {"linear_srgb_reflected", reflected_srgb(spectrum)},
+          {"linear_srgb_emitted", emitted_srgb(spectrum)}};
 }
 
 // Textures and the environment have no band averages of their own here yet; failing keeps a caller (the Blender

@@ -47,7 +47,8 @@ def build_material_nodes(material):
             colour.interpolation = "Closest"  # the reference tracer looks up the nearest texel
         else:
             colour = _new(nodes, "ShaderNodeRGB", REFLECTANCE_NODE, (-400, 100))
-            preview = tuple(s.reflectance.rgb) if s.reflectance.kind == "RGB" else (0.8, 0.8, 0.8)
+            preview = (tuple(s.reflectance.rgb) if s.reflectance.kind == "RGB"
+                       else tuple(min(c, 1.0) for c in s.reflectance.preview_colour((0.8, 0.8, 0.8))))
             colour.outputs[0].default_value = (*preview, 1.0)
         if s.model in ("LAMBERT", "DICHROMATIC"):
             diffuse = _new(nodes, "ShaderNodeBsdfDiffuse", "ct_diffuse", (-100, 150))
@@ -78,7 +79,8 @@ def build_material_nodes(material):
             shader = glossy
     if s.emissive:
         colour = _new(nodes, "ShaderNodeRGB", EMISSION_NODE, (-400, -250))
-        colour.outputs[0].default_value = (*(s.emission.rgb if s.emission.kind == "RGB" else (1.0, 1.0, 1.0)), 1.0)
+        colour.outputs[0].default_value = (*(s.emission.rgb if s.emission.kind == "RGB"
+                                             else s.emission.preview_colour((1.0, 1.0, 1.0))), 1.0)
         emission = _new(nodes, "ShaderNodeEmission", "ct_emit", (-100, -250))
         links.new(colour.outputs[0], emission.inputs["Color"])
         if s.two_sided:

@@ -82,6 +82,8 @@ class Planned:
         return json.dumps({"target_de00": self.report["target_de00"], "camera": self.report["camera"],
                            "max_bounces": self.max_bounces, "cycles_samples": self.samples,
                            "predicted_mean_de00": cycles["mean_de00"], "predicted_range": cycles["mean_de00_range"],
+                           "predicted_noise_mean_de00": cycles["noise_only_mean_de00"],
+                           "predicted_bands_mean_de00": self.report["prediction"]["mean_de00"],
                            "noise_ratio_to_tracer": cycles["noise_ratio_to_tracer"],
                            "tracer_noise_at_one_sample": cycles["tracer_noise_at_one_sample"],
                            "worst_object": self.worst_object()})

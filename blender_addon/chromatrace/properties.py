@@ -65,6 +65,25 @@ class CHROMATRACE_PG_spectrum(bpy.types.PropertyGroup):
     texture_path: StringProperty(name="Image", subtype="FILE_PATH")
     texture_colour_space: EnumProperty(name="Colour space", items=_TEXTURE_SPACE_ITEMS, default="auto")
     texture_scale: FloatProperty(name="Scale", min=0.0, default=1.0, soft_max=10.0)
+    # The colour Blender shows for a spectrum that is neither RGB nor a texture (in its viewport and a plain render):
+    # chromatrace's linear sRGB of it (scene-bands: a reflectance's under D65, an emission's relative to D65), kept
+    # with the source it was computed for; a source changed since shows the fallback, not a stale colour.
+    preview: FloatVectorProperty(name="Preview colour", size=3, min=0.0, default=(0.8, 0.8, 0.8), options={"HIDDEN"})
+    preview_of: StringProperty(options={"HIDDEN"})
+
+    def preview_colour(self, fallback):
+        """The preview colour, or `fallback` where none was computed for the source as it is now."""
+        if not self.preview_of:
+            return fallback
+        try:
+            current = json.dumps(self.to_json(), sort_keys=True)
+        except (spectra.SourceError, ValueError):
+            return fallback
+        return tuple(self.preview) if current == self.preview_of else fallback
+
+    def set_preview(self, colour):
+        self.preview = [max(0.0, float(c)) for c in colour]
+        self.preview_of = json.dumps(self.to_json(), sort_keys=True)
 
     def values(self):
         return {"name": self.spectrum_name, "library": self.library, "constant": self.constant,

@@ -79,6 +79,40 @@ def _emitter_material(light, reflect, scene_dir):
     return material
 
 
+def _show_spectra_in_colour(scene, imported, tool, work_dir):
+    """Gives every imported material's spectrum that is neither RGB nor a texture the colour chromatrace computes
+    of it (`chromatrace scene-bands`: a reflectance's linear sRGB under D65, an emission's relative to D65, at its
+    radiance), and rebuilds the material's nodes: Blender's viewport and a plain RGB render then show the scene's
+    colours and its lights' brightness instead of a grey and a unit emission. The spectral render sets its own
+    values and puts these back."""
+    named = {entry.name: entry.source for entry in scene.chromatrace.spectra}
+    wanted = []  # (material, source settings, "reflected" or "emitted")
+    for material in imported:
+        s = material.chromatrace
+        if s.model in ("LAMBERT", "DICHROMATIC", "MIRROR", "PRINCIPLED"):
+            wanted.append((material, s.reflectance, "reflected"))
+        if s.emissive:
+            wanted.append((material, s.emission, "emitted"))
+    reflected, emitted, keys = {}, {}, []
+    for material, settings, role in wanted:
+        resolved = named[settings.spectrum_name] if settings.kind == "NAMED" else settings
+        if settings.kind in ("RGB", "TEXTURE") or resolved.kind in ("RGB", "TEXTURE"):
+            continue
+        key = f"s{len(keys)}"
+        (reflected if role == "reflected" else emitted)[key] = resolved.to_json()
+        keys.append((key, material, settings, role))
+    if not keys:
+        return
+    request = os.path.join(work_dir, "preview-spectra.json")
+    with open(request, "w") as f:
+        json.dump({"format": "chromatrace-spectra/1", "spectra": reflected, "radiance": emitted}, f)
+    report = tool.band_averages(request)["spectra"]
+    for key, _material, settings, role in keys:
+        settings.set_preview(report[key][f"linear_srgb_{role}"])
+    for material in {material for _key, material, _settings, _role in keys}:
+        materials.build_material_nodes(material)
+
+
 def _source_of(settings):
     return json.dumps(settings.to_json())
 
@@ -272,10 +306,12 @@ def import_scene(path, scene, tool, log=print, ggx_masking="scene", warn=None, m
             if isinstance(light["radiance"], dict) and "texture" in light["radiance"]:
                 raise BadInput(f"lights[{i}].radiance: a textured light is not imported (give the emitter an Image "
                                "Texture node in Blender instead)")
+        emitters = []
         for entry, light in zip(index["lights"], document["lights"]):
             reflect = built.get(light["material"]) if "material" in light else None
             ob = _mesh_object(light["name"], os.path.join(mesh_dir, entry["file"]), collection)
-            ob.data.materials.append(_emitter_material(light, reflect, scene_dir))
+            emitters.append(_emitter_material(light, reflect, scene_dir))
+            ob.data.materials.append(emitters[-1])
             ob.pass_index = entry["id"]
             group = light.get("group", light["name"])
             ob.chromatrace.role = "LIGHT"
@@ -286,6 +322,7 @@ def import_scene(path, scene, tool, log=print, ggx_masking="scene", warn=None, m
             if hasattr(ob, "lightgroup"):
                 _ensure_lightgroup(view_layer, group)
                 ob.lightgroup = group
+        _show_spectra_in_colour(scene, list(built.values()) + emitters, tool, mesh_dir)
         if "environment" in document:
             scene.world = _world(document["environment"], scene_dir, view_layer, warn or log)
         elif scene.world is not None and not _dark(scene.world):

@@ -24,7 +24,7 @@ import bpy
 
 sys.path.insert(0, os.path.join(os.environ["CHROMATRACE_SOURCE_DIR"], "tests", "blender"))
 from harness import SOURCE, TOOL, chromatrace, expect, failures, finish, scene_file  # noqa: E402,F401
-from chromatrace import ply, scene_export, scene_import  # noqa: E402
+from chromatrace import materials, ply, scene_export, scene_import  # noqa: E402
 
 
 def fresh_scene():
@@ -122,6 +122,32 @@ def round_trip(original):
 round_trip(scene_file("cornell_box", "cornell_box.json"))
 round_trip(scene_file("textured", "textured.json"))  # image textures, UVs, an HDRI world
 scene, work = round_trip(scene_file("paper", "box.json"))
+
+# Imported spectra show their colours in Blender (the viewport, a plain render): each managed material's colour node
+# holds chromatrace's linear sRGB of its spectrum (scene-bands: a reflectance under D65, an emission relative to
+# D65 at its radiance), not a grey; a source changed since shows the grey again, not a stale colour.
+box_bands = TOOL.band_averages(scene_file("paper", "box.json"))["spectra"]
+
+
+def node_colour(material, node):
+    return list(bpy.data.materials[material].node_tree.nodes[node].outputs[0].default_value[:3])
+
+
+for material, spectrum in (("left_wall", "cornell_red"), ("right_wall", "cornell_green"), ("ceiling", "white_paint")):
+    want = [min(max(c, 0.0), 1.0) for c in box_bands[spectrum]["linear_srgb_reflected"]]
+    got = node_colour(material, "ct_reflectance")
+    expect(max(abs(a - b) for a, b in zip(got, want)) < 1e-6, f"{material}: preview {got}, not {spectrum}'s {want}")
+red, green = node_colour("left_wall", "ct_reflectance"), node_colour("right_wall", "ct_reflectance")
+expect(red[0] > 2 * max(red[1], red[2]) and green[1] > max(green[0], green[2]), f"walls not red and green: {red}, {green}")
+lamp = node_colour("ceiling_lamp (emitter)", "ct_emission")
+want = box_bands["lamp"]["linear_srgb_emitted"]
+expect(max(abs(a - b) / b for a, b in zip(lamp, want)) < 1e-6 and min(lamp) > 50,
+       f"the lamp's emission {lamp}, not D65's colour at its radiance {want}")
+wall = bpy.data.materials["left_wall"]
+wall.chromatrace.reflectance.kind = "CONSTANT"
+materials.build_material_nodes(wall)
+expect(max(abs(c - 0.8) for c in node_colour("left_wall", "ct_reflectance")) < 1e-6,
+       f"a changed source kept its stale preview: {node_colour('left_wall', 'ct_reflectance')}")
 
 # An object moved in Blender: written as a world-space mesh that moved with it.
 sphere = bpy.data.objects["sphere"]

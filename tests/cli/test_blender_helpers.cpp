@@ -12,6 +12,8 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "core/cie.h"
+#include "core/colour.h"
 #include "core/ply.h"
 #include "core/scene.h"
 #include "core/spectral_exr.h"
@@ -101,6 +103,33 @@ TEST(SceneBands, SpectraListAndBandPlanFile) {
   EXPECT_EQ(report["spectra"]["ramp"]["max"], 1.0);
   EXPECT_EQ(report["spectra"]["ramp"]["max_nm"], 500.0);
   EXPECT_FALSE(report.contains("materials"));
+}
+
+// Each spectrum's colour in linear sRGB, as a reflectance under D65 and as an emission relative to D65 (what the
+// add-on shows in Blender). Tolerance 1e-3 of the colour's scale: the sRGB white is D65's defining chromaticity, the CIE table's integral
+// differs from it by about 3e-4; an {"rgb"} source comes back within the upsampling table's round trip (bench/README.md,
+// "RGB upsampling table": under 1e-3 for these colours).
+TEST(SceneBands, ColoursAsAReflectanceUnderD65AndAsAnEmissionRelativeToD65) {
+  test::TempDir dir;
+  write_text(dir.file("spectra.json"), R"({"format": "chromatrace-spectra/1",
+      "spectra": {"white": {"constant": 1.0}, "paint": {"rgb": [0.2, 0.4, 0.6]}, "d65": {"illuminant": "D65"}},
+      "radiance": {"orange": {"rgb": [0.9, 0.5, 0.1]}}})");
+  const auto r = run_chromatrace({"scene-bands", dir.file("spectra.json").string(), "--json"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const json spectra = json::parse(r.out)["spectra"];
+  auto expect_rgb = [](const json& got, const Vec3d& want, const char* what, double scale = 1.0) {
+    for (std::size_t c = 0; c < 3; ++c)
+      EXPECT_NEAR(got[c].get<double>(), want[c], 1e-3 * scale) << what << " channel " << c;
+  };
+  expect_rgb(spectra["white"]["linear_srgb_reflected"], {1, 1, 1}, "the perfect white under D65");
+  expect_rgb(spectra["paint"]["linear_srgb_reflected"], {0.2, 0.4, 0.6}, "an RGB reflectance");
+  expect_rgb(spectra["orange"]["linear_srgb_emitted"], {0.9, 0.5, 0.1}, "an emitted RGB");
+  // The flat spectrum emitted is illuminant E, XYZ = (1, 1, 1) at its own luminance.
+  expect_rgb(spectra["white"]["linear_srgb_emitted"], xyz_to_linear_srgb({1, 1, 1}), "the flat spectrum emitted");
+  // D65 emitted is grey, at its luminance over the flat spectrum 1's.
+  const double y = spectrum_to_xyz(cie::illuminant("D65"))[1] /
+                   spectrum_to_xyz(PiecewiseLinearSpectrum::constant(1.0))[1];
+  expect_rgb(spectra["d65"]["linear_srgb_emitted"], {y, y, y}, "D65 emitted", y);
 }
 
 TEST(SceneBands, BadInputGetsExitTwoAndOneLineNamingTheField) {

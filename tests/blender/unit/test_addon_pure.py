@@ -287,7 +287,9 @@ class Planning(unittest.TestCase):
     def test_the_plan_said_and_kept_in_the_header(self):
         report = {"target_de00": 1.0, "camera": "cie1931",
                   "settings": {"band_count": 6, "max_bounces": 5, "cycles_samples": [212, 186]},
-                  "prediction": {"cycles": {"mean_de00": 0.998, "mean_de00_range": [0.79, 1.28],
+                  "prediction": {"mean_de00": 0.31,
+                                 "cycles": {"mean_de00": 0.998, "mean_de00_range": [0.79, 1.28],
+                                            "noise_only_mean_de00": 0.95,
                                             "noise_ratio_to_tracer": 0.746, "tracer_noise_at_one_sample": 18.1}}}
         planned = planning.Planned("plan.json", report)
         self.assertEqual(planned.summary(), "plan for a mean ΔE00 of 1: 6 bands, max 5 bounces, samples per band "
@@ -300,15 +302,16 @@ class Planning(unittest.TestCase):
         self.assertEqual(header["cycles_samples"], [212, 186])
         self.assertEqual(header["predicted_range"], [0.79, 1.28])
         self.assertEqual(header["tracer_noise_at_one_sample"], 18.1)
+        self.assertEqual((header["predicted_noise_mean_de00"], header["predicted_bands_mean_de00"]), (0.95, 0.31))
         self.assertIsNone(header["worst_object"])
 
     def test_the_worst_object_said_with_the_samples_it_took(self):
         objects = [{"name": "floor", "object_id": 1, "mean_de00": 0.8}, {"name": "ceiling", "object_id": 2, "mean_de00": 1.96}]
-        cycles = {"mean_de00": 0.81, "mean_de00_range": [0.6, 1.1], "noise_ratio_to_tracer": 0.8,
+        cycles = {"mean_de00": 0.81, "mean_de00_range": [0.6, 1.1], "noise_only_mean_de00": 0.7, "noise_ratio_to_tracer": 0.8,
                   "tracer_noise_at_one_sample": 18.1, "objects": objects, "object_limit_mean_de00": 2.0}
         report = {"target_de00": 1.0, "camera": "cie1931",
                   "settings": {"band_count": 6, "max_bounces": 5, "cycles_samples": [262, 236]},
-                  "prediction": {"cycles": dict(cycles, samples_raised_for_objects=1.24)}}
+                  "prediction": {"mean_de00": 0.3, "cycles": dict(cycles, samples_raised_for_objects=1.24)}}
         planned = planning.Planned("plan.json", report)
         self.assertTrue(planned.summary().endswith("; worst object ceiling 1.96 (objects held to 2, samples × 1.24 for "
                                                    "it)"), planned.summary())
