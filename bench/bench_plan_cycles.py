@@ -4,7 +4,7 @@
 
     CHROMATRACE_EXE=build/cli/chromatrace python3 bench/bench_plan_cycles.py [--resolution 96] [--samples 256]
         [--reference-spp 8192] [--target 1] [--light d65|f11|both] [--scene box|textured|artist|both|all]
-        [--blender blender [--blender build/tests/blender/blender-4.5 ...]]
+        [--blender blender [--blender build/tests/blender/blender-4.5 ...]] [--reference-dir DIR]
 
 Each --blender is run in turn (a Blender binary, or a bpy module behind tests/blender/bpy_blender.py, as the
 build's build/tests/blender/blender-4.5, blender-5.2 and blender-5.3 are), the scene's GGX masking set to that Cycles' own
@@ -41,7 +41,12 @@ For each:
 A second plain render has the samples of the planned render's largest band group: a plain render as noisy as the
 planned one, whose ratio separates the spectral render's own cost from the samples the target asks for.
 
-A third, the first's twin with seed 2, gives the plain render's own noise (bench_plain_noise: the ΔE00 between the two
+Both sides are rendered again at one sample (the planned render's band groups at one sample each, with its bands and
+bounce limit; the plain render at one sample): what does not grow with the pixels or the samples — loading the
+scene, the images, the world's importance map, once per band group. The ratio of what is left is what a large image
+costs (at 96 × 96 the fixed part is most of a textured scene's render).
+
+A third plain render, the first's twin with seed 2, gives the plain render's own noise (bench_plain_noise: the ΔE00 between the two
 over √2, over the image and per object). From it the floor of an unbiased planned render: every band group is a
 Cycles render no less noisy than the plain render at equal samples (the plan's predicted noise over the plain
 render's is printed to check it), so each group needs at least the samples at which the plain render's own noise
@@ -54,6 +59,7 @@ ratios from one run.
 """
 
 import argparse
+import hashlib
 import json
 import math
 import os
@@ -169,6 +175,17 @@ def header_plan(exe, exr):
     return json.loads(info["metadata"]["chromatrace.plan"])
 
 
+def _digest(scene, blend):
+    """A short digest of the scene file (and .blend) a reference is rendered from, so a kept one is not reused for
+    another scene."""
+    h = hashlib.sha256()
+    for path in (scene, blend):
+        if path:
+            with open(path, "rb") as f:
+                h.update(f.read())
+    return h.hexdigest()[:10]
+
+
 def plain_noise_of(plain_exr, scene, reference, exe):
     """One plain render's Monte Carlo noise in ΔE00 (bench_plain_noise on two seeds): {"image": n, objects: {name: n}}."""
     names = json.loads(run([exe, "info", reference, "--json"]).stdout)["object_ids"]["names"]
@@ -225,12 +242,14 @@ def bench(scene_name, light, args, work, blender_exe, version, references):
     with open(scene) as f:
         scene_bounces = json.load(f)["render"]["max_bounces"]
 
-    # The reference, once per scene, light and masking.
-    reference = os.path.join(work, f"{case}-{masking}-reference.exr")
+    # The reference, once per scene, light and masking (kept in --reference-dir across runs when given).
+    reference = os.path.join(args.reference_dir or work,
+                             f"{case}-{masking}-{res}-{args.reference_spp}spp-{_digest(scene, blend)}-reference.exr")
     if reference not in references:
         start_cpu = _children_cpu()
-        run([exe, "render", scene, "-o", reference, "--resolution", res, "--bands", "380:780:5", "--spp",
-             str(args.reference_spp), "--max-bounces", str(scene_bounces), "--seed", "7", "-q"])
+        if not os.path.exists(reference):
+            run([exe, "render", scene, "-o", reference, "--resolution", res, "--bands", "380:780:5", "--spp",
+                 str(args.reference_spp), "--max-bounces", str(scene_bounces), "--seed", "7", "-q"])
         references[reference] = _children_cpu() - start_cpu
 
     blender = [blender_exe, "--background", "--factory-startup"]
@@ -249,6 +268,18 @@ def bench(scene_name, light, args, work, blender_exe, version, references):
     spectral_cpu = sum(float(cpu) for _what, _wall, cpu in timings)
     planning_cpu = float(planning.group(2))
     plan = header_plan(exe, spectral_exr)
+    # Its fixed part: the same renders at one sample a group (what does not grow with the pixels or the samples).
+    one_sample = os.path.join(out_dir, f"{case}-one-sample-bands.json")
+    edges = json.loads(run([exe, "info", spectral_exr, "--json"]).stdout)["bands"]["edges_nm"]
+    with open(one_sample, "w") as f:
+        json.dump({"format": "chromatrace-bands/1", "edges_nm": edges, "cycles_samples": [1] * len(plan["cycles_samples"])}, f)
+    fixed = run(blender + ["--python", os.path.join(ROOT, "blender_addon", "batch.py"), "--", *source,
+                           "--out", os.path.join(out_dir, f"{case}-one-sample.exr"), "--resolution", res,
+                           "--bands-file", one_sample, "--max-bounces", str(plan["max_bounces"]), "--components", "paths",
+                           "--cache-dir", os.path.join(out_dir, f"{case}-one-sample-cache")],
+                env=dict(os.environ, CHROMATRACE_EXE=exe))
+    spectral_fixed_cpu = sum(float(cpu) for _what, _wall, cpu in re.findall(
+        r"chromatrace: render \d+/\d+ \(([^)]*)\): ([0-9.]+) s, ([0-9.]+) s CPU", fixed.stderr))
     reference_noise = plan["tracer_noise_at_one_sample"] / args.reference_spp ** 0.5
     predicted = math.hypot(plan["predicted_mean_de00"], reference_noise)
     low, high = (math.hypot(x, reference_noise) for x in plan["predicted_range"])
@@ -270,6 +301,9 @@ def bench(scene_name, light, args, work, blender_exe, version, references):
     # Its noise from the difference of two seeds; its cost the cheaper of the two (the same work: the machine's noise).
     plain_cpu = min(plain_render(args.samples, 1, plain_exr[0]), plain_render(args.samples, 2, plain_exr[1]))
     plain_noise = plain_noise_of(plain_exr, scene, reference, exe)
+    plain_fixed_cpu = plain_render(1, 1, os.path.join(out_dir, f"{case}-rgb-one-sample.exr"))
+    # What grows with the pixels and the samples: each side's CPU less its one-sample render's.
+    samples_part = (spectral_cpu - spectral_fixed_cpu) / max(plain_cpu - plain_fixed_cpu, 1e-9)
     # And a plain render as noisy as the planned one: the samples of its largest band group.
     equal_samples = max(plan["cycles_samples"])
     equal_cpu = plain_render(equal_samples, 1, os.path.join(out_dir, f"{case}-rgb-equal.exr"))
@@ -291,6 +325,8 @@ def bench(scene_name, light, args, work, blender_exe, version, references):
     print(f"  plain RGB Cycles render ({args.samples} samples): {plain_cpu:.2f} s CPU")
     print(f"  ratio planned spectral / plain RGB: {spectral_cpu / plain_cpu:.2f}x CPU "
           f"({(spectral_cpu + planning_cpu) / plain_cpu:.2f}x with the planning)")
+    print(f"  at one sample a group: planned {spectral_fixed_cpu:.2f} s CPU, plain {plain_fixed_cpu:.2f} s CPU; "
+          f"the parts that grow with the pixels and samples: {samples_part:.2f}x")
     print(f"  plain RGB Cycles render at the planned groups' largest samples ({equal_samples}): {equal_cpu:.2f} s CPU; "
           f"ratio planned spectral / it: {spectral_cpu / equal_cpu:.2f}x")
     print(f"  mean dE00 against the 5 nm reference ({args.reference_spp} paths per pixel, "
@@ -308,6 +344,7 @@ def bench(scene_name, light, args, work, blender_exe, version, references):
                 measured=mean_de, predicted=predicted, low=low, high=high, worst=f"{worst_de:.2f} ({worst})",
                 worst_predicted=worst_predicted,
                 samples=",".join(map(str, plan["cycles_samples"])), plain_noise=plain_noise["image"],
+                samples_part=samples_part, fixed=spectral_fixed_cpu, plain_fixed=plain_fixed_cpu,
                 plain_worst=f"{floor['worst']:.2f} ({floor['worst_name']})", floor=floor["ratio"],
                 floor_samples=floor["samples"])
 
@@ -322,6 +359,7 @@ def main():
     p.add_argument("--scene", choices=("box", "textured", "artist", "both", "all"), default="both",
                    help="both: the box and the textured scene; all: the artist's too")
     p.add_argument("--blender", action="append", help="a Blender (repeatable; default: blender)")
+    p.add_argument("--reference-dir", help="keep the tracer's references here and reuse them in later runs")
     args = p.parse_args()
     if not os.environ.get("CHROMATRACE_EXE"):
         sys.exit("set CHROMATRACE_EXE to the chromatrace executable (e.g. build/cli/chromatrace)")
@@ -344,10 +382,11 @@ def main():
             print(f"{version:8s} {scene_name:9s} {light.upper():5s}  {r['samples']:17s}  {r['ratio']:10.2f}x  "
                   f"{r['with_planning']:12.2f}x  {r['equal']:24.2f}x"
                   f"  {r['measured']:17.2f}  {r['predicted']:.2f} ({r['low']:.2f}-{r['high']:.2f})  {r['worst']}, {r['worst_predicted']}")
-        print("\nBlender  scene     light  plain render's noise: mean, worst object   samples a group needs at the least  "
-              "floor / plain")
+        print("\nBlender  scene     light  one-sample CPU: planned, plain  growing part / plain  "
+              "plain render's noise: mean, worst object   samples a group needs at the least  floor / plain")
         for version, scene_name, light, r in results:
-            print(f"{version:8s} {scene_name:9s} {light.upper():5s}  {r['plain_noise']:.2f}, {r['plain_worst']:27s}  "
+            print(f"{version:8s} {scene_name:9s} {light.upper():5s}  {r['fixed']:21.2f}, {r['plain_fixed']:5.2f}  "
+                  f"{r['samples_part']:19.2f}x  {r['plain_noise']:.2f}, {r['plain_worst']:27s}  "
                   f"{r['floor_samples']:34.0f}  {r['floor']:12.2f}x")
 
 
