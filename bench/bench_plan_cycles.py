@@ -208,7 +208,8 @@ def floor_of(plan, plain_noise, args, spectral_cpu, plain_cpu):
     floor"). Each band group is a Cycles render, no less noisy than the plain render at equal samples (printed: the
     plan's predicted noise over the plain render's at the planned samples), so each group needs at least the samples
     N at which the plain render's own noise meets the target: the image's mean in quadrature with the bands' and
-    bounces' predicted error, and every object's limit (2 × the target) with the object's noise alone. The planned
+    bounces' predicted error, and the noisiest object's limit (2 × the target) in quadrature with its bands' error
+    where the plan judged that object (else its noise alone). The planned
     groups' CPU scaled to N (a lower bound where a group has a fixed cost and N is below its samples), over the plain
     render's."""
     samples = plan["cycles_samples"]
@@ -217,7 +218,10 @@ def floor_of(plan, plain_noise, args, spectral_cpu, plain_cpu):
     budget = max(args.target ** 2 - bands ** 2, 1e-9)
     worst_name, worst = max(plain_noise["objects"].items(), key=lambda item: item[1])
     need_mean = args.samples * plain_noise["image"] ** 2 / budget
-    need_object = args.samples * worst ** 2 / (2 * args.target) ** 2
+    # The object's own band error where the plan judged it (the header keeps the worst object the plan predicted).
+    judged = plan.get("worst_object") or {}
+    object_bands = judged.get("bands_only_mean_de00", 0.0) if judged.get("name") == worst_name else 0.0
+    need_object = args.samples * worst ** 2 / max((2 * args.target) ** 2 - object_bands ** 2, 1e-9)
     need = max(need_mean, need_object)
     noisier = None
     if "predicted_noise_mean_de00" in plan:  # the plan's noise over the plain render's at the planned samples
