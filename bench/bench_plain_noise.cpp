@@ -15,6 +15,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
+#include <initializer_list>
 #include <map>
 #include <memory>
 #include <set>
@@ -41,13 +42,15 @@ Plain read_plain(const std::string& path) {
   auto in = OIIO::ImageInput::open(path);
   if (!in) throw std::runtime_error(fmt::format("{}: cannot open: {}", path, OIIO::geterror()));
   const OIIO::ImageSpec& spec = in->spec();
-  auto channel = [&](const std::string& name) {
-    for (int c = 0; c < spec.nchannels; ++c)
-      if (spec.channelnames[static_cast<std::size_t>(c)] == name) return c;
-    throw std::runtime_error(fmt::format("{}: no channel {}", path, name));
+  // The first of `names` the file has (Blender 5 names the object-index pass "Object Index", earlier ones "IndexOB").
+  auto channel = [&](std::initializer_list<std::string> names) {
+    for (const std::string& name : names)
+      for (int c = 0; c < spec.nchannels; ++c)
+        if (spec.channelnames[static_cast<std::size_t>(c)] == name) return c;
+    throw std::runtime_error(fmt::format("{}: no channel {}", path, *names.begin()));
   };
-  const int r = channel("ViewLayer.Combined.R"), g = channel("ViewLayer.Combined.G"),
-            b = channel("ViewLayer.Combined.B"), id = channel("ViewLayer.IndexOB.X");
+  const int r = channel({"ViewLayer.Combined.R"}), g = channel({"ViewLayer.Combined.G"}),
+            b = channel({"ViewLayer.Combined.B"}), id = channel({"ViewLayer.IndexOB.X", "ViewLayer.Object Index.X"});
   const std::size_t n = static_cast<std::size_t>(spec.width) * static_cast<std::size_t>(spec.height);
   const std::size_t nc = static_cast<std::size_t>(spec.nchannels);
   std::vector<float> pixels(n * nc);

@@ -145,7 +145,10 @@ scene = bpy.context.scene
 scene_import.import_scene({box!r}, scene, tool.Tool(tool.find_executable()), lambda m: None)
 """
 assert _IMPORT in PLAIN, "bench_blender.PLAIN no longer imports the scene as this bench expects"
-PLAIN_BLEND = PLAIN.replace(_IMPORT, "scene = bpy.context.scene\n")
+# The .blend's objects get the export's object ids as pass indices, as the spectral render gives them, so that the
+# plain render's noise is measured per object too.
+PLAIN_BLEND = PLAIN.replace(_IMPORT, "scene = bpy.context.scene\nids = {ids!r}\nfor ob in scene.objects:\n"
+                                     "    ob.pass_index = ids.get(ob.name, ob.pass_index)\n")
 
 
 def artist_blend(blender_exe, out_dir):
@@ -216,7 +219,7 @@ def floor_of(plan, plain_noise, args, spectral_cpu, plain_cpu):
     mean_samples = sum(samples) / len(samples)
     bands = plan.get("predicted_bands_mean_de00", 0.0)
     budget = max(args.target ** 2 - bands ** 2, 1e-9)
-    worst_name, worst = max(plain_noise["objects"].items(), key=lambda item: item[1])
+    worst_name, worst = max(plain_noise["objects"].items(), key=lambda item: item[1], default=("-", 0.0))
     need_mean = args.samples * plain_noise["image"] ** 2 / budget
     # The object's own band error where the plan judged it (the header keeps the worst object the plan predicted).
     judged = plan.get("worst_object") or {}
@@ -291,9 +294,12 @@ def bench(scene_name, light, args, work, blender_exe, version, references):
     worst_predicted = (f"{math.hypot(worst_plan['mean_de00'], reference_noise * worst_plan['noise_to_image_noise']):.2f} "
                        f"({worst_plan['name']})") if worst_plan else "-"
 
+    names = json.loads(run([exe, "info", reference, "--json"]).stdout)["object_ids"]["names"]
+    ids = {name: int(i) for i, name in names.items()}
+
     def plain_render(samples, seed, out):
         script = (PLAIN_BLEND if blend else PLAIN).format(root=ROOT, box=scene, samples=samples, seed=seed,
-                                                           res=args.resolution, out=out)
+                                                           res=args.resolution, out=out, ids=ids)
         plain = run(([blender_exe, blend, "--background", "--factory-startup"] if blend else blender)
                     + ["--python-expr", script])
         found = re.search(r"PLAIN_RENDER_SECONDS ([0-9.]+) ([0-9.]+)", plain.stdout)
@@ -333,8 +339,8 @@ def bench(scene_name, light, args, work, blender_exe, version, references):
           f"the parts that grow with the pixels and samples: {samples_part:.2f}x")
     print(f"  plain RGB Cycles render at the planned groups' largest samples ({equal_samples}): {equal_cpu:.2f} s CPU; "
           f"ratio planned spectral / it: {spectral_cpu / equal_cpu:.2f}x")
-    print(f"  mean dE00 against the 5 nm reference ({args.reference_spp} paths per pixel, "
-          f"{references[reference]:.0f} s CPU): measured {mean_de:.2f}, predicted {predicted:.2f} "
+    made = f"{references[reference]:.0f} s CPU" if references[reference] > 0 else "kept from an earlier run"
+    print(f"  mean dE00 against the 5 nm reference ({args.reference_spp} paths per pixel, {made}): measured {mean_de:.2f}, predicted {predicted:.2f} "
           f"({low:.2f}-{high:.2f}); without the reference's noise predicted {plan['predicted_mean_de00']:.2f}; "
           f"worst object {worst} {worst_de:.2f}, predicted {worst_predicted}")
     print(f"  plain RGB render's own noise at {args.samples} samples (seeds 1 and 2): mean dE00 {plain_noise['image']:.2f}, "
