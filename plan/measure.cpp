@@ -188,6 +188,7 @@ NoiseRatio measure_cycles_noise(const Scene& scene, const std::filesystem::path&
                                  ia.file, scene.source));
   out.cycles = cycles;
   out.tracer = traced;
+  out.tracer_at_one = traced / std::sqrt(2.0) * std::sqrt(static_cast<double>(out.samples));
   out.ratio = cycles / traced;
   out.se = out.ratio * std::hypot(cycles_se / std::max(cycles, 1e-300), traced_se / traced);
   return out;

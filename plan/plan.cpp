@@ -777,7 +777,7 @@ CyclesNoise cycles_noise(const Model& model, const std::vector<int>& edges, int 
   CyclesNoise n;
   n.groups = groups;
   n.ratio = ratio;
-  n.at_one = noise_at(model, 1);
+  n.at_one = options.cycles_pilot_tracer_noise_at_one > 0 ? options.cycles_pilot_tracer_noise_at_one : noise_at(model, 1);
   // Shares measured on Cycles' pilots of these very bands.
   bool measured = options.cycles_group_shares.size() == groups * groups &&
                   options.cycles_group_shares_edges_nm.size() == nb + 1;
@@ -1038,6 +1038,7 @@ Plan make_plan(const Scene& scene, const PlanOptions& options) {
     auto with = [&](double noise_de00) { return std::hypot(plan.predicted_mean, noise_de00); };
     plan.cycles_noise_ratio = ratio;
     plan.tracer_noise_at_one = noise.at_one;
+    plan.tracer_noise_from_pilots = options.cycles_pilot_tracer_noise_at_one > 0;
     for (std::size_t g = 0; g < noise.groups; ++g) plan.cycles_noise_shares.push_back(noise.share[g * noise.groups + g]);
     if (noise.measured) plan.cycles_noise_pair_shares = noise.share;
     plan.cycles_noise_shares_measured = noise.measured;
@@ -1052,7 +1053,7 @@ Plan make_plan(const Scene& scene, const PlanOptions& options) {
     noise.ratio = range[1] * (1 + kCyclesNoiseModelAccuracy);
     plan.cycles_predicted_high = with(noise.at(n));
     if (options.reference_samples > 0) {
-      const double reference = noise_at(model, options.reference_samples);
+      const double reference = noise.at_one / std::sqrt(static_cast<double>(options.reference_samples));
       plan.cycles_predicted_against_reference = std::hypot(plan.cycles_predicted_mean, reference);
       plan.cycles_against_reference_low = std::hypot(plan.cycles_predicted_low, reference);
       plan.cycles_against_reference_high = std::hypot(plan.cycles_predicted_high, reference);
@@ -1159,6 +1160,8 @@ Json report_document(const Plan& plan, const Scene& scene, const PlanOptions& op
            {"noise_only_mean_de00", plan.cycles_noise_only},
            {"noise_ratio_to_tracer", plan.cycles_noise_ratio},
            {"tracer_noise_at_one_sample", plan.tracer_noise_at_one},
+           {"tracer_noise_from", plan.tracer_noise_from_pilots ? "the tracer's renders beside the Cycles pilots (their size and samples)"
+                                                               : "the preview (its paths per pixel)"},
            {"noise_share_per_band_group", plan.cycles_noise_shares},
            {"noise_shares_between_band_groups", plan.cycles_noise_pair_shares},
            {"noise_shares_from", plan.cycles_noise_shares_measured ? "the Cycles pilots" : "plan's model of the preview's noise"},

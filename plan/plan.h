@@ -60,6 +60,11 @@ struct PlanOptions {
   std::vector<double> cycles_group_shares, cycles_group_shares_edges_nm;
   // No band group below this many samples: those Cycles' noise was measured at (the pilots'; 0: kCyclesMinSamples).
   int cycles_min_samples = 0;
+  // The tracer's noise (one render's mean ΔE00) at one path per pixel as measured beside the pilots, at their size and
+  // samples (NoiseRatio::tracer_at_one): the scale Cycles' predicted noise is the ratio times. 0: the preview's
+  // (Model's noise at its 16 paths, scaled by 1/√paths), which a scene with rare bright paths (an HDRI's sun)
+  // overstates at so few paths (docs/plan.md).
+  double cycles_pilot_tracer_noise_at_one = 0;
   // Also predict the mean ΔE00 that comparing the Cycles render with a tracer reference of this many paths per
   // pixel measures (its noise counts too); 0: not.
   int reference_samples = 0;
@@ -117,6 +122,7 @@ struct Plan {
   std::vector<int> cycles_samples;
   double cycles_noise_ratio = 0;                  // the ratio the prediction used
   double tracer_noise_at_one = 0;                 // the tracer's noise (mean ΔE00) at one path per pixel
+  bool tracer_noise_from_pilots = false;          // measured beside Cycles' pilots, else from the preview
   std::vector<double> cycles_noise_shares;        // each band group's share of the noise's variance (diagonal)
   bool cycles_noise_shares_measured = false;      // on Cycles' pilots, else by plan's model
   std::vector<double> cycles_noise_pair_shares;   // measured: G × G with the pairs' terms (NoiseRatio)
@@ -180,6 +186,7 @@ struct NoiseRatio {
   double ratio = 0, se = 0;
   double cycles = 0, tracer = 0;  // mean ΔE00 between the two renders of each
   int samples = 0;
+  double tracer_at_one = 0;  // one tracer render's noise at one path per pixel: tracer / √2 × √samples
   // How Cycles' noise is shared between the band groups (three bands a render) and between pairs of them, whose
   // noise is correlated where they share paths (the same seed): G × G, row by row, summing to 1. Diagonal: e_g², e_g
   // the mean ΔE00 between the first pilot and the first with group g's bands from the second; off the diagonal,
