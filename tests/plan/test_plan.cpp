@@ -483,6 +483,36 @@ TEST_F(Plan, CyclesSamplesPerBandGroupMeetTheTargetWithTheBands) {
   EXPECT_TRUE(read_band_plan_file(bands).cycles_samples.empty());
 }
 
+// With pilots, Cycles' predicted noise is the pilots' ratio times the tracer's noise measured beside them
+// (NoiseRatio::tracer_at_one), not the preview's: twice that scale is twice the noise at equal samples, so four
+// times the samples for the same budget, with the same bands; and the report says where the scale came from.
+TEST_F(Plan, CyclesNoiseIsScaledByThePilotsTracerNoiseWhenGiven) {
+  const Scene scene = load_scene(kBox);
+  plan::PlanOptions options;
+  options.threads = 2;
+  options.preview_size = 24;
+  options.edge_step_nm = 5;
+  options.cycles_noise_ratio = 1;
+  options.object_target_de00 = 100;  // the mean's law alone
+  const plan::Plan preview = plan::make_plan(scene, options);
+  ASSERT_FALSE(preview.cycles_samples.empty());
+  EXPECT_FALSE(preview.tracer_noise_from_pilots);
+  EXPECT_EQ(plan::report_document(preview, scene, options)["prediction"]["cycles"]["tracer_noise_from"],
+            "the preview (its paths per pixel)");
+
+  options.cycles_pilot_tracer_noise_at_one = 2 * preview.tracer_noise_at_one;
+  const plan::Plan pilots = plan::make_plan(scene, options);
+  EXPECT_TRUE(pilots.tracer_noise_from_pilots);
+  EXPECT_DOUBLE_EQ(pilots.tracer_noise_at_one, 2 * preview.tracer_noise_at_one);
+  ASSERT_EQ(pilots.bands.edges(), preview.bands.edges());
+  ASSERT_EQ(pilots.cycles_samples.size(), preview.cycles_samples.size());
+  for (std::size_t g = 0; g < preview.cycles_samples.size(); ++g)
+    EXPECT_NEAR(pilots.cycles_samples[g], 4.0 * preview.cycles_samples[g], 4.0) << g;  // rounding: a sample a group
+  EXPECT_NEAR(pilots.cycles_noise_only, preview.cycles_noise_only, 0.01 * preview.cycles_noise_only);
+  EXPECT_EQ(plan::report_document(pilots, scene, options)["prediction"]["cycles"]["tracer_noise_from"],
+            "the tracer's renders beside the Cycles pilots (their size and samples)");
+}
+
 TEST_F(Plan, BadInputGetsExitTwoAndOneLineNamingTheField) {
   const fs::path bad_scene = dir_ / "bad.json";
   Json doc = read_json(kBox);
