@@ -742,10 +742,11 @@ int samples_for(const Model& model, double target) {
 
 // Cycles' samples per band group for the bands `edges` (grid indices) at the bounce limit K, whose bands and
 // bounces alone are predicted at `bands_error`. Cycles' noise is `ratio` times the tracer's at equal samples, and the
-// tracer's falls as 1/√samples from the preview's (noise_at). How it is shared between the groups is a G × G matrix
+// tracer's falls as 1/√samples from its noise at one sample, at_one: measured beside the pilots where they are given
+// (PlanOptions::cycles_pilot_tracer_noise_at_one), else the preview's (noise_at). How it is shared between the groups is a G × G matrix
 // s (summing to 1): s_gg a group's own part, s_gh (g ≠ h) the part of two groups' correlated noise (Cycles traces
 // the same paths for every group with the same seed, so their noise is correlated over the samples they share). With
-// N_g samples a group the noise is ratio · noise_at(1) · √(Σ_gh s_gh / max(N_g, N_h)) (two groups share the samples of
+// N_g samples a group the noise is ratio · at_one · √(Σ_gh s_gh / max(N_g, N_h)) (two groups share the samples of
 // the fewer: their covariance falls with the more), and it adds to the bands' error as the square root of the sum of
 // squares. Measured on two Cycles pilots (measure_cycles_noise) s has all its terms; else plan's model gives the
 // diagonal alone, each group's part in the preview's noise (Model::band_noise). On the paper box under D65 the
