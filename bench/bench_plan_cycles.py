@@ -189,9 +189,9 @@ def _digest(scene, blend):
     return h.hexdigest()[:10]
 
 
-def plain_noise_of(plain_exr, scene, reference, exe):
-    """One plain render's Monte Carlo noise in ΔE00 (bench_plain_noise on two seeds): {"image": n, objects: {name: n}}."""
-    names = json.loads(run([exe, "info", reference, "--json"]).stdout)["object_ids"]["names"]
+def plain_noise_of(plain_exr, scene, names, exe):
+    """One plain render's Monte Carlo noise in ΔE00 (bench_plain_noise on two seeds): {"image": n, objects: {name: n}}.
+    `names`: the reference's object names by id."""
     with open(scene) as f:
         lights = {light.get("name") for light in json.load(f).get("lights", [])}
     emitters = ",".join(i for i, name in names.items() if name in lights)
@@ -310,7 +310,7 @@ def bench(scene_name, light, args, work, blender_exe, version, references):
     plain_exr = [os.path.join(out_dir, f"{case}-rgb-{seed}.exr") for seed in (1, 2)]
     # Its noise from the difference of two seeds; its cost the cheaper of the two (the same work: the machine's noise).
     plain_cpu = min(plain_render(args.samples, 1, plain_exr[0]), plain_render(args.samples, 2, plain_exr[1]))
-    plain_noise = plain_noise_of(plain_exr, scene, reference, exe)
+    plain_noise = plain_noise_of(plain_exr, scene, names, exe)
     plain_fixed_cpu = plain_render(1, 1, os.path.join(out_dir, f"{case}-rgb-one-sample.exr"))
     # What grows with the pixels and the samples: each side's CPU less its one-sample render's.
     samples_part = (spectral_cpu - spectral_fixed_cpu) / max(plain_cpu - plain_fixed_cpu, 1e-9)
