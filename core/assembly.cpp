@@ -5,12 +5,14 @@
 #include <cmath>
 #include <cstdlib>
 #include <memory>
+#include <optional>
 
 #include <fmt/core.h>
 
 #include "core/band_plan.h"
 #include "core/error.h"
 #include "core/exr_vocabulary.h"
+#include "core/guided.h"
 #include "core/json_input.h"
 #include "core/progress.h"
 #include "core/spectral_channel_name.h"
@@ -120,6 +122,23 @@ std::map<std::string, std::string> read_attributes(const JsonNode& attributes) {
     result[key] = value.string();
   }
   return result;
+}
+
+GuidedAssembly read_guided(const JsonNode& node, std::size_t band_count) {
+  node.expect_object({"bands", "radius", "false_refusal"});
+  GuidedAssembly guided;
+  std::vector<bool> seen(band_count, false);
+  for (const JsonNode& band : node["bands"].elements()) {
+    const auto b = static_cast<std::size_t>(band.integer_in(0, static_cast<std::int64_t>(band_count) - 1));
+    if (seen[b]) band.fail(fmt::format("band {} given twice", b));
+    seen[b] = true;
+    guided.bands.push_back(b);
+  }
+  if (guided.bands.empty()) node["bands"].fail("names no band");
+  if (guided.bands.size() == band_count) node["bands"].fail("names every band: none is left to guide them");
+  if (const auto radius = node.find("radius")) guided.radius = static_cast<int>(radius->integer_in(1, 64));
+  if (const auto p = node.find("false_refusal")) guided.false_refusal = p->number_in(1e-12, 0.5);
+  return guided;
 }
 
 // ---- the driver --------------------------------------------------------------------------------------
@@ -257,7 +276,7 @@ AssemblyManifest read_assembly_manifest(const fs::path& file) {
   if (format != "chromatrace-assemble/1")
     root["format"].fail(fmt::format("must be \"chromatrace-assemble/1\", got \"{}\"", format));
   root.expect_object({"format", "edges_nm", "reconstruction", "view_layer", "bands", "total", "components", "object_ids",
-                      "object_names", "attributes", "sum_tolerance"});
+                      "object_names", "attributes", "sum_tolerance", "guided"});
   const fs::path directory = file.parent_path();
   manifest.bands = read_edges(root["edges_nm"]);
   if (const auto r = root.find("reconstruction")) manifest.bands = read_reconstruction(*r, manifest.bands);
@@ -287,6 +306,7 @@ AssemblyManifest read_assembly_manifest(const fs::path& file) {
   }
   if (const auto attributes = root.find("attributes")) manifest.attributes = read_attributes(*attributes);
   if (const auto tolerance = root.find("sum_tolerance")) manifest.sum_tolerance = tolerance->number_in(0.0, 1.0);
+  if (const auto guided = root.find("guided")) manifest.guided = read_guided(*guided, manifest.bands.size());
   return manifest;
 }
 
@@ -326,12 +346,96 @@ std::optional<FamilyMismatch> reconcile_families(double total, std::span<double>
   return std::nullopt;
 }
 
+namespace {
+
+// The image held whole for guided reconstruction, filled block by block.
+GuidedImage whole_image(const AssemblyManifest& manifest, int width, int height) {
+  GuidedImage image;
+  image.width = width, image.height = height, image.bands = manifest.bands.size();
+  image.components = manifest.components;
+  const std::size_t values = static_cast<std::size_t>(width) * height * image.bands;
+  image.layers.assign(1 + manifest.components.size(), std::vector<float>(values));
+  if (manifest.object_ids) image.object_ids.assign(static_cast<std::size_t>(width) * height, 0);
+  return image;
+}
+
+void copy_block(const OutputBlock& out, int y0, GuidedImage& image) {
+  const std::size_t offset = static_cast<std::size_t>(y0) * image.width;
+  std::copy(out.total.begin(), out.total.end(), image.layers[0].begin() + offset * image.bands);
+  for (std::size_t c = 0; c < out.components.size(); ++c)
+    std::copy(out.components[c].begin(), out.components[c].end(), image.layers[c + 1].begin() + offset * image.bands);
+  std::copy(out.object_ids.begin(), out.object_ids.end(), image.object_ids.begin() + offset);
+}
+
+// The header's chromatrace.guided: which bands were reconstructed, from which, and where it was refused.
+std::string guided_attribute(const AssemblyManifest& manifest, const GuidedOptions& options, const GuidedReport& report) {
+  const auto band_list = [&](const std::vector<std::size_t>& bands) {
+    Json list = Json::array();
+    for (const std::size_t b : bands)
+      list.push_back({{"band", b}, {"nm", {manifest.bands.lo(b), manifest.bands.hi(b)}}});
+    return list;
+  };
+  Json refused = Json::array();
+  std::size_t tested = 0;
+  for (const GuidedVerdict& v : report.verdicts) {
+    ++tested;
+    if (!v.refused) continue;
+    const auto name = manifest.object_names.find(v.object);
+    refused.push_back({{"layer", v.layer == 0 ? "total" : manifest.components[v.layer - 1]},
+                       {"object", name != manifest.object_names.end() ? name->second : std::to_string(v.object)},
+                       {"band", v.band},
+                       {"z", std::round(v.worst_z * 100) / 100},
+                       {"threshold", std::round(v.threshold * 100) / 100}});
+  }
+  const Json j = {{"method", "ratio to the guide bands' sum, per object and component (core/guided.h)"},
+                  {"guided", band_list(options.guided_bands)},
+                  {"guides", band_list(options.guide_bands)},
+                  {"radius", options.radius},
+                  {"false_refusal", options.false_refusal},
+                  {"tested", tested},
+                  {"refused", refused}};
+  return j.dump();
+}
+
+// Reconstructs the guided bands of the whole image and writes it.
+void write_guided(const AssemblyManifest& manifest, GuidedImage& image, SpectralExrLayout layout, const fs::path& output,
+                  bool show_progress) {
+  GuidedOptions options;
+  options.guided_bands = manifest.guided->bands;
+  for (std::size_t b = 0; b < image.bands; ++b)
+    if (std::find(options.guided_bands.begin(), options.guided_bands.end(), b) == options.guided_bands.end())
+      options.guide_bands.push_back(b);
+  options.radius = manifest.guided->radius;
+  options.false_refusal = manifest.guided->false_refusal;
+  const GuidedReport report = reconstruct_guided(image, options);
+  layout.attributes["chromatrace.guided"] = guided_attribute(manifest, options, report);
+  if (show_progress)
+    fmt::print(stderr, "assemble: {} of {} bands guided; {} of {} object layers and bands refused (the header's "
+               "chromatrace.guided names them)\n", options.guided_bands.size(), image.bands, report.refused(),
+               report.verdicts.size());
+  SpectralExrWriter writer(output, std::move(layout));
+  SpectralRowBlock block;
+  block.rows = image.height;
+  block.total = image.layers[0];
+  for (std::size_t c = 1; c < image.layers.size(); ++c) block.components.emplace_back(image.layers[c]);
+  block.object_ids = image.object_ids;
+  writer.write_rows(block);
+  writer.finish();
+}
+
+}  // namespace
+
 void assemble(const AssemblyManifest& manifest, const fs::path& output, bool show_progress) {
   std::vector<SpectralExrReader> readers = open_inputs(manifest);
   const int width = readers[0].info().width, height = readers[0].info().height;
-  SpectralExrWriter writer(output, output_layout(manifest, width, height));
+  SpectralExrLayout layout = output_layout(manifest, width, height);
+  // Guided: the writer is made once the image is whole, with the reconstruction's report in its header.
+  std::optional<SpectralExrWriter> writer;
+  if (!manifest.guided) writer.emplace(output, layout);
   check_channels_present(manifest, readers);
   const std::vector<SummingFamily> families = summing_families(manifest.components);
+  GuidedImage image;
+  if (manifest.guided) image = whole_image(manifest, width, height);
 
   // Created after the first block, so that a problem found there is reported on one line.
   std::unique_ptr<Progress> progress;
@@ -344,17 +448,22 @@ void assemble(const AssemblyManifest& manifest, const fs::path& output, bool sho
     assemble_values(manifest, families, in, out);
     convert_object_ids(manifest, in, out);
 
-    SpectralRowBlock block;
-    block.rows = rows;
-    block.total = out.total;
-    for (const std::vector<float>& c : out.components) block.components.emplace_back(c);
-    block.object_ids = out.object_ids;
-    writer.write_rows(block);
+    if (writer) {
+      SpectralRowBlock block;
+      block.rows = rows;
+      block.total = out.total;
+      for (const std::vector<float>& c : out.components) block.components.emplace_back(c);
+      block.object_ids = out.object_ids;
+      writer->write_rows(block);
+    } else {
+      copy_block(out, y0, image);
+    }
     if (!progress) progress = std::make_unique<Progress>("assemble", static_cast<std::size_t>(height), show_progress);
     progress->advance(static_cast<std::size_t>(rows));
   }
-  writer.finish();
+  if (writer) writer->finish();
   progress->finish();
+  if (manifest.guided) write_guided(manifest, image, std::move(layout), output, show_progress);
 }
 
 }  // namespace ct

@@ -14,7 +14,8 @@
 //    "total": [{"passes": ["Combined"]}],
 //    "components": [{"name": "diffuse_direct", "terms": [{"passes": ["DiffDir", "DiffCol"]}]}, ...],
 //    "object_ids": {"file": "g000.exr", "channel": "ViewLayer.IndexOB.X"}, "object_names": {"1": "floor"},
-//    "attributes": {"chromatrace.renderer": "..."}, "sum_tolerance": 1e-4}
+//    "attributes": {"chromatrace.renderer": "..."}, "sum_tolerance": 1e-4,
+//    "guided": {"bands": [3, 4, 5], "radius": 8, "false_refusal": 1e-4}}  (optional)
 //
 // A term's "file" names an entry of each band's "files" (default "main"); "sign" is 1 or -1 (default 1);
 // file paths are relative to the manifest. Pass channel names are "<view_layer>.<pass>.<channel>".
@@ -24,6 +25,11 @@
 // relative to the pixel's magnitude (else an InputError names the family, pixel and band). That rounding
 // residual is then added to the family's largest component at that pixel (reconcile_families), so the file
 // satisfies the exact bound `chromatrace info --check` verifies.
+//
+// "guided" names the bands rendered with fewer samples than the rest: after assembly they are reconstructed
+// from the others (core/guided.h), object by object and component by component, and the header's
+// chromatrace.guided says which bands were, from which, and where a reconstruction was refused. The whole
+// image is then held in memory (a 1920 × 1080 image of 6 bands and 8 layers takes 400 MB).
 
 #include <cstddef>
 #include <cstdint>
@@ -60,6 +66,13 @@ struct ObjectIdChannel {
   std::size_t channel = 0;  // index into that input's channels
 };
 
+// The manifest's "guided": the bands reconstructed from the others (core/guided.h: GuidedOptions).
+struct GuidedAssembly {
+  std::vector<std::size_t> bands;
+  int radius = 8;
+  double false_refusal = 1e-4;
+};
+
 // A manifest as read: every file and channel resolved, ready to assemble.
 struct AssemblyManifest {
   std::string file;  // the manifest's path as given, for messages
@@ -72,6 +85,7 @@ struct AssemblyManifest {
   std::map<std::int32_t, std::string> object_names;
   std::map<std::string, std::string> attributes;  // chromatrace.<key>
   double sum_tolerance = 1e-4;
+  std::optional<GuidedAssembly> guided;
 };
 
 // Reads and checks a manifest. Bad input is a one-line InputError naming the file and the JSON path of the
