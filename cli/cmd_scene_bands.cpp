@@ -128,6 +128,8 @@ int run(const SceneBandsOptions& o) {
   if (const BandReconstruction* r = bands.reconstruction()) report["bands"]["reconstruction"] = reconstruction_json(*r);
   if (given && !given->cycles_samples.empty())  // the Cycles samples of each band group, which the add-on renders with
     report["bands"]["cycles_samples"] = given->cycles_samples;
+  if (given && !given->cycles_guided_groups.empty())  // the groups the add-on's assembly reconstructs from the others
+    report["bands"]["cycles_guided_groups"] = given->cycles_guided_groups;
   Json spectra_json = Json::object();
   for (const NamedSpectrum& s : spectra) spectra_json[s.name] = spectrum_entry(s.spectrum, bands);
   report["spectra"] = spectra_json;

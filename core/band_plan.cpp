@@ -16,7 +16,7 @@ BandPlanFile read_band_plan_file(const std::filesystem::path& file) {
   const JsonNode root(document, file.string());
   const std::string format = root["format"].string();
   if (format != "chromatrace-bands/1") root["format"].fail(fmt::format("must be \"chromatrace-bands/1\", got \"{}\"", format));
-  root.expect_object({"format", "edges_nm", "reconstruction", "cycles_samples"});
+  root.expect_object({"format", "edges_nm", "reconstruction", "cycles_samples", "cycles_guided_groups"});
   const JsonNode edges_node = root["edges_nm"];
   std::vector<double> edges;
   for (const JsonNode& edge : edges_node.elements()) {
@@ -29,7 +29,7 @@ BandPlanFile read_band_plan_file(const std::filesystem::path& file) {
   if (edges.back() <= 360.0 || edges.front() >= 830.0)
     edges_node.fail(fmt::format("bands [{}, {}] nm do not overlap the visible range 360-830 nm (wavelengths in nm?)",
                                 edges.front(), edges.back()));
-  BandPlanFile plan{Bands::from_edges(std::move(edges), edges_node.location()), {}};
+  BandPlanFile plan{Bands::from_edges(std::move(edges), edges_node.location()), {}, {}};
   if (const auto r = root.find("reconstruction")) plan.bands = read_reconstruction(*r, plan.bands);
   if (const auto samples = root.find("cycles_samples")) {
     const std::vector<JsonNode> groups = samples->elements();
@@ -39,17 +39,30 @@ BandPlanFile read_band_plan_file(const std::filesystem::path& file) {
                                 groups.size(), wanted, plan.bands.size()));
     for (const JsonNode& g : groups) plan.cycles_samples.push_back(static_cast<int>(g.integer_in(1, std::numeric_limits<int>::max())));
   }
+  if (const auto guided = root.find("cycles_guided_groups")) {
+    if (plan.cycles_samples.empty()) guided->fail("needs cycles_samples: the guided groups are those rendered with fewer");
+    const std::size_t groups = plan.cycles_samples.size();
+    for (const JsonNode& g : guided->elements()) {
+      const auto group = static_cast<std::size_t>(g.integer_in(0, static_cast<std::int64_t>(groups) - 1));
+      if (!plan.cycles_guided_groups.empty() && group <= plan.cycles_guided_groups.back())
+        g.fail("groups must increase");
+      plan.cycles_guided_groups.push_back(group);
+    }
+    if (plan.cycles_guided_groups.size() == groups) guided->fail("names every group: none is left to guide them");
+  }
   return plan;
 }
 
 Bands read_band_plan(const std::filesystem::path& file) { return read_band_plan_file(file).bands; }
 
-Json band_plan_document(const Bands& bands, const std::vector<int>& cycles_samples) {
+Json band_plan_document(const Bands& bands, const std::vector<int>& cycles_samples,
+                        const std::vector<std::size_t>& cycles_guided_groups) {
   Json j;
   j["format"] = "chromatrace-bands/1";
   j["edges_nm"] = bands.edges();
   if (const BandReconstruction* r = bands.reconstruction()) j["reconstruction"] = reconstruction_json(*r);
   if (!cycles_samples.empty()) j["cycles_samples"] = cycles_samples;
+  if (!cycles_guided_groups.empty()) j["cycles_guided_groups"] = cycles_guided_groups;
   return j;
 }
 

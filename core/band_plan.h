@@ -6,13 +6,15 @@
 //
 //   {"format": "chromatrace-bands/1", "edges_nm": [380, 400, 420, 440, 450, 460, 480, 520, 600, 780],
 //    "reconstruction": {"lo_nm": 380, "step_nm": 1, "matrix": [[m_00, ..., m_08], ...]},
-//    "cycles_samples": [256, 128, 64]}
+//    "cycles_samples": [256, 32, 32], "cycles_guided_groups": [1, 2]}
 //
 // N + 1 strictly increasing edges give N contiguous bands [edge_i, edge_i+1) that must overlap the visible
 // range 360–830 nm. The reconstruction's matrix has one row per fine band [lo + j·step, lo + (j+1)·step) and one
 // column per band. cycles_samples, optional, gives Cycles' samples per pixel for each band group, the bands
 // 3g, 3g + 1, 3g + 2 that one Cycles render carries (⌈N / 3⌉ whole numbers ≥ 1); the Blender add-on renders each
-// group with its own, and the tracer, which carries every band along each path, has no use for them. Errors name
+// group with its own, and the tracer, which carries every band along each path, has no use for them.
+// cycles_guided_groups, optional (with cycles_samples), names the groups rendered with few samples and then
+// reconstructed from the others (core/guided.h); at least one group must be left to guide them. Errors name
 // the file and the JSON path ("plan.json: edges_nm[3]: ...").
 
 #include <cstddef>
@@ -29,6 +31,7 @@ namespace ct {
 struct BandPlanFile {
   Bands bands;
   std::vector<int> cycles_samples;
+  std::vector<std::size_t> cycles_guided_groups;  // in increasing order
 };
 BandPlanFile read_band_plan_file(const std::filesystem::path& file);
 Bands read_band_plan(const std::filesystem::path& file);  // the bands alone
@@ -37,7 +40,8 @@ Bands read_band_plan(const std::filesystem::path& file);  // the bands alone
 constexpr std::size_t cycles_band_groups(std::size_t band_count) { return (band_count + 2) / 3; }
 
 // The chromatrace-bands/1 document of `bands` (with its reconstruction, if any, and the groups' samples if given).
-Json band_plan_document(const Bands& bands, const std::vector<int>& cycles_samples = {});
+Json band_plan_document(const Bands& bands, const std::vector<int>& cycles_samples = {},
+                        const std::vector<std::size_t>& cycles_guided_groups = {});
 
 // A reconstruction as JSON ({"lo_nm", "step_nm", "matrix"}), for the band-plan file and the assembly manifest,
 // and back onto `bands` (errors name the node's path).

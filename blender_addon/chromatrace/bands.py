@@ -38,6 +38,13 @@ def group_samples(groups, cycles_samples, samples):
     return [max(cycles_samples[b // len(CHANNELS)] for b in group) for group in groups]
 
 
+def guided_bands(band_count, guided_groups):
+    """The bands of the band plan's `cycles_guided_groups` (groups of three, bands 3g to 3g + 2): rendered with few
+    samples and reconstructed from the others when assembled."""
+    groups = set(guided_groups or [])
+    return [b for b in range(band_count) if b // len(CHANNELS) in groups]
+
+
 def channel_of(group, band):
     """The colour channel ("R", "G" or "B") that carries `band` in the render of `group`."""
     return CHANNELS[group.index(band)]

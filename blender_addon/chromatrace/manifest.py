@@ -24,7 +24,8 @@ IDS_FILE = "ids.exr"
 
 
 def build_manifest(edges_nm, groups, variants, view_layer, total, components, object_names=None,
-                   attributes=None, replicate=False, sum_tolerance=1e-4, reconstruction=None, pass_names=None):
+                   attributes=None, replicate=False, sum_tolerance=1e-4, reconstruction=None, pass_names=None,
+                   guided_bands=None):
     """The manifest dict, with file paths relative to the directory the manifest is written to.
 
     groups: lists of band indices, one per render; variants: names of the renders every group has
@@ -32,7 +33,8 @@ def build_manifest(edges_nm, groups, variants, view_layer, total, components, ob
     replicate: one band per render copied to R, G and B (read back from R); reconstruction: the band plan's
     reconstruction ({"lo_nm", "step_nm", "matrix"}), which the EXR header carries; pass_names: {short pass name:
     the name in the files} where the running Blender writes other names than the components use
-    (blender_compat.pass_names).
+    (blender_compat.pass_names); guided_bands: the bands rendered with few samples, which the assembly reconstructs
+    from the others (core/guided.h).
     """
     renamed = dict(pass_names or {})
     total = _renamed_terms(total, renamed)
@@ -63,6 +65,8 @@ def build_manifest(edges_nm, groups, variants, view_layer, total, components, ob
         manifest["attributes"] = dict(attributes)
     if reconstruction is not None:
         manifest["reconstruction"] = reconstruction
+    if guided_bands:
+        manifest["guided"] = {"bands": sorted(guided_bands)}
     return manifest
 
 

@@ -26,7 +26,7 @@ import bpy
 
 from . import blender_compat, cache, components, cycles_setup, manifest, materials, node_resolution, node_rules
 from . import readback, render_setup, scene_parts
-from .bands import band_groups, describe_band_range, group_samples
+from .bands import band_groups, describe_band_range, group_samples, guided_bands
 from .cache_description import cache_description
 from .camera_math import camera_description
 from .errors import BadInput
@@ -261,7 +261,8 @@ class SpectralRender:
         return manifest.build_manifest(
             plan.edges, plan.groups, list(plan.variants), plan.view_layer.name, plan.total,
             plan.components, object_names=names, attributes=attributes, replicate=plan.replicate,
-            reconstruction=plan.bands["bands"].get("reconstruction"), pass_names=blender_compat.pass_names())
+            reconstruction=plan.bands["bands"].get("reconstruction"), pass_names=blender_compat.pass_names(),
+            guided_bands=guided_bands(len(plan.edges) - 1, plan.bands["bands"].get("cycles_guided_groups")))
 
     def _assemble(self, plan):
         request = self.request

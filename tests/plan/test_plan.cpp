@@ -414,6 +414,28 @@ TEST_F(Plan, BandPlanFileCarriesTheSamplesOfEachCyclesBandGroup) {
   write_file_atomically(file, band_plan_document(bands).dump());
   EXPECT_TRUE(read_band_plan_file(file).cycles_samples.empty());
   EXPECT_FALSE(read_json(file).contains("cycles_samples"));
+  // And the groups rendered with few samples and reconstructed from the others, which need the samples and must
+  // leave a group to guide them.
+  write_file_atomically(file, band_plan_document(bands, {256, 32, 32}, {1, 2}).dump());
+  EXPECT_EQ(read_band_plan_file(file).cycles_guided_groups, (std::vector<std::size_t>{1, 2}));
+  const auto error_with = [&](const Json& edit) {
+    Json doc = band_plan_document(bands, {256, 32, 32});
+    doc.update(edit);
+    write_file_atomically(file, doc.dump());
+    try {
+      read_band_plan_file(file);
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  EXPECT_NE(error_with({{"cycles_guided_groups", {0, 1, 2}}}).find("cycles_guided_groups: names every group"), std::string::npos);
+  EXPECT_NE(error_with({{"cycles_guided_groups", {2, 1}}}).find("cycles_guided_groups[1]: groups must increase"), std::string::npos);
+  EXPECT_NE(error_with({{"cycles_guided_groups", {3}}}).find("cycles_guided_groups[0]"), std::string::npos);
+  Json no_samples = band_plan_document(bands);
+  no_samples["cycles_guided_groups"] = {1};
+  write_file_atomically(file, no_samples.dump());
+  EXPECT_THROW(read_band_plan_file(file), InputError);
 }
 
 // For Cycles, plan gives samples to each band group of three with the bands: Cycles' noise `ratio` × the tracer's

@@ -186,6 +186,16 @@ class Manifest(unittest.TestCase):
         for passes in ("Combined", "Emit", "DiffDir", "DiffInd", "DiffCol", "GlossDir", "GlossInd", "GlossCol"):
             self.assertIn(f"VL.{passes}.R", wanted["g001_main.exr"])
 
+    def test_guided_groups_name_their_bands_for_the_assembly(self):
+        total, planned = components.component_plan({"paths"}, [], 2)
+        guided = bands.guided_bands(7, [1, 2])
+        self.assertEqual(guided, [3, 4, 5, 6])  # groups of three: bands 3g to 3g + 2, the last group short
+        self.assertEqual(bands.guided_bands(7, None), [])
+        edges = [400 + 25 * i for i in range(8)]
+        m = manifest.build_manifest(edges, bands.band_groups(7), ["main"], "V", total, planned, guided_bands=guided)
+        self.assertEqual(m["guided"], {"bands": [3, 4, 5, 6]})
+        self.assertNotIn("guided", manifest.build_manifest(edges, bands.band_groups(7), ["main"], "V", total, planned))
+
     def test_missing_renders(self):
         with tempfile.TemporaryDirectory() as d:
             groups = bands.band_groups(6)
