@@ -356,7 +356,52 @@ GuidedImage whole_image(const AssemblyManifest& manifest, int width, int height)
   const std::size_t values = static_cast<std::size_t>(width) * height * image.bands;
   image.layers.assign(1 + manifest.components.size(), std::vector<float>(values));
   if (manifest.object_ids) image.object_ids.assign(static_cast<std::size_t>(width) * height, 0);
+  image.colours.resize(image.layers.size());
   return image;
+}
+
+// Where a component is one product of a light pass and a colour pass in every band (Cycles' DiffDir × DiffCol,
+// GlossDir × GlossCol, … as "<view_layer>.Diffuse Color.R" in Blender 5), the channel index of each, by band.
+struct LightTimesColour {
+  std::vector<std::size_t> light, colour;  // [band]: indices into the product's input's channels
+};
+
+std::vector<std::optional<LightTimesColour>> light_times_colour(const AssemblyManifest& manifest) {
+  std::vector<std::optional<LightTimesColour>> found(manifest.components.size());
+  const auto is_colour = [&](const PassProduct& t, std::size_t k) {
+    const std::string& channel = manifest.inputs[t.input].channels[t.channels[k]];
+    return channel.find("Col") != std::string::npos;
+  };
+  for (std::size_t c = 0; c < manifest.components.size(); ++c) {
+    LightTimesColour split;
+    for (const PassSum& sum : manifest.component_sums[c]) {
+      if (sum.size() != 1 || sum[0].channels.size() != 2 || sum[0].sign != 1.0) break;
+      const bool first_is_colour = is_colour(sum[0], 0);
+      if (first_is_colour == is_colour(sum[0], 1)) break;
+      split.light.push_back(sum[0].channels[first_is_colour ? 1 : 0]);
+      split.colour.push_back(sum[0].channels[first_is_colour ? 0 : 1]);
+    }
+    if (split.light.size() == manifest.bands.size()) found[c] = std::move(split);
+  }
+  return found;
+}
+
+// The light and the colour of each such component, in place of their product.
+void copy_factors(const AssemblyManifest& manifest, const std::vector<std::optional<LightTimesColour>>& factors,
+                  const InputBlock& block, GuidedImage& image) {
+  const std::size_t nb = image.bands, offset = static_cast<std::size_t>(block.y0) * image.width;
+  for (std::size_t c = 0; c < factors.size(); ++c) {
+    if (!factors[c]) continue;
+    for (std::size_t b = 0; b < nb; ++b) {
+      const PassProduct& t = manifest.component_sums[c][b][0];
+      const std::size_t stride = manifest.inputs[t.input].channels.size();
+      for (std::size_t p = 0; p < block.pixels(); ++p) {
+        const std::size_t i = (offset + p) * nb + b;
+        image.layers[c + 1][i] = block.values[t.input][p * stride + factors[c]->light[b]];
+        image.colours[c + 1][i] = block.values[t.input][p * stride + factors[c]->colour[b]];
+      }
+    }
+  }
 }
 
 void copy_block(const OutputBlock& out, int y0, GuidedImage& image) {
@@ -435,7 +480,13 @@ void assemble(const AssemblyManifest& manifest, const fs::path& output, bool sho
   check_channels_present(manifest, readers);
   const std::vector<SummingFamily> families = summing_families(manifest.components);
   GuidedImage image;
-  if (manifest.guided) image = whole_image(manifest, width, height);
+  std::vector<std::optional<LightTimesColour>> factors;
+  if (manifest.guided) {
+    image = whole_image(manifest, width, height);
+    factors = light_times_colour(manifest);
+    for (std::size_t c = 0; c < factors.size(); ++c)
+      if (factors[c]) image.colours[c + 1].resize(image.layers[c + 1].size());
+  }
 
   // Created after the first block, so that a problem found there is reported on one line.
   std::unique_ptr<Progress> progress;
@@ -457,6 +508,7 @@ void assemble(const AssemblyManifest& manifest, const fs::path& output, bool sho
       writer->write_rows(block);
     } else {
       copy_block(out, y0, image);
+      copy_factors(manifest, factors, in, image);
     }
     if (!progress) progress = std::make_unique<Progress>("assemble", static_cast<std::size_t>(height), show_progress);
     progress->advance(static_cast<std::size_t>(rows));

@@ -15,7 +15,7 @@
 //    "components": [{"name": "diffuse_direct", "terms": [{"passes": ["DiffDir", "DiffCol"]}]}, ...],
 //    "object_ids": {"file": "g000.exr", "channel": "ViewLayer.IndexOB.X"}, "object_names": {"1": "floor"},
 //    "attributes": {"chromatrace.renderer": "..."}, "sum_tolerance": 1e-4,
-//    "guided": {"bands": [3, 4, 5], "radius": 8, "false_refusal": 1e-4}}  (optional)
+//    "guided": {"bands": [3, 4, 5], "radius": 4, "false_refusal": 1e-4}}  (optional)
 //
 // A term's "file" names an entry of each band's "files" (default "main"); "sign" is 1 or -1 (default 1);
 // file paths are relative to the manifest. Pass channel names are "<view_layer>.<pass>.<channel>".
@@ -69,7 +69,7 @@ struct ObjectIdChannel {
 // The manifest's "guided": the bands reconstructed from the others (core/guided.h: GuidedOptions).
 struct GuidedAssembly {
   std::vector<std::size_t> bands;
-  int radius = 8;
+  int radius = 4;
   double false_refusal = 1e-4;
 };
 

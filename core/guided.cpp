@@ -210,6 +210,11 @@ void check_options(const GuidedImage& image, const GuidedOptions& options) {
       used[b] = true;
     }
   if (options.radius < 1) throw std::invalid_argument("guided reconstruction: radius below 1");
+  if (!image.colours.empty() && image.colours.size() != image.layers.size())
+    throw std::invalid_argument("guided reconstruction: colours given for some layers but not one per layer");
+  for (std::size_t l = 0; l < image.colours.size(); ++l)
+    if (!image.colours[l].empty() && image.colours[l].size() != image.layers[l].size())
+      throw std::invalid_argument(fmt::format("guided reconstruction: layer {}'s colour is not its size", l));
   if (!(options.false_refusal > 0.0 && options.false_refusal < 1.0))
     throw std::invalid_argument("guided reconstruction: false_refusal outside (0, 1)");
 }
@@ -269,8 +274,10 @@ GuidedReport reconstruct_guided(GuidedImage& image, const GuidedOptions& options
   GuidedReport report;
   // With a family of components that adds up to it, the total is their sum, not reconstructed on its own; and
   // the only member of a further family (one light group) is the total, set by the reconciliation.
-  std::vector<bool> reconstructed(image.layers.size(), true);
-  reconstructed[0] = families.empty();
+  std::vector<bool> reconstructed(image.layers.size(), options.unfactored_layers);
+  for (std::size_t l = 0; l < image.colours.size(); ++l)
+    if (!image.colours[l].empty()) reconstructed[l] = true;
+  reconstructed[0] = reconstructed[0] && families.empty();
   for (std::size_t f = 1; f < families.size(); ++f)
     if (families[f].members.size() == 1) reconstructed[families[f].members.front() + 1] = false;
   for (std::size_t layer = 0; layer < image.layers.size(); ++layer)
@@ -296,6 +303,9 @@ GuidedReport reconstruct_guided(GuidedImage& image, const GuidedOptions& options
           }
       }
     }
+  for (std::size_t layer = 0; layer < image.colours.size(); ++layer)
+    for (std::size_t i = 0; i < image.colours[layer].size(); ++i) image.layers[layer][i] *= image.colours[layer][i];
+  image.colours.clear();
   reconcile(image, families, options.guided_bands);
   return report;
 }

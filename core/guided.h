@@ -31,6 +31,12 @@
 // component more than its noise shows as a mean residual many standard errors from zero, and is refused:
 // that object keeps its few-sample values in that layer and band, and the report names it.
 //
+// What the test cannot see: a structure finer than its squares whose sign changes from pixel to pixel (a
+// texture the guide's colours do not show, the shadows of a fine grating) looks to it like noise, since the
+// noise's variance is itself taken from neighbouring pixels. Hence the colour factors below, and no layer
+// without one reconstructed unless the caller knows better. And its power is the few-sample render's noise: a
+// bias is found when it stands out of that noise over a square or an object, not of the full-sample render's.
+//
 // The total is not reconstructed on its own when the components include a family that adds up to it (the
 // path types, else the light groups, else the bounces): a total reconstructed by its own ratio would mix
 // components whose ratios differ (a white highlight on a yellow body) and be biased where their mixture
@@ -46,19 +52,31 @@
 namespace ct {
 
 // A spectral image held whole: the total and its components, each [y][x][band].
+//
+// A component that is light × colour (Cycles' Diffuse Direct × Diffuse Color: the light reaching a surface and
+// the surface's albedo, which a texture varies from pixel to pixel) may be given as its two factors: the light
+// in `layers` and the colour in `colours`. Only the light is then reconstructed, its guide being the light of
+// the guide bands: smooth where the texture is not, so that a texture the guide's colours cannot tell apart
+// does not bias it; the colour, an albedo, is nearly free of noise at few samples. reconstruct_guided leaves
+// the product in `layers`.
 struct GuidedImage {
   int width = 0, height = 0;
   std::size_t bands = 0;
-  std::vector<std::string> components;     // the layers after the total, by name
-  std::vector<std::vector<float>> layers;  // total, then components
-  std::vector<std::int32_t> object_ids;    // [y][x]; empty: the whole image is one object
+  std::vector<std::string> components;      // the layers after the total, by name
+  std::vector<std::vector<float>> layers;   // total, then components
+  std::vector<std::int32_t> object_ids;     // [y][x]; empty: the whole image is one object
+  std::vector<std::vector<float>> colours;  // empty, or one per layer: empty, or the colour factor, [y][x][band]
 };
 
 struct GuidedOptions {
   std::vector<std::size_t> guide_bands;   // rendered with the full samples
   std::vector<std::size_t> guided_bands;  // rendered with few samples, reconstructed
-  int radius = 8;                         // the window is (2·radius + 1)² pixels
+  int radius = 4;                         // the window is (2·radius + 1)² pixels
   double false_refusal = 1e-4;            // chance of refusing a good reconstruction, per layer and band
+  // Whether a layer without a colour factor is reconstructed. A texture the guide cannot see varies the ratio
+  // from pixel to pixel like noise, so the test cannot tell it from noise, and the window would average it
+  // away; only a caller who knows the image has no such texture (a scene of plain materials) should say yes.
+  bool unfactored_layers = false;
   int threads = 0;
 };
 
@@ -78,7 +96,8 @@ struct GuidedReport {
   std::size_t refused() const;
 };
 
-// Reconstructs options.guided_bands of every layer in place, object by object, and reconciles the families.
+// Reconstructs options.guided_bands of every layer with a colour factor (and, with unfactored_layers, of every
+// other) in place, object by object, and reconciles the families.
 // Throws std::invalid_argument for options that do not fit the image (a band out of range, in both lists,
 // or no guide band).
 GuidedReport reconstruct_guided(GuidedImage& image, const GuidedOptions& options);

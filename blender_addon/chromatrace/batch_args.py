@@ -38,6 +38,9 @@ def _parser():
     p.add_argument("--plan-edge-step", type=float, metavar="NM",
                    help="with --plan: band edges on multiples of NM nm (chromatrace plan --edge-step; 5 lets compare "
                         "hold the render against a reference of 5 nm bands)")
+    p.add_argument("--plan-out", metavar="FILE",
+                   help="with --plan: also write the plan's band file (bands, reconstruction, each group's samples) to "
+                        "FILE, to render the same plan again with --bands-file and --max-bounces")
     p.add_argument("--max-bounces", type=int, help="scattering events per path: 0 emitters, 1 direct, >= 2 global")
     p.add_argument("--components", help="component families: paths, lights, bounces, all, none (default: the scene's)")
     p.add_argument("--resolution", help="image size WxH, overriding the camera's")
@@ -111,6 +114,8 @@ def parse_batch_args(argv):
                 raise BadInput(f"{option}: --plan chooses the bands, bounce limit and samples; give one of them")
     if args.plan_edge_step is not None and args.plan is None:
         raise BadInput("--plan-edge-step: needs --plan (the plan whose band edges it places)")
+    if args.plan_out is not None and args.plan is None:
+        raise BadInput("--plan-out: needs --plan (the plan it writes)")
     if args.bands and args.bands_file:
         raise BadInput("--bands-file: give either --bands or --bands-file, not both")
     if args.bands_file and not os.path.isfile(args.bands_file):

@@ -79,7 +79,7 @@ def _ensure_registered(bpy):
 def run(argv):
     args = parse_batch_args(argv)
     import bpy
-    from . import planning, scene_import, tool
+    from . import cache, planning, scene_import, tool
 
     _ensure_registered(bpy)
     log = (lambda message: None) if args.quiet else _log
@@ -97,6 +97,10 @@ def run(argv):
             work = planning.planning_folder()
             planned = _plan(args, scene, chromatrace_tool, work, log)
             args.bands_file, args.max_bounces = planned.bands_file, planned.max_bounces
+            if args.plan_out:
+                with open(planned.bands_file) as f:
+                    cache.write_json(os.path.abspath(args.plan_out), json.load(f))
+                log(f"plan written to {args.plan_out} (max {planned.max_bounces} bounces)")
         _render(args, bpy, scene, chromatrace_tool, log, planned)
     finally:
         if work:

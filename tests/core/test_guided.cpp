@@ -18,7 +18,7 @@ namespace {
 // A w × h image of four bands, one object, no components: band b at pixel (x, y) is shading(x, y) · ratio(b),
 // and band 3 is then given `noise` (Gaussian, of standard deviation noise · its value).
 GuidedImage shaded(int w, int h, double step_ratio, double noise, std::uint64_t seed) {
-  GuidedImage image{w, h, 4, {}, {std::vector<float>(static_cast<std::size_t>(w) * h * 4)}, {}};
+  GuidedImage image{w, h, 4, {}, {std::vector<float>(static_cast<std::size_t>(w) * h * 4)}, {}, {}};
   Random random(seed, 0);
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x) {
@@ -36,7 +36,15 @@ GuidedImage shaded(int w, int h, double step_ratio, double noise, std::uint64_t 
   return image;
 }
 
-const GuidedOptions kOptions{{0, 1, 2}, {3}};
+// Bands 0-2 guide band 3; the images here have no textures, so every layer may be reconstructed.
+GuidedOptions options(bool unfactored_layers = true) {
+  GuidedOptions o;
+  o.guide_bands = {0, 1, 2};
+  o.guided_bands = {3};
+  o.unfactored_layers = unfactored_layers;
+  return o;
+}
+const GuidedOptions kOptions = options();
 
 TEST(Guided, ABandThatIsAMultipleOfTheGuideComesBackExactly) {
   GuidedImage image = shaded(64, 48, 0.5, 0.0, 1);
@@ -65,7 +73,7 @@ TEST(Guided, NoiseShrinksByTheWindowsAveraging) {
       before += noise * noise;
       n += 1;
     }
-  const double window = 17.0 * 17.0;
+  const double window = std::pow(2.0 * kOptions.radius + 1, 2);
   // The relative variance after is noise² / window (within the scatter of its estimate over n correlated
   // pixels; bounded by twice that, and far below the noise before).
   EXPECT_LT(after / n, 2.0 * noise * noise / window);
@@ -95,7 +103,7 @@ TEST(Guided, FamiliesAddUpToTheTotalAfterwards) {
   GuidedImage a = shaded(48, 48, 0.5, 0.1, 11), b = shaded(48, 48, 0.9, 0.1, 12);
   GuidedImage image{48, 48, 4, {"emission", "diffuse_direct", "diffuse_indirect", "glossy_direct", "glossy_indirect",
                                 "light.a", "light.b"},
-                    {}, std::vector<std::int32_t>(48 * 48, 1)};
+                    {}, std::vector<std::int32_t>(48 * 48, 1), {}};
   const std::vector<float> zero(a.layers[0].size(), 0.0f);
   std::vector<float> total(a.layers[0].size());
   for (std::size_t i = 0; i < total.size(); ++i) total[i] = a.layers[0][i] + b.layers[0][i];
@@ -106,6 +114,31 @@ TEST(Guided, FamiliesAddUpToTheTotalAfterwards) {
     EXPECT_FLOAT_EQ(image.layers[0][i], image.layers[2][i]) << i;  // the total is the path types' sum
     EXPECT_NEAR(image.layers[6][i] + image.layers[7][i], image.layers[0][i], 1e-6 * image.layers[0][i]) << i;
   }
+}
+
+TEST(Guided, ATextureIsCarriedByItsColourFactorNotGuessedFromTheGuide) {
+  // A texture whose band 3 varies from pixel to pixel independently of bands 0-2 (as a red print on a grey card
+  // does under lights the guide bands see alike): as a product, its ratio to the guide jumps from pixel to pixel
+  // like noise, which the test cannot tell from noise, so an unfactored layer is not reconstructed unless asked;
+  // as light × colour, only the smooth light is reconstructed, and comes back exactly, times each pixel's own
+  // colour.
+  const GuidedImage light = shaded(64, 48, 0.5, 0.0, 1);
+  GuidedImage product = light, factored = light;
+  factored.colours = {std::vector<float>(light.layers[0].size())};
+  Random random(5, 0);
+  for (std::size_t i = 0; i < light.layers[0].size(); ++i) {
+    const float colour = i % 4 == 3 ? static_cast<float>(0.2 + 0.7 * random.uniform()) : 0.6f;
+    factored.colours[0][i] = colour;
+    product.layers[0][i] = light.layers[0][i] * colour;
+  }
+  const GuidedImage expected = product;
+  // Unfactored, by default, the product is left as it is.
+  EXPECT_EQ(reconstruct_guided(product, options(false)).verdicts.size(), 0u);
+  EXPECT_EQ(product.layers, expected.layers);
+  EXPECT_EQ(reconstruct_guided(factored, options(false)).refused(), 0u);
+  EXPECT_TRUE(factored.colours.empty());
+  for (std::size_t i = 0; i < expected.layers[0].size(); ++i)
+    EXPECT_NEAR(factored.layers[0][i], expected.layers[0][i], 1e-6 * expected.layers[0][i]) << i;
 }
 
 TEST(Guided, OptionsThatDoNotFitTheImageAreRefusedByName) {
