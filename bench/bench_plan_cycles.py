@@ -233,6 +233,32 @@ def floor_of(plan, plain_noise, args, spectral_cpu, plain_cpu):
                 ratio=spectral_cpu * need / mean_samples / plain_cpu, noisier=noisier, groups=len(samples))
 
 
+def guided_render(args, plan_file, plan, blender, source, res, out_dir, case, exe, compared_with_reference):
+    """The planned render again with its group of most samples as the guide and the others at --guided of its
+    samples, reconstructed from it when assembled (core/guided.h): its CPU, its error and the refusals."""
+    with open(plan_file) as f:
+        bands = json.load(f)
+    planned = bands["cycles_samples"]
+    guide = planned.index(max(planned))
+    few = max(1, math.ceil(planned[guide] * args.guided))
+    bands["cycles_samples"] = [planned[guide] if g == guide else few for g in range(len(planned))]
+    bands["cycles_guided_groups"] = [g for g in range(len(planned)) if g != guide]
+    guided_file = os.path.join(out_dir, f"{case}-guided-bands.json")
+    with open(guided_file, "w") as f:
+        json.dump(bands, f)
+    exr = os.path.join(out_dir, f"{case}-guided.exr")
+    done = run(blender + ["--python", os.path.join(ROOT, "blender_addon", "batch.py"), "--", *source, "--out", exr,
+                          "--resolution", res, "--bands-file", guided_file, "--max-bounces", str(plan["max_bounces"]),
+                          "--components", "paths", "--cache-dir", os.path.join(out_dir, f"{case}-guided-cache")],
+               env=dict(os.environ, CHROMATRACE_EXE=exe))
+    cpu = sum(float(cpu) for _what, _wall, cpu in re.findall(
+        r"chromatrace: render \d+/\d+ \(([^)]*)\): ([0-9.]+) s, ([0-9.]+) s CPU", done.stderr))
+    report = json.loads(json.loads(run([exe, "info", exr, "--json"]).stdout)["metadata"]["chromatrace.guided"])
+    mean, worst, worst_name = compared_with_reference(exr, "guided-")
+    return dict(guide=guide, samples=bands["cycles_samples"], cpu=cpu, mean=mean, worst=worst, worst_name=worst_name,
+                refused=len(report["refused"]), tested=report["tested"])
+
+
 def bench(scene_name, light, args, work, blender_exe, version, references):
     exe = os.environ["CHROMATRACE_EXE"]
     masking = "height-correlated" if int(version.split(".")[0]) >= 4 else "separable"
@@ -261,10 +287,11 @@ def bench(scene_name, light, args, work, blender_exe, version, references):
 
     blender = [blender_exe, "--background", "--factory-startup"]
     spectral_exr = os.path.join(out_dir, f"{case}-cycles.exr")
+    plan_file = os.path.join(out_dir, f"{case}-plan.json")
     source = ["--blend", blend] if blend else ["--scene", scene]
     spectral = run(blender + ["--python", os.path.join(ROOT, "blender_addon", "batch.py"), "--", *source,
                               "--out", spectral_exr, "--resolution", res, "--plan", repr(args.target),
-                              "--plan-edge-step", "5", "--components", "paths",
+                              "--plan-edge-step", "5", "--components", "paths", "--plan-out", plan_file,
                               "--cache-dir", os.path.join(out_dir, f"{case}-cache")],
                    env=dict(os.environ, CHROMATRACE_EXE=exe))
     timings = re.findall(r"chromatrace: render \d+/\d+ \(([^)]*)\): ([0-9.]+) s, ([0-9.]+) s CPU", spectral.stderr)
@@ -319,13 +346,18 @@ def bench(scene_name, light, args, work, blender_exe, version, references):
     equal_cpu = plain_render(equal_samples, 1, os.path.join(out_dir, f"{case}-rgb-equal.exr"))
     floor = floor_of(plan, plain_noise, args, spectral_cpu, plain_cpu)
 
-    compare_dir = os.path.join(out_dir, f"{case}-compare")
-    run([exe, "compare", spectral_exr, reference, "-o", compare_dir, "--colour", "own", "-q"])
-    with open(os.path.join(compare_dir, "compare.json")) as f:
-        compared = json.load(f)
-    mean_de = compared["image"]["delta_e00"]["mean"]
-    worst_de, worst = max((o["delta_e00_mean"], o["object"]) for o in compared["objects"]
-                          if o["object_id"] >= 0 and "delta_e00_mean" in o)
+    def compared_with_reference(exr, tag):
+        compare_dir = os.path.join(out_dir, f"{case}-{tag}compare")
+        run([exe, "compare", exr, reference, "-o", compare_dir, "--colour", "own", "-q"])
+        with open(os.path.join(compare_dir, "compare.json")) as f:
+            compared = json.load(f)
+        worst_de, worst = max((o["delta_e00_mean"], o["object"]) for o in compared["objects"]
+                              if o["object_id"] >= 0 and "delta_e00_mean" in o)
+        return compared["image"]["delta_e00"]["mean"], worst_de, worst
+
+    mean_de, worst_de, worst = compared_with_reference(spectral_exr, "")
+    guided = guided_render(args, plan_file, plan, blender, source, res, out_dir, case, exe,
+                           compared_with_reference) if args.guided else None
 
     print(f"\nBlender {version}, {scene_name}, {light.upper()}: {said.group(1)}")
     for what, _wall, cpu in timings:
@@ -349,7 +381,14 @@ def bench(scene_name, light, args, work, blender_exe, version, references):
     print(f"  floor: the plain render's noise meets the mean at {floor['need_mean']:.0f} samples and "
           f"{floor['worst_name']}'s limit at {floor['need_object']:.0f}; {floor['groups']} groups of "
           f"{floor['samples']:.0f} samples cost at least {floor['ratio']:.2f}x the plain render")
+    if guided:
+        print(f"  guided: the plan's group {guided['guide']} at its {guided['samples'][guided['guide']]} samples guides the "
+              f"others at {args.guided:g} of that ({', '.join(map(str, guided['samples']))}): {guided['cpu']:.2f} s CPU, "
+              f"{guided['cpu'] / plain_cpu:.2f}x the plain render; mean dE00 {guided['mean']:.2f}, worst object "
+              f"{guided['worst_name']} {guided['worst']:.2f}; {guided['refused']} of {guided['tested']} object layers and "
+              f"bands refused")
     return dict(ratio=spectral_cpu / plain_cpu, with_planning=(spectral_cpu + planning_cpu) / plain_cpu,
+                guided=guided and dict(guided, ratio=guided["cpu"] / plain_cpu),
                 equal=spectral_cpu / equal_cpu,
                 measured=mean_de, predicted=predicted, low=low, high=high, worst=f"{worst_de:.2f} ({worst})",
                 worst_predicted=worst_predicted,
@@ -370,6 +409,9 @@ def main():
                    help="both: the box and the textured scene; all: the artist's too")
     p.add_argument("--blender", action="append", help="a Blender (repeatable; default: blender)")
     p.add_argument("--reference-dir", help="keep the tracer's references here and reuse them in later runs")
+    p.add_argument("--guided", type=float, metavar="FRACTION",
+                   help="also render the plan with its group of most samples guiding the others at this fraction of "
+                        "its samples (core/guided.h), and measure it beside the plan")
     args = p.parse_args()
     if not os.environ.get("CHROMATRACE_EXE"):
         sys.exit("set CHROMATRACE_EXE to the chromatrace executable (e.g. build/cli/chromatrace)")
@@ -392,6 +434,14 @@ def main():
             print(f"{version:8s} {scene_name:9s} {light.upper():5s}  {r['samples']:17s}  {r['ratio']:10.2f}x  "
                   f"{r['with_planning']:12.2f}x  {r['equal']:24.2f}x"
                   f"  {r['measured']:17.2f}  {r['predicted']:.2f} ({r['low']:.2f}-{r['high']:.2f})  {r['worst']}, {r['worst_predicted']}")
+        if args.guided:
+            print(f"\nGuided: the plan's group of most samples guides the others at {args.guided:g} of its samples")
+            print("Blender  scene     light  samples per group  CPU / plain  mean dE00  worst object        refused")
+            for version, scene_name, light, r in results:
+                g = r["guided"]
+                print(f"{version:8s} {scene_name:9s} {light.upper():5s}  {','.join(map(str, g['samples'])):17s}  "
+                      f"{g['ratio']:10.2f}x  {g['mean']:9.2f}  {g['worst']:.2f} ({g['worst_name']}){'':4s}"
+                      f"{g['refused']} of {g['tested']}")
         print("\nBlender  scene     light  one-sample CPU: planned, plain  growing part / plain  "
               "plain render's noise: mean, worst object   samples a group needs at the least  floor / plain")
         for version, scene_name, light, r in results:

@@ -75,12 +75,15 @@ struct Plane {
   const std::vector<std::size_t>& guide_bands;
 
   const std::vector<std::uint8_t>& interior;
+  bool factored;  // a light with a colour factor: its edge pixels are reconstructed too
 
   std::size_t index(int x, int y) const { return static_cast<std::size_t>(y) * image.width + x; }
   // Whether a pixel is reconstructed as part of object o: it is o's, and so are its eight neighbours. A pixel
-  // on an edge mixes the light of two objects, whose ratios differ; it keeps its own values.
+  // on an edge mixes the light of two objects, whose ratios differ, and keeps its own values; but where the
+  // colour is a factor apart, what is mixed is the light reaching either object, whose spectrum changes across
+  // an edge only as the illumination does (the same lamp's direct light not at all).
   bool on(const ObjectExtent& o, int x, int y) const {
-    return interior[index(x, y)] && (image.object_ids.empty() || image.object_ids[index(x, y)] == o.id);
+    return (factored || interior[index(x, y)]) && (image.object_ids.empty() || image.object_ids[index(x, y)] == o.id);
   }
   double t(int x, int y) const { return layer[index(x, y) * image.bands + band]; }
   double g(int x, int y) const {
@@ -283,7 +286,8 @@ GuidedReport reconstruct_guided(GuidedImage& image, const GuidedOptions& options
   for (std::size_t layer = 0; layer < image.layers.size(); ++layer)
     for (const std::size_t band : options.guided_bands) {
       if (!reconstructed[layer]) continue;
-      const Plane plane{image, image.layers[layer], band, options.guide_bands, interior};
+      const bool factored = layer < image.colours.size() && !image.colours[layer].empty();
+      const Plane plane{image, image.layers[layer], band, options.guide_bands, interior, factored};
       std::vector<ObjectResult> results(objects.size());
       parallel_for(objects.size(), options.threads,
                    [&](std::size_t k) { results[k] = reconstruct_object(plane, objects[k], options.radius); });

@@ -467,10 +467,15 @@ TEST_F(Blender, PlannedRenderMeetsThePredictedError) {
     std::vector<double> measured;
     for (int seed : {1, 2}) {
       const fs::path out = dir_.file(fmt::format("{}-{}.exr", name, seed)), cmp = dir_.file(fmt::format("{}-cmp{}", name, seed));
+      const fs::path plan_out = dir_.file(fmt::format("{}-{}-plan.json", name, seed));
       const CommandResult c = batch({"--scene", scene, "--out", out.string(), "--resolution", res, "--plan", "1",
-                                     "--plan-edge-step", "5", "--components", "none", "--seed", std::to_string(seed)},
+                                     "--plan-edge-step", "5", "--components", "none", "--seed", std::to_string(seed),
+                                     "--plan-out", plan_out.string()},
                                     fmt::format("cache-{}-{}", name, seed));
       ASSERT_EQ(c.exit_code, 0) << c.err;
+      // --plan-out: the band file the render was made with, its bands those of the output and its samples the plan's.
+      const BandPlanFile kept = read_band_plan_file(plan_out);
+      EXPECT_EQ(kept.bands.edges(), SpectralExrReader(out).info().bands.edges());
       const std::vector<std::string> said = lines_starting(c.err, "chromatrace: plan for a mean ΔE00 of 1: ");
       ASSERT_EQ(said.size(), 1u) << c.err;
       const json plan = json::parse(SpectralExrReader(out).info().metadata.at("chromatrace.plan"));
@@ -480,6 +485,7 @@ TEST_F(Blender, PlannedRenderMeetsThePredictedError) {
       const double hi = std::hypot(plan["predicted_range"][1].get<double>(), reference_noise);
       EXPECT_LE(plan["predicted_mean_de00"].get<double>(), 1.0);
       const auto samples = plan["cycles_samples"].get<std::vector<int>>();
+      EXPECT_EQ(kept.cycles_samples, samples);
       EXPECT_EQ(SpectralExrReader(out).info().metadata.at("chromatrace.samples"),
                 std::set<int>(samples.begin(), samples.end()).size() == 1 ? std::to_string(samples[0])
                                                                           : fmt::format("{}", fmt::join(samples, ",")));

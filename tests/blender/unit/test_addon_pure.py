@@ -279,6 +279,7 @@ class BatchArgs(unittest.TestCase):
             (["--scene", self.scene, "--out", self.out, "--plan", "1", "--band-group", "0"], "--band-group"),
             (["--scene", self.scene, "--plan", "1", "--explain"], "--explain"),
             (["--scene", self.scene, "--out", self.out, "--plan-edge-step", "5"], "--plan-edge-step"),
+            (["--scene", self.scene, "--out", self.out, "--plan-out", self.out + ".json"], "--plan-out"),
         ]
         for argv, option in cases:
             with self.assertRaises(BadInput, msg=argv) as caught:
