@@ -75,15 +75,14 @@ struct Plane {
   const std::vector<std::size_t>& guide_bands;
 
   const std::vector<std::uint8_t>& interior;
-  bool factored;  // a light with a colour factor: its edge pixels are reconstructed too
 
   std::size_t index(int x, int y) const { return static_cast<std::size_t>(y) * image.width + x; }
   // Whether a pixel is reconstructed as part of object o: it is o's, and so are its eight neighbours. A pixel
-  // on an edge mixes the light of two objects, whose ratios differ, and keeps its own values; but where the
-  // colour is a factor apart, what is mixed is the light reaching either object, whose spectrum changes across
-  // an edge only as the illumination does (the same lamp's direct light not at all).
+  // on an edge mixes two objects, and keeps its own values: their ratios differ; and even where the colour is a
+  // factor apart, Cycles' passes are averages over the pixel's samples, whose product at an edge (where the
+  // colour changes from sample to sample) depends on how many samples there were.
   bool on(const ObjectExtent& o, int x, int y) const {
-    return (factored || interior[index(x, y)]) && (image.object_ids.empty() || image.object_ids[index(x, y)] == o.id);
+    return interior[index(x, y)] && (image.object_ids.empty() || image.object_ids[index(x, y)] == o.id);
   }
   double t(int x, int y) const { return layer[index(x, y) * image.bands + band]; }
   double g(int x, int y) const {
@@ -286,8 +285,7 @@ GuidedReport reconstruct_guided(GuidedImage& image, const GuidedOptions& options
   for (std::size_t layer = 0; layer < image.layers.size(); ++layer)
     for (const std::size_t band : options.guided_bands) {
       if (!reconstructed[layer]) continue;
-      const bool factored = layer < image.colours.size() && !image.colours[layer].empty();
-      const Plane plane{image, image.layers[layer], band, options.guide_bands, interior, factored};
+      const Plane plane{image, image.layers[layer], band, options.guide_bands, interior};
       std::vector<ObjectResult> results(objects.size());
       parallel_for(objects.size(), options.threads,
                    [&](std::size_t k) { results[k] = reconstruct_object(plane, objects[k], options.radius); });
@@ -310,7 +308,10 @@ GuidedReport reconstruct_guided(GuidedImage& image, const GuidedOptions& options
   for (std::size_t layer = 0; layer < image.colours.size(); ++layer)
     for (std::size_t i = 0; i < image.colours[layer].size(); ++i) image.layers[layer][i] *= image.colours[layer][i];
   image.colours.clear();
-  reconcile(image, families, options.guided_bands);
+  // Every band: a product of light and colour recomputed in float no longer carries the assembly's rounding fix.
+  std::vector<std::size_t> all_bands(image.bands);
+  for (std::size_t b = 0; b < image.bands; ++b) all_bands[b] = b;
+  reconcile(image, families, all_bands);
   return report;
 }
 

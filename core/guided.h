@@ -16,11 +16,11 @@
 // cast by one of two lights of different spectra, a coloured interreflection's edge, a texture whose colours
 // the guide does not tell apart.
 //
-// Where it cannot work it is not tried, and the pixel keeps its few-sample values: where the window's guide is
-// dark, or its light lies in fewer than 16 pixels' worth (a small highlight, whose ratio would be as noisy as
-// those pixels); and, in a layer without a colour factor (below), on an object's edge (a pixel whose eight
-// neighbours are not all of its object mixes two objects' ratios). With the colour a factor apart, an edge pixel
-// mixes only the light reaching the two objects, and is reconstructed with its own object's ratio.
+// Where it cannot work it is not tried, and the pixel keeps its few-sample values: on an object's edge (a pixel
+// whose eight neighbours are not all of its object mixes two objects' ratios, and Cycles' light and colour
+// passes, each averaged over the pixel's samples, multiply there to a value that depends on the samples); where
+// the window's guide is dark, or its light lies in fewer than 16 pixels' worth (a small highlight, whose ratio
+// would be as noisy as those pixels).
 //
 // Each reconstruction is tested before it is kept. The residual of the few-sample band against it,
 // e(p) = t(p) − t̂(p), is noise of mean zero where the ratio is constant over the window. Over each object,
