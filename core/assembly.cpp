@@ -458,14 +458,7 @@ void write_guided(const AssemblyManifest& manifest, GuidedImage& image, Spectral
     fmt::print(stderr, "assemble: {} of {} bands guided; {} of {} object layers and bands refused (the header's "
                "chromatrace.guided names them)\n", options.guided_bands.size(), image.bands, report.refused(),
                report.verdicts.size());
-  SpectralExrWriter writer(output, std::move(layout));
-  SpectralRowBlock block;
-  block.rows = image.height;
-  block.total = image.layers[0];
-  for (std::size_t c = 1; c < image.layers.size(); ++c) block.components.emplace_back(image.layers[c]);
-  block.object_ids = image.object_ids;
-  writer.write_rows(block);
-  writer.finish();
+  write_spectral_exr(output, std::move(layout), image.layers, image.object_ids);
 }
 
 }  // namespace

@@ -55,11 +55,11 @@ std::vector<ObjectExtent> object_extents(const GuidedImage& image) {
   return out;
 }
 
-// Summed-area tables over an object's rectangle of the guided band t, the guide g, |g| and the object's mask,
-// each restricted to the object; entry (x, y) holds the sums over [x0, x0 + x) × [y0, y0 + y).
+// Summed-area tables over an object's rectangle of the guided band t, the guide g, |g| and g², each over the
+// object's pixels that are reconstructed; entry (x, y) holds the sums over [x0, x0 + x) × [y0, y0 + y).
 struct WindowSums {
   int w = 0, h = 0;
-  std::vector<double> t, g, abs_g, g2, n;
+  std::vector<double> t, g, abs_g, g2;
 
   double at(const std::vector<double>& s, int x, int y) const { return s[static_cast<std::size_t>(y) * (w + 1) + x]; }
   // The sum of `s` over the local rectangle [xa, xb) × [ya, yb).
@@ -96,17 +96,17 @@ WindowSums window_sums(const Plane& plane, const ObjectExtent& o) {
   WindowSums s;
   s.w = o.x1 - o.x0, s.h = o.y1 - o.y0;
   const std::size_t size = static_cast<std::size_t>(s.w + 1) * (s.h + 1);
-  s.t.assign(size, 0.0), s.g.assign(size, 0.0), s.abs_g.assign(size, 0.0), s.g2.assign(size, 0.0), s.n.assign(size, 0.0);
+  s.t.assign(size, 0.0), s.g.assign(size, 0.0), s.abs_g.assign(size, 0.0), s.g2.assign(size, 0.0);
   for (int y = 0; y < s.h; ++y) {
-    double row_t = 0, row_g = 0, row_abs_g = 0, row_g2 = 0, row_n = 0;
+    double row_t = 0, row_g = 0, row_abs_g = 0, row_g2 = 0;
     for (int x = 0; x < s.w; ++x) {
       if (plane.on(o, o.x0 + x, o.y0 + y)) {
         const double g = plane.g(o.x0 + x, o.y0 + y);
-        row_t += plane.t(o.x0 + x, o.y0 + y), row_g += g, row_abs_g += std::abs(g), row_g2 += g * g, row_n += 1;
+        row_t += plane.t(o.x0 + x, o.y0 + y), row_g += g, row_abs_g += std::abs(g), row_g2 += g * g;
       }
       const std::size_t above = static_cast<std::size_t>(y) * (s.w + 1) + x + 1, here = above + (s.w + 1);
       s.t[here] = s.t[above] + row_t, s.g[here] = s.g[above] + row_g;
-      s.abs_g[here] = s.abs_g[above] + row_abs_g, s.g2[here] = s.g2[above] + row_g2, s.n[here] = s.n[above] + row_n;
+      s.abs_g[here] = s.abs_g[above] + row_abs_g, s.g2[here] = s.g2[above] + row_g2;
     }
   }
   return s;
@@ -147,7 +147,7 @@ constexpr int kTestSquare = 8;
 constexpr double kMinTestPixels = 32;
 
 struct ObjectResult {
-  std::vector<float> reconstructed;  // over the object's rectangle, row-major; NaN off the object
+  std::vector<float> reconstructed;  // over the object's rectangle, row-major; NaN where a pixel keeps its value
   double worst_z = 0;
   std::size_t tests = 0;
 };

@@ -799,4 +799,16 @@ void SpectralExrWriter::finish() {
   file_.reset();
 }
 
+void write_spectral_exr(const std::filesystem::path& path, SpectralExrLayout layout,
+                        const std::vector<std::vector<float>>& layers, std::span<const std::int32_t> object_ids) {
+  SpectralExrWriter writer(path, std::move(layout));
+  SpectralRowBlock block;
+  block.rows = writer.layout().height;
+  block.total = layers.at(0);
+  for (std::size_t l = 1; l < layers.size(); ++l) block.components.emplace_back(layers[l]);
+  block.object_ids = object_ids;
+  writer.write_rows(block);
+  writer.finish();
+}
+
 }  // namespace ct

@@ -176,4 +176,9 @@ class SpectralExrWriter {
   int rows_written_ = 0;
 };
 
+// Writes a whole image at once, atomically: `layers` holds the total, then the components in the layout's order,
+// each height · width · bands floats ([y][x][band]); `object_ids` height · width ids when the layout has them.
+void write_spectral_exr(const std::filesystem::path& path, SpectralExrLayout layout,
+                        const std::vector<std::vector<float>>& layers, std::span<const std::int32_t> object_ids);
+
 }  // namespace ct

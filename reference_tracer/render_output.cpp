@@ -39,14 +39,7 @@ void write_render(const std::filesystem::path& path, const Scene& scene, const R
   layout.attributes["chromatrace.scene"] = scene.json.dump(-1, ' ', false, kReplaceInvalidUtf8);
   layout.attributes["chromatrace.camera"] = camera.dump(-1, ' ', false, kReplaceInvalidUtf8);
 
-  SpectralExrWriter writer(path, std::move(layout));
-  SpectralRowBlock block;
-  block.rows = image.height;
-  block.total = image.layers[0];
-  for (std::size_t l = 1; l < image.layers.size(); ++l) block.components.emplace_back(image.layers[l]);
-  block.object_ids = image.object_ids;
-  writer.write_rows(block);
-  writer.finish();
+  write_spectral_exr(path, std::move(layout), image.layers, image.object_ids);
 }
 
 }  // namespace ct::rt
