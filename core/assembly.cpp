@@ -368,9 +368,14 @@ struct LightTimesColour {
 
 std::vector<std::optional<LightTimesColour>> light_times_colour(const AssemblyManifest& manifest) {
   std::vector<std::optional<LightTimesColour>> found(manifest.components.size());
+  // The pass of "<view_layer>.<pass>.<channel>" (a view layer's name may hold dots; a pass's does not).
   const auto is_colour = [&](const PassProduct& t, std::size_t k) {
     const std::string& channel = manifest.inputs[t.input].channels[t.channels[k]];
-    return channel.find("Col") != std::string::npos;
+    const std::size_t last = channel.rfind('.');
+    const std::size_t before = last == std::string::npos || last == 0 ? std::string::npos : channel.rfind('.', last - 1);
+    const std::string pass = channel.substr(before == std::string::npos ? 0 : before + 1,
+                                            last == std::string::npos ? std::string::npos : last - (before + 1));
+    return pass.find("Col") != std::string::npos;
   };
   for (std::size_t c = 0; c < manifest.components.size(); ++c) {
     LightTimesColour split;
