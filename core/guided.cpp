@@ -221,16 +221,16 @@ void check_options(const GuidedImage& image, const GuidedOptions& options) {
     throw std::invalid_argument("guided reconstruction: false_refusal outside (0, 1)");
 }
 
-// Makes the families add up to the total again at every pixel of the guided bands. The total becomes the sum
+// Makes the families add up to the total again at every pixel and band. The total becomes the sum
 // of the first family's members: a total reconstructed by its own ratio would mix components whose ratios
 // differ (a white highlight on a yellow body) and be biased where their mixture changes. Each further
 // family's residual is spread over its members in proportion to their magnitudes (to the first member where
 // all are zero).
-void reconcile(GuidedImage& image, const std::vector<SummingFamily>& families, const std::vector<std::size_t>& bands) {
+void reconcile(GuidedImage& image, const std::vector<SummingFamily>& families) {
   const std::size_t pixels = static_cast<std::size_t>(image.width) * image.height;
   for (std::size_t f = 0; f < families.size(); ++f)
     for (std::size_t p = 0; p < pixels; ++p)
-      for (const std::size_t b : bands) {
+      for (std::size_t b = 0; b < image.bands; ++b) {
         const std::size_t i = p * image.bands + b;
         double sum = 0, magnitude = 0;
         for (const std::size_t m : families[f].members) {
@@ -282,9 +282,9 @@ GuidedReport reconstruct_guided(GuidedImage& image, const GuidedOptions& options
   reconstructed[0] = reconstructed[0] && families.empty();
   for (std::size_t f = 1; f < families.size(); ++f)
     if (families[f].members.size() == 1) reconstructed[families[f].members.front() + 1] = false;
-  for (std::size_t layer = 0; layer < image.layers.size(); ++layer)
+  for (std::size_t layer = 0; layer < image.layers.size(); ++layer) {
+    if (!reconstructed[layer]) continue;
     for (const std::size_t band : options.guided_bands) {
-      if (!reconstructed[layer]) continue;
       const Plane plane{image, image.layers[layer], band, options.guide_bands, interior};
       std::vector<ObjectResult> results(objects.size());
       parallel_for(objects.size(), options.threads,
@@ -305,13 +305,13 @@ GuidedReport reconstruct_guided(GuidedImage& image, const GuidedOptions& options
           }
       }
     }
+  }
   for (std::size_t layer = 0; layer < image.colours.size(); ++layer)
     for (std::size_t i = 0; i < image.colours[layer].size(); ++i) image.layers[layer][i] *= image.colours[layer][i];
   image.colours.clear();
-  // Every band: a product of light and colour recomputed in float no longer carries the assembly's rounding fix.
-  std::vector<std::size_t> all_bands(image.bands);
-  for (std::size_t b = 0; b < image.bands; ++b) all_bands[b] = b;
-  reconcile(image, families, all_bands);
+  // Every band, the guides too: a product of light and colour recomputed in float no longer carries the
+  // assembly's rounding fix.
+  reconcile(image, families);
   return report;
 }
 
