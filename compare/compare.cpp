@@ -529,16 +529,14 @@ void image_level(Comparison& c, const std::vector<Render>& A, const std::vector<
   c.delta_e_mean = de.mean;
   c.delta_e_p95 = de.p95;
   c.delta_e_max = de.max;
-  std::map<std::int32_t, std::pair<double, std::size_t>> by_object;
-  const std::vector<std::int32_t>&ida = A.front().ids, &idb = B.front().ids;
-  if (ida.size() == N && idb.size() == N)
-    for (std::size_t p = 0; p < N; ++p)
-      if (ida[p] == idb[p]) {
-        auto& [sum, count] = by_object[ida[p]];
-        sum += c.delta_e[p];
-        ++count;
-      }
-  for (const auto& [id, s] : by_object) c.delta_e_by_object[id] = s.first / static_cast<double>(s.second);
+  // Each object's mean over its region's pixels: with --pixels interior, edge pixels (which mix two objects) are
+  // left out of it as they are of the band comparison.
+  for (const Region& r : regions) {
+    if (r.id < 0 || r.pixels.empty()) continue;
+    double sum = 0;
+    for (const std::size_t p : r.pixels) sum += c.delta_e[p];
+    c.delta_e_by_object[r.id] = sum / static_cast<double>(r.pixels.size());
+  }
   const double yw = white[1];
   c.rgb_a.resize(N * 3);
   c.rgb_b.resize(N * 3);

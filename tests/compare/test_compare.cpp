@@ -34,6 +34,7 @@ struct Synthetic {
   double sigma = 0.01;  // per-pixel noise, relative to the value
   std::uint64_t seed = 1;
   double ball_diffuse_scale = 1.0;  // multiplies diffuse_direct (and so the total) on object 2
+  double edge_scale = 1.0;  // multiplies diffuse_direct on the two columns where the objects meet
   int width = kW;
   double camera_x = 0.0;
   double slope = 0.001;  // relative change of every spectrum per nm about 580 nm (0: flat within each 40 nm bin)
@@ -82,6 +83,7 @@ void write_render(const fs::path& file, const Synthetic& s) {
       const double slope = 1.0 + s.slope * (c - 580.0);
       double d = diffuse_value(o, std::size_t((c - 380) / 40)) * slope * (1 + s.sigma * noise(rng));
       if (o == 2) d *= s.ball_diffuse_scale;
+      if (const int x = int(p % std::size_t(s.width)); x == s.width / 2 - 1 || x == s.width / 2) d *= s.edge_scale;
       const double g = glossy_value(o, std::size_t((c - 380) / 40)) * slope * (1 + s.sigma * noise(rng));
       diffuse[p * nb + b] = float(d);
       glossy[p * nb + b] = float(g);
@@ -315,6 +317,24 @@ TEST_F(Compare, IdenticalRendersHaveZeroDeltaE) {
   EXPECT_EQ(by_object.at("(image)"), d2["image"]["delta_e00"]["mean"].get<double>());
   EXPECT_GT(by_object.at("ball"), by_object.at("(image)"));
   EXPECT_GT(by_object.at("(image)"), 0.0);
+
+  // With --pixels interior an object's mean leaves out its edge pixels, as its cells do: a difference only in the
+  // two columns where the objects meet is none inside either, and there with the edges matched.
+  Synthetic edges;
+  edges.edge_scale = 1.05;
+  edges.sigma = a.sigma;
+  const std::string fe = render("edges.exr", edges).string();
+  for (const std::string pixels : {"interior", "matched"}) {
+    const auto r4 = run({fa, fe, "-o", dir_.file("out-" + pixels).string(), "--pixels", pixels});
+    ASSERT_EQ(r4.exit_code, 0) << r4.err;
+    for (const json& o : result("out-" + pixels)["objects"]) {
+      if (o["object_id"].get<int>() < 0) continue;
+      if (pixels == "interior")
+        EXPECT_EQ(o["delta_e00_mean"].get<double>(), 0.0) << o["object"];
+      else
+        EXPECT_GT(o["delta_e00_mean"].get<double>(), 0.0) << o["object"];
+    }
+  }
 
   // A camera's curves from a file under a hostile folder name: its path reaches compare.html as text, not as a tag.
   const fs::path folder = dir_.file("cam<img src=x onerror=alert(1)>");
