@@ -5,6 +5,7 @@
     CHROMATRACE_EXE=build/cli/chromatrace python3 bench/bench_plan_cycles.py [--resolution 96] [--samples 256]
         [--reference-spp 8192] [--target 1] [--light d65|f11|both] [--scene box|textured|artist|both|all]
         [--blender blender [--blender build/tests/blender/blender-4.5 ...]] [--reference-dir DIR]
+        [--guided FRACTION [--guided-threshold T]]
 
 Each --blender is run in turn (a Blender binary, or a bpy module behind tests/blender/bpy_blender.py, as the
 build's build/tests/blender/blender-4.5, blender-5.2 and blender-5.3 are), the scene's GGX masking set to that Cycles' own
@@ -52,6 +53,11 @@ Cycles render no less noisy than the plain render at equal samples (the plan's p
 render's is printed to check it), so each group needs at least the samples at which the plain render's own noise
 meets the target, for the mean (with the bands' error) and for the worst object's limit; the planned groups' CPU at
 those samples, over the plain render's, is the least an unbiased spectral render can cost here.
+
+With --guided, the plan is rendered again with its group of most samples guiding the others at FRACTION of its
+samples, reconstructed from it when assembled (core/guided.h); with --guided-threshold, the guided groups use Cycles'
+adaptive sampling up to the guide's samples where a pixel's noise stays above T (objects' edges and highlights, which
+the reconstruction leaves at their own samples).
 
 Prints, per Blender and light, the CPU ratio planned spectral / plain RGB with and without the planning, the
 predicted and measured mean ΔE00 and the worst object's. Not a test: the machine is shared, so read the figures as
@@ -243,6 +249,8 @@ def guided_render(args, plan_file, plan, blender, source, res, out_dir, case, ex
     few = max(1, math.ceil(planned[guide] * args.guided))
     bands["cycles_samples"] = [planned[guide] if g == guide else few for g in range(len(planned))]
     bands["cycles_guided_groups"] = [g for g in range(len(planned)) if g != guide]
+    if args.guided_threshold:
+        bands["cycles_guided_threshold"] = args.guided_threshold
     guided_file = os.path.join(out_dir, f"{case}-guided-bands.json")
     with open(guided_file, "w") as f:
         json.dump(bands, f)
@@ -412,7 +420,12 @@ def main():
     p.add_argument("--guided", type=float, metavar="FRACTION",
                    help="also render the plan with its group of most samples guiding the others at this fraction of "
                         "its samples (core/guided.h), and measure it beside the plan")
+    p.add_argument("--guided-threshold", type=float, metavar="T",
+                   help="with --guided: render the guided groups with Cycles' adaptive sampling at this noise threshold, "
+                        "up to the guide's samples where a pixel stays noisier (objects' edges, highlights)")
     args = p.parse_args()
+    if args.guided_threshold and not args.guided:
+        p.error("--guided-threshold needs --guided")
     if not os.environ.get("CHROMATRACE_EXE"):
         sys.exit("set CHROMATRACE_EXE to the chromatrace executable (e.g. build/cli/chromatrace)")
     print(f"{args.resolution}x{args.resolution}, plain render {args.samples} samples, plan for a mean dE00 "
@@ -435,7 +448,9 @@ def main():
                   f"{r['with_planning']:12.2f}x  {r['equal']:24.2f}x"
                   f"  {r['measured']:17.2f}  {r['predicted']:.2f} ({r['low']:.2f}-{r['high']:.2f})  {r['worst']}, {r['worst_predicted']}")
         if args.guided:
-            print(f"\nGuided: the plan's group of most samples guides the others at {args.guided:g} of its samples")
+            print(f"\nGuided: the plan's group of most samples guides the others at {args.guided:g} of its samples"
+                  + (f", adaptive up to the guide's where their noise stays above {args.guided_threshold:g}"
+                     if args.guided_threshold else ""))
             print("Blender  scene     light  samples per group  CPU / plain  mean dE00  worst object        refused")
             for version, scene_name, light, r in results:
                 g = r["guided"]

@@ -130,6 +130,8 @@ int run(const SceneBandsOptions& o) {
     report["bands"]["cycles_samples"] = given->cycles_samples;
   if (given && !given->cycles_guided_groups.empty())  // the groups the add-on's assembly reconstructs from the others
     report["bands"]["cycles_guided_groups"] = given->cycles_guided_groups;
+  if (given && given->cycles_guided_threshold > 0)  // their adaptive sampling's noise threshold
+    report["bands"]["cycles_guided_threshold"] = given->cycles_guided_threshold;
   Json spectra_json = Json::object();
   for (const NamedSpectrum& s : spectra) spectra_json[s.name] = spectrum_entry(s.spectrum, bands);
   report["spectra"] = spectra_json;

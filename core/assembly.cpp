@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <limits>
 #include <memory>
 #include <optional>
 
@@ -125,7 +126,7 @@ std::map<std::string, std::string> read_attributes(const JsonNode& attributes) {
 }
 
 GuidedAssembly read_guided(const JsonNode& node, std::size_t band_count) {
-  node.expect_object({"bands", "radius", "false_refusal"});
+  node.expect_object({"bands", "radius", "false_refusal", "adaptive"});
   GuidedAssembly guided;
   std::vector<bool> seen(band_count, false);
   for (const JsonNode& band : node["bands"].elements()) {
@@ -138,6 +139,12 @@ GuidedAssembly read_guided(const JsonNode& node, std::size_t band_count) {
   if (guided.bands.size() == band_count) node["bands"].fail("names every band: none is left to guide them");
   if (const auto radius = node.find("radius")) guided.radius = static_cast<int>(radius->integer_in(1, 64));
   if (const auto p = node.find("false_refusal")) guided.false_refusal = p->number_in(1e-12, 0.5);
+  if (const auto adaptive = node.find("adaptive")) {
+    adaptive->expect_object({"threshold", "max_samples"});
+    guided.adaptive_threshold = (*adaptive)["threshold"].number_in(1e-4, 1.0);
+    guided.adaptive_max_samples =
+        static_cast<int>((*adaptive)["max_samples"].integer_in(1, std::numeric_limits<int>::max()));
+  }
   return guided;
 }
 
@@ -437,13 +444,16 @@ std::string guided_attribute(const AssemblyManifest& manifest, const GuidedOptio
                        {"z", std::round(v.worst_z * 100) / 100},
                        {"threshold", std::round(v.threshold * 100) / 100}});
   }
-  const Json j = {{"method", "ratio to the guide bands' sum, per object and component (core/guided.h)"},
+  Json j = {{"method", "ratio to the guide bands' sum, per object and component (core/guided.h)"},
                   {"guided", band_list(options.guided_bands)},
                   {"guides", band_list(options.guide_bands)},
                   {"radius", options.radius},
                   {"false_refusal", options.false_refusal},
                   {"tested", tested},
                   {"refused", refused}};
+  if (manifest.guided->adaptive_threshold > 0)
+    j["adaptive"] = {{"threshold", manifest.guided->adaptive_threshold},
+                     {"max_samples", manifest.guided->adaptive_max_samples}};
   return j.dump();
 }
 

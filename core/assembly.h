@@ -71,6 +71,10 @@ struct GuidedAssembly {
   std::vector<std::size_t> bands;
   int radius = 4;
   double false_refusal = 1e-4;
+  // The guided bands' renders used Cycles' adaptive sampling (threshold > 0): each pixel had their own samples and,
+  // where its noise stayed above the threshold, up to max_samples. Recorded in the header; it changes nothing here.
+  double adaptive_threshold = 0;
+  int adaptive_max_samples = 0;
 };
 
 // A manifest as read: every file and channel resolved, ready to assemble.

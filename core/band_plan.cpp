@@ -16,7 +16,8 @@ BandPlanFile read_band_plan_file(const std::filesystem::path& file) {
   const JsonNode root(document, file.string());
   const std::string format = root["format"].string();
   if (format != "chromatrace-bands/1") root["format"].fail(fmt::format("must be \"chromatrace-bands/1\", got \"{}\"", format));
-  root.expect_object({"format", "edges_nm", "reconstruction", "cycles_samples", "cycles_guided_groups"});
+  root.expect_object(
+      {"format", "edges_nm", "reconstruction", "cycles_samples", "cycles_guided_groups", "cycles_guided_threshold"});
   const JsonNode edges_node = root["edges_nm"];
   std::vector<double> edges;
   for (const JsonNode& edge : edges_node.elements()) {
@@ -29,7 +30,7 @@ BandPlanFile read_band_plan_file(const std::filesystem::path& file) {
   if (edges.back() <= 360.0 || edges.front() >= 830.0)
     edges_node.fail(fmt::format("bands [{}, {}] nm do not overlap the visible range 360-830 nm (wavelengths in nm?)",
                                 edges.front(), edges.back()));
-  BandPlanFile plan{Bands::from_edges(std::move(edges), edges_node.location()), {}, {}};
+  BandPlanFile plan{Bands::from_edges(std::move(edges), edges_node.location()), {}, {}, 0.0};
   if (const auto r = root.find("reconstruction")) plan.bands = read_reconstruction(*r, plan.bands);
   if (const auto samples = root.find("cycles_samples")) {
     const std::vector<JsonNode> groups = samples->elements();
@@ -50,19 +51,24 @@ BandPlanFile read_band_plan_file(const std::filesystem::path& file) {
     }
     if (plan.cycles_guided_groups.size() == groups) guided->fail("names every group: none is left to guide them");
   }
+  if (const auto threshold = root.find("cycles_guided_threshold")) {
+    if (plan.cycles_guided_groups.empty()) threshold->fail("needs cycles_guided_groups: it is their adaptive sampling's");
+    plan.cycles_guided_threshold = threshold->number_in(1e-4, 1.0);
+  }
   return plan;
 }
 
 Bands read_band_plan(const std::filesystem::path& file) { return read_band_plan_file(file).bands; }
 
 Json band_plan_document(const Bands& bands, const std::vector<int>& cycles_samples,
-                        const std::vector<std::size_t>& cycles_guided_groups) {
+                        const std::vector<std::size_t>& cycles_guided_groups, double cycles_guided_threshold) {
   Json j;
   j["format"] = "chromatrace-bands/1";
   j["edges_nm"] = bands.edges();
   if (const BandReconstruction* r = bands.reconstruction()) j["reconstruction"] = reconstruction_json(*r);
   if (!cycles_samples.empty()) j["cycles_samples"] = cycles_samples;
   if (!cycles_guided_groups.empty()) j["cycles_guided_groups"] = cycles_guided_groups;
+  if (cycles_guided_threshold > 0) j["cycles_guided_threshold"] = cycles_guided_threshold;
   return j;
 }
 

@@ -6,7 +6,7 @@
 //
 //   {"format": "chromatrace-bands/1", "edges_nm": [380, 400, 420, 440, 450, 460, 480, 520, 600, 780],
 //    "reconstruction": {"lo_nm": 380, "step_nm": 1, "matrix": [[m_00, ..., m_08], ...]},
-//    "cycles_samples": [256, 32, 32], "cycles_guided_groups": [1, 2]}
+//    "cycles_samples": [256, 32, 32], "cycles_guided_groups": [1, 2], "cycles_guided_threshold": 0.01}
 //
 // N + 1 strictly increasing edges give N contiguous bands [edge_i, edge_i+1) that must overlap the visible
 // range 360–830 nm. The reconstruction's matrix has one row per fine band [lo + j·step, lo + (j+1)·step) and one
@@ -14,8 +14,11 @@
 // 3g, 3g + 1, 3g + 2 that one Cycles render carries (⌈N / 3⌉ whole numbers ≥ 1); the Blender add-on renders each
 // group with its own, and the tracer, which carries every band along each path, has no use for them.
 // cycles_guided_groups, optional (with cycles_samples), names the groups rendered with few samples and then
-// reconstructed from the others (core/guided.h); at least one group must be left to guide them. Errors name
-// the file and the JSON path ("plan.json: edges_nm[3]: ...").
+// reconstructed from the others (core/guided.h); at least one group must be left to guide them.
+// cycles_guided_threshold, optional (with cycles_guided_groups), renders the guided groups with Cycles' adaptive
+// sampling: every pixel gets the group's samples, and a pixel whose noise stays above the threshold (Cycles'
+// adaptive_threshold: objects' edges and highlights, which the reconstruction leaves at their own samples) gets
+// more, up to the guides' samples. Errors name the file and the JSON path ("plan.json: edges_nm[3]: ...").
 
 #include <cstddef>
 #include <filesystem>
@@ -32,6 +35,7 @@ struct BandPlanFile {
   Bands bands;
   std::vector<int> cycles_samples;
   std::vector<std::size_t> cycles_guided_groups;  // in increasing order
+  double cycles_guided_threshold = 0;             // 0: the guided groups render their samples, no more
 };
 BandPlanFile read_band_plan_file(const std::filesystem::path& file);
 Bands read_band_plan(const std::filesystem::path& file);  // the bands alone
@@ -41,7 +45,7 @@ constexpr std::size_t cycles_band_groups(std::size_t band_count) { return (band_
 
 // The chromatrace-bands/1 document of `bands` (with its reconstruction, if any, and the groups' samples if given).
 Json band_plan_document(const Bands& bands, const std::vector<int>& cycles_samples = {},
-                        const std::vector<std::size_t>& cycles_guided_groups = {});
+                        const std::vector<std::size_t>& cycles_guided_groups = {}, double cycles_guided_threshold = 0);
 
 // A reconstruction as JSON ({"lo_nm", "step_nm", "matrix"}), for the band-plan file and the assembly manifest,
 // and back onto `bands` (errors name the node's path).

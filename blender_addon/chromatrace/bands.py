@@ -45,6 +45,18 @@ def guided_bands(band_count, guided_groups):
     return [b for b in range(band_count) if b // len(CHANNELS) in groups]
 
 
+def guided_adaptive(groups, cycles_samples, guided_groups, threshold):
+    """Cycles' adaptive sampling for each render of `groups`: None, or (threshold, most samples) for a render of
+    guided bands when the band plan gives their `cycles_guided_threshold`. Such a render gives every pixel its own
+    samples and, where a pixel's noise stays above the threshold (objects' edges and highlights, which the
+    reconstruction leaves at their own samples), up to the most samples a guiding group has."""
+    guided = set(guided_groups or [])
+    if not threshold or not guided or not cycles_samples:
+        return [None] * len(groups)
+    most = max(s for g, s in enumerate(cycles_samples) if g not in guided)
+    return [(threshold, most) if all(b // len(CHANNELS) in guided for b in group) else None for group in groups]
+
+
 def channel_of(group, band):
     """The colour channel ("R", "G" or "B") that carries `band` in the render of `group`."""
     return CHANNELS[group.index(band)]

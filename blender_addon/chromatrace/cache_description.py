@@ -82,6 +82,8 @@ def cache_description(scene, request, plan, resolution):
         "textures": {k: v["hash"] for k, v in plan.textures.items()},
         # A plan's samples per band group; otherwise the one number, as before (caches made earlier stay valid).
         "samples": plan.samples if plan.planned_samples else request.samples,
+        # The guided groups' adaptive sampling, where the band plan asks for it (absent otherwise, as before).
+        **({"adaptive": plan.adaptive} if any(plan.adaptive) else {}),
         "seed": request.seed, "max_bounces": request.max_bounces,
         "device": request.device, "variants": plan.variants, "point_filter": request.point_filter,
         "resolution": resolution,

@@ -2,7 +2,8 @@
 """Cycles settings that keep every colour channel linear and unbiased on its own, so that each channel of a
 render is an independent estimate of its band (applied through the journal, so they are undone after).
 
-Off: clamping (direct and indirect), Filter Glossy, denoising, adaptive sampling, the light threshold,
+Off: clamping (direct and indirect), Filter Glossy, denoising, adaptive sampling (but in guided band groups when the
+band plan asks for it: set_samples), the light threshold,
 path guiding, fast GI, simplify, motion blur, Freestyle, compositing and the sequencer. On: both kinds of
 caustics. Box pixel filter of width 1 (for the scene format's "point", a Gaussian 0.01 wide), Standard view
 transform with look None, exposure 0 and gamma 1, Cycles film exposure 1, 32-bit float multilayer OpenEXR.
@@ -35,7 +36,8 @@ RENDER_SETTINGS = (("film_transparent", False), ("use_motion_blur", False), ("us
 BOUNCES = ("max_bounces", "diffuse_bounces", "glossy_bounces", "transmission_bounces")
 # Every scene.cycles and scene.render setting a render sets, whatever the scene held: the cache key leaves them out.
 FIXED = {"cycles": {a for a, _v in CYCLES_SETTINGS} | set(BOUNCES) | {"device", "samples", "seed", "pixel_filter_type",
-                                                                       "filter_width"},
+                                                                       "filter_width", "adaptive_min_samples",
+                                                                       "adaptive_threshold"},
          "render": {a for a, _v in RENDER_SETTINGS} | {"engine", "resolution_x", "resolution_y", "filepath"}}
 
 
@@ -121,9 +123,25 @@ def apply(journal, scene, view_layer, samples, seed, point_filter, resolution, p
     _set_if(journal, getattr(view_layer, "cycles", None), "denoising_store_passes", False)
 
 
+def set_samples(journal, scene, samples, adaptive=None):
+    """One band group's samples per pixel. With `adaptive` (threshold, most samples: bands.guided_adaptive), Cycles'
+    adaptive sampling: every pixel gets `samples`, and one whose noise stays above the threshold up to the most;
+    without, adaptive sampling stays off and every pixel gets `samples`."""
+    c = scene.cycles
+    journal.set(c, "use_adaptive_sampling", adaptive is not None)
+    if adaptive is None:
+        journal.set(c, "samples", samples)
+        return
+    threshold, most = adaptive
+    journal.set(c, "samples", max(most, samples))
+    journal.set(c, "adaptive_min_samples", samples)
+    journal.set(c, "adaptive_threshold", threshold)
+
+
 def set_id_render(journal, scene, view_layer):
     """Settings of the object-id render, after apply(): one sample per pixel through the point filter (at the
     pixel's centre, where the reference tracer takes a pixel's id), the Object Index pass on."""
+    journal.set(scene.cycles, "use_adaptive_sampling", False)
     journal.set(scene.cycles, "samples", 1)
     for attribute, value in pixel_filter(point=True):
         journal.set(scene.cycles, attribute, value)

@@ -25,7 +25,7 @@ IDS_FILE = "ids.exr"
 
 def build_manifest(edges_nm, groups, variants, view_layer, total, components, object_names=None,
                    attributes=None, replicate=False, sum_tolerance=1e-4, reconstruction=None, pass_names=None,
-                   guided_bands=None):
+                   guided_bands=None, guided_adaptive=None):
     """The manifest dict, with file paths relative to the directory the manifest is written to.
 
     groups: lists of band indices, one per render; variants: names of the renders every group has
@@ -34,7 +34,8 @@ def build_manifest(edges_nm, groups, variants, view_layer, total, components, ob
     reconstruction ({"lo_nm", "step_nm", "matrix"}), which the EXR header carries; pass_names: {short pass name:
     the name in the files} where the running Blender writes other names than the components use
     (blender_compat.pass_names); guided_bands: the bands rendered with few samples, which the assembly reconstructs
-    from the others (core/guided.h).
+    from the others (core/guided.h); guided_adaptive: (threshold, most samples) of their renders' adaptive sampling
+    (bands.guided_adaptive), which the header records.
     """
     renamed = dict(pass_names or {})
     total = _renamed_terms(total, renamed)
@@ -67,6 +68,8 @@ def build_manifest(edges_nm, groups, variants, view_layer, total, components, ob
         manifest["reconstruction"] = reconstruction
     if guided_bands:
         manifest["guided"] = {"bands": sorted(guided_bands)}
+        if guided_adaptive:
+            manifest["guided"]["adaptive"] = {"threshold": guided_adaptive[0], "max_samples": guided_adaptive[1]}
     return manifest
 
 

@@ -26,7 +26,7 @@ import bpy
 
 from . import blender_compat, cache, components, cycles_setup, manifest, materials, node_resolution, node_rules
 from . import readback, render_setup, scene_parts
-from .bands import band_groups, describe_band_range, group_samples, guided_bands
+from .bands import band_groups, describe_band_range, group_samples, guided_adaptive, guided_bands
 from .cache_description import cache_description
 from .camera_math import camera_description
 from .errors import BadInput
@@ -91,6 +91,9 @@ class SpectralRender:
                           groups=groups, replicate=replicate, per_render=per_render,
                           samples=group_samples(groups, bands["bands"].get("cycles_samples"), request.samples),
                           planned_samples=bool(bands["bands"].get("cycles_samples")),
+                          adaptive=guided_adaptive(groups, bands["bands"].get("cycles_samples"),
+                                                   bands["bands"].get("cycles_guided_groups"),
+                                                   bands["bands"].get("cycles_guided_threshold")),
                           light_groups=light_groups, assignments=assignments, total=total, components=planned,
                           variants=components.render_variants(request.max_bounces, "bounces" in request.families),
                           passes=components.passes_needed(planned),
@@ -156,7 +159,7 @@ class SpectralRender:
                         render_setup.set_colours(journal, plan, group, request.max_bounces)
                         colours_set = True
                     cycles_setup.set_bounces(journal, self.scene, cycles_bounces)
-                    journal.set(self.scene.cycles, "samples", plan.samples[g])
+                    cycles_setup.set_samples(journal, self.scene, plan.samples[g], plan.adaptive[g])
                     if TEST_HOOK is not None:
                         TEST_HOOK("before_render", group=g, variant=variant, rendered=self.rendered)
                     took = self._render_into_cache(journal, final, wanted.get(os.path.basename(final), set()),
@@ -262,7 +265,8 @@ class SpectralRender:
             plan.edges, plan.groups, list(plan.variants), plan.view_layer.name, plan.total,
             plan.components, object_names=names, attributes=attributes, replicate=plan.replicate,
             reconstruction=plan.bands["bands"].get("reconstruction"), pass_names=blender_compat.pass_names(),
-            guided_bands=guided_bands(len(plan.edges) - 1, plan.bands["bands"].get("cycles_guided_groups")))
+            guided_bands=guided_bands(len(plan.edges) - 1, plan.bands["bands"].get("cycles_guided_groups")),
+            guided_adaptive=next((a for a in plan.adaptive if a), None))
 
     def _assemble(self, plan):
         request = self.request

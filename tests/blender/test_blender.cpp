@@ -464,6 +464,8 @@ TEST_F(Blender, GuidedBandGroupsKeepEveryObjectsComponentsWithinThreeStandardErr
   };
   const std::string full = plan("full.json", R"("cycles_samples": [128, 128])");
   const std::string guided = plan("guided.json", R"("cycles_samples": [128, 16], "cycles_guided_groups": [1])");
+  const std::string adaptive = plan("adaptive.json", R"("cycles_samples": [128, 16], "cycles_guided_groups": [1], )"
+                                                     R"("cycles_guided_threshold": 0.01)");
   const std::string few = plan("few.json", R"("cycles_samples": [16, 16])");
   const auto render = [&](const std::string& bands, int seed) {
     const fs::path out = dir_.file(fmt::format("{}-{}.exr", fs::path(bands).stem().string(), seed));
@@ -473,54 +475,94 @@ TEST_F(Blender, GuidedBandGroupsKeepEveryObjectsComponentsWithinThreeStandardErr
     EXPECT_EQ(r.exit_code, 0) << r.err;
     return SpectralExrReader(out);
   };
-  SpectralExrReader unguided = render(full, 1), twin = render(full, 2), reconstructed = render(guided, 3),
-                    sparse = render(few, 4), sparse_twin = render(few, 5);
-  const json report = json::parse(reconstructed.info().metadata.at("chromatrace.guided"));
-  EXPECT_EQ(report["guided"].size(), 3u);
-  EXPECT_GT(report["tested"].get<int>(), 0);
+  SpectralExrReader unguided = render(full, 1), twin = render(full, 2), sparse = render(few, 4),
+                    sparse_twin = render(few, 5);
   std::vector<std::int32_t> ids(48 * 48);
   unguided.read_object_ids(0, 48, ids);
-  int compared = 0, beyond_three = 0;
-  double worst = 0;
   const std::vector<float> total = unguided.read_layer(unguided.info().total());
-  for (const std::string component : {"diffuse_direct", "diffuse_indirect", "glossy_direct", "glossy_indirect"}) {
-    const std::vector<float> a = layer(unguided, component), a2 = layer(twin, component),
-                             g = layer(reconstructed, component), f = layer(sparse, component),
-                             f2 = layer(sparse_twin, component);
-    for (const auto& [id, name] : unguided.info().object_names) {
-      double worst_band = 0;
-      for (std::size_t b = 3; b < 6; ++b) {
-        double sum_a = 0, sum_g = 0, sum_total = 0, var_a = 0, var_f = 0, n = 0;
-        for (std::size_t p = 0; p < ids.size(); ++p) {
-          if (ids[p] != id) continue;
-          const std::size_t i = p * 6 + b;
-          sum_a += a[i], sum_g += g[i], sum_total += total[i], n += 1;
-          var_a += 0.5 * (a[i] - a2[i]) * (a[i] - a2[i]);
-          var_f += 0.5 * (f[i] - f2[i]) * (f[i] - f2[i]);
+  const std::vector<std::string> components = {"diffuse_direct", "diffuse_indirect", "glossy_direct", "glossy_indirect"};
+  // The guided render's squared differences from the unguided one over objects' edge pixels (those the
+  // reconstruction leaves at their own samples), in the guided bands and all components.
+  const auto edge_squared_difference = [&](SpectralExrReader& reconstructed) {
+    double sum = 0;
+    for (const std::string& component : components) {
+      const std::vector<float> a = layer(unguided, component), g = layer(reconstructed, component);
+      for (int y = 1; y + 1 < 48; ++y)
+        for (int x = 1; x + 1 < 48; ++x) {
+          bool edge = false;
+          for (int dy = -1; dy <= 1; ++dy)
+            for (int dx = -1; dx <= 1; ++dx) edge = edge || ids[(y + dy) * 48 + x + dx] != ids[y * 48 + x];
+          if (!edge) continue;
+          for (std::size_t b = 3; b < 6; ++b) {
+            const std::size_t i = static_cast<std::size_t>(y * 48 + x) * 6 + b;
+            sum += (g[i] - a[i]) * (g[i] - a[i]);
+          }
         }
-        // No such light on this object, or too little to change its colour (under a thousandth of its light).
-        if (n == 0 || var_a == 0 || std::abs(sum_a) < 1e-3 * std::abs(sum_total)) continue;
-        const double se = std::sqrt(2 * var_a + var_f) / n;
-        const double z = std::abs(sum_g - sum_a) / n / se;
-        EXPECT_LE(z, kSigmasPerItem) << component << ", " << name << ", band " << b;
-        if (z > kSigmasOneCheck)
-          std::fprintf(stderr, "%s, %s, band %zu: %.2f standard errors away\n", component.c_str(), name.c_str(), b, z);
-        worst_band = std::max(worst_band, z);
-        worst = std::max(worst, z);
-        ++compared;
-      }
-      if (worst_band > kSigmasOneCheck) ++beyond_three;
     }
-  }
-  EXPECT_GT(compared, 40);
-  // Within 3 standard errors but for what chance puts beyond them. The three guided bands share their paths, so an
-  // object's component counts once: 17 of them here, each beyond 3 in 2.7 ‰ (bands alike) to 8 ‰ (bands apart) of
-  // runs; two or more beyond happen by chance once in 1000 to 130 runs.
-  EXPECT_LE(beyond_three, 1);
-  std::fprintf(stderr, "%d object, component and band means compared, the worst %.2f standard errors away; %zu of %d "
-               "reconstructions refused\n", compared, worst, report["refused"].size(), report["tested"].get<int>());
-  const CommandResult check = test::run_chromatrace({"info", "--check", dir_.file("guided-3.exr").string()});
-  EXPECT_EQ(check.exit_code, 0) << check.out << check.err;
+    return sum;
+  };
+  // The guided mean is as uncertain as the few-sample render's mean and the guide's together (with adaptive
+  // sampling the edges have more samples than that: the bound is then conservative), the unguided one as its own.
+  const auto check = [&](SpectralExrReader& reconstructed, const std::string& file) {
+    SCOPED_TRACE(file);
+    const json report = json::parse(reconstructed.info().metadata.at("chromatrace.guided"));
+    EXPECT_EQ(report["guided"].size(), 3u);
+    EXPECT_GT(report["tested"].get<int>(), 0);
+    int compared = 0, beyond_three = 0;
+    double worst = 0;
+    for (const std::string& component : components) {
+      const std::vector<float> a = layer(unguided, component), a2 = layer(twin, component),
+                               g = layer(reconstructed, component), f = layer(sparse, component),
+                               f2 = layer(sparse_twin, component);
+      for (const auto& [id, name] : unguided.info().object_names) {
+        double worst_band = 0;
+        for (std::size_t b = 3; b < 6; ++b) {
+          double sum_a = 0, sum_g = 0, sum_total = 0, var_a = 0, var_f = 0, n = 0;
+          for (std::size_t p = 0; p < ids.size(); ++p) {
+            if (ids[p] != id) continue;
+            const std::size_t i = p * 6 + b;
+            sum_a += a[i], sum_g += g[i], sum_total += total[i], n += 1;
+            var_a += 0.5 * (a[i] - a2[i]) * (a[i] - a2[i]);
+            var_f += 0.5 * (f[i] - f2[i]) * (f[i] - f2[i]);
+          }
+          // No such light on this object, or too little to change its colour (under a thousandth of its light).
+          if (n == 0 || var_a == 0 || std::abs(sum_a) < 1e-3 * std::abs(sum_total)) continue;
+          const double se = std::sqrt(2 * var_a + var_f) / n;
+          const double z = std::abs(sum_g - sum_a) / n / se;
+          EXPECT_LE(z, kSigmasPerItem) << component << ", " << name << ", band " << b;
+          if (z > kSigmasOneCheck)
+            std::fprintf(stderr, "%s, %s, band %zu: %.2f standard errors away\n", component.c_str(), name.c_str(), b, z);
+          worst_band = std::max(worst_band, z);
+          worst = std::max(worst, z);
+          ++compared;
+        }
+        if (worst_band > kSigmasOneCheck) ++beyond_three;
+      }
+    }
+    EXPECT_GT(compared, 40);
+    // Within 3 standard errors but for what chance puts beyond them. The three guided bands share their paths, so
+    // an object's component counts once: 17 of them here, each beyond 3 in 2.7 ‰ (bands alike) to 8 ‰ (bands
+    // apart) of runs; two or more beyond happen by chance once in 1000 to 130 runs.
+    EXPECT_LE(beyond_three, 1);
+    std::fprintf(stderr, "%s: %d object, component and band means compared, the worst %.2f standard errors away; "
+                 "%zu of %d reconstructions refused\n", file.c_str(), compared, worst, report["refused"].size(),
+                 report["tested"].get<int>());
+    const CommandResult info = test::run_chromatrace({"info", "--check", dir_.file(file).string()});
+    EXPECT_EQ(info.exit_code, 0) << info.out << info.err;
+    return report;
+  };
+  SpectralExrReader fixed = render(guided, 3), sampled = render(adaptive, 6);
+  EXPECT_FALSE(check(fixed, "guided-3.exr").contains("adaptive"));
+  // And with the guided group's adaptive sampling (cycles_guided_threshold): the same bound, the header saying so,
+  // and the edges, which keep their own samples, nearer the unguided render than at the fixed few samples. Each
+  // edge pixel's squared difference is the two renders' variances; the fixed render's is the few samples' (8 times
+  // the guide's at 16 of 128), the adaptive one's at most that, so a mean over a few hundred pixels and four
+  // components that is not lower would mean the extra samples went nowhere.
+  EXPECT_EQ(check(sampled, "adaptive-6.exr")["adaptive"], json::parse(R"({"threshold": 0.01, "max_samples": 128})"));
+  const double fixed_edges = edge_squared_difference(fixed), adaptive_edges = edge_squared_difference(sampled);
+  std::fprintf(stderr, "edges' squared difference from the unguided render: adaptive / fixed %.2f\n",
+               adaptive_edges / fixed_edges);
+  EXPECT_LT(adaptive_edges, 0.75 * fixed_edges);
 }
 
 // The batch's --plan: chromatrace plan, Cycles' noise measured on two pilot renders of this Cycles, and each band

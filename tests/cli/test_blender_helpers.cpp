@@ -335,11 +335,31 @@ TEST_F(Assemble, GuidedBandsAreNamedInTheHeaderAndTheFileStillPassesInfoCheck) {
   EXPECT_EQ(guided["guided"], json::parse(R"([{"band": 3, "nm": [550.0, 600.0]}])"));
   EXPECT_EQ(guided["guides"].size(), 3u);
   EXPECT_EQ(guided["refused"], json::array());
+  EXPECT_FALSE(guided.contains("adaptive"));  // fixed samples unless the manifest says otherwise
   const std::vector<float> total = reader.read_layer(reader.info().total());
   for (int y = 0; y < kH; ++y)
     for (int x = 0; x < kW; ++x) EXPECT_FLOAT_EQ(total[static_cast<std::size_t>((y * kW + x) * 4 + 3)], 5 * f(1, 0, x, y));
   const auto check = run_chromatrace({"info", "--check", out.string()});
   EXPECT_EQ(check.exit_code, 0) << check.out << check.err;
+
+  // Guided bands rendered with Cycles' adaptive sampling: the header says so, with the threshold and the most samples.
+  manifest_["guided"]["adaptive"] = {{"threshold", 0.01}, {"max_samples", 256}};
+  const fs::path adaptive = dir_.file("adaptive.exr");
+  ASSERT_EQ(run_chromatrace({"assemble", write_manifest(manifest_).string(), "-o", adaptive.string(), "-q"}).exit_code, 0);
+  EXPECT_EQ(json::parse(SpectralExrReader(adaptive).info().metadata.at("chromatrace.guided"))["adaptive"],
+            json::parse(R"({"threshold": 0.01, "max_samples": 256})"));
+  for (const auto& [bad_adaptive, message] : std::vector<std::pair<json, std::string>>{
+           {{{"threshold", 0}, {"max_samples", 256}}, "guided.adaptive.threshold"},
+           {{{"threshold", 0.01}}, "guided.adaptive"},
+           {{{"threshold", 0.01}, {"max_samples", 0}}, "guided.adaptive.max_samples"}}) {
+    manifest_["guided"]["adaptive"] = bad_adaptive;
+    const auto bad = run_chromatrace({"assemble", write_manifest(manifest_).string(), "-o", dir_.file("bad.exr").string()});
+    EXPECT_EQ(bad.exit_code, 2) << bad_adaptive;
+    EXPECT_EQ(line_count(bad.err), 1) << bad.err;
+    EXPECT_NE(bad.err.find(message), std::string::npos) << bad.err;
+    EXPECT_FALSE(fs::exists(dir_.file("bad.exr")));
+  }
+  manifest_["guided"].erase("adaptive");
 
   for (const auto& [bands, message] : std::vector<std::pair<json, std::string>>{
            {json::array(), "guided.bands: names no band"},

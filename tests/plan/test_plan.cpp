@@ -432,6 +432,17 @@ TEST_F(Plan, BandPlanFileCarriesTheSamplesOfEachCyclesBandGroup) {
   EXPECT_NE(error_with({{"cycles_guided_groups", {0, 1, 2}}}).find("cycles_guided_groups: names every group"), std::string::npos);
   EXPECT_NE(error_with({{"cycles_guided_groups", {2, 1}}}).find("cycles_guided_groups[1]: groups must increase"), std::string::npos);
   EXPECT_NE(error_with({{"cycles_guided_groups", {3}}}).find("cycles_guided_groups[0]"), std::string::npos);
+  // The guided groups' adaptive sampling threshold, which needs them and is Cycles' (0, 1].
+  Json adaptive = band_plan_document(bands, {256, 32, 32}, {1, 2});
+  adaptive["cycles_guided_threshold"] = 0.01;
+  write_file_atomically(file, adaptive.dump());
+  EXPECT_DOUBLE_EQ(read_band_plan_file(file).cycles_guided_threshold, 0.01);
+  EXPECT_NE(error_with({{"cycles_guided_threshold", 0.01}}).find("cycles_guided_threshold: needs cycles_guided_groups"),
+            std::string::npos);
+  EXPECT_NE(error_with({{"cycles_guided_groups", {1}}, {"cycles_guided_threshold", 0}}).find("cycles_guided_threshold"),
+            std::string::npos);
+  EXPECT_NE(error_with({{"cycles_guided_groups", {1}}, {"cycles_guided_threshold", 1.5}}).find("cycles_guided_threshold"),
+            std::string::npos);
   Json no_samples = band_plan_document(bands);
   no_samples["cycles_guided_groups"] = {1};
   write_file_atomically(file, no_samples.dump());

@@ -11,7 +11,7 @@ import unittest
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "..", "..", "blender_addon"))
 
 from chromatrace import bands, batch_args, cache, camera_math, components, defaults, floats, manifest, node_rules, ply, spectra  # noqa: E402
-from chromatrace import cameras, planning, scene_parts, tool  # noqa: E402
+from chromatrace import cameras, cycles_setup, planning, scene_parts, tool  # noqa: E402
 from types import SimpleNamespace  # noqa: E402
 from chromatrace.errors import BadInput  # noqa: E402
 from chromatrace.journal import Journal  # noqa: E402
@@ -195,6 +195,19 @@ class Manifest(unittest.TestCase):
         m = manifest.build_manifest(edges, bands.band_groups(7), ["main"], "V", total, planned, guided_bands=guided)
         self.assertEqual(m["guided"], {"bands": [3, 4, 5, 6]})
         self.assertNotIn("guided", manifest.build_manifest(edges, bands.band_groups(7), ["main"], "V", total, planned))
+
+    def test_guided_groups_sample_adaptively_up_to_their_guides_when_the_plan_gives_a_threshold(self):
+        groups = bands.band_groups(7)  # three renders: bands 0-2, 3-5, 6
+        self.assertEqual(bands.guided_adaptive(groups, [300, 40, 30], [1, 2], 0.01), [None, (0.01, 300), (0.01, 300)])
+        # The most samples of any guiding group, not of a guided one.
+        self.assertEqual(bands.guided_adaptive(groups, [40, 300, 500], [0, 2], 0.02), [(0.02, 300), None, (0.02, 300)])
+        for threshold, guided in ((None, [1, 2]), (0.01, None), (0.01, [])):
+            self.assertEqual(bands.guided_adaptive(groups, [300, 40, 30], guided, threshold), [None] * 3)
+        total, planned = components.component_plan({"paths"}, [], 2)
+        edges = [400 + 25 * i for i in range(8)]
+        m = manifest.build_manifest(edges, groups, ["main"], "V", total, planned, guided_bands=[3, 4, 5, 6],
+                                    guided_adaptive=(0.01, 300))
+        self.assertEqual(m["guided"], {"bands": [3, 4, 5, 6], "adaptive": {"threshold": 0.01, "max_samples": 300}})
 
     def test_missing_renders(self):
         with tempfile.TemporaryDirectory() as d:
@@ -555,6 +568,18 @@ class SceneParts(unittest.TestCase):
         self.assertEqual(world, "environment")
         self.assertEqual(scene_parts.light_groups(scene, {"paths"}, view_layer, objects, {"glow"}, {"status": "lit"}),
                          ([], {}, None))
+
+
+class WorldMap(unittest.TestCase):
+    def test_an_environment_image_gets_a_map_of_its_width_within_cycles_bounds_where_cycles_would_choose(self):
+        self.assertEqual(cycles_setup.world_map_resolution("AUTOMATIC", [64]), 1024)  # no coarser than 1024
+        self.assertEqual(cycles_setup.world_map_resolution("AUTOMATIC", [2048, 512]), 2048)  # the widest image
+        self.assertEqual(cycles_setup.world_map_resolution("AUTOMATIC", [16384]), 4096)  # Cycles' own at most
+        # The artist's own choice, or a world without an image (0: an image without pixels), is left alone.
+        for method in ("MANUAL", "NONE"):
+            self.assertIsNone(cycles_setup.world_map_resolution(method, [64]))
+        self.assertIsNone(cycles_setup.world_map_resolution("AUTOMATIC", []))
+        self.assertIsNone(cycles_setup.world_map_resolution("AUTOMATIC", [0]))
 
 
 if __name__ == "__main__":
