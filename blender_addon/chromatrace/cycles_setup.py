@@ -138,6 +138,23 @@ def set_samples(journal, scene, samples, adaptive=None):
     journal.set(c, "adaptive_threshold", threshold)
 
 
+# The world importance map's resolution (its width; the map is width × width / 2 cells) for a band group, where
+# Cycles' automatic choice would build one of 4096 × 2048 for any world without a single sun: the environment
+# image's width, no less than WORLD_MAP_MIN. Cycles shades every cell once per render, and each band group is a
+# render with its own world image, so the map is built again for each (1.4 s of CPU at 4096 on the textured test
+# scene, most of a band group at 96 × 96); at 1024 it is a sixteenth of that, and the render as noisy (docs/plan.md).
+WORLD_MAP_MIN, WORLD_MAP_MAX = 1024, 4096
+
+
+def world_map_resolution(sampling_method, image_widths):
+    """The world's MANUAL map resolution for a band group, or None to leave the world's sampling as it is: when its
+    sampling is AUTOMATIC and it is an environment image (or several) of these widths."""
+    widths = [w for w in image_widths if w > 0]
+    if sampling_method != "AUTOMATIC" or not widths:
+        return None
+    return min(WORLD_MAP_MAX, max(WORLD_MAP_MIN, max(widths)))
+
+
 def set_id_render(journal, scene, view_layer):
     """Settings of the object-id render, after apply(): one sample per pixel through the point filter (at the
     pixel's centre, where the reference tracer takes a pixel's id), the Object Index pass on."""

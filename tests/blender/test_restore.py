@@ -17,7 +17,7 @@ import bpy
 
 sys.path.insert(0, os.path.join(os.environ["CHROMATRACE_SOURCE_DIR"], "tests", "blender"))
 from harness import SOURCE, TOOL, chromatrace, expect, failures, finish, scene_file  # noqa: E402,F401
-from chromatrace import scene_import, spectral_render  # noqa: E402
+from chromatrace import blender_compat, scene_import, spectral_render  # noqa: E402
 from chromatrace.errors import BadInput  # noqa: E402
 
 
@@ -59,7 +59,8 @@ def snapshot():
     scene = bpy.context.scene
     state = {"render": rna(scene.render), "image": rna(scene.render.image_settings), "cycles": rna(scene.cycles),
              "view": rna(scene.view_settings), "display": rna(scene.display_settings), "camera": scene.camera.name,
-             "world": rna(scene.world), "world_nodes": node_tree(scene.world.node_tree),
+             "world": rna(scene.world), "world_cycles": rna(scene.world.cycles),
+             "world_nodes": node_tree(scene.world.node_tree),
              "scene_chromatrace": rna(scene.chromatrace)}
     for layer in scene.view_layers:
         state[f"layer {layer.name}"] = rna(layer)
@@ -203,6 +204,26 @@ if after != converted:
     failures.append(f"after a Blackbody light render: changed {[k for k in after if after[k] != converted.get(k)][:5]}")
 else:
     print("ok: after a Blackbody light and a Mix node: every setting restored", flush=True)
+
+# 6. A world lit by an environment image, its importance map left to Cycles (AUTOMATIC): the band groups render it
+#    with a map of the image's width, at least 1024 (cycles_setup.world_map_resolution; the sky is 64 wide), and
+#    the world's own sampling comes back after.
+world = scene.world
+blender_compat.enable_nodes(world)  # the factory world has no node tree before 5.0
+environment = world.node_tree.nodes.new("ShaderNodeTexEnvironment")
+environment.image = bpy.data.images.load(os.path.join(SOURCE, "scenes", "textured", "textures", "sky.exr"))
+world.node_tree.links.new(environment.outputs["Color"], world.node_tree.nodes["Background"].inputs["Color"])
+world.node_tree.nodes["Background"].inputs["Strength"].default_value = 1.0  # the import's dark world has 0
+world.cycles.sampling_method = "AUTOMATIC"
+lit = snapshot()
+seen = []
+spectral_render.TEST_HOOK = lambda event, **info: seen.append((world.cycles.sampling_method,
+                                                                 world.cycles.sample_map_resolution))
+spectral_render.SpectralRender(scene, request("world", cache_root=os.path.join(work, "cache6")), TOOL).run()
+spectral_render.TEST_HOOK = None
+if not seen or set(seen) != {("MANUAL", 1024)}:
+    failures.append(f"the band groups' world map: expected MANUAL at 1024 in every render, got {sorted(set(seen))}")
+check_same(lit, "after a render under an environment image")
 
 if digest(blend) != blend_digest or os.path.exists(blend + "1"):
     failures.append("the .blend on disk was written")
