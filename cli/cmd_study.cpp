@@ -31,6 +31,7 @@ struct StudyCommandOptions {
   std::vector<std::string> modes = {"continuous"};
   std::vector<std::string> renderers = {"tracer"};
   bool no_plan = false;
+  double guided = 0;
   int reference_spp = 0;
   std::uint64_t seed = 1;
   int threads = 0;
@@ -70,6 +71,14 @@ study::StudyOptions study_options(const StudyCommandOptions& o, const Scene& sce
   s.bounces = o.bounces;
   s.modes = o.modes;
   s.planned = !o.no_plan;
+  if (o.guided != 0) {
+    if (!(o.guided > 0 && o.guided < 1))
+      throw InputError(fmt::format("--guided: the guided groups' fraction of the guide's samples must be in (0, 1), got {}", o.guided));
+    if (o.no_plan) throw InputError("--guided: guides the planned setting's groups, which --no-plan leaves out");
+    if (std::find(o.renderers.begin(), o.renderers.end(), "cycles") == o.renderers.end())
+      throw InputError("--guided: band groups are Cycles': needs --renderers cycles");
+  }
+  s.guided_fraction = o.guided;
   s.reference_samples = o.reference_spp;
   s.camera = o.camera;
   s.seed = o.seed;
@@ -117,6 +126,9 @@ Action add_study(CLI::App& app) {
       ->delimiter(',')
       ->capture_default_str();
   cmd->add_flag("--no-plan", o->no_plan, "Leave out the setting chromatrace plan chooses for a mean dE00 of 1");
+  cmd->add_option("--guided", o->guided,
+                  "Cycles: also the planned setting with its group of most samples guiding the others, rendered at this "
+                  "fraction of its samples (e.g. 0.125) with adaptive sampling up to them (docs/plan.md)");
   cmd->add_option("--reference-spp", o->reference_spp, "Samples of the reference render (default: 4 x the most tried)");
   cmd->add_option("--camera", o->camera, "Observer of the dE00: cie1931 or a shipped camera")->capture_default_str();
   cmd->add_option("--seed", o->seed, "Random seed of the first render of each setting (the second: seed + 1)")

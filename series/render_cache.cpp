@@ -64,6 +64,10 @@ Json render_inputs(const Scene& scene, const RunOptions& options) {
   // The reconstruction changes no pixel's band values, but the file carries it and every colour made of them.
   if (const BandReconstruction* r = bands.reconstruction()) inputs["reconstruction"] = reconstruction_json(*r);
   if (!options.cycles_samples.empty()) inputs["cycles_samples"] = options.cycles_samples;
+  if (!options.cycles_guided_groups.empty()) {
+    inputs["cycles_guided_groups"] = options.cycles_guided_groups;
+    inputs["cycles_guided_threshold"] = options.cycles_guided_threshold;
+  }
   // Another Blender is another Cycles (its GGX masking, its sampling): the executable, and its size and time, so
   // that one upgraded in place renders again too.
   if (options.renderer == Renderer::Cycles) inputs["blender"] = executable_identity(options.blender);

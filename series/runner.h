@@ -45,6 +45,10 @@ struct RunOptions {
   // Cycles: the band file gives each band group of three its samples (its cycles_samples), which the batch renders
   // instead of `spp`; part of the render's cache key.
   std::vector<int> cycles_samples;
+  // And the groups it guides from the others, with their adaptive sampling's threshold (core/band_plan.h); part of
+  // the cache key too.
+  std::vector<std::size_t> cycles_guided_groups;
+  double cycles_guided_threshold = 0;
   std::string components = "paths,lights";
   int threads = 0;
   bool progress = true;

@@ -32,7 +32,7 @@ const std::vector<std::pair<std::string, cv::Scalar>>& knob_colours() {
   static const std::vector<std::pair<std::string, cv::Scalar>> colours = {
       {"base", cv::Scalar(30, 30, 30)},      {"bands", cv::Scalar(178, 114, 0)},   {"fitted", cv::Scalar(115, 158, 0)},
       {"samples", cv::Scalar(0, 159, 230)},  {"bounces", cv::Scalar(167, 121, 204)}, {"mode", cv::Scalar(0, 94, 213)},
-      {"planned", cv::Scalar(66, 66, 220)}};
+      {"planned", cv::Scalar(66, 66, 220)},  {"guided", cv::Scalar(150, 40, 120)}};
   return colours;
 }
 
@@ -50,6 +50,7 @@ std::string short_label(const Setting& s) {
   if (s.knob == "samples") return fmt::format("{} spp", s.samples);
   if (s.knob == "bounces") return fmt::format("{} bounce{}", s.max_bounces, s.max_bounces == 1 ? "" : "s");
   if (s.knob == "planned") return "planned";
+  if (s.knob == "guided") return "guided";
   return s.value;
 }
 

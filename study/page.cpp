@@ -35,7 +35,8 @@ void write_page(const fs::path& file, const StudyResult& result) {
        "img{max-width:100%;border:1px solid #eee;margin:6px 0}.note{color:#555}</style></head><body>\n";
   h << "<h1>Speed against accuracy: " << scene << "</h1>\n";
   h << "<p>Each setting is the scene's own render settings with one knob changed (<em>planned</em>: every knob as "
-       "<code>chromatrace plan</code> chose it for a mean ΔE00 of 1), rendered twice with two seeds, seen by an ideal "
+       "<code>chromatrace plan</code> chose it for a mean ΔE00 of 1; <em>guided</em>, with <code>--guided</code>: the "
+       "planned Cycles setting with its band group of most samples guiding the others, rendered with fewer), rendered twice with two seeds, seen by an ideal "
        "noise-free camera and analysed. It is compared with the <strong>reference</strong>: "
     << escape_html(result.reference.value) << " (" << fmt::format("{:.1f}", result.reference_cpu_s)
     << " CPU seconds). ΔE00 is over every pixel of the image, through the observer, in CIELAB under the light's "

@@ -26,6 +26,8 @@ namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
 
 constexpr const char* kComponents = "paths";  // every setting renders the same layers, so costs compare
+// The guided groups' adaptive sampling threshold: Cycles' own default Noise Threshold (docs/plan.md).
+constexpr double kGuidedThreshold = 0.01;
 
 double sq(double x) { return x * x; }
 double mean_of(const std::vector<double>& v) {
@@ -64,7 +66,8 @@ int cycles_renders(const Bands& bands) { return static_cast<int>((bands.size() +
 
 bool same_settings(const Setting& a, const Setting& b) {
   return a.renderer == b.renderer && a.bands == b.bands && a.samples == b.samples && a.max_bounces == b.max_bounces &&
-         a.mode == b.mode && a.cycles_samples == b.cycles_samples;
+         a.mode == b.mode && a.cycles_samples == b.cycles_samples && a.cycles_guided_groups == b.cycles_guided_groups &&
+         a.cycles_guided_threshold == b.cycles_guided_threshold;
 }
 
 
@@ -238,6 +241,31 @@ std::vector<Setting> make_settings(const Scene& scene, const StudyOptions& optio
              s.samples = groups ? *std::max_element(p.cycles_samples.begin(), p.cycles_samples.end()) : p.samples;
              if (groups) s.cycles_samples = p.cycles_samples;
            });
+      // Guided: the group of most samples keeps them and guides the others, rendered at a fraction of them, with
+      // adaptive sampling up to them where a pixel stays noisy (at Cycles' own default threshold, 0.01).
+      if (groups && options.guided_fraction > 0) {
+        const auto guide = static_cast<std::size_t>(
+            std::max_element(p.cycles_samples.begin(), p.cycles_samples.end()) - p.cycles_samples.begin());
+        const int most = p.cycles_samples[guide];
+        const int few = std::max(1, static_cast<int>(std::ceil(most * options.guided_fraction)));
+        std::vector<int> samples;
+        std::vector<std::size_t> guided;
+        for (std::size_t g = 0; g < p.cycles_samples.size(); ++g) {
+          samples.push_back(g == guide ? most : few);
+          if (g != guide) guided.push_back(g);
+        }
+        vary("guided",
+             fmt::format("{} bands, {} bounces, samples per band group {}, groups {} guided", p.bands.size(),
+                         p.max_bounces, fmt::join(samples, ", "), fmt::join(guided, ", ")),
+             "1", [&](Setting& s) {
+               s.bands = p.bands;
+               s.max_bounces = p.max_bounces;
+               s.samples = most;
+               s.cycles_samples = samples;
+               s.cycles_guided_groups = guided;
+               s.cycles_guided_threshold = kGuidedThreshold;
+             });
+      }
     }
   }
   return out;
@@ -299,7 +327,12 @@ StudyResult run_study(const fs::path& scene_file, const fs::path& dir, const Stu
     ro.bands = s.bands;
     ro.bands_file = fs::absolute(dir / "plans" / (s.name + ".json"));
     ro.cycles_samples = s.cycles_samples;
-    write_file_atomically(ro.bands_file, band_plan_document(s.bands, s.cycles_samples).dump(2, ' ', false, kReplaceInvalidUtf8) + "\n");
+    ro.cycles_guided_groups = s.cycles_guided_groups;
+    ro.cycles_guided_threshold = s.cycles_guided_threshold;
+    write_file_atomically(ro.bands_file, band_plan_document(s.bands, s.cycles_samples, s.cycles_guided_groups,
+                                                            s.cycles_guided_threshold)
+                                             .dump(2, ' ', false, kReplaceInvalidUtf8) +
+                                             "\n");
     ro.components = kComponents;
     ro.threads = options.threads;
     ro.progress = options.progress;
@@ -419,6 +452,10 @@ Json result_json(const StudyResult& result) {
            {"max_bounces", s.max_bounces},
            {"spectral_mode", s.mode}};
     if (!s.cycles_samples.empty()) j["cycles_samples"] = s.cycles_samples;
+    if (!s.cycles_guided_groups.empty()) {
+      j["cycles_guided_groups"] = s.cycles_guided_groups;
+      j["cycles_guided_threshold"] = s.cycles_guided_threshold;
+    }
     return j;
   };
   auto optional = [](const std::optional<double>& v) { return v ? Json(*v) : Json(); };

@@ -45,6 +45,9 @@ struct StudyOptions {
   std::vector<std::string> modes;    // spectral modes besides the scene's ("bands", "continuous"; tracer only)
   std::vector<series::Renderer> renderers = {series::Renderer::Tracer};
   bool planned = true;          // a setting with every knob from `plan` at target 1
+  // > 0: for Cycles also the planned setting guided (docs/plan.md, "Guided band groups"): its group of most samples
+  // guides the others, rendered at this fraction of its samples with adaptive sampling up to them.
+  double guided_fraction = 0;
   int reference_samples = 0;    // 0: 4 × the most samples of any setting
   double reference_band_nm = 5;  // the reference's uniform band width
   std::string camera = "cie1931";  // the observer of the ΔE00
@@ -58,12 +61,14 @@ struct StudyOptions {
 // One setting: the base with one knob changed.
 struct Setting {
   std::string name;   // unique, also the series variant's name: "tracer-bands-6", "cycles-base"
-  std::string knob;   // base, bands, fitted, samples, bounces, mode, renderer, planned, reference
+  std::string knob;   // base, bands, fitted, samples, bounces, mode, renderer, planned, guided, reference
   std::string value;  // the knob's value as a person reads it: "6 uniform", "fitted for 1", "64", "continuous"
   series::Renderer renderer = series::Renderer::Tracer;
   Bands bands;
   int samples = 0, max_bounces = 0;
   std::vector<int> cycles_samples;  // Cycles, planned: each band group's samples (then `samples` is the most of them)
+  std::vector<std::size_t> cycles_guided_groups;  // Cycles, guided: the groups reconstructed from the others
+  double cycles_guided_threshold = 0;             // and their adaptive sampling's noise threshold
   std::string mode = "bands";
 };
 

@@ -44,6 +44,16 @@ TEST(RenderCache, TheKeyFollowsTheRendererTheSettingsAndTheBlender) {
   std::ofstream(a, std::ios::app) << "# upgraded\n";
   fs::last_write_time(a, fs::last_write_time(a) + std::chrono::seconds(10));
   EXPECT_NE(key(scene, cycles), before);
+  // Each band group's samples, and which groups are guided with what threshold, render anew.
+  RunOptions planned = cycles;
+  planned.cycles_samples = {256, 32};
+  RunOptions guided = planned;
+  guided.cycles_guided_groups = {1};
+  RunOptions adaptive = guided;
+  adaptive.cycles_guided_threshold = 0.01;
+  EXPECT_NE(key(scene, planned), key(scene, cycles));
+  EXPECT_NE(key(scene, guided), key(scene, planned));
+  EXPECT_NE(key(scene, adaptive), key(scene, guided));
   // The tracer's key does not depend on any Blender.
   RunOptions tracer_with_blender = tracer;
   tracer_with_blender.blender = b;

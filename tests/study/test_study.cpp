@@ -170,6 +170,26 @@ TEST(Study, PlannedCyclesSettingTakesEachBandGroupsSamples) {
     }
   }
   EXPECT_EQ(found, 2);
+
+  // And guided (--guided 0.125): the group of most samples keeps them and guides the others at an eighth of them
+  // (rounded up), rendered with adaptive sampling at Cycles' default threshold.
+  options.guided_fraction = 0.125;
+  int guided = 0;
+  for (const study::Setting& s : study::make_settings(scene, options)) {
+    if (s.knob != "guided") continue;
+    ++guided;
+    EXPECT_EQ(s.renderer, series::Renderer::Cycles);
+    const auto most = std::max_element(cycles.cycles_samples.begin(), cycles.cycles_samples.end());
+    const auto guide = static_cast<std::size_t>(most - cycles.cycles_samples.begin());
+    ASSERT_EQ(s.cycles_samples.size(), cycles.cycles_samples.size());
+    for (std::size_t g = 0; g < s.cycles_samples.size(); ++g) {
+      EXPECT_EQ(s.cycles_samples[g], g == guide ? *most : (*most + 7) / 8) << g;
+      EXPECT_EQ(std::count(s.cycles_guided_groups.begin(), s.cycles_guided_groups.end(), g), g == guide ? 0 : 1) << g;
+    }
+    EXPECT_EQ(s.cycles_guided_threshold, 0.01);
+    EXPECT_EQ(s.bands, cycles.bands);
+  }
+  EXPECT_EQ(guided, 1);
 }
 
 TEST(StudyPareto, MarksExactlyTheUndominated) {
@@ -191,7 +211,8 @@ TEST(StudyPareto, MarksExactlyTheUndominated) {
 TEST(StudyCommand, BadInputIsOneLineAndExit2) {
   const fs::path dir = fresh_dir("bad");
   const std::vector<std::vector<std::string>> cases = {
-      {"--bands", "0"}, {"--renderers", "vray"}, {"--modes", "hero"}, {"--fitted", "-1"}, {"--camera", "nope"}};
+      {"--bands", "0"}, {"--renderers", "vray"}, {"--modes", "hero"}, {"--fitted", "-1"}, {"--camera", "nope"},
+      {"--guided", "1.5"}, {"--guided", "0.125"}, {"--guided", "0.125", "--renderers", "cycles", "--no-plan"}};
   for (const auto& extra : cases) {
     std::vector<std::string> args = {"study", kBox.string(), "-o", dir.string(), "-q"};
     args.insert(args.end(), extra.begin(), extra.end());
