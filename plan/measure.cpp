@@ -3,6 +3,7 @@
 // `chromatrace check-scene` runs, is linked without OpenEXR (chromatrace_plan_model).
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <numeric>
 #include <optional>
 
@@ -65,8 +66,8 @@ Vec3d white_of(const std::vector<Vec3d>& level, const std::vector<std::int32_t>&
                      policy);
 }
 
-// The mean ΔE00 between two renders' tristimulus values under `white`, and its standard error over the pixels.
-std::pair<double, double> mean_difference(const std::vector<Vec3d>& a, const std::vector<Vec3d>& b, const Vec3d& white) {
+// Each pixel's ΔE00 between two renders' tristimulus values under `white`.
+std::vector<double> pixel_differences(const std::vector<Vec3d>& a, const std::vector<Vec3d>& b, const Vec3d& white) {
   // ΔE00 in its linear regime: between m − ε·d/2 and m + ε·d/2 (m the pair's mean, d their difference), over ε.
   // The mean ΔE00 of a large difference grows more slowly than the difference (CIELAB's cube root, ΔE00's
   // compression of chroma), so a pilot's few samples would understate the noisier renderer's part; linearised,
@@ -82,11 +83,32 @@ std::pair<double, double> mean_difference(const std::vector<Vec3d>& a, const std
     }
     de.push_back(delta_e_2000(xyz_to_lab(lo, white), xyz_to_lab(hi, white)) / kEpsilon);
   }
+  return de;
+}
+
+// Their mean and its standard error over the pixels.
+std::pair<double, double> mean_and_error(const std::vector<double>& de) {
   const double n = static_cast<double>(de.size());
   const double mean = n > 0 ? std::accumulate(de.begin(), de.end(), 0.0) / n : 0.0;
   double var = 0;
   for (double x : de) var += (x - mean) * (x - mean);
   return {mean, n > 1 ? std::sqrt(var / (n - 1) / n) : 0.0};
+}
+
+std::pair<double, double> mean_difference(const std::vector<Vec3d>& a, const std::vector<Vec3d>& b, const Vec3d& white) {
+  return mean_and_error(pixel_differences(a, b, white));
+}
+
+// The mean of `de` over each object's pixels, and their number.
+std::map<std::int32_t, std::pair<double, std::size_t>> means_by_object(const std::vector<double>& de,
+                                                                       const std::vector<std::int32_t>& ids) {
+  std::map<std::int32_t, std::pair<double, std::size_t>> sums;
+  for (std::size_t p = 0; p < de.size() && p < ids.size(); ++p) {
+    auto& [sum, n] = sums[ids[p]];
+    sum += de[p], ++n;
+  }
+  for (auto& [id, s] : sums) s.first /= static_cast<double>(s.second);
+  return sums;
 }
 
 int integer_metadata(const SpectralExrInfo& info, const std::string& key) {
@@ -140,7 +162,8 @@ NoiseRatio measure_cycles_noise(const Scene& scene, const std::filesystem::path&
   if (ia.has_object_ids) ra.read_object_ids(0, ia.height, ids);
   const std::vector<Vec3d> xa = tristimuli(va);
   const Vec3d cycles_white = white_of(xa, ids, ia.width, ia.height, scene, ia.bands, curves);
-  const auto [cycles, cycles_se] = mean_difference(xa, tristimuli(vb), cycles_white);
+  const std::vector<double> cycles_de = pixel_differences(xa, tristimuli(vb), cycles_white);
+  const auto [cycles, cycles_se] = mean_and_error(cycles_de);
   // Each group's part, and each pair's: the first pilot with those groups' bands taken from the second.
   const std::size_t nb = ia.bands.size(), groups = (nb + 2) / 3;
   auto swapped = [&](std::size_t g, std::size_t h) {
@@ -181,8 +204,9 @@ NoiseRatio measure_cycles_noise(const Scene& scene, const std::filesystem::path&
     tracer[seed - 1] = sensor::camera_tristimulus(image.layers[0], ia.bands, curves, pixels);
     tracer_ids = image.object_ids;
   }
-  const auto [traced, traced_se] =
-      mean_difference(tracer[0], tracer[1], white_of(tracer[0], tracer_ids, ia.width, ia.height, scene, ia.bands, curves));
+  const std::vector<double> tracer_de =
+      pixel_differences(tracer[0], tracer[1], white_of(tracer[0], tracer_ids, ia.width, ia.height, scene, ia.bands, curves));
+  const auto [traced, traced_se] = mean_and_error(tracer_de);
   if (!(traced > 0))
     throw InputError(fmt::format("{}: the tracer's renders of {} at its size and samples show no noise to compare with",
                                  ia.file, scene.source));
@@ -191,6 +215,17 @@ NoiseRatio measure_cycles_noise(const Scene& scene, const std::filesystem::path&
   out.tracer_at_one = traced / std::sqrt(2.0) * std::sqrt(static_cast<double>(out.samples));
   out.ratio = cycles / traced;
   out.se = out.ratio * std::hypot(cycles_se / std::max(cycles, 1e-300), traced_se / traced);
+  // Each object's ratio over the image's, where both sides hold enough of its pixels to judge it.
+  if (ia.has_object_ids) {
+    const auto on_cycles = means_by_object(cycles_de, ids), on_tracer = means_by_object(tracer_de, tracer_ids);
+    for (const auto& [id, c] : on_cycles) {
+      const auto t = on_tracer.find(id);
+      if (id <= 0 || t == on_tracer.end() || c.second < kPilotObjectPixels || t->second.second < kPilotObjectPixels ||
+          !(t->second.first > 0) || !(out.ratio > 0))
+        continue;
+      out.object_ratio[id] = c.first / t->second.first / out.ratio;
+    }
+  }
   return out;
 }
 

@@ -861,7 +861,8 @@ int bounces_for(const Model& model, double target) {
 
 // Each surface seen by at least kObjectPixels lit pixels of the preview (fewer hold too little of its noise to
 // judge): its bands' and bounces' error (its pixels' mean ΔE00), and its noise as its share of the image's (its
-// pixels' noise in the preview over the image's) at the planned samples, in quadrature. Where one is predicted
+// pixels' noise in the preview over the image's, times its own Cycles-to-tracer ratio over the image's where the
+// pilots measured it) at the planned samples, in quadrature. Where one is predicted
 // above the object limit, every group's samples grow by the same factor until none is (the noise falls as
 // 1/√samples); a surface whose bands and bounces alone exceed it is said in a note.
 constexpr std::size_t kObjectPixels = 16;
@@ -875,11 +876,16 @@ void limit_objects(Plan& plan, const Scene& scene, const Model& model, const std
     return id <= scene.objects.size() ? scene.objects[id - 1].name : scene.lights[id - scene.objects.size() - 1].name;
   };
   const double image_noise = model.preview_noise();
+  // Its own Cycles-to-tracer noise ratio over the image's, where the pilots measured it.
+  auto cycles_ratio_of = [&](std::size_t id) {
+    const auto measured = options.cycles_object_noise_ratio.find(static_cast<std::int32_t>(id));
+    return measured != options.cycles_object_noise_ratio.end() ? measured->second : 1.0;
+  };
   double factor = 1;  // on the samples
   std::vector<std::pair<std::size_t, double>> judged;  // id, its noise at the planned samples
   for (std::size_t id = 1; id < bands.size(); ++id) {
     if (model.pixels_by_id()[id] < kObjectPixels || !(image_noise > 0)) continue;
-    const double own = noise.at(plan.cycles_samples) * noise_by_id[id] / image_noise;
+    const double own = noise.at(plan.cycles_samples) * noise_by_id[id] / image_noise * cycles_ratio_of(id);
     judged.emplace_back(id, own);
     if (bands[id] >= limit) {
       plan.notes.push_back(fmt::format("{}: its bands and bounces alone are predicted at a mean ΔE00 of {:.2f}, above "
@@ -894,7 +900,8 @@ void limit_objects(Plan& plan, const Scene& scene, const Model& model, const std
   }
   for (const auto& [id, own] : judged)
     plan.objects.push_back({name(id), static_cast<int>(id), model.pixels_by_id()[id], bands[id],
-                            std::hypot(bands[id], own / std::sqrt(factor)), noise_by_id[id] / image_noise});
+                            std::hypot(bands[id], own / std::sqrt(factor)), noise_by_id[id] / image_noise,
+                            cycles_ratio_of(id)});
 }
 
 }  // namespace
@@ -1181,7 +1188,7 @@ Json report_document(const Plan& plan, const Scene& scene, const PlanOptions& op
     for (const Plan::ObjectPrediction& o : plan.objects) {
       Json j{{"name", o.name}, {"object_id", o.id}, {"preview_pixels", o.preview_pixels},
              {"bands_only_mean_de00", o.bands_only}, {"mean_de00", o.predicted_mean},
-             {"noise_to_image_noise", o.noise_scale}};
+             {"noise_to_image_noise", o.noise_scale}, {"cycles_noise_ratio_to_image", o.cycles_ratio}};
       if (options.reference_samples > 0)
         j["against_tracer_reference_mean_de00"] =
             std::hypot(o.predicted_mean, plan.tracer_noise_at_one * o.noise_scale / std::sqrt(options.reference_samples));

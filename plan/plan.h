@@ -21,6 +21,7 @@
 // its widest bands split.
 
 #include <array>
+#include <map>
 #include <cstdint>
 #include <filesystem>
 #include <optional>
@@ -65,6 +66,9 @@ struct PlanOptions {
   // (Model's noise at its 16 paths, scaled by 1/√paths), which a scene with rare bright paths (an HDRI's sun)
   // overstates at so few paths (docs/plan.md).
   double cycles_pilot_tracer_noise_at_one = 0;
+  // Each object's Cycles-to-tracer noise ratio over the image's as the pilots measured it (NoiseRatio::object_ratio):
+  // an object's predicted noise is the preview's share of it times this. Absent: 1.
+  std::map<std::int32_t, double> cycles_object_noise_ratio;
   // Also predict the mean ΔE00 that comparing the Cycles render with a tracer reference of this many paths per
   // pixel measures (its noise counts too); 0: not.
   int reference_samples = 0;
@@ -137,6 +141,7 @@ struct Plan {
     std::size_t preview_pixels = 0;
     double bands_only = 0, predicted_mean = 0;
     double noise_scale = 1;  // its pixels' noise over the image's, in the preview
+    double cycles_ratio = 1;  // PlanOptions::cycles_object_noise_ratio's for it (1: none measured)
   };
   std::vector<ObjectPrediction> objects;
   double object_target_de00 = 0, object_samples_factor = 1;
@@ -193,7 +198,12 @@ struct NoiseRatio {
   // (e_gh² − e_g² − e_h²) / 2 with both groups' bands from the second.
   std::vector<double> group_shares;
   std::vector<double> edges_nm;  // the pilots' band edges, which the shares are of
+  // Each object's own ratio (Cycles' noise over the tracer's on its pixels) over the image's, for the objects of
+  // which both pilots and both tracer renders hold at least kPilotObjectPixels: Cycles samples a glossy highlight
+  // otherwise than the tracer, so an object's share of the noise may differ between them.
+  std::map<std::int32_t, double> object_ratio;
 };
+constexpr std::size_t kPilotObjectPixels = 16;
 NoiseRatio measure_cycles_noise(const Scene& scene, const std::filesystem::path& a, const std::filesystem::path& b,
                                 const std::string& camera = "cie1931", int threads = 0);
 

@@ -546,6 +546,91 @@ TEST_F(Plan, CyclesNoiseIsScaledByThePilotsTracerNoiseWhenGiven) {
             "the tracer's renders beside the Cycles pilots (their size and samples)");
 }
 
+// Each object's own Cycles-to-tracer noise ratio, from the pilots (NoiseRatio::object_ratio). Known answer: "Cycles"
+// pilots that are the tracer's own renders (its seeds 1 and 2, the renders measure_cycles_noise makes beside them) but
+// for the sphere, whose second pilot is twice as far from the first: every other object's ratio is the image's
+// exactly (1 over it), the sphere's twice (the ΔE00 is linearised at the two pilots' midpoint, which moves by half the
+// difference: at 64 paths within a few per cent), and the plan predicts each object's noise with its own ratio.
+TEST_F(Plan, PilotsGiveEachObjectItsOwnCyclesToTracerNoiseRatio) {
+  Scene scene = load_scene(kBox);
+  scene.camera.width = scene.camera.height = 32;
+  const Bands bands = Bands::uniform(400, 700, 6);
+  rt::RenderOptions o;
+  o.samples = 64;
+  o.bands = bands;
+  o.mode = SpectralMode::Bands;
+  o.components = rt::ComponentSelection::parse("none");
+  o.threads = 2;
+  o.progress = false;
+  std::int32_t sphere = 0;
+  for (std::size_t i = 0; i < scene.objects.size(); ++i)
+    if (scene.objects[i].name == "sphere") sphere = static_cast<std::int32_t>(i + 1);
+  ASSERT_GT(sphere, 0);
+  std::vector<rt::RenderedImage> images;
+  for (std::uint64_t seed : {1, 2}) {
+    o.seed = seed;
+    images.push_back(rt::render(scene, o));
+  }
+  const std::size_t nb = bands.size();
+  for (std::size_t p = 0; p < images[0].object_ids.size(); ++p)
+    if (images[0].object_ids[p] == sphere)
+      for (std::size_t b = 0; b < nb; ++b) {
+        const float a = images[0].layers[0][p * nb + b];
+        float& v = images[1].layers[0][p * nb + b];
+        v = a + 2 * (v - a);
+      }
+  std::vector<fs::path> pilots;
+  for (std::uint64_t seed : {1, 2}) {
+    SpectralExrLayout layout;
+    layout.width = layout.height = 32;
+    layout.bands = bands;
+    layout.object_ids = true;
+    layout.object_names = images[seed - 1].object_names;
+    layout.attributes["chromatrace.renderer"] = "Cycles (the tracer's render, relabelled for this test)";
+    layout.attributes["chromatrace.samples"] = "64";
+    layout.attributes["chromatrace.seed"] = std::to_string(seed);
+    pilots.push_back(dir_ / fmt::format("pilot-{}.exr", seed));
+    write_spectral_exr(pilots.back(), layout, {images[seed - 1].layers[0]}, images[seed - 1].object_ids);
+  }
+  const plan::NoiseRatio r = plan::measure_cycles_noise(load_scene(kBox), pilots[0], pilots[1], "cie1931", 2);
+  EXPECT_GT(r.ratio, 1.0);  // the sphere's part of the image is noisier
+  ASSERT_TRUE(r.object_ratio.count(sphere));
+  EXPECT_NEAR(r.object_ratio.at(sphere) * r.ratio, 2.0, 0.1);
+  std::size_t others = 0;
+  for (const auto& [id, k] : r.object_ratio) {
+    if (id == sphere) continue;
+    EXPECT_NEAR(k * r.ratio, 1.0, 1e-9) << id;
+    ++others;
+  }
+  EXPECT_GE(others, 3u);  // the walls, at least, hold 16 pixels of 32 × 32
+
+  // The plan takes it: the sphere's predicted noise (its mean in quadrature less its bands') is 3 times what it is
+  // without, every other object's the same.
+  plan::PlanOptions options;
+  options.threads = 2;
+  options.preview_size = 24;
+  options.edge_step_nm = 5;
+  options.cycles_noise_ratio = 1;
+  options.object_target_de00 = 100;  // the mean's law alone: the samples do not move
+  const plan::Plan without = plan::make_plan(scene, options);
+  options.cycles_object_noise_ratio = {{sphere, 3.0}};
+  const plan::Plan with = plan::make_plan(scene, options);
+  ASSERT_EQ(with.objects.size(), without.objects.size());
+  ASSERT_EQ(with.cycles_samples, without.cycles_samples);
+  const auto noise = [](const plan::Plan::ObjectPrediction& p) {
+    return std::sqrt(p.predicted_mean * p.predicted_mean - p.bands_only * p.bands_only);
+  };
+  bool found = false;
+  for (std::size_t i = 0; i < with.objects.size(); ++i) {
+    const bool is_sphere = with.objects[i].id == sphere;
+    found = found || is_sphere;
+    EXPECT_NEAR(noise(with.objects[i]), (is_sphere ? 3.0 : 1.0) * noise(without.objects[i]),
+                1e-9 * noise(without.objects[i])) << with.objects[i].name;
+    EXPECT_EQ(with.objects[i].cycles_ratio, is_sphere ? 3.0 : 1.0);
+  }
+  EXPECT_TRUE(found);
+}
+
 TEST_F(Plan, BadInputGetsExitTwoAndOneLineNamingTheField) {
   const fs::path bad_scene = dir_ / "bad.json";
   Json doc = read_json(kBox);
