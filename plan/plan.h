@@ -67,7 +67,7 @@ struct PlanOptions {
   // overstates at so few paths (docs/plan.md).
   double cycles_pilot_tracer_noise_at_one = 0;
   // Each object's Cycles-to-tracer noise ratio over the image's as the pilots measured it (NoiseRatio::object_ratio):
-  // an object's predicted noise is the preview's share of it times this. Absent: 1.
+  // an object's predicted noise is the preview's share of it times this where it is above 1. Absent: 1.
   std::map<std::int32_t, double> cycles_object_noise_ratio;
   // Also predict the mean ΔE00 that comparing the Cycles render with a tracer reference of this many paths per
   // pixel measures (its noise counts too); 0: not.
@@ -141,7 +141,7 @@ struct Plan {
     std::size_t preview_pixels = 0;
     double bands_only = 0, predicted_mean = 0;
     double noise_scale = 1;  // its pixels' noise over the image's, in the preview
-    double cycles_ratio = 1;  // PlanOptions::cycles_object_noise_ratio's for it (1: none measured)
+    double cycles_ratio = 1;  // PlanOptions::cycles_object_noise_ratio's for it, at least 1 (1: none measured)
   };
   std::vector<ObjectPrediction> objects;
   double object_target_de00 = 0, object_samples_factor = 1;

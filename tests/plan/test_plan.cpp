@@ -604,8 +604,8 @@ TEST_F(Plan, PilotsGiveEachObjectItsOwnCyclesToTracerNoiseRatio) {
   }
   EXPECT_GE(others, 3u);  // the walls, at least, hold 16 pixels of 32 × 32
 
-  // The plan takes it: the sphere's predicted noise (its mean in quadrature less its bands') is 3 times what it is
-  // without, every other object's the same.
+  // The plan takes it where it raises the prediction: the sphere's predicted noise (its mean in quadrature less its
+  // bands') at a ratio of 3 is 3 times what it is without; the ceiling's at 0.5 and every other object's the same.
   plan::PlanOptions options;
   options.threads = 2;
   options.preview_size = 24;
@@ -613,7 +613,11 @@ TEST_F(Plan, PilotsGiveEachObjectItsOwnCyclesToTracerNoiseRatio) {
   options.cycles_noise_ratio = 1;
   options.object_target_de00 = 100;  // the mean's law alone: the samples do not move
   const plan::Plan without = plan::make_plan(scene, options);
-  options.cycles_object_noise_ratio = {{sphere, 3.0}};
+  std::int32_t ceiling = 0;
+  for (std::size_t i = 0; i < scene.objects.size(); ++i)
+    if (scene.objects[i].name == "ceiling") ceiling = static_cast<std::int32_t>(i + 1);
+  ASSERT_GT(ceiling, 0);
+  options.cycles_object_noise_ratio = {{sphere, 3.0}, {ceiling, 0.5}};
   const plan::Plan with = plan::make_plan(scene, options);
   ASSERT_EQ(with.objects.size(), without.objects.size());
   ASSERT_EQ(with.cycles_samples, without.cycles_samples);
