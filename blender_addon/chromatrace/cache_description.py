@@ -8,7 +8,7 @@ import json
 
 import bpy
 
-from . import VERSION, blender_compat, cycles_setup, materials
+from . import VERSION, blender_compat, cycles_setup, materials, render_setup
 from .geometry_digest import update_with_mesh
 
 # Settings that cannot change a final render's pixels (the viewport's, baking, stamps and output naming, which
@@ -72,6 +72,7 @@ def cache_description(scene, request, plan, resolution):
     geometry = {ob.name: _object_digest(ob, depsgraph) for ob in plan.objects}
     camera = scene.camera
     world = scene.world
+    world_map = render_setup.world_map(world, plan)
     focus = camera.data.dof.focus_object
     view_layer = plan.view_layer
     return {
@@ -101,6 +102,8 @@ def cache_description(scene, request, plan, resolution):
                         list(world.color) if world is not None else None],
         "world_settings": [_rna_plain(getattr(world, "cycles", None)),
                            _rna_plain(getattr(world, "cycles_visibility", None))] if world is not None else None,
+        # The importance map the groups' renders give it (absent where they leave it, as before).
+        **({"world_map": world_map} if world_map else {}),
         # Cycles and render settings the render does not set itself: light paths (transparent bounces,
         # minimum bounces, volume steps), sampling pattern, dicing, culling, film transparency of glass, …
         "cycles": _pixel_settings(scene.cycles, cycles_setup.FIXED["cycles"]),

@@ -56,22 +56,21 @@ def _set_world(journal, world, plan):
                     journal.set(node.inputs["Strength"], "default_value", 0.0)
     if world is not None and plan.world_group and world.lightgroup != plan.world_group:
         journal.set(world, "lightgroup", plan.world_group)
-    if world is not None and plan.world["status"] == "lit":
-        _set_world_map(journal, world)
+    resolution = world_map(world, plan)
+    if resolution is not None:
+        journal.set(world.cycles, "sampling_method", "MANUAL")
+        journal.set(world.cycles, "sample_map_resolution", resolution)
 
 
-def _set_world_map(journal, world):
-    """The world's importance map at cycles_setup.world_map_resolution for the band groups' renders (restored
-    after), where Cycles would choose it itself."""
-    settings = getattr(world, "cycles", None)
-    if settings is None or not blender_compat.uses_nodes(world):
-        return
+def world_map(world, plan):
+    """The importance map resolution the band groups' renders give a lit world (cycles_setup.world_map_resolution),
+    or None where they leave its sampling as it is; part of the cache key."""
+    settings = getattr(world, "cycles", None) if world is not None else None
+    if settings is None or plan.world["status"] != "lit" or not blender_compat.uses_nodes(world):
+        return None
     widths = [node.image.size[0] for node in world.node_tree.nodes
               if node.bl_idname == "ShaderNodeTexEnvironment" and node.image is not None]
-    resolution = cycles_setup.world_map_resolution(getattr(settings, "sampling_method", None), widths)
-    if resolution is not None:
-        journal.set(settings, "sampling_method", "MANUAL")
-        journal.set(settings, "sample_map_resolution", resolution)
+    return cycles_setup.world_map_resolution(getattr(settings, "sampling_method", None), widths)
 
 
 def apply_settings(journal, scene, request, plan, resolution):
