@@ -62,15 +62,26 @@ struct LogAxis {
   }
 };
 
-// The range of the values, padded by a tenth of a decade each side (a single value: half a decade).
-std::pair<double, double> log_range(std::vector<double> values, double floor) {
+}  // namespace
+
+LogRange log_range(std::vector<double> values, double floor) {
   for (double& v : values) v = std::max(v, floor);
-  if (values.empty()) return {floor, floor * 10};
-  auto [mn, mx] = std::minmax_element(values.begin(), values.end());
-  double lo = std::log10(*mn), hi = std::log10(*mx);
-  const double pad = hi - lo < 0.2 ? 0.5 : 0.1 * (hi - lo);
-  return {std::pow(10.0, lo - pad), std::pow(10.0, hi + pad)};
+  LogRange r{floor, floor * 10, {}};
+  if (!values.empty()) {
+    auto [mn, mx] = std::minmax_element(values.begin(), values.end());
+    const double lo = std::log10(*mn), hi = std::log10(*mx);
+    const double pad = hi - lo < 0.2 ? 0.5 : 0.1 * (hi - lo);
+    r.lo = std::pow(10.0, lo - pad), r.hi = std::pow(10.0, hi + pad);
+  }
+  // Where fewer than two of 1, 2 and 5 times a power of ten fall inside, log_ticks gives the powers of ten just
+  // outside: the axis reaches them, so that its ticks are on it.
+  r.ticks = log_ticks(r.lo, r.hi);
+  r.lo = std::min(r.lo, r.ticks.front()), r.hi = std::max(r.hi, r.ticks.back());
+  r.ticks = log_ticks(r.lo, r.hi);
+  return r;
 }
+
+namespace {
 
 double value_of(const SettingResult& r, ChartValue value) {
   switch (value) {
@@ -118,18 +129,17 @@ cv::Mat chart(const StudyResult& result, ChartValue value) {
     if (value == ChartValue::SystematicRms) ys.push_back(std::max(r->systematic_rms_hi, floor));
   }
   if (value != ChartValue::DirectionDeg) ys.push_back(1.0);  // the ΔE00 = 1 line is always in view
-  const auto [xlo, xhi] = log_range(xs, 1e-3);
-  const auto [ylo, yhi] = log_range(ys, floor);
-  const LogAxis x{xlo, xhi, left, W - right}, y{ylo, yhi, H - bottom, top};
+  const LogRange xr = log_range(xs, 1e-3), yr = log_range(ys, floor);
+  const LogAxis x{xr.lo, xr.hi, left, W - right}, y{yr.lo, yr.hi, H - bottom, top};
 
   // Grid, ticks and their values.
-  for (double t : log_ticks(xlo, xhi)) {
+  for (double t : xr.ticks) {
     const int px = static_cast<int>(std::lround(x.at(t)));
     cv::line(img, {px, top}, {px, H - bottom}, kGrid, 1);
     cv::line(img, {px, H - bottom}, {px, H - bottom + 5}, kInk, 1);
     put_text(img, log_tick_label(t), {px, H - bottom + 22}, 0.45, kInk, Align::Centre);
   }
-  for (double t : log_ticks(ylo, yhi)) {
+  for (double t : yr.ticks) {
     const int py = static_cast<int>(std::lround(y.at(t)));
     cv::line(img, {left, py}, {W - right, py}, kGrid, 1);
     cv::line(img, {left - 5, py}, {left, py}, kInk, 1);

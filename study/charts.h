@@ -13,6 +13,7 @@
 //                          a setting that changes any object's class is drawn as a cross
 
 #include <filesystem>
+#include <vector>
 
 #include <opencv2/core.hpp>
 
@@ -21,6 +22,15 @@
 namespace ct::study {
 
 enum class ChartValue { MeanDe00, P95De00, SystematicRms, DirectionDeg };
+
+// A logarithmic axis over `values` (each at least `floor`): their range padded by a tenth of a decade each side (a
+// single value: half a decade), widened to its ticks (plot::log_ticks) where they fall outside, so that at least
+// two ticks are on the axis.
+struct LogRange {
+  double lo, hi;
+  std::vector<double> ticks;
+};
+LogRange log_range(std::vector<double> values, double floor);
 
 // 8-bit BGR.
 cv::Mat chart(const StudyResult& result, ChartValue value);

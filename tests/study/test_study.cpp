@@ -192,6 +192,29 @@ TEST(Study, PlannedCyclesSettingTakesEachBandGroupsSamples) {
   EXPECT_EQ(guided, 1);
 }
 
+// A chart's axis holds at least two of its ticks: settings between 3.4 and 7.8 CPU seconds, whose padded range
+// holds only the 5 of 1, 2 and 5 times a power of ten, get an axis from 1 to 10 with 1, 2, 5 and 10 on it (it used to
+// keep 3.1–8.5 and draw the powers of ten just outside, off the frame).
+TEST(StudyCharts, AnAxisReachesItsTicks) {
+  for (const std::vector<double>& values : {std::vector<double>{3.38, 7.83}, std::vector<double>{0.004, 90.0},
+                                            std::vector<double>{5.0}, std::vector<double>{}}) {
+    const study::LogRange r = study::log_range(values, 1e-3);
+    ASSERT_GE(r.ticks.size(), 2u);
+    for (double t : r.ticks) {
+      EXPECT_GE(t, r.lo * (1 - 1e-9));
+      EXPECT_LE(t, r.hi * (1 + 1e-9));
+    }
+    for (double v : values) {
+      EXPECT_GE(v, r.lo);
+      EXPECT_LE(v, r.hi);
+    }
+  }
+  const study::LogRange narrow = study::log_range({3.38, 7.83}, 1e-3);
+  EXPECT_DOUBLE_EQ(narrow.lo, 1.0);
+  EXPECT_DOUBLE_EQ(narrow.hi, 10.0);
+  EXPECT_EQ(narrow.ticks, (std::vector<double>{1, 2, 5, 10}));
+}
+
 TEST(StudyPareto, MarksExactlyTheUndominated) {
   std::vector<study::SettingResult> s(5);
   const double cost[] = {1, 2, 3, 2, 4}, error[] = {5, 3, 1, 4, 1};
