@@ -445,12 +445,12 @@ std::string guided_attribute(const AssemblyManifest& manifest, const GuidedOptio
                        {"threshold", std::round(v.threshold * 100) / 100}});
   }
   Json j = {{"method", "ratio to the guide bands' sum, per object and component (core/guided.h)"},
-                  {"guided", band_list(options.guided_bands)},
-                  {"guides", band_list(options.guide_bands)},
-                  {"radius", options.radius},
-                  {"false_refusal", options.false_refusal},
-                  {"tested", tested},
-                  {"refused", refused}};
+            {"guided", band_list(options.guided_bands)},
+            {"guides", band_list(options.guide_bands)},
+            {"radius", options.radius},
+            {"false_refusal", options.false_refusal},
+            {"tested", tested},
+            {"refused", refused}};
   if (manifest.guided->adaptive_threshold > 0)
     j["adaptive"] = {{"threshold", manifest.guided->adaptive_threshold},
                      {"max_samples", manifest.guided->adaptive_max_samples}};
