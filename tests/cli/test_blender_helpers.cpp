@@ -348,31 +348,24 @@ TEST_F(Assemble, GuidedBandsAreNamedInTheHeaderAndTheFileStillPassesInfoCheck) {
   ASSERT_EQ(run_chromatrace({"assemble", write_manifest(manifest_).string(), "-o", adaptive.string(), "-q"}).exit_code, 0);
   EXPECT_EQ(json::parse(SpectralExrReader(adaptive).info().metadata.at("chromatrace.guided"))["adaptive"],
             json::parse(R"({"threshold": 0.01, "max_samples": 256})"));
-  for (const auto& [bad_adaptive, message] : std::vector<std::pair<json, std::string>>{
-           {{{"threshold", 0}, {"max_samples", 256}}, "guided.adaptive.threshold"},
-           {{{"threshold", 0.01}}, "guided.adaptive"},
-           {{{"threshold", 0.01}, {"max_samples", 0}}, "guided.adaptive.max_samples"}}) {
-    manifest_["guided"]["adaptive"] = bad_adaptive;
-    const auto bad = run_chromatrace({"assemble", write_manifest(manifest_).string(), "-o", dir_.file("bad.exr").string()});
-    EXPECT_EQ(bad.exit_code, 2) << bad_adaptive;
+  // A bad guided record: one line naming the field, exit 2, no output.
+  const auto refused = [&](const std::string& field, const json& value, const std::string& message) {
+    json manifest = manifest_;
+    manifest["guided"][field] = value;
+    const auto bad = run_chromatrace({"assemble", write_manifest(manifest).string(), "-o", dir_.file("bad.exr").string()});
+    EXPECT_EQ(bad.exit_code, 2) << value;
     EXPECT_EQ(line_count(bad.err), 1) << bad.err;
     EXPECT_NE(bad.err.find(message), std::string::npos) << bad.err;
     EXPECT_FALSE(fs::exists(dir_.file("bad.exr")));
-  }
+  };
   manifest_["guided"].erase("adaptive");
-
-  for (const auto& [bands, message] : std::vector<std::pair<json, std::string>>{
-           {json::array(), "guided.bands: names no band"},
-           {{0, 1, 2, 3}, "guided.bands: names every band"},
-           {{3, 3}, "guided.bands[1]: band 3 given twice"},
-           {{4}, "guided.bands[0]"}}) {
-    manifest_["guided"]["bands"] = bands;
-    const auto bad = run_chromatrace({"assemble", write_manifest(manifest_).string(), "-o", dir_.file("bad.exr").string()});
-    EXPECT_EQ(bad.exit_code, 2) << bands;
-    EXPECT_EQ(line_count(bad.err), 1) << bad.err;
-    EXPECT_NE(bad.err.find(message), std::string::npos) << bad.err;
-    EXPECT_FALSE(fs::exists(dir_.file("bad.exr")));
-  }
+  refused("adaptive", {{"threshold", 0}, {"max_samples", 256}}, "guided.adaptive.threshold");
+  refused("adaptive", {{"threshold", 0.01}}, "guided.adaptive");
+  refused("adaptive", {{"threshold", 0.01}, {"max_samples", 0}}, "guided.adaptive.max_samples");
+  refused("bands", json::array(), "guided.bands: names no band");
+  refused("bands", {0, 1, 2, 3}, "guided.bands: names every band");
+  refused("bands", {3, 3}, "guided.bands[1]: band 3 given twice");
+  refused("bands", {4}, "guided.bands[0]");
 }
 
 TEST_F(Assemble, FloatRoundingBetweenPassesIsFoldedSoInfoCheckHolds) {
