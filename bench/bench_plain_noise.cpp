@@ -4,11 +4,12 @@
 //
 // A and B are two plain renders of one scene that differ only in their seed (Blender's multilayer EXR with the
 // Combined and IndexOB passes). Their pixels are linear Rec. 709 (Blender's scene-linear), taken to CIE XYZ and
-// compared as `compare` compares two renders (core/render_delta_e.h): in CIELAB under D65 at the 99th percentile of
-// A's luminance over the pixels not on or next to an emitter. The difference of two renders holds twice the variance
+// compared as `compare` compares two renders (core/render_delta_e.h): in CIELAB under the white of the scene's light
+// (SCENE, plan::scene_light_spectrum; D65 without it) at the 99th percentile of A's luminance over the pixels not on
+// or next to an emitter. The difference of two renders holds twice the variance
 // of either, so one render's noise is their mean ΔE00 / √2 (the convention of `plan`, docs/plan.md "Samples").
 //
-//   bench_plain_noise A.exr B.exr [--emitters ID,ID,...]
+//   bench_plain_noise A.exr B.exr [--emitters ID,ID,...] [--scene SCENE]
 //
 // prints `image NOISE` and, per object id (Blender's pass index, which the add-on's import sets to the scene's id),
 // `object ID PIXELS NOISE`.
@@ -27,8 +28,12 @@
 #include <OpenImageIO/imageio.h>
 #include <fmt/core.h>
 
+#include "core/cie.h"
 #include "core/colour.h"
 #include "core/render_delta_e.h"
+#include "core/scene.h"
+#include "core/spectrum.h"
+#include "plan/plan.h"
 
 namespace {
 
@@ -75,22 +80,30 @@ int main(int argc, char** argv) {
   try {
     std::vector<std::string> files;
     std::set<std::int32_t> emitters;
+    std::string scene_file;
     for (int i = 1; i < argc; ++i) {
       const std::string a = argv[i];
       if (a == "--emitters" && i + 1 < argc) {
         std::stringstream list(argv[++i]);
         for (std::string id; std::getline(list, id, ',');)
           if (!id.empty()) emitters.insert(std::stoi(id));
+      } else if (a == "--scene" && i + 1 < argc) {
+        scene_file = argv[++i];
       } else {
         files.push_back(a);
       }
     }
-    if (files.size() != 2) throw std::runtime_error("usage: bench_plain_noise A.exr B.exr [--emitters ID,ID,...]");
+    if (files.size() != 2) throw std::runtime_error("usage: bench_plain_noise A.exr B.exr [--emitters ID,ID,...] [--scene SCENE]");
     const Plain a = read_plain(files[0]), b = read_plain(files[1]);
     if (a.width != b.width || a.height != b.height) throw std::runtime_error("A and B differ in size");
 
     ct::WhitePolicy policy;
     policy.light = ct::d65_white();  // as compare without the scene's light
+    if (!scene_file.empty()) {
+      const ct::PiecewiseLinearSpectrum light = ct::plan::scene_light_spectrum(ct::load_scene(scene_file));
+      const ct::PiecewiseLinearSpectrum* bar[3] = {&ct::cie::x_bar(), &ct::cie::y_bar(), &ct::cie::z_bar()};
+      for (int c = 0; c < 3; ++c) policy.light[c] = ct::integral_of_product(light, *bar[c], 380, 780);
+    }
     const ct::Vec3d white = ct::white_point(
         a.xyz, ct::near_emitters(a.ids, a.width, a.height, [&](std::int32_t id) { return emitters.count(id) > 0; }),
         policy);

@@ -202,7 +202,7 @@ def plain_noise_of(plain_exr, scene, names, exe):
         lights = {light.get("name") for light in json.load(f).get("lights", [])}
     emitters = ",".join(i for i, name in names.items() if name in lights)
     tool = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(exe))), "bench", "bench_plain_noise")
-    said = run([tool, *plain_exr, "--emitters", emitters]).stdout.split("\n")
+    said = run([tool, *plain_exr, "--emitters", emitters, "--scene", scene]).stdout.split("\n")
     noise = {"image": float(said[0].split()[1]), "objects": {}}
     for line in said[1:]:
         if line.startswith("object "):

@@ -53,7 +53,8 @@ double parse_tolerance(const std::string& text) {
 Action add_compare(CLI::App& app) {
   auto* cmd = add_command(app, "compare");
   struct Options {
-    std::string a, b, output, tolerance, pixels = "matched", camera = "cie1931", colour = "common";
+    std::string a, b, output, tolerance, pixels = "matched", camera = "cie1931", colour = "common",
+                white = "scene";
     double sigmas = 4.0;
     bool quiet = false;
   };
@@ -72,6 +73,10 @@ Action add_compare(CLI::App& app) {
                   "Image-level colours: common (both on the coarser band plan: what the renderers do differently) or "
                   "own (each over its own bands: a coarser plan's colour error counts too)")
       ->capture_default_str();
+  cmd->add_option("--white", o->white,
+                  "The white of the image level's CIELAB: scene (the scene's light, from A's header; D65 where it "
+                  "holds none) or d65")
+      ->capture_default_str();
   cmd->add_flag("-q,--quiet", o->quiet, "No verdict on stderr");
 
   return [o] {
@@ -83,6 +88,7 @@ Action add_compare(CLI::App& app) {
     options.pixels = o->pixels;
     options.camera = o->camera;
     options.colour = o->colour;
+    options.white = o->white;
     if (o->output.empty()) throw InputError("--output: no directory name");
     std::vector<std::filesystem::path> inputs(options.a.begin(), options.a.end());
     inputs.insert(inputs.end(), options.b.begin(), options.b.end());

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <limits>
 #include <numeric>
 #include <set>
@@ -18,7 +19,9 @@
 #include "core/json_input.h"
 #include "core/spectral_exr.h"
 #include "core/render_delta_e.h"
+#include "core/scene.h"
 #include "core/statistics.h"
+#include "plan/plan.h"
 #include "sensor_sim/spectral_response.h"
 
 namespace ct::cmp {
@@ -302,10 +305,38 @@ std::vector<Vec3d> responses(const std::vector<T>& spectra, const Bands& bands, 
   return sensor::camera_tristimulus(std::span<const T>(spectra), bands, curves, pixels);
 }
 
-// D65 through the camera over `bands` (the white's chromaticity: compare does not know the scene's light).
-Vec3d d65_response(const Bands& bands, const sensor::CameraCurves& curves) {
-  const std::vector<double> d65 = band_averages(cie::illuminant("D65"), bands);
-  return responses(d65, bands, curves, 1).front();
+// The white's light (CompareOptions::white): the scene's, from A's header or else B's (its relative paths from
+// chromatrace.scene_directory, else the file's folder), else D65; and what it is, said.
+std::pair<PiecewiseLinearSpectrum, std::string> white_light(const Render& a, const Render& b, const std::string& white) {
+  if (white == "d65") return {cie::illuminant("D65"), "D65"};
+  std::vector<std::string> why;
+  for (const Render* r : {&a, &b}) {
+    const std::string side = r == &a ? "A" : "B";
+    const auto it = r->info.metadata.find("chromatrace.scene");
+    if (it == r->info.metadata.end()) {
+      why.push_back(fmt::format("{}: no chromatrace.scene", side));
+      continue;
+    }
+    const auto dir = r->info.metadata.find("chromatrace.scene_directory");
+    const std::filesystem::path directory =
+        dir != r->info.metadata.end() ? std::filesystem::path(dir->second) : std::filesystem::path(r->info.file).parent_path();
+    try {
+      const Scene scene = parse_scene(json::parse(it->second), r->info.file + ": chromatrace.scene", directory);
+      return {plan::scene_light_spectrum(scene), fmt::format("the scene's light ({}'s chromatrace.scene)", side)};
+    } catch (const std::exception& e) {  // a texture no longer where the scene says, a .blend's name for its scene
+      why.push_back(fmt::format("{}: {}", side, e.what()));
+    }
+  }
+  return {cie::illuminant("D65"), fmt::format("D65: no scene's light in either header ({})", fmt::join(why, "; "))};
+}
+
+// The white's light through the camera over the range of `bands`: its spectrum as it is, not band-averaged (a
+// fluorescent lamp's lines would move its colour), as plan::measure_delta_e takes it.
+Vec3d light_response(const PiecewiseLinearSpectrum& light, const Bands& bands, const sensor::CameraCurves& curves) {
+  Vec3d out{};
+  for (int c = 0; c < 3; ++c)
+    out[c] = integral_of_product(light, curves.curves[c], bands.min_wavelength(), bands.max_wavelength());
+  return out;
 }
 
 // With --colour own: each side through the camera over its own bands, before the finer side is averaged into the
@@ -331,6 +362,8 @@ void check_options(const CompareOptions& options) {
   if (!(options.sigmas >= 0)) throw InputError(fmt::format("--sigmas: must be >= 0, got {:g}", options.sigmas));
   if (options.colour != "common" && options.colour != "own")
     throw InputError(fmt::format("--colour: must be common or own, got \"{}\"", options.colour));
+  if (options.white != "scene" && options.white != "d65")
+    throw InputError(fmt::format("--white: must be scene or d65, got \"{}\"", options.white));
 }
 
 // Load: each side's renders, checked against each other and across the sides.
@@ -498,11 +531,12 @@ void compare_cells(Comparison& c, const std::vector<Render>& A, const std::vecto
   }
 }
 
-// Image level: ΔE00 through the camera between the sides' average images (core/render_delta_e.h), under D65 at
-// the level of A's surfaces (pixels on or next to an emitter left out); the linear previews of both sides.
+// Image level: ΔE00 through the camera between the sides' average images (core/render_delta_e.h), under the white
+// of `light` (CompareOptions::white) at the level of A's surfaces (pixels on or next to an emitter left out); the
+// linear previews of both sides.
 void image_level(Comparison& c, const std::vector<Render>& A, const std::vector<Render>& B,
                  const std::vector<Region>& regions, const sensor::CameraCurves& curves,
-                 const std::vector<Vec3d>& own_a, const std::vector<Vec3d>& own_b) {
+                 const std::vector<Vec3d>& own_a, const std::vector<Vec3d>& own_b, const PiecewiseLinearSpectrum& light) {
   const std::size_t N = static_cast<std::size_t>(c.width) * static_cast<std::size_t>(c.height), nb = c.bands.size();
   auto average = [&](const std::vector<Render>& side) {
     std::vector<double> out(N * nb, 0.0);
@@ -520,7 +554,7 @@ void image_level(Comparison& c, const std::vector<Render>& A, const std::vector<
   for (const Region& r : regions)
     if (r.brdf == "emitter") emitters.insert(r.id);
   WhitePolicy policy;
-  policy.light = d65_response(own ? B.front().info.bands : c.bands, curves);
+  policy.light = light_response(light, own ? B.front().info.bands : c.bands, curves);
   const Vec3d white = white_point(
       xa, near_emitters(A.front().ids, c.width, c.height, [&](std::int32_t id) { return emitters.count(id) > 0; }),
       policy);
@@ -582,7 +616,9 @@ Comparison compare(const CompareOptions& options) {
   shared_components(c, A, B);
   const std::vector<Region> regions = object_regions(c, A.front(), B.front(), options.pixels, brdf_types(scene));
   compare_cells(c, A, B, regions, options);
-  image_level(c, A, B, regions, curves, own_a, own_b);
+  const auto [light, white] = white_light(A.front(), B.front(), options.white);
+  c.white = white;
+  image_level(c, A, B, regions, curves, own_a, own_b, light);
   return c;
 }
 

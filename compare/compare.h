@@ -42,6 +42,11 @@ struct CompareOptions {
   // renderers do differently counts; "own" — each side through the camera over its own bands, so that a coarser
   // plan's colour error counts too (how far a cheap render's colours are from a fine reference's).
   std::string colour = "common";
+  // The white the image level's CIELAB is under: "scene" — the scene's light (plan::scene_light_spectrum of A's
+  // chromatrace.scene, else B's: its lights by radiance × area, its environment's mean), the white `plan` predicts
+  // under and `study` measures under; where neither header holds a scene whose light can be read, D65, and
+  // compare.json says why. "d65": D65 whatever the scene's light.
+  std::string white = "scene";
 };
 
 struct Cell {
@@ -71,6 +76,7 @@ struct Comparison {
   int width = 0, height = 0;
   Bands bands;  // the common (coarser) plan
   std::string colour = "common";  // how the image level's colours were made (CompareOptions::colour)
+  std::string white;  // the white's light, said: "the scene's light (A's chromatrace.scene)", "D65", or "D65: … why"
   std::vector<std::string> components;  // compared: "total" and the components both have
   std::vector<std::string> only_a, only_b;
   std::size_t id_mismatch_pixels = 0;  // pixels whose object id differs between A and B

@@ -116,6 +116,7 @@ json to_json(const Comparison& c) {
           {"standard_error", c.se_method},
           {"image", {{"camera", c.camera},
                      {"colour", c.colour},
+                     {"white", c.white},
                      {"delta_e00", {{"mean", c.delta_e_mean}, {"p95", c.delta_e_p95}, {"max", c.delta_e_max}}}}},
           {"verdict", {{"cells", c.cells.size()}, {"failed", c.failed}, {"agree", c.failed == 0}}},
           {"objects", objects},

@@ -2,6 +2,7 @@
 // write_render: a render written as a spectral EXR. Apart from render.cpp so that the tracer itself, which
 // `chromatrace check-scene` runs through plan's model, is linked without OpenEXR (chromatrace_tracer_core).
 #include <cmath>
+#include <filesystem>
 
 #include <fmt/core.h>
 #include <nlohmann/json.hpp>
@@ -37,6 +38,8 @@ void write_render(const std::filesystem::path& path, const Scene& scene, const R
   layout.attributes["chromatrace.samples"] = std::to_string(image.samples);
   layout.attributes["chromatrace.seed"] = std::to_string(image.settings.seed);
   layout.attributes["chromatrace.scene"] = scene.json.dump(-1, ' ', false, kReplaceInvalidUtf8);
+  // Where its relative paths (textures, spectra, meshes) resolve, for a reader of the scene (compare's white).
+  if (!scene.directory.empty()) layout.attributes["chromatrace.scene_directory"] = std::filesystem::absolute(scene.directory).string();
   layout.attributes["chromatrace.camera"] = camera.dump(-1, ' ', false, kReplaceInvalidUtf8);
 
   write_spectral_exr(path, std::move(layout), image.layers, image.object_ids);

@@ -298,6 +298,8 @@ class SpectralRender:
             attributes["chromatrace.warning"] = node_resolution.world_warning(plan.world)
         if request.plan_header:
             attributes["chromatrace.plan"] = request.plan_header
+        if s.source_json and s.source_file:  # where the scene's relative paths resolve (compare's white reads them)
+            attributes["chromatrace.scene_directory"] = os.path.dirname(os.path.abspath(bpy.path.abspath(s.source_file)))
         return attributes | {
             "chromatrace.renderer": (f"Cycles (Blender {bpy.app.version_string}) via the chromatrace add-on: "
                                      f"{plan.per_render} band(s) per render, max {request.max_bounces} bounces, "

@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: Apache-2.0
 // chromatrace compare on synthetic renders with known means and known noise: agreement, a known
 // disagreement found in exactly its cells, standard errors from one render and from several seeds, nested
-// band plans, and incomparable or bad input (exit 2, one line, nothing written).
+// band plans, and incomparable or bad input (exit 2, one line, nothing written); and the white of its ΔE00, on
+// the tracer's renders of the paper box under F11.
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -13,8 +14,12 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "core/json_input.h"
+#include "core/scene.h"
 #include "core/spectral_exr.h"
+#include "plan/plan.h"
 #include "tests/cli/run_command.h"
+#include "tests/cli/text_files.h"
 #include "tests/core/spectral_exr_fixtures.h"
 
 namespace ct {
@@ -399,6 +404,54 @@ TEST_F(Compare, OwnColoursCountTheCoarserPlansColourError) {
   EXPECT_EQ(bad.exit_code, 2);
   EXPECT_NE(bad.err.find("--colour"), std::string::npos) << bad.err;
   EXPECT_FALSE(fs::exists(dir_.file("x")));
+}
+
+}  // namespace
+}  // namespace ct
+
+namespace ct {
+namespace {
+
+// The image level's white is the scene's light (CompareOptions::white), the white plan predicts under: two tracer
+// renders of the paper box lit by F11 (its seeds 1 and 2), whose ΔE00 between them compare measures exactly as
+// plan::measure_delta_e does (its white from the scene's light at the level of its reference, here A); under
+// --white d65 another, the renders' colours being no longer those of a light its observer has adapted to; and a
+// render whose header holds no scene with a light is compared under D65, said with the reason.
+TEST_F(Compare, TheWhiteIsTheScenesLightAsPlanMeasures) {
+  Json doc = read_json(test::kPaperBox);
+  doc["spectra"]["lamp"] = {{"illuminant", "F11"}};
+  for (auto& [name, spectrum] : doc["spectra"].items())
+    if (spectrum.contains("csv"))
+      spectrum["csv"] = (fs::path(test::kPaperBox).parent_path() / spectrum["csv"].get<std::string>()).lexically_normal().string();
+  const fs::path scene_file = dir_.file("box-f11.json");
+  std::ofstream(scene_file) << doc.dump(1);
+  std::vector<std::string> renders;
+  for (int seed : {1, 2}) {
+    renders.push_back(dir_.file(fmt::format("box-f11-{}.exr", seed)).string());
+    const test::CommandResult r =
+        test::run_chromatrace({"render", scene_file.string(), "-o", renders.back(), "--resolution", "24x24", "--bands",
+                               "400:700:30", "--spp", "16", "--seed", std::to_string(seed), "-q"});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+  }
+  ASSERT_EQ(run({renders[0], renders[1], "-o", dir_.file("scene").string(), "--colour", "own"}).exit_code, 0);
+  ASSERT_EQ(run({renders[0], renders[1], "-o", dir_.file("d65").string(), "--colour", "own", "--white", "d65"}).exit_code,
+            0);
+  const json scene = result("scene"), d65 = result("d65");
+  EXPECT_EQ(scene["image"]["white"], "the scene's light (A's chromatrace.scene)");
+  EXPECT_EQ(d65["image"]["white"], "D65");
+  const double measured = plan::measure_delta_e(renders[1], renders[0], load_scene(scene_file)).mean;
+  // The same pixels, observer, white and formula: equal but for the order of floating-point sums.
+  EXPECT_NEAR(scene["image"]["delta_e00"]["mean"].get<double>(), measured, 1e-9 * measured);
+  EXPECT_GT(std::abs(d65["image"]["delta_e00"]["mean"].get<double>() - measured), 0.02 * measured);
+
+  Synthetic s;  // its scene has neither lights nor the fields a scene file needs
+  const std::string fa = render("synthetic-a.exr", s).string(), fb = render("synthetic-b.exr", s).string();
+  ASSERT_EQ(run({fa, fb, "-o", dir_.file("synthetic").string()}).exit_code, 0);
+  const std::string said = result("synthetic")["image"]["white"].get<std::string>();
+  EXPECT_EQ(said.rfind("D65: no scene's light in either header (A: ", 0), 0u) << said;
+  const auto bad = run({fa, fb, "-o", dir_.file("x").string(), "--white", "d50"});
+  EXPECT_EQ(bad.exit_code, 2);
+  EXPECT_NE(bad.err.find("--white"), std::string::npos) << bad.err;
 }
 
 }  // namespace
