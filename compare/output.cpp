@@ -190,7 +190,7 @@ tr.fail{{background:#fdd}} .verdict{{font-size:1.2em;font-weight:bold}} img{{ima
 <b>B</b>: {b_files} — {b_renderer}, {b_samples} samples, seeds {b_seeds}<br>
 {w}×{h} pixels, {bands} bands {lo:g}–{hi:g} nm; components {components}; pixels: {pixels} ({mismatch} pixels with different
 object ids left out); tolerance {tolerance}, plus {sigmas:g} standard errors.</p>
-<p>ΔE00 through {camera}: mean {de_mean:.3f}, 95th percentile {de_p95:.3f}, max {de_max:.3f}.</p>
+<p>ΔE00 through {camera}, white: {white}: mean {de_mean:.3f}, 95th percentile {de_p95:.3f}, max {de_max:.3f}.</p>
 <img alt="A | B | A-B | ΔE00" src="data:image/png;base64,{png}">
 <h2>Cells (object × component × band), failures and largest |z| first</h2>
 <table id="cells"><tr><th>object</th><th>BRDF</th><th>component</th><th>band</th><th>pixels</th><th>mean A ± se</th>
@@ -209,7 +209,7 @@ object ids left out); tolerance {tolerance}, plus {sigmas:g} standard errors.</p
       fmt::arg("components", escape_html(fmt::format("{}", fmt::join(c.components, ", ")))),
       fmt::arg("pixels", c.pixels_mode), fmt::arg("mismatch", c.id_mismatch_pixels),
       fmt::arg("tolerance", escape_html(c.tolerance_mode)), fmt::arg("sigmas", c.sigmas), fmt::arg("camera", escape_html(c.camera)),
-      fmt::arg("de_mean", c.delta_e_mean), fmt::arg("de_p95", c.delta_e_p95), fmt::arg("de_max", c.delta_e_max),
+      fmt::arg("white", escape_html(c.white)), fmt::arg("de_mean", c.delta_e_mean), fmt::arg("de_p95", c.delta_e_p95), fmt::arg("de_max", c.delta_e_max),
       fmt::arg("png", base64(png_bytes)), fmt::arg("rows", rows));
 }
 
@@ -239,8 +239,8 @@ std::string verdict(const Comparison& c, std::size_t max_lines) {
                      c.width, c.height, c.bands.size(), c.bands.min_wavelength(), c.bands.max_wavelength(),
                      c.components.size(), c.pixels_mode, c.id_mismatch_pixels);
   out += fmt::format("  standard errors from {}\n", c.se_method);
-  out += fmt::format("  ΔE00 ({}): mean {:.3f}, 95th percentile {:.3f}, max {:.3f}\n", c.camera, c.delta_e_mean,
-                     c.delta_e_p95, c.delta_e_max);
+  out += fmt::format("  ΔE00 ({}, white: {}): mean {:.3f}, 95th percentile {:.3f}, max {:.3f}\n", c.camera, c.white,
+                     c.delta_e_mean, c.delta_e_p95, c.delta_e_max);
   const auto cells = worst_cells(c);
   if (c.failed == 0) {
     out += fmt::format("  AGREE: all {} cells (object × component × band) within tolerance ({}, + {:g} SE)", c.cells.size(),

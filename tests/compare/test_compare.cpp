@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <fstream>
 #include <random>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -439,6 +440,9 @@ TEST_F(Compare, TheWhiteIsTheScenesLightAsPlanMeasures) {
   const json scene = result("scene"), d65 = result("d65");
   EXPECT_EQ(scene["image"]["white"], "the scene's light (A's chromatrace.scene)");
   EXPECT_EQ(d65["image"]["white"], "D65");
+  std::stringstream page;
+  page << std::ifstream(dir_.file("scene") / "compare.html").rdbuf();
+  EXPECT_NE(page.str().find("white: the scene&#39;s light (A&#39;s chromatrace.scene)"), std::string::npos);  // said to its reader
   const double measured = plan::measure_delta_e(renders[1], renders[0], load_scene(scene_file)).mean;
   // The same pixels, observer, white and formula: equal but for the order of floating-point sums.
   EXPECT_NEAR(scene["image"]["delta_e00"]["mean"].get<double>(), measured, 1e-9 * measured);
