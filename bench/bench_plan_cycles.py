@@ -240,14 +240,19 @@ def floor_of(plan, plain_noise, args, spectral_cpu, plain_cpu):
 
 
 def guided_render(args, plan_file, plan, blender, source, res, out_dir, case, exe, compared_with_reference):
-    """The planned render again with its group of most samples as the guide and the others at --guided of its
-    samples, reconstructed from it when assembled (core/guided.h): its CPU, its error and the refusals."""
+    """The planned render again with the plan's guide group (else its group of most samples) at the most samples of
+    any group and the others at --guided of them, reconstructed from it when assembled (core/guided.h): its CPU, its
+    error and the refusals."""
     with open(plan_file) as f:
         bands = json.load(f)
     planned = bands["cycles_samples"]
-    guide = planned.index(max(planned))
-    few = max(1, math.ceil(planned[guide] * args.guided))
-    bands["cycles_samples"] = [planned[guide] if g == guide else few for g in range(len(planned))]
+    # The plan's guide (the group its pilots measured least noisy relative to its signal), with the most samples.
+    guide = plan.get("guide_band_group")
+    if guide is None:
+        guide = planned.index(max(planned))
+    most = max(planned)
+    few = max(1, math.ceil(most * args.guided))
+    bands["cycles_samples"] = [most if g == guide else few for g in range(len(planned))]
     bands["cycles_guided_groups"] = [g for g in range(len(planned)) if g != guide]
     if args.guided_threshold:
         bands["cycles_guided_threshold"] = args.guided_threshold

@@ -3,6 +3,7 @@
 // `chromatrace check-scene` runs, is linked without OpenEXR (chromatrace_plan_model).
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <numeric>
 #include <optional>
@@ -185,6 +186,34 @@ NoiseRatio measure_cycles_noise(const Scene& scene, const std::filesystem::path&
       sum += d;
     }
   for (double& d : out.group_shares) d = sum > 0 ? d / sum : 0.0;
+  // Each group's noise relative to its signal, on the image and on each object; its largest.
+  const auto first_light = static_cast<std::int32_t>(scene.objects.size()) + 1;
+  out.group_relative_noise.assign(groups, 0.0);
+  for (std::size_t g = 0; g < groups; ++g) {
+    struct Sums {
+      double noise = 0, signal = 0;
+      std::size_t pixels = 0;
+    };
+    Sums image;
+    std::map<std::int32_t, Sums> objects;
+    for (std::size_t p = 0; p < pixels; ++p) {
+      if (ids[p] >= first_light) continue;  // a light's own pixels
+      double d = 0, m = 0;
+      for (std::size_t b = 3 * g; b < std::min(nb, 3 * g + 3); ++b) {
+        d += double{va[p * nb + b]} - vb[p * nb + b];
+        m += 0.5 * (double{va[p * nb + b]} + vb[p * nb + b]);
+      }
+      for (Sums* s : {&image, ids[p] > 0 ? &objects[ids[p]] : nullptr})
+        if (s) s->noise += std::abs(d) / std::sqrt(2.0), s->signal += m, ++s->pixels;
+    }
+    auto relative = [](const Sums& s) {
+      return s.signal > 0 ? s.noise / s.signal : std::numeric_limits<double>::infinity();
+    };
+    double worst = relative(image);
+    for (const auto& [id, s] : objects)
+      if (s.pixels >= kPilotObjectPixels) worst = std::max(worst, relative(s));
+    out.group_relative_noise[g] = worst;
+  }
   // The tracer alike: the pilots' size, bands and samples.
   Scene s = scene;
   s.camera.width = ia.width;

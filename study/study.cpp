@@ -241,12 +241,14 @@ std::vector<Setting> make_settings(const Scene& scene, const StudyOptions& optio
              s.samples = groups ? *std::max_element(p.cycles_samples.begin(), p.cycles_samples.end()) : p.samples;
              if (groups) s.cycles_samples = p.cycles_samples;
            });
-      // Guided: the group of most samples keeps them and guides the others, rendered at a fraction of them, with
-      // adaptive sampling up to them where a pixel stays noisy (at Cycles' own default threshold, 0.01).
+      // Guided: the plan's guide group (the least noisy relative to its signal on the pilots), else the group of
+      // most samples, takes the most samples and guides the others, rendered at a fraction of them, with adaptive
+      // sampling up to them where a pixel stays noisy (at Cycles' own default threshold, 0.01).
       if (groups && options.guided_fraction > 0) {
-        const auto guide = static_cast<std::size_t>(
-            std::max_element(p.cycles_samples.begin(), p.cycles_samples.end()) - p.cycles_samples.begin());
-        const int most = p.cycles_samples[guide];
+        const auto most_at = std::max_element(p.cycles_samples.begin(), p.cycles_samples.end());
+        const auto guide = p.cycles_guide_group >= 0 ? static_cast<std::size_t>(p.cycles_guide_group)
+                                                     : static_cast<std::size_t>(most_at - p.cycles_samples.begin());
+        const int most = *most_at;
         const int few = std::max(1, static_cast<int>(std::ceil(most * options.guided_fraction)));
         std::vector<int> samples;
         std::vector<std::size_t> guided;

@@ -86,6 +86,7 @@ class Planned:
                            "predicted_bands_mean_de00": self.report["prediction"]["mean_de00"],
                            "noise_ratio_to_tracer": cycles["noise_ratio_to_tracer"],
                            "tracer_noise_at_one_sample": cycles["tracer_noise_at_one_sample"],
+                           "guide_band_group": cycles.get("guide_band_group"),
                            "worst_object": self.worst_object()})
 
 

@@ -8,6 +8,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <functional>
 #include <map>
 #include <optional>
 
@@ -43,6 +44,54 @@ class Plan : public ::testing::Test {
     fs::create_directories(dir_);
   }
   void TearDown() override { fs::remove_all(dir_); }
+
+  static std::int32_t object_id(const Scene& scene, const std::string& name) {
+    for (std::size_t i = 0; i < scene.objects.size(); ++i)
+      if (scene.objects[i].name == name) return static_cast<std::int32_t>(i + 1);
+    ADD_FAILURE() << name;
+    return 0;
+  }
+
+  // "Cycles" pilots that are the tracer's own renders of `scene` in 6 nm bands over 400-700 nm at 64 paths (its seeds 1
+  // and 2, the renders measure_cycles_noise makes beside them), the second moved from the first by `scale(id, band)`
+  // times their difference (1: as rendered).
+  std::vector<fs::path> tracer_pilots(const Scene& scene, const std::function<double(std::int32_t, std::size_t)>& scale) {
+    const Bands bands = Bands::uniform(400, 700, 6);
+    rt::RenderOptions o;
+    o.samples = 64;
+    o.bands = bands;
+    o.mode = SpectralMode::Bands;
+    o.components = rt::ComponentSelection::parse("none");
+    o.threads = 2;
+    o.progress = false;
+    std::vector<rt::RenderedImage> images;
+    for (std::uint64_t seed : {1, 2}) {
+      o.seed = seed;
+      images.push_back(rt::render(scene, o));
+    }
+    const std::size_t nb = bands.size();
+    for (std::size_t p = 0; p < images[0].object_ids.size(); ++p)
+      for (std::size_t b = 0; b < nb; ++b) {
+        const float a = images[0].layers[0][p * nb + b];
+        float& v = images[1].layers[0][p * nb + b];
+        v = static_cast<float>(a + scale(images[0].object_ids[p], b) * (v - a));
+      }
+    std::vector<fs::path> pilots;
+    for (std::uint64_t seed : {1, 2}) {
+      SpectralExrLayout layout;
+      layout.width = scene.camera.width;
+      layout.height = scene.camera.height;
+      layout.bands = bands;
+      layout.object_ids = true;
+      layout.object_names = images[seed - 1].object_names;
+      layout.attributes["chromatrace.renderer"] = "Cycles (the tracer's render, relabelled for this test)";
+      layout.attributes["chromatrace.samples"] = "64";
+      layout.attributes["chromatrace.seed"] = std::to_string(seed);
+      pilots.push_back(dir_ / fmt::format("pilot-{}.exr", seed));
+      write_spectral_exr(pilots.back(), layout, {images[seed - 1].layers[0]}, images[seed - 1].object_ids);
+    }
+    return pilots;
+  }
 
   // Renders `scene` at 24×24 into `name` with the given bands and bounce limit.
   fs::path render(const Scene& scene, const Bands& bands, int max_bounces, std::uint64_t seed, int spp,
@@ -554,44 +603,8 @@ TEST_F(Plan, CyclesNoiseIsScaledByThePilotsTracerNoiseWhenGiven) {
 TEST_F(Plan, PilotsGiveEachObjectItsOwnCyclesToTracerNoiseRatio) {
   Scene scene = load_scene(kBox);
   scene.camera.width = scene.camera.height = 32;
-  const Bands bands = Bands::uniform(400, 700, 6);
-  rt::RenderOptions o;
-  o.samples = 64;
-  o.bands = bands;
-  o.mode = SpectralMode::Bands;
-  o.components = rt::ComponentSelection::parse("none");
-  o.threads = 2;
-  o.progress = false;
-  std::int32_t sphere = 0;
-  for (std::size_t i = 0; i < scene.objects.size(); ++i)
-    if (scene.objects[i].name == "sphere") sphere = static_cast<std::int32_t>(i + 1);
-  ASSERT_GT(sphere, 0);
-  std::vector<rt::RenderedImage> images;
-  for (std::uint64_t seed : {1, 2}) {
-    o.seed = seed;
-    images.push_back(rt::render(scene, o));
-  }
-  const std::size_t nb = bands.size();
-  for (std::size_t p = 0; p < images[0].object_ids.size(); ++p)
-    if (images[0].object_ids[p] == sphere)
-      for (std::size_t b = 0; b < nb; ++b) {
-        const float a = images[0].layers[0][p * nb + b];
-        float& v = images[1].layers[0][p * nb + b];
-        v = a + 2 * (v - a);
-      }
-  std::vector<fs::path> pilots;
-  for (std::uint64_t seed : {1, 2}) {
-    SpectralExrLayout layout;
-    layout.width = layout.height = 32;
-    layout.bands = bands;
-    layout.object_ids = true;
-    layout.object_names = images[seed - 1].object_names;
-    layout.attributes["chromatrace.renderer"] = "Cycles (the tracer's render, relabelled for this test)";
-    layout.attributes["chromatrace.samples"] = "64";
-    layout.attributes["chromatrace.seed"] = std::to_string(seed);
-    pilots.push_back(dir_ / fmt::format("pilot-{}.exr", seed));
-    write_spectral_exr(pilots.back(), layout, {images[seed - 1].layers[0]}, images[seed - 1].object_ids);
-  }
+  const std::int32_t sphere = object_id(scene, "sphere");
+  const std::vector<fs::path> pilots = tracer_pilots(scene, [&](std::int32_t id, std::size_t) { return id == sphere ? 2.0 : 1.0; });
   const plan::NoiseRatio r = plan::measure_cycles_noise(load_scene(kBox), pilots[0], pilots[1], "cie1931", 2);
   EXPECT_GT(r.ratio, 1.0);  // the sphere's part of the image is noisier
   ASSERT_TRUE(r.object_ratio.count(sphere));
@@ -633,6 +646,52 @@ TEST_F(Plan, PilotsGiveEachObjectItsOwnCyclesToTracerNoiseRatio) {
     EXPECT_EQ(with.objects[i].cycles_ratio, is_sphere ? 3.0 : 1.0);
   }
   EXPECT_TRUE(found);
+}
+
+// The guide of a guided render (NoiseRatio::group_relative_noise, Plan::cycles_guide_group): each band group's noise
+// over its signal, the largest over the image and its objects, and the group of the least. Known answers: the second
+// pilot moved k = 3 times as far from the first in the least noisy group's bands multiplies its relative noise by k
+// (within what the move does to its signal: the pair's mean moves by (k − 1)/2 of their difference, at most
+// (k − 1)/√2 times the relative noise) and leaves the others' as they were; and the plan names as guide the group of
+// the least, where the pilots' shares are of its own bands, and none where no pilots measured them.
+TEST_F(Plan, TheGuideIsTheGroupLeastNoisyOnItsWorstObject) {
+  Scene scene = load_scene(kBox);
+  scene.camera.width = scene.camera.height = 32;
+  const auto as_rendered = tracer_pilots(scene, [](std::int32_t, std::size_t) { return 1.0; });
+  const plan::NoiseRatio r = plan::measure_cycles_noise(load_scene(kBox), as_rendered[0], as_rendered[1], "cie1931", 2);
+  const std::vector<double>& before = r.group_relative_noise;
+  ASSERT_EQ(before.size() * before.size(), r.group_shares.size());  // one a band group
+  const auto least = static_cast<std::size_t>(std::min_element(before.begin(), before.end()) - before.begin());
+  constexpr double k = 3;
+  const auto moved = tracer_pilots(scene, [&](std::int32_t, std::size_t b) { return b / 3 == least ? k : 1.0; });
+  const plan::NoiseRatio m = plan::measure_cycles_noise(load_scene(kBox), moved[0], moved[1], "cie1931", 2);
+  const double eps = (k - 1) / std::sqrt(2.0) * before[least];
+  ASSERT_LT(eps, 0.5);
+  EXPECT_GE(m.group_relative_noise[least], k * before[least] / (1 + eps));
+  EXPECT_LE(m.group_relative_noise[least], k * before[least] / (1 - eps));
+  for (std::size_t g = 0; g < before.size(); ++g) {
+    if (g == least) continue;
+    EXPECT_NEAR(m.group_relative_noise[g], before[g], 1e-6 * before[g]) << g;
+  }
+
+  plan::PlanOptions options;
+  options.threads = 2;
+  options.preview_size = 24;
+  options.edge_step_nm = 5;
+  options.cycles_noise_ratio = 1;
+  const plan::Plan unmeasured = plan::make_plan(scene, options);
+  EXPECT_EQ(unmeasured.cycles_guide_group, -1);
+  const std::size_t groups = unmeasured.cycles_samples.size();
+  ASSERT_GE(groups, 2u);
+  options.cycles_group_shares_edges_nm = unmeasured.bands.edges();
+  options.cycles_group_shares.assign(groups * groups, 0.0);
+  for (std::size_t g = 0; g < groups; ++g) options.cycles_group_shares[g * groups + g] = 1.0 / static_cast<double>(groups);
+  options.cycles_group_relative_noise.assign(groups, 0.5);
+  options.cycles_group_relative_noise[groups - 1] = 0.1;
+  const plan::Plan named = plan::make_plan(scene, options);
+  ASSERT_EQ(named.bands.edges(), unmeasured.bands.edges());
+  EXPECT_EQ(named.cycles_guide_group, static_cast<int>(groups - 1));
+  EXPECT_EQ(plan::report_document(named, scene, options)["prediction"]["cycles"]["guide_band_group"], groups - 1);
 }
 
 TEST_F(Plan, BadInputGetsExitTwoAndOneLineNamingTheField) {

@@ -328,6 +328,9 @@ class Planning(unittest.TestCase):
         self.assertEqual(header["tracer_noise_at_one_sample"], 18.1)
         self.assertEqual((header["predicted_noise_mean_de00"], header["predicted_bands_mean_de00"]), (0.95, 0.31))
         self.assertIsNone(header["worst_object"])
+        self.assertIsNone(header["guide_band_group"])  # the report names none: no pilots measured the groups
+        report["prediction"]["cycles"]["guide_band_group"] = 1
+        self.assertEqual(json.loads(planning.Planned("plan.json", report).header())["guide_band_group"], 1)
 
     def test_the_worst_object_said_with_the_samples_it_took(self):
         objects = [{"name": "floor", "object_id": 1, "mean_de00": 0.8}, {"name": "ceiling", "object_id": 2, "mean_de00": 1.96}]
