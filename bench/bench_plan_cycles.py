@@ -364,6 +364,8 @@ def bench(scene_name, light, args, work, blender_exe, version, references):
         run([exe, "compare", exr, reference, "-o", compare_dir, "--colour", "own", "-q"])
         with open(os.path.join(compare_dir, "compare.json")) as f:
             compared = json.load(f)
+        if not compared["image"]["white"].startswith("the scene's light"):  # as the plan predicts (docs/compare.md)
+            sys.exit(f"{exr}: compared under {compared['image']['white']}, not under the scene's light")
         worst_de, worst = max((o["delta_e00_mean"], o["object"]) for o in compared["objects"]
                               if o["object_id"] >= 0 and "delta_e00_mean" in o)
         return compared["image"]["delta_e00"]["mean"], worst_de, worst
