@@ -203,8 +203,13 @@ NoiseRatio measure_cycles_noise(const Scene& scene, const std::filesystem::path&
         d += double{va[p * nb + b]} - vb[p * nb + b];
         m += 0.5 * (double{va[p * nb + b]} + vb[p * nb + b]);
       }
-      for (Sums* s : {&image, ids[p] > 0 ? &objects[ids[p]] : nullptr})
-        if (s) s->noise += std::abs(d) / std::sqrt(2.0), s->signal += m, ++s->pixels;
+      auto add = [&](Sums& s) {
+        s.noise += std::abs(d) / std::sqrt(2.0);
+        s.signal += m;
+        ++s.pixels;
+      };
+      add(image);
+      if (ids[p] > 0) add(objects[ids[p]]);
     }
     auto relative = [](const Sums& s) {
       return s.signal > 0 ? s.noise / s.signal : std::numeric_limits<double>::infinity();
