@@ -94,7 +94,7 @@ Action add_plan(CLI::App& app) {
       o->plan.cycles_min_samples = r.samples;
       o->plan.cycles_pilot_tracer_noise_at_one = r.tracer_at_one;
       o->plan.cycles_object_noise_ratio = r.object_ratio;
-      o->plan.cycles_group_relative_noise = r.group_relative_noise;
+      o->plan.cycles_group_guided_delta_e = r.group_guided_delta_e;
       o->plan.cycles_noise_ratio_from = fmt::format(
           "Cycles pilots {} and {} ({} samples): mean ΔE00 {:.3f} between them against the tracer's {:.3f}, ratio ± "
           "2 standard errors",

@@ -186,38 +186,43 @@ NoiseRatio measure_cycles_noise(const Scene& scene, const std::filesystem::path&
       sum += d;
     }
   for (double& d : out.group_shares) d = sum > 0 ? d / sum : 0.0;
-  // Each group's noise relative to its signal, on the image and on each object; its largest.
+  // Each group as the guide of a guided render: every band reconstructed from it takes its noise relative to its
+  // signal, δ_g(p) = Σ_b (a_b − b_b) / √2 over Σ_b (a_b + b_b) / 2 (b the group's bands), as a factor common to all
+  // bands (|δ| ≤ √2: the pilots' values are not negative). Its ΔE00 is that between x̄ · (1 ∓ δ_g / 2), x̄ the pilots'
+  // mean, linearised as pixel_differences does, since it scales as the guide's noise at any samples; under the white
+  // at the level of x̄. Averaged over the image's pixels (lights' own left out) and over the pixels of each object
+  // that holds kPilotObjectPixels, then over the image and those objects, each once.
   const auto first_light = static_cast<std::int32_t>(scene.objects.size()) + 1;
-  out.group_relative_noise.assign(groups, 0.0);
-  for (std::size_t g = 0; g < groups; ++g) {
-    struct Sums {
-      double noise = 0, signal = 0;
-      std::size_t pixels = 0;
-    };
-    Sums image;
-    std::map<std::int32_t, Sums> objects;
-    for (std::size_t p = 0; p < pixels; ++p) {
-      if (ids[p] >= first_light) continue;  // a light's own pixels
-      double d = 0, m = 0;
-      for (std::size_t b = 3 * g; b < std::min(nb, 3 * g + 3); ++b) {
-        d += double{va[p * nb + b]} - vb[p * nb + b];
-        m += 0.5 * (double{va[p * nb + b]} + vb[p * nb + b]);
+  {
+    std::vector<float> mean(va.size());
+    for (std::size_t i = 0; i < va.size(); ++i) mean[i] = 0.5f * (va[i] + vb[i]);
+    const std::vector<Vec3d> xm = tristimuli(mean);
+    const Vec3d white = white_of(xm, ids, ia.width, ia.height, scene, ia.bands, curves);
+    std::vector<std::int32_t> lit = ids;  // −1 on a light's own pixels
+    for (std::int32_t& id : lit)
+      if (id >= first_light) id = -1;
+    out.group_guided_delta_e.assign(groups, 0.0);
+    for (std::size_t g = 0; g < groups; ++g) {
+      std::vector<Vec3d> lo(pixels), hi(pixels);
+      for (std::size_t p = 0; p < pixels; ++p) {
+        double d = 0, m = 0;
+        for (std::size_t b = 3 * g; b < std::min(nb, 3 * g + 3); ++b) {
+          d += double{va[p * nb + b]} - vb[p * nb + b];
+          m += 0.5 * (double{va[p * nb + b]} + vb[p * nb + b]);
+        }
+        const double delta = m > 0 ? d / std::sqrt(2.0) / m : 0.0;
+        for (int c = 0; c < 3; ++c) lo[p][c] = xm[p][c] * (1 - delta / 2), hi[p][c] = xm[p][c] * (1 + delta / 2);
       }
-      auto add = [&](Sums& s) {
-        s.noise += std::abs(d) / std::sqrt(2.0);
-        s.signal += m;
-        ++s.pixels;
-      };
-      add(image);
-      if (ids[p] > 0) add(objects[ids[p]]);
+      const std::vector<double> de = pixel_differences(lo, hi, white);
+      double image = 0;
+      std::size_t n = 0, members = 1;
+      for (std::size_t p = 0; p < pixels; ++p)
+        if (lit[p] >= 0) image += de[p], ++n;
+      double sum = n > 0 ? image / static_cast<double>(n) : 0.0;
+      for (const auto& [id, s] : means_by_object(de, lit))
+        if (id > 0 && s.second >= kPilotObjectPixels) sum += s.first, ++members;
+      out.group_guided_delta_e[g] = sum / static_cast<double>(members);
     }
-    auto relative = [](const Sums& s) {
-      return s.signal > 0 ? s.noise / s.signal : std::numeric_limits<double>::infinity();
-    };
-    double worst = relative(image);
-    for (const auto& [id, s] : objects)
-      if (s.pixels >= kPilotObjectPixels) worst = std::max(worst, relative(s));
-    out.group_relative_noise[g] = worst;
   }
   // The tracer alike: the pilots' size, bands and samples.
   Scene s = scene;

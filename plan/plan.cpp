@@ -1052,9 +1052,9 @@ Plan make_plan(const Scene& scene, const PlanOptions& options) {
     for (std::size_t g = 0; g < noise.groups; ++g) plan.cycles_noise_shares.push_back(noise.share[g * noise.groups + g]);
     if (noise.measured) plan.cycles_noise_pair_shares = noise.share;
     plan.cycles_noise_shares_measured = noise.measured;
-    if (noise.measured && options.cycles_group_relative_noise.size() == noise.groups) {
-      plan.cycles_group_relative_noise = options.cycles_group_relative_noise;
-      const auto& r = plan.cycles_group_relative_noise;
+    if (noise.measured && options.cycles_group_guided_delta_e.size() == noise.groups) {
+      plan.cycles_group_guided_delta_e = options.cycles_group_guided_delta_e;
+      const auto& r = plan.cycles_group_guided_delta_e;
       plan.cycles_guide_group = static_cast<int>(std::min_element(r.begin(), r.end()) - r.begin());
     }
     plan.cycles_noise_only = noise.at(n);
@@ -1180,7 +1180,7 @@ Json report_document(const Plan& plan, const Scene& scene, const PlanOptions& op
            {"noise_share_per_band_group", plan.cycles_noise_shares},
            {"noise_shares_between_band_groups", plan.cycles_noise_pair_shares},
            {"noise_shares_from", plan.cycles_noise_shares_measured ? "the Cycles pilots" : "plan's model of the preview's noise"},
-           {"relative_noise_per_band_group", plan.cycles_group_relative_noise},
+           {"guided_delta_e_per_band_group", plan.cycles_group_guided_delta_e},
            {"guide_band_group", plan.cycles_guide_group >= 0 ? Json(plan.cycles_guide_group) : Json(nullptr)},
            {"noise_ratio_from", options.cycles_noise_ratio > 0
                                     ? (options.cycles_noise_ratio_from.empty() ? std::string("--cycles-noise-ratio")

@@ -69,9 +69,9 @@ struct PlanOptions {
   // Each object's Cycles-to-tracer noise ratio over the image's as the pilots measured it (NoiseRatio::object_ratio):
   // an object's predicted noise is the preview's share of it times this where it is above 1. Absent: 1.
   std::map<std::int32_t, double> cycles_object_noise_ratio;
-  // Each band group's relative noise as the pilots measured it (NoiseRatio::group_relative_noise), for the bands of
-  // cycles_group_shares_edges_nm: the plan names the least noisy the guide of a guided render.
-  std::vector<double> cycles_group_relative_noise;
+  // Each band group's ΔE00 as a guide as the pilots measured it (NoiseRatio::group_guided_delta_e), for the bands of
+  // cycles_group_shares_edges_nm: the plan names the group of the least the guide of a guided render.
+  std::vector<double> cycles_group_guided_delta_e;
   // Also predict the mean ΔE00 that comparing the Cycles render with a tracer reference of this many paths per
   // pixel measures (its noise counts too); 0: not.
   int reference_samples = 0;
@@ -132,10 +132,11 @@ struct Plan {
   bool tracer_noise_from_pilots = false;          // measured beside Cycles' pilots, else from the preview
   std::vector<double> cycles_noise_shares;        // each band group's share of the noise's variance (diagonal)
   bool cycles_noise_shares_measured = false;      // on Cycles' pilots, else by plan's model
-  // The band group to guide a guided render (core/guided.h): the least noisy relative to its signal on its worst
-  // object, as the pilots measured it (PlanOptions::cycles_group_relative_noise); -1 where they did not.
+  // The band group to guide a guided render (core/guided.h): the one whose noise, carried into every band, makes the
+  // least ΔE00 over the image and its objects, as the pilots measured it (PlanOptions::cycles_group_guided_delta_e);
+  // -1 where they did not.
   int cycles_guide_group = -1;
-  std::vector<double> cycles_group_relative_noise;
+  std::vector<double> cycles_group_guided_delta_e;
   std::vector<double> cycles_noise_pair_shares;   // measured: G × G with the pairs' terms (NoiseRatio)
   double cycles_predicted_mean = 0;               // mean ΔE00 of bands, bounces and noise at cycles_samples
   double cycles_predicted_low = 0, cycles_predicted_high = 0;  // the same over the ratio's range
@@ -209,11 +210,11 @@ struct NoiseRatio {
   // which both pilots and both tracer renders hold at least kPilotObjectPixels: Cycles samples a glossy highlight
   // otherwise than the tracer, so an object's share of the noise may differ between them.
   std::map<std::int32_t, double> object_ratio;
-  // Each group's noise relative to its signal, the largest of the image's and of its objects' (those the first
-  // pilot holds at least kPilotObjectPixels of): over the pixels, the mean of |Σ_b (a_b − b_b)| / √2 over the mean of
-  // Σ_b (a_b + b_b) / 2, b the group's bands. A band reconstructed from a guide (core/guided.h) takes the guide's
-  // relative noise, so the group least noisy so on its worst object guides best.
-  std::vector<double> group_relative_noise;
+  // Each group as the guide of a guided render (core/guided.h), whose every band takes the guide's noise relative to
+  // its signal as a common factor: the ΔE00 that factor makes, at the pilots' size and samples, averaged over the
+  // image and over each object the first pilot holds at least kPilotObjectPixels of, each once. It ranks the groups
+  // as guides; it is not the guided render's error, to which its few-sample pixels (objects' edges, highlights) add.
+  std::vector<double> group_guided_delta_e;
 };
 constexpr std::size_t kPilotObjectPixels = 16;
 NoiseRatio measure_cycles_noise(const Scene& scene, const std::filesystem::path& a, const std::filesystem::path& b,

@@ -55,7 +55,10 @@ class Plan : public ::testing::Test {
   // "Cycles" pilots that are the tracer's own renders of `scene` in 6 nm bands over 400-700 nm at 64 paths (its seeds 1
   // and 2, the renders measure_cycles_noise makes beside them), the second moved from the first by `scale(id, band)`
   // times their difference (1: as rendered).
-  std::vector<fs::path> tracer_pilots(const Scene& scene, const std::function<double(std::int32_t, std::size_t)>& scale) {
+  // Two tracer renders relabelled as Cycles pilots, the second moved `scale(object, band)` times as far from the first;
+  // with `about_their_mean`, both moved so about their mean, which stays.
+  std::vector<fs::path> tracer_pilots(const Scene& scene, const std::function<double(std::int32_t, std::size_t)>& scale,
+                                      bool about_their_mean = false) {
     const Bands bands = Bands::uniform(400, 700, 6);
     rt::RenderOptions o;
     o.samples = 64;
@@ -72,9 +75,15 @@ class Plan : public ::testing::Test {
     const std::size_t nb = bands.size();
     for (std::size_t p = 0; p < images[0].object_ids.size(); ++p)
       for (std::size_t b = 0; b < nb; ++b) {
-        const float a = images[0].layers[0][p * nb + b];
-        float& v = images[1].layers[0][p * nb + b];
-        v = static_cast<float>(a + scale(images[0].object_ids[p], b) * (v - a));
+        float &a = images[0].layers[0][p * nb + b], &v = images[1].layers[0][p * nb + b];
+        const double k = scale(images[0].object_ids[p], b);
+        if (about_their_mean) {
+          const double m = 0.5 * (double{a} + v), h = 0.5 * (double{v} - a);
+          a = static_cast<float>(m - k * h);
+          v = static_cast<float>(m + k * h);
+        } else {
+          v = static_cast<float>(a + k * (v - a));
+        }
       }
     std::vector<fs::path> pilots;
     for (std::uint64_t seed : {1, 2}) {
@@ -648,30 +657,29 @@ TEST_F(Plan, PilotsGiveEachObjectItsOwnCyclesToTracerNoiseRatio) {
   EXPECT_TRUE(found);
 }
 
-// The guide of a guided render (NoiseRatio::group_relative_noise, Plan::cycles_guide_group): each band group's noise
-// over its signal, the largest over the image and its objects, and the group of the least. Known answers: the second
-// pilot moved k = 3 times as far from the first in the least noisy group's bands multiplies its relative noise by k
-// (within what the move does to its signal: the pair's mean moves by (k − 1)/2 of their difference, at most
-// (k − 1)/√2 times the relative noise) and leaves the others' as they were; and the plan names as guide the group of
-// the least, where the pilots' shares are of its own bands, and none where no pilots measured them.
-TEST_F(Plan, TheGuideIsTheGroupLeastNoisyOnItsWorstObject) {
+// The guide of a guided render (NoiseRatio::group_guided_delta_e, Plan::cycles_guide_group): the ΔE00 each band
+// group's noise relative to its signal makes when every band takes it, over the image and its objects, and the group
+// of the least. Known answers: the two pilots moved k = 3 times as far apart about their mean in one group's bands
+// (the mean, so the pixels' colours, unchanged) multiply that group's value by k, the ΔE00 being linearised, and
+// leave the others' as they were; moved together onto their mean (no noise) it is 0; and the plan names as guide the
+// group of the least, where the pilots' shares are of its own bands, and none where no pilots measured them.
+TEST_F(Plan, TheGuideIsTheGroupWhoseNoiseInEveryBandMakesTheLeastDeltaE) {
   Scene scene = load_scene(kBox);
   scene.camera.width = scene.camera.height = 32;
-  const auto as_rendered = tracer_pilots(scene, [](std::int32_t, std::size_t) { return 1.0; });
-  const plan::NoiseRatio r = plan::measure_cycles_noise(load_scene(kBox), as_rendered[0], as_rendered[1], "cie1931", 2);
-  const std::vector<double>& before = r.group_relative_noise;
-  ASSERT_EQ(before.size() * before.size(), r.group_shares.size());  // one a band group
-  const auto least = static_cast<std::size_t>(std::min_element(before.begin(), before.end()) - before.begin());
+  auto measured = [&](std::size_t group, double k) {
+    const auto pilots = tracer_pilots(scene, [&](std::int32_t, std::size_t b) { return b / 3 == group ? k : 1.0; }, true);
+    return plan::measure_cycles_noise(load_scene(kBox), pilots[0], pilots[1], "cie1931", 2).group_guided_delta_e;
+  };
+  const std::vector<double> before = measured(0, 1.0);
+  ASSERT_GE(before.size(), 3u);
+  for (double v : before) EXPECT_GT(v, 0);
   constexpr double k = 3;
-  const auto moved = tracer_pilots(scene, [&](std::int32_t, std::size_t b) { return b / 3 == least ? k : 1.0; });
-  const plan::NoiseRatio m = plan::measure_cycles_noise(load_scene(kBox), moved[0], moved[1], "cie1931", 2);
-  const double eps = (k - 1) / std::sqrt(2.0) * before[least];
-  ASSERT_LT(eps, 0.5);
-  EXPECT_GE(m.group_relative_noise[least], k * before[least] / (1 + eps));
-  EXPECT_LE(m.group_relative_noise[least], k * before[least] / (1 - eps));
-  for (std::size_t g = 0; g < before.size(); ++g) {
-    if (g == least) continue;
-    EXPECT_NEAR(m.group_relative_noise[g], before[g], 1e-6 * before[g]) << g;
+  for (std::size_t g : {std::size_t{0}, before.size() / 2, before.size() - 1}) {
+    const std::vector<double> wider = measured(g, k), none = measured(g, 0.0);
+    for (std::size_t h = 0; h < before.size(); ++h) {
+      EXPECT_NEAR(wider[h], (h == g ? k : 1.0) * before[h], 1e-3 * before[h]) << g << " " << h;
+      EXPECT_NEAR(none[h], h == g ? 0.0 : before[h], 1e-3 * before[h]) << g << " " << h;
+    }
   }
 
   plan::PlanOptions options;
@@ -686,8 +694,8 @@ TEST_F(Plan, TheGuideIsTheGroupLeastNoisyOnItsWorstObject) {
   options.cycles_group_shares_edges_nm = unmeasured.bands.edges();
   options.cycles_group_shares.assign(groups * groups, 0.0);
   for (std::size_t g = 0; g < groups; ++g) options.cycles_group_shares[g * groups + g] = 1.0 / static_cast<double>(groups);
-  options.cycles_group_relative_noise.assign(groups, 0.5);
-  options.cycles_group_relative_noise[groups - 1] = 0.1;
+  options.cycles_group_guided_delta_e.assign(groups, 0.5);
+  options.cycles_group_guided_delta_e[groups - 1] = 0.1;
   const plan::Plan named = plan::make_plan(scene, options);
   ASSERT_EQ(named.bands.edges(), unmeasured.bands.edges());
   EXPECT_EQ(named.cycles_guide_group, static_cast<int>(groups - 1));
