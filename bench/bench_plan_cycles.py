@@ -21,7 +21,10 @@ For two scenes, each under a smooth light (D65) and under CIE F11 (three narrow 
 And an artist's scene, under its own light: a .blend made by each Blender (tests/blender/make_artist_scene.py
 artist: Principled BSDFs, a packed image texture, Blender's studio HDRI as the world and an area light coloured by a
 Blackbody node), rendered from the .blend as an artist renders it, and its reference rendered by the tracer from the
-scene file the add-on's Export writes of it (which holds all of it exactly, blender.cross_validate.principled).
+scene file the add-on's Export writes of it (which holds all of it exactly, blender.cross_validate.principled). With
+--reference-dir the .blend and its export are kept there too, one per Blender, so that runs plan and measure the
+same scene: two runs of make_artist_scene.py do not make the same meshes to the last bit (the spheres' vertices come
+in another order), which moves the plan's preview and pilots by their noise.
 
 For each:
 
@@ -157,9 +160,11 @@ PLAIN_BLEND = PLAIN.replace(_IMPORT, "scene = bpy.context.scene\nids = {ids!r}\n
                                      "    ob.pass_index = ids.get(ob.name, ob.pass_index)\n")
 
 
-def artist_blend(blender_exe, out_dir):
-    """make_artist_scene.py's artist .blend made by this Blender, and the scene file Export writes of it."""
-    blend, scene = os.path.join(out_dir, "artist.blend"), os.path.join(out_dir, "artist.json")
+def artist_blend(blender_exe, out_dir, version):
+    """make_artist_scene.py's artist .blend made by this Blender, and the scene file Export writes of it: in
+    `out_dir`, kept and reused where they are already there."""
+    os.makedirs(out_dir, exist_ok=True)
+    blend, scene = (os.path.join(out_dir, f"artist-{version}.{ext}") for ext in ("blend", "json"))
     if not os.path.exists(scene):
         here = os.path.join(ROOT, "tests", "blender")
         run([blender_exe, "--background", "--factory-startup", "--python", os.path.join(here, "make_artist_scene.py"),
@@ -279,7 +284,7 @@ def bench(scene_name, light, args, work, blender_exe, version, references):
     os.makedirs(out_dir, exist_ok=True)
     blend = None
     if scene_name == "artist":  # its reference is of its export, which holds this Blender's Principled BSDF
-        blend, scene = artist_blend(blender_exe, out_dir)
+        blend, scene = artist_blend(blender_exe, args.reference_dir or out_dir, version)
         masking = f"principled-v{2 if int(version.split('.')[0]) >= 4 else 1}"  # one reference per Principled BSDF
     else:
         scene = scene_for(scene_name, light, work, masking)
