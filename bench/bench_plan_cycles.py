@@ -251,7 +251,8 @@ def guided_render(args, plan_file, plan, blender, source, res, out_dir, case, ex
     with open(plan_file) as f:
         bands = json.load(f)
     planned = bands["cycles_samples"]
-    # The plan's guide (the group its pilots measured least noisy relative to its signal), with the most samples.
+    # The plan's guide (the group whose noise, carried into every band, makes the least ΔE00 on the pilots), with the
+    # most samples.
     guide = plan.get("guide_band_group")
     if guide is None:
         guide = planned.index(max(planned))

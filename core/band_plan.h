@@ -43,6 +43,21 @@ Bands read_band_plan(const std::filesystem::path& file);  // the bands alone
 // The number of Cycles renders, of three bands each, that `band_count` bands take.
 constexpr std::size_t cycles_band_groups(std::size_t band_count) { return (band_count + 2) / 3; }
 
+// The renders' bands, `per_render` (1 to 3) to a render: interleaved, render g of G = ⌈band_count / per_render⌉
+// holding bands g, g + G, g + 2G (7 bands, 3 to a render: [0, 3, 6], [1, 4], [2, 5]), so that every render spans the
+// spectrum. Cycles picks a Principled BSDF's lobe (and a Mix Shader's side) with a probability that follows the
+// lobe's colour weight averaged over the render's three channels; renders of neighbouring bands (one blue, one red)
+// would pick differently for the same random numbers, their paths part at the first such surface, and the groups'
+// noise would stop moving together and add up as chroma: on a scene of Principled BSDFs, two renders of consecutive
+// bands were 1.2–1.5 times as noisy as one render of three bands or as a plain RGB render at equal samples, two
+// interleaved ones as noisy as either (docs/plan.md, "Why band groups were noisier than an RGB render").
+// The band plan's groups (cycles_samples, cycles_guided_groups) are these with per_render 3.
+std::vector<std::vector<std::size_t>> cycles_render_groups(std::size_t band_count, int per_render = 3);
+// The band plan's group (cycles_render_groups with 3 to a render) that holds `band`.
+constexpr std::size_t cycles_band_group_of(std::size_t band_count, std::size_t band) {
+  return band % cycles_band_groups(band_count);
+}
+
 // The chromatrace-bands/1 document of `bands` (with its reconstruction, if any, and the groups' samples if given).
 Json band_plan_document(const Bands& bands, const std::vector<int>& cycles_samples = {},
                         const std::vector<std::size_t>& cycles_guided_groups = {}, double cycles_guided_threshold = 0);

@@ -14,6 +14,7 @@
 #include <ImfHeader.h>
 #include <fmt/core.h>
 
+#include "core/band_plan.h"
 #include "core/error.h"
 #include "core/exr_output.h"
 #include "core/file_io.h"
@@ -24,7 +25,7 @@ namespace ct {
 namespace {
 
 // Bump when the upsampling or the output layout changes, so that old caches are not reused.
-constexpr std::string_view kPrepVersion = "chromatrace-texture-prep/2";
+constexpr std::string_view kPrepVersion = "chromatrace-texture-prep/3";
 constexpr int kRowsPerWrite = 64;
 
 // Two independent 64-bit multiply-xor lanes over 8-byte words (not cryptographic; a content key for a cache).
@@ -132,14 +133,7 @@ Json negative_texels_json(const NegativeTexels& n) {
 }
 
 std::vector<std::vector<std::size_t>> band_groups(std::size_t band_count, int per_render) {
-  if (per_render < 1 || per_render > 3) throw InputError(fmt::format("bands per render must be 1 to 3, got {}", per_render));
-  std::vector<std::vector<std::size_t>> groups;
-  for (std::size_t first = 0; first < band_count; first += static_cast<std::size_t>(per_render)) {
-    std::vector<std::size_t> g;
-    for (std::size_t b = first; b < std::min(first + static_cast<std::size_t>(per_render), band_count); ++b) g.push_back(b);
-    groups.push_back(std::move(g));
-  }
-  return groups;
+  return cycles_render_groups(band_count, per_render);
 }
 
 std::string texture_prep_hash(const TexturePrepRequest& request) {

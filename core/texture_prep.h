@@ -3,8 +3,8 @@
 // Per-band-group textures for a renderer that works in RGB (Cycles through the Blender add-on), made from an
 // artist's image texture or HDRI (`chromatrace prepare-texture`, docs/blender.md).
 //
-// The bands are rendered in groups of up to three consecutive bands (blender_addon/chromatrace/bands.py,
-// band_groups: 7 bands, 3 to a render -> [0,1,2], [3,4,5], [6]). For each group this writes a linear float
+// The bands are rendered in groups of up to three interleaved bands (core/band_plan.h, cycles_render_groups, and
+// blender_addon/chromatrace/bands.py, band_groups: 7 bands, 3 to a render -> [0,3,6], [1,4], [2,5]). For each group this writes a linear float
 // OpenEXR whose R, G, B are, per texel, the averages over the group's bands of the texel's spectrum exactly as
 // the tracer upsamples it (core/texture.h: upsample_texels, palette_band_averages); channels without a band are 0.
 //
@@ -24,7 +24,7 @@
 
 namespace ct {
 
-// Consecutive groups of band indices, `per_render` (1 to 3) to a group; the last may be shorter.
+// The renders' groups of band indices, `per_render` (1 to 3) to a group: cycles_render_groups (core/band_plan.h).
 std::vector<std::vector<std::size_t>> band_groups(std::size_t band_count, int per_render = 3);
 
 struct TexturePrepRequest {

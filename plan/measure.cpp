@@ -10,6 +10,7 @@
 
 #include <fmt/core.h>
 
+#include "core/band_plan.h"
 #include "core/colour.h"
 #include "core/error.h"
 #include "core/spectral_exr.h"
@@ -166,12 +167,15 @@ NoiseRatio measure_cycles_noise(const Scene& scene, const std::filesystem::path&
   const std::vector<double> cycles_de = pixel_differences(xa, tristimuli(vb), cycles_white);
   const auto [cycles, cycles_se] = mean_and_error(cycles_de);
   // Each group's part, and each pair's: the first pilot with those groups' bands taken from the second.
-  const std::size_t nb = ia.bands.size(), groups = (nb + 2) / 3;
+  const std::size_t nb = ia.bands.size(), groups = cycles_band_groups(nb);
+  const std::vector<std::vector<std::size_t>> members = cycles_render_groups(nb);
+  std::vector<std::size_t> group_of(nb);
+  for (std::size_t b = 0; b < nb; ++b) group_of[b] = cycles_band_group_of(nb, b);
   auto swapped = [&](std::size_t g, std::size_t h) {
     std::vector<float> hybrid = va;
     for (std::size_t p = 0; p < pixels; ++p)
       for (std::size_t b = 0; b < nb; ++b)
-        if (b / 3 == g || b / 3 == h) hybrid[p * nb + b] = vb[p * nb + b];
+        if (group_of[b] == g || group_of[b] == h) hybrid[p * nb + b] = vb[p * nb + b];
     const double e = mean_difference(xa, tristimuli(hybrid), cycles_white).first;
     return e * e;
   };
@@ -206,7 +210,7 @@ NoiseRatio measure_cycles_noise(const Scene& scene, const std::filesystem::path&
       std::vector<Vec3d> lo(pixels), hi(pixels);
       for (std::size_t p = 0; p < pixels; ++p) {
         double d = 0, m = 0;
-        for (std::size_t b = 3 * g; b < std::min(nb, 3 * g + 3); ++b) {
+        for (std::size_t b : members[g]) {
           d += double{va[p * nb + b]} - vb[p * nb + b];
           m += 0.5 * (double{va[p * nb + b]} + vb[p * nb + b]);
         }

@@ -791,9 +791,10 @@ CyclesNoise cycles_noise(const Model& model, const std::vector<int>& edges, int 
   }
   n.share.assign(groups * groups, 0.0);
   double sum = 0;
+  const std::vector<std::vector<std::size_t>> members = cycles_render_groups(nb);
   for (std::size_t g = 0; g < groups; ++g) {
     std::vector<bool> carry(nb, false);
-    for (std::size_t b = 3 * g; b < std::min(nb, 3 * g + 3); ++b) carry[b] = true;
+    for (std::size_t b : members[g]) carry[b] = true;
     sum += n.share[g * groups + g] = std::pow(model.band_noise(edges, max_bounces, carry), 2);
   }
   for (std::size_t g = 0; g < groups; ++g)

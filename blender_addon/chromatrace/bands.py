@@ -11,12 +11,23 @@ CHANNELS = ("R", "G", "B")
 
 
 def band_groups(band_count, per_render=3):
-    """Consecutive groups of band indices, `per_render` (1 to 3) to a render: 7 bands -> [0,1,2], [3,4,5], [6]."""
+    """The renders' groups of band indices, `per_render` (1 to 3) to a render, interleaved so that each render spans
+    the spectrum: render g of G = ceil(band_count / per_render) holds bands g, g + G, g + 2G (7 bands -> [0,3,6],
+    [1,4], [2,5]), as `chromatrace` groups them (core/band_plan.h, cycles_render_groups). Cycles picks a Principled
+    BSDF's lobe with a probability that follows its colour averaged over the render's channels: renders of
+    neighbouring bands would pick differently, their paths part and their noise adds up as chroma."""
     if not 1 <= per_render <= len(CHANNELS):
         raise ValueError(f"per_render must be 1 to {len(CHANNELS)}, got {per_render}")
     if band_count < 1:
         raise ValueError(f"band_count must be at least 1, got {band_count}")
-    return [list(range(first, min(first + per_render, band_count))) for first in range(0, band_count, per_render)]
+    renders = -(-band_count // per_render)
+    return [list(range(g, band_count, renders)) for g in range(renders)]
+
+
+def plan_group_of(band_count, band):
+    """The band plan's group (of three: band_groups(band_count)) that holds `band`, whose `cycles_samples` and
+    `cycles_guided_groups` entry are its."""
+    return band % -(-band_count // len(CHANNELS))
 
 
 def planned_samples(bands_file):
@@ -32,17 +43,18 @@ def planned_samples(bands_file):
 
 def group_samples(groups, cycles_samples, samples):
     """Cycles' samples per pixel for each render of `groups`: the band plan's `cycles_samples` (one per band group
-    of three, bands 3g to 3g + 2) where it gives them, the most any of a render's bands asks for; else `samples`."""
+    of three, plan_group_of) where it gives them, the most any of a render's bands asks for; else `samples`."""
     if not cycles_samples:
         return [samples] * len(groups)
-    return [max(cycles_samples[b // len(CHANNELS)] for b in group) for group in groups]
+    count = sum(len(group) for group in groups)
+    return [max(cycles_samples[plan_group_of(count, b)] for b in group) for group in groups]
 
 
 def guided_bands(band_count, guided_groups):
-    """The bands of the band plan's `cycles_guided_groups` (groups of three, bands 3g to 3g + 2): rendered with few
+    """The bands of the band plan's `cycles_guided_groups` (groups of three, plan_group_of): rendered with few
     samples and reconstructed from the others when assembled."""
     groups = set(guided_groups or [])
-    return [b for b in range(band_count) if b // len(CHANNELS) in groups]
+    return [b for b in range(band_count) if plan_group_of(band_count, b) in groups]
 
 
 def guided_adaptive(groups, cycles_samples, guided_groups, threshold):
@@ -54,7 +66,8 @@ def guided_adaptive(groups, cycles_samples, guided_groups, threshold):
     if not threshold or not guided or not cycles_samples:
         return [None] * len(groups)
     most = max(s for g, s in enumerate(cycles_samples) if g not in guided)
-    return [(threshold, most) if all(b // len(CHANNELS) in guided for b in group) else None for group in groups]
+    count = sum(len(group) for group in groups)
+    return [(threshold, most) if all(plan_group_of(count, b) in guided for b in group) else None for group in groups]
 
 
 def channel_of(group, band):
@@ -79,5 +92,11 @@ def group_colour(band_values, group, replicate=False):
 
 
 def describe_band_range(edges_nm, group):
-    """'400-550 nm' for the bands of a group, for progress messages."""
-    return f"{edges_nm[group[0]]:g}-{edges_nm[group[-1] + 1]:g} nm"
+    """'400-450, 500-550 nm' for the bands of a group (adjacent ones joined), for progress messages."""
+    spans = []
+    for b in group:
+        if spans and spans[-1][1] == edges_nm[b]:
+            spans[-1][1] = edges_nm[b + 1]
+        else:
+            spans.append([edges_nm[b], edges_nm[b + 1]])
+    return ", ".join(f"{lo:g}-{hi:g}" for lo, hi in spans) + " nm"

@@ -78,6 +78,8 @@ def cache_description(scene, request, plan, resolution):
     return {
         "addon": list(VERSION), "blender": bpy.app.version_string,
         "edges": plan.edges, "per_render": plan.per_render, "replicate": plan.replicate,
+        # Each render's bands (interleaved: bands.band_groups); caches of consecutive groups are not these renders.
+        "groups": plan.groups,
         "inputs": [[i.label, i.role, key, scale] for i, key, scale, _owner in plan.inputs],
         "averages": {k: v["bands"] for k, v in plan.bands["spectra"].items()},
         "textures": {k: v["hash"] for k, v in plan.textures.items()},

@@ -463,6 +463,25 @@ TEST_F(Plan, SeriesTakesThePlan) {
 TEST_F(Plan, BandPlanFileCarriesTheSamplesOfEachCyclesBandGroup) {
   EXPECT_EQ(cycles_band_groups(6), 2u);
   EXPECT_EQ(cycles_band_groups(7), 3u);
+  // The groups interleave the bands, so that each render spans the spectrum; every band in one group, the one
+  // cycles_band_group_of names.
+  using Groups = std::vector<std::vector<std::size_t>>;
+  EXPECT_EQ(cycles_render_groups(7), (Groups{{0, 3, 6}, {1, 4}, {2, 5}}));
+  EXPECT_EQ(cycles_render_groups(6), (Groups{{0, 2, 4}, {1, 3, 5}}));
+  EXPECT_EQ(cycles_render_groups(5, 2), (Groups{{0, 3}, {1, 4}, {2}}));
+  EXPECT_EQ(cycles_render_groups(2, 1), (Groups{{0}, {1}}));
+  EXPECT_THROW(cycles_render_groups(3, 4), InputError);
+  for (std::size_t n = 1; n <= 40; ++n) {
+    const Groups groups = cycles_render_groups(n);
+    ASSERT_EQ(groups.size(), cycles_band_groups(n));
+    std::vector<int> seen(n, 0);
+    for (std::size_t g = 0; g < groups.size(); ++g)
+      for (std::size_t b : groups[g]) {
+        ++seen[b];
+        EXPECT_EQ(cycles_band_group_of(n, b), g) << n << " " << b;
+      }
+    EXPECT_EQ(seen, std::vector<int>(n, 1)) << n;
+  }
   const Bands bands = Bands::from_edges({400, 440, 480, 520, 560, 600, 640, 700}, "edges");
   const fs::path file = dir_ / "plan.json";
   write_file_atomically(file, band_plan_document(bands, {256, 64, 32}).dump());
@@ -666,8 +685,9 @@ TEST_F(Plan, PilotsGiveEachObjectItsOwnCyclesToTracerNoiseRatio) {
 TEST_F(Plan, TheGuideIsTheGroupWhoseNoiseInEveryBandMakesTheLeastDeltaE) {
   Scene scene = load_scene(kBox);
   scene.camera.width = scene.camera.height = 32;
+  const std::size_t nb = Bands::uniform(400, 700, 6).size();  // tracer_pilots' bands
   auto measured = [&](std::size_t group, double k) {
-    const auto pilots = tracer_pilots(scene, [&](std::int32_t, std::size_t b) { return b / 3 == group ? k : 1.0; }, true);
+    const auto pilots = tracer_pilots(scene, [&](std::int32_t, std::size_t b) { return cycles_band_group_of(nb, b) == group ? k : 1.0; }, true);
     return plan::measure_cycles_noise(load_scene(kBox), pilots[0], pilots[1], "cie1931", 2).group_guided_delta_e;
   };
   const std::vector<double> before = measured(0, 1.0);

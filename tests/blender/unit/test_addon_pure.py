@@ -18,9 +18,15 @@ from chromatrace.journal import Journal  # noqa: E402
 
 
 class Bands(unittest.TestCase):
-    def test_groups_of_three_and_one(self):
-        self.assertEqual(bands.band_groups(7), [[0, 1, 2], [3, 4, 5], [6]])
+    def test_groups_of_three_and_one_interleave_the_bands(self):
+        # Each render spans the spectrum (core/band_plan.h, cycles_render_groups, groups them alike).
+        self.assertEqual(bands.band_groups(7), [[0, 3, 6], [1, 4], [2, 5]])
+        self.assertEqual(bands.band_groups(6), [[0, 2, 4], [1, 3, 5]])
+        self.assertEqual(bands.band_groups(5, 2), [[0, 3], [1, 4], [2]])
         self.assertEqual(bands.band_groups(2, 1), [[0], [1]])
+        self.assertEqual([bands.plan_group_of(7, b) for b in range(7)], [0, 1, 2, 0, 1, 2, 0])
+        self.assertEqual(bands.describe_band_range([400, 450, 500, 550, 600], [0, 2]), "400-450, 500-550 nm")
+        self.assertEqual(bands.describe_band_range([400, 450, 500, 550, 600], [1, 2]), "450-550 nm")
         with self.assertRaises(ValueError):
             bands.band_groups(3, 4)
 
@@ -29,8 +35,10 @@ class Bands(unittest.TestCase):
         # bands from two groups (two bands per render) the more of theirs; one band per render its own group's.
         self.assertEqual(bands.group_samples(bands.band_groups(7), None, 128), [128, 128, 128])
         self.assertEqual(bands.group_samples(bands.band_groups(7), [256, 64, 16], 128), [256, 64, 16])
-        self.assertEqual(bands.group_samples(bands.band_groups(7, 2), [256, 64, 16], 128), [256, 256, 64, 16])
-        self.assertEqual(bands.group_samples(bands.band_groups(4, 1), [256, 64], 128), [256, 256, 256, 64])
+        # Two a render: [0, 4], [1, 5], [2, 6], [3] of the plan's groups [0, 3, 6], [1, 4], [2, 5].
+        self.assertEqual(bands.group_samples(bands.band_groups(7, 2), [256, 64, 16], 128), [256, 64, 256, 256])
+        # One a render: the plan's groups of 4 bands are [0, 2] and [1, 3].
+        self.assertEqual(bands.group_samples(bands.band_groups(4, 1), [256, 64], 128), [256, 64, 256, 64])
 
     def test_group_colour_fills_channels_in_order_and_zero_pads(self):
         values = [0.1, 0.2, 0.3, 0.4]
@@ -145,7 +153,7 @@ class Manifest(unittest.TestCase):
         m = manifest.build_manifest([400, 450, 500, 550, 600], groups, ["main"], "ViewLayer", total, planned,
                                     object_names={2: "b", 1: "a"}, attributes={"chromatrace.samples": "4"})
         self.assertEqual(m["format"], "chromatrace-assemble/1")
-        self.assertEqual([b["channel"] for b in m["bands"]], ["R", "G", "B", "R"])
+        self.assertEqual([b["channel"] for b in m["bands"]], ["R", "R", "G", "G"])  # renders [0, 2] and [1, 3]
         self.assertEqual(m["bands"][3]["files"], {"main": "g001_main.exr"})
         self.assertEqual(m["object_names"], {"1": "a", "2": "b"})
         self.assertEqual(m["object_ids"]["channel"], "ViewLayer.IndexOB.X")
@@ -180,24 +188,25 @@ class Manifest(unittest.TestCase):
         wanted = manifest.channels_by_file(m)
         self.assertEqual(set(wanted), {"g000_main.exr", "g000_k1.exr", "g001_main.exr", "g001_k1.exr", "ids.exr"})
         self.assertEqual(wanted["ids.exr"], {"VL.IndexOB.X"})
-        # The second group holds one band, in R; its K = 1 render gives bounce.0 (Emit) and bounce.1 (Combined).
-        self.assertEqual(wanted["g001_k1.exr"], {"VL.Combined.R", "VL.Emit.R"})
-        self.assertEqual({c[-1] for c in wanted["g000_main.exr"]}, {"R", "G", "B"})
+        # The second render holds bands 1 and 3, in R and G; its K = 1 render gives bounce.0 (Emit) and bounce.1
+        # (Combined).
+        self.assertEqual(wanted["g001_k1.exr"], {"VL.Combined.R", "VL.Combined.G", "VL.Emit.R", "VL.Emit.G"})
+        self.assertEqual({c[-1] for c in wanted["g000_main.exr"]}, {"R", "G"})
         for passes in ("Combined", "Emit", "DiffDir", "DiffInd", "DiffCol", "GlossDir", "GlossInd", "GlossCol"):
             self.assertIn(f"VL.{passes}.R", wanted["g001_main.exr"])
 
     def test_guided_groups_name_their_bands_for_the_assembly(self):
         total, planned = components.component_plan({"paths"}, [], 2)
         guided = bands.guided_bands(7, [1, 2])
-        self.assertEqual(guided, [3, 4, 5, 6])  # groups of three: bands 3g to 3g + 2, the last group short
+        self.assertEqual(guided, [1, 2, 4, 5])  # the plan's groups of 7 bands: [0, 3, 6], [1, 4], [2, 5]
         self.assertEqual(bands.guided_bands(7, None), [])
         edges = [400 + 25 * i for i in range(8)]
         m = manifest.build_manifest(edges, bands.band_groups(7), ["main"], "V", total, planned, guided_bands=guided)
-        self.assertEqual(m["guided"], {"bands": [3, 4, 5, 6]})
+        self.assertEqual(m["guided"], {"bands": [1, 2, 4, 5]})
         self.assertNotIn("guided", manifest.build_manifest(edges, bands.band_groups(7), ["main"], "V", total, planned))
 
     def test_guided_groups_sample_adaptively_up_to_their_guides_when_the_plan_gives_a_threshold(self):
-        groups = bands.band_groups(7)  # three renders: bands 0-2, 3-5, 6
+        groups = bands.band_groups(7)  # three renders: bands 0, 3, 6; 1, 4; 2, 5
         self.assertEqual(bands.guided_adaptive(groups, [300, 40, 30], [1, 2], 0.01), [None, (0.01, 300), (0.01, 300)])
         # The most samples of any guiding group, not of a guided one.
         self.assertEqual(bands.guided_adaptive(groups, [40, 300, 500], [0, 2], 0.02), [(0.02, 300), None, (0.02, 300)])
@@ -205,9 +214,9 @@ class Manifest(unittest.TestCase):
             self.assertEqual(bands.guided_adaptive(groups, [300, 40, 30], guided, threshold), [None] * 3)
         total, planned = components.component_plan({"paths"}, [], 2)
         edges = [400 + 25 * i for i in range(8)]
-        m = manifest.build_manifest(edges, groups, ["main"], "V", total, planned, guided_bands=[3, 4, 5, 6],
+        m = manifest.build_manifest(edges, groups, ["main"], "V", total, planned, guided_bands=[1, 2, 4, 5],
                                     guided_adaptive=(0.01, 300))
-        self.assertEqual(m["guided"], {"bands": [3, 4, 5, 6], "adaptive": {"threshold": 0.01, "max_samples": 300}})
+        self.assertEqual(m["guided"], {"bands": [1, 2, 4, 5], "adaptive": {"threshold": 0.01, "max_samples": 300}})
 
     def test_missing_renders(self):
         with tempfile.TemporaryDirectory() as d:
