@@ -8,7 +8,6 @@
 #include <fmt/core.h>
 
 #include "core/error.h"
-
 #include "core/json_input.h"
 
 namespace ct {

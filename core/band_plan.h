@@ -49,7 +49,7 @@ constexpr std::size_t cycles_band_groups(std::size_t band_count) { return (band_
 // lobe's colour weight averaged over the render's three channels; renders of neighbouring bands (one blue, one red)
 // would pick differently for the same random numbers, their paths part at the first such surface, and the groups'
 // noise would stop moving together and add up as chroma: on a scene of Principled BSDFs, two renders of consecutive
-// bands were 1.2–1.5 times as noisy as one render of three bands or as a plain RGB render at equal samples, two
+// bands were 1.1–1.5 times as noisy as one render of three bands or as a plain RGB render at equal samples, two
 // interleaved ones as noisy as either (docs/plan.md, "Why band groups were noisier than an RGB render").
 // The band plan's groups (cycles_samples, cycles_guided_groups) are these with per_render 3.
 std::vector<std::vector<std::size_t>> cycles_render_groups(std::size_t band_count, int per_render = 3);

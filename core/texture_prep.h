@@ -4,9 +4,10 @@
 // artist's image texture or HDRI (`chromatrace prepare-texture`, docs/blender.md).
 //
 // The bands are rendered in groups of up to three interleaved bands (core/band_plan.h, cycles_render_groups, and
-// blender_addon/chromatrace/bands.py, band_groups: 7 bands, 3 to a render -> [0,3,6], [1,4], [2,5]). For each group this writes a linear float
-// OpenEXR whose R, G, B are, per texel, the averages over the group's bands of the texel's spectrum exactly as
-// the tracer upsamples it (core/texture.h: upsample_texels, palette_band_averages); channels without a band are 0.
+// blender_addon/chromatrace/bands.py, band_groups: 7 bands, 3 to a render -> [0,3,6], [1,4], [2,5]). For each
+// group this writes a linear float OpenEXR whose R, G, B are, per texel, the averages over the group's bands of the
+// texel's spectrum exactly as the tracer upsamples it (core/texture.h: upsample_texels, palette_band_averages);
+// channels without a band are 0.
 //
 // The outputs are cached by content: every file is named by a hash of the image's bytes, the kind, the
 // colour space, the band edges and the group size, and a manifest <hash>.json (written last) lists them; when it
