@@ -54,9 +54,7 @@ class Plan : public ::testing::Test {
 
   // "Cycles" pilots that are the tracer's own renders of `scene` in 6 nm bands over 400-700 nm at 64 paths (its seeds 1
   // and 2, the renders measure_cycles_noise makes beside them), the second moved from the first by `scale(id, band)`
-  // times their difference (1: as rendered).
-  // Two tracer renders relabelled as Cycles pilots, the second moved `scale(object, band)` times as far from the first;
-  // with `about_their_mean`, both moved so about their mean, which stays.
+  // times their difference (1: as rendered); with `about_their_mean`, both moved so about their mean, which stays.
   std::vector<fs::path> tracer_pilots(const Scene& scene, const std::function<double(std::int32_t, std::size_t)>& scale,
                                       bool about_their_mean = false) {
     const Bands bands = Bands::uniform(400, 700, 6);
@@ -687,7 +685,8 @@ TEST_F(Plan, TheGuideIsTheGroupWhoseNoiseInEveryBandMakesTheLeastDeltaE) {
   scene.camera.width = scene.camera.height = 32;
   const std::size_t nb = Bands::uniform(400, 700, 6).size();  // tracer_pilots' bands
   auto measured = [&](std::size_t group, double k) {
-    const auto pilots = tracer_pilots(scene, [&](std::int32_t, std::size_t b) { return cycles_band_group_of(nb, b) == group ? k : 1.0; }, true);
+    const auto in_group = [&](std::int32_t, std::size_t b) { return cycles_band_group_of(nb, b) == group ? k : 1.0; };
+    const auto pilots = tracer_pilots(scene, in_group, true);
     return plan::measure_cycles_noise(load_scene(kBox), pilots[0], pilots[1], "cie1931", 2).group_guided_delta_e;
   };
   const std::vector<double> before = measured(0, 1.0);
