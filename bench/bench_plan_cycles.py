@@ -24,7 +24,8 @@ Blackbody node), rendered from the .blend as an artist renders it, and its refer
 scene file the add-on's Export writes of it (which holds all of it exactly, blender.cross_validate.principled). With
 --reference-dir the .blend and its export are kept there too, one per Blender, so that runs plan and measure the
 same scene: two runs of make_artist_scene.py do not make the same meshes to the last bit (the spheres' vertices come
-in another order), which moves the plan's preview and pilots by their noise.
+in another order), which moves the plan's preview and pilots by their noise. Remove them there when
+make_artist_scene.py changes.
 
 For each:
 
