@@ -31,6 +31,7 @@
 #include "core/random.h"
 #include "core/rgb_to_spectrum.h"
 #include "core/spectral_exr.h"
+#include "core/band_plan.h"
 #include "core/texture_prep.h"
 
 namespace {
@@ -138,7 +139,7 @@ int main(int argc, char** argv) {
   request.use = hdr ? ct::TextureUse::Radiance : ct::TextureUse::Reflectance;
   request.bands = ct::Bands::parse(bands_text);
   request.threads = threads;
-  const std::size_t groups = ct::band_groups(request.bands.size()).size();
+  const std::size_t groups = ct::cycles_band_groups(request.bands.size());
 
   std::vector<double> io, cold, cached;
   ct::TexturePrepResult result;

@@ -99,8 +99,10 @@ Bands read_reconstruction(const JsonNode& node, const Bands& bands) {
 }
 
 std::vector<std::vector<std::size_t>> cycles_render_groups(std::size_t band_count, int per_render) {
-  if (per_render < 1 || per_render > 3) throw InputError(fmt::format("bands per render must be 1 to 3, got {}", per_render));
-  const std::size_t renders = (band_count + static_cast<std::size_t>(per_render) - 1) / static_cast<std::size_t>(per_render);
+  if (per_render < 1 || per_render > 3)
+    throw InputError(fmt::format("bands per render must be 1 to 3, got {}", per_render));
+  const auto per = static_cast<std::size_t>(per_render);
+  const std::size_t renders = (band_count + per - 1) / per;
   std::vector<std::vector<std::size_t>> groups(renders);
   for (std::size_t b = 0; b < band_count; ++b) groups[b % renders].push_back(b);
   return groups;

@@ -132,10 +132,6 @@ Json negative_texels_json(const NegativeTexels& n) {
   return {{"zeroed", n.count}, {"largest", n.largest}, {"threshold", n.threshold}};
 }
 
-std::vector<std::vector<std::size_t>> band_groups(std::size_t band_count, int per_render) {
-  return cycles_render_groups(band_count, per_render);
-}
-
 std::string texture_prep_hash(const TexturePrepRequest& request) {
   return hash_of(request, resolved_colour_space(request));
 }
@@ -150,7 +146,7 @@ TexturePrepResult prepare_texture(const TexturePrepRequest& request, const std::
     throw InputError(fmt::format("scale: must be a finite number >= 0, got {}", request.scale));
   check_input_file(request.image, InputAccess::Seekable, std::numeric_limits<std::uintmax_t>::max());
   TexturePrepResult result;
-  result.groups = band_groups(request.bands.size(), request.bands_per_render);
+  result.groups = cycles_render_groups(request.bands.size(), request.bands_per_render);
   result.colour_space = resolved_colour_space(request);
   result.hash = hash_of(request, result.colour_space);
   result.manifest = directory / (result.hash + ".json");

@@ -25,9 +25,6 @@
 
 namespace ct {
 
-// The renders' groups of band indices, `per_render` (1 to 3) to a group: cycles_render_groups (core/band_plan.h).
-std::vector<std::vector<std::size_t>> band_groups(std::size_t band_count, int per_render = 3);
-
 struct TexturePrepRequest {
   std::filesystem::path image;
   TextureUse use = TextureUse::Reflectance;

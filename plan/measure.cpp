@@ -169,13 +169,12 @@ NoiseRatio measure_cycles_noise(const Scene& scene, const std::filesystem::path&
   // Each group's part, and each pair's: the first pilot with those groups' bands taken from the second.
   const std::size_t nb = ia.bands.size(), groups = cycles_band_groups(nb);
   const std::vector<std::vector<std::size_t>> members = cycles_render_groups(nb);
-  std::vector<std::size_t> group_of(nb);
-  for (std::size_t b = 0; b < nb; ++b) group_of[b] = cycles_band_group_of(nb, b);
   auto swapped = [&](std::size_t g, std::size_t h) {
     std::vector<float> hybrid = va;
     for (std::size_t p = 0; p < pixels; ++p)
       for (std::size_t b = 0; b < nb; ++b)
-        if (group_of[b] == g || group_of[b] == h) hybrid[p * nb + b] = vb[p * nb + b];
+        if (const std::size_t of = cycles_band_group_of(nb, b); of == g || of == h)
+          hybrid[p * nb + b] = vb[p * nb + b];
     const double e = mean_difference(xa, tristimuli(hybrid), cycles_white).first;
     return e * e;
   };
@@ -219,13 +218,13 @@ NoiseRatio measure_cycles_noise(const Scene& scene, const std::filesystem::path&
       }
       const std::vector<double> de = pixel_differences(lo, hi, white);
       double image = 0;
-      std::size_t n = 0, members = 1;
+      std::size_t n = 0, counted = 1;  // the image, then each object
       for (std::size_t p = 0; p < pixels; ++p)
         if (lit[p] >= 0) image += de[p], ++n;
       double sum = n > 0 ? image / static_cast<double>(n) : 0.0;
       for (const auto& [id, s] : means_by_object(de, lit))
-        if (id > 0 && s.second >= kPilotObjectPixels) sum += s.first, ++members;
-      out.group_guided_delta_e[g] = sum / static_cast<double>(members);
+        if (id > 0 && s.second >= kPilotObjectPixels) sum += s.first, ++counted;
+      out.group_guided_delta_e[g] = sum / static_cast<double>(counted);
     }
   }
   // The tracer alike: the pilots' size, bands and samples.
