@@ -30,8 +30,10 @@ make_artist_scene.py changes.
 For each:
 
 1. The planned spectral render: the add-on's batch (blender_addon/batch.py) with --plan TARGET --plan-edge-step 5
-   (chromatrace plan, two pilot renders for Cycles' noise, plan again: bands, bounce limit and each band group's
-   samples), path-type components. Its cost: the CPU seconds of its Cycles renders (band groups and the one-sample
+   --plan-reference-spp REFERENCE_SPP (chromatrace plan, two pilot renders for Cycles' noise, plan again: bands,
+   bounce limit and each band group's samples, for the target as compare measures it against the reference below,
+   whose own noise counts; where the scene uses Cycles' light tree, the pilots and the plan again without it, and the
+   plan of fewer samples taken), path-type components. Its cost: the CPU seconds of its Cycles renders (band groups and the one-sample
    object-id render) from the batch's progress lines, and apart the planning's (the batch's "planning:" line: the
    two runs of chromatrace plan and the pilots), which does not grow with the image.
 2. One plain RGB Cycles render of the same imported scene, --samples per pixel and the same resolution, the scene's
@@ -40,8 +42,10 @@ For each:
 3. The planned render's error: `chromatrace compare` of it against a reference-tracer render with 5 nm bands, the
    scene's bounce limit and --reference-spp paths per pixel (one per light and masking, shared by the Blenders): the
    image's mean ΔE00 (CIE 1931 observer) and the worst object's. The reference's own noise is in what compare
-   measures; the plan's prediction against it (the header's chromatrace.plan: its prediction, and the tracer's noise
-   at one sample over √(reference paths), in quadrature) is printed beside it.
+   measures, and the plan's prediction against it (the header's chromatrace.plan, against_tracer_reference: the
+   bands' error, Cycles' noise and the reference's added pixel by pixel) is printed beside it. Where the plan turned
+   the light tree off, the plain render is made that way too and printed beside: how much of the saving that alone
+   gives.
 
 A second plain render has the samples of the planned render's largest band group: a plain render as noisy as the
 planned one, whose ratio separates the spectral render's own cost from the samples the target asks for.
@@ -155,6 +159,8 @@ scene = bpy.context.scene
 scene_import.import_scene({box!r}, scene, tool.Tool(tool.find_executable()), lambda m: None)
 """
 assert _IMPORT in PLAIN, "bench_blender.PLAIN no longer imports the scene as this bench expects"
+_RENDER = "scene.render.filepath = "
+assert _RENDER in PLAIN, "bench_blender.PLAIN no longer sets the output before it renders"
 # The .blend's objects get the export's object ids as pass indices, as the spectral render gives them, so that the
 # plain render's noise is measured per object too.
 PLAIN_BLEND = PLAIN.replace(_IMPORT, "scene = bpy.context.scene\nids = {ids!r}\nfor ob in scene.objects:\n"
@@ -311,7 +317,8 @@ def bench(scene_name, light, args, work, blender_exe, version, references):
     source = ["--blend", blend] if blend else ["--scene", scene]
     spectral = run(blender + ["--python", os.path.join(ROOT, "blender_addon", "batch.py"), "--", *source,
                               "--out", spectral_exr, "--resolution", res, "--plan", repr(args.target),
-                              "--plan-edge-step", "5", "--components", "paths", "--plan-out", plan_file,
+                              "--plan-edge-step", "5", "--plan-reference-spp", str(args.reference_spp),
+                              "--components", "paths", "--plan-out", plan_file,
                               "--cache-dir", os.path.join(out_dir, f"{case}-cache")],
                    env=dict(os.environ, CHROMATRACE_EXE=exe))
     timings = re.findall(r"chromatrace: render \d+/\d+ \(([^)]*)\): ([0-9.]+) s, ([0-9.]+) s CPU", spectral.stderr)
@@ -335,8 +342,9 @@ def bench(scene_name, light, args, work, blender_exe, version, references):
     spectral_fixed_cpu = sum(float(cpu) for _what, _wall, cpu in re.findall(
         r"chromatrace: render \d+/\d+ \(([^)]*)\): ([0-9.]+) s, ([0-9.]+) s CPU", fixed.stderr))
     reference_noise = plan["tracer_noise_at_one_sample"] / args.reference_spp ** 0.5
-    predicted = math.hypot(plan["predicted_mean_de00"], reference_noise)
-    low, high = (math.hypot(x, reference_noise) for x in plan["predicted_range"])
+    # The plan's own prediction against the reference (its noise added pixel by pixel), for which it was planned.
+    against = plan["against_tracer_reference"]
+    predicted, (low, high) = against["mean_de00"], against["mean_de00_range"]
     worst_plan = plan.get("worst_object")
     worst_predicted = (f"{math.hypot(worst_plan['mean_de00'], reference_noise * worst_plan['noise_to_image_noise']):.2f} "
                        f"({worst_plan['name']})") if worst_plan else "-"
@@ -344,9 +352,11 @@ def bench(scene_name, light, args, work, blender_exe, version, references):
     names = json.loads(run([exe, "info", reference, "--json"]).stdout)["object_ids"]["names"]
     ids = {name: int(i) for i, name in names.items()}
 
-    def plain_render(samples, seed, out):
+    def plain_render(samples, seed, out, light_tree_off=False):
         script = (PLAIN_BLEND if blend else PLAIN).format(root=ROOT, box=scene, samples=samples, seed=seed,
                                                            res=args.resolution, out=out, ids=ids)
+        if light_tree_off:  # as the plan renders its groups where its pilots asked for it (docs/plan.md)
+            script = script.replace(_RENDER, "scene.cycles.use_light_tree = False\n" + _RENDER)
         plain = run(([blender_exe, blend, "--background", "--factory-startup"] if blend else blender)
                     + ["--python-expr", script])
         found = re.search(r"PLAIN_RENDER_SECONDS ([0-9.]+) ([0-9.]+)", plain.stdout)
@@ -365,6 +375,12 @@ def bench(scene_name, light, args, work, blender_exe, version, references):
     equal_samples = max(plan["cycles_samples"])
     equal_cpu = plain_render(equal_samples, 1, os.path.join(out_dir, f"{case}-rgb-equal.exr"))
     floor = floor_of(plan, plain_noise, args, spectral_cpu, plain_cpu)
+    # Where the plan turned Cycles' light tree off, the plain render so too: how much of the saving that alone makes.
+    plain_off = None
+    if plan.get("cycles_light_tree") is False:
+        off_exr = [os.path.join(out_dir, f"{case}-rgb-light-tree-off-{seed}.exr") for seed in (1, 2)]
+        off_cpu = min(plain_render(args.samples, seed, exr, light_tree_off=True) for seed, exr in zip((1, 2), off_exr))
+        plain_off = dict(cpu=off_cpu, noise=plain_noise_of(off_exr, scene, names, exe)["image"])
 
     def compared_with_reference(exr, tag):
         compare_dir = os.path.join(out_dir, f"{case}-{tag}compare")
@@ -384,7 +400,7 @@ def bench(scene_name, light, args, work, blender_exe, version, references):
     print(f"\nBlender {version}, {scene_name}, {light.upper()}: {said.group(1)}")
     for what, _wall, cpu in timings:
         print(f"  Cycles render ({what}): {float(cpu):.2f} s CPU")
-    print(f"  planned spectral, all Cycles renders: {spectral_cpu:.2f} s CPU; planning (plan twice, pilots): "
+    print(f"  planned spectral, all Cycles renders: {spectral_cpu:.2f} s CPU; planning (plan, pilots, plan again): "
           f"{planning_cpu:.2f} s CPU")
     print(f"  plain RGB Cycles render ({args.samples} samples): {plain_cpu:.2f} s CPU")
     print(f"  ratio planned spectral / plain RGB: {spectral_cpu / plain_cpu:.2f}x CPU "
@@ -403,6 +419,10 @@ def bench(scene_name, light, args, work, blender_exe, version, references):
     print(f"  floor: the plain render's noise meets the mean at {floor['need_mean']:.0f} samples and "
           f"{floor['worst_name']}'s limit at {floor['need_object']:.0f}; {floor['groups']} groups of "
           f"{floor['samples']:.0f} samples cost at least {floor['ratio']:.2f}x the plain render")
+    if plain_off:
+        print(f"  plain RGB render with Cycles' light tree off, as the plan's groups ({args.samples} samples): "
+              f"{plain_off['cpu']:.2f} s CPU ({plain_off['cpu'] / plain_cpu:.2f}x the artist's), its noise mean dE00 "
+              f"{plain_off['noise']:.2f}; ratio planned spectral / it: {spectral_cpu / plain_off['cpu']:.2f}x")
     if guided:
         print(f"  guided: the plan's group {guided['guide']} at its {guided['samples'][guided['guide']]} samples guides the "
               f"others at {args.guided:g} of that ({', '.join(map(str, guided['samples']))}): {guided['cpu']:.2f} s CPU, "
@@ -416,7 +436,8 @@ def bench(scene_name, light, args, work, blender_exe, version, references):
                 worst_predicted=worst_predicted,
                 samples=",".join(map(str, plan["cycles_samples"])), plain_noise=plain_noise["image"],
                 samples_part=samples_part, fixed=spectral_fixed_cpu, plain_fixed=plain_fixed_cpu,
-                plain_worst=f"{floor['worst']:.2f} ({floor['worst_name']})", floor=floor["ratio"],
+                plain_worst=f"{floor['worst']:.2f} ({floor['worst_name']})", floor=floor["ratio"], plain_off=plain_off,
+                plain_cpu=plain_cpu,
                 floor_samples=floor["samples"])
 
 
@@ -477,6 +498,14 @@ def main():
             print(f"{version:8s} {scene_name:9s} {light.upper():5s}  {r['fixed']:21.2f}, {r['plain_fixed']:5.2f}  "
                   f"{r['samples_part']:19.2f}x  {r['plain_noise']:.2f}, {r['plain_worst']:27s}  "
                   f"{r['floor_samples']:34.0f}  {r['floor']:12.2f}x")
+        off = [(version, scene_name, light, r) for version, scene_name, light, r in results if r["plain_off"]]
+        if off:
+            print("\nWhere the plan turned Cycles' light tree off: the plain render so too")
+            print("Blender  scene     light  plain, light tree off: CPU / the artist's  its noise  planned spectral / it")
+            for version, scene_name, light, r in off:
+                o = r["plain_off"]
+                print(f"{version:8s} {scene_name:9s} {light.upper():5s}  {o['cpu'] / r['plain_cpu']:38.2f}x  "
+                      f"{o['noise']:9.2f}  {r['ratio'] * r['plain_cpu'] / o['cpu']:20.2f}x")
 
 
 if __name__ == "__main__":

@@ -51,6 +51,9 @@ Action add_plan(CLI::App& app) {
       ->expected(2);
   cmd->add_option("--reference-spp", o->plan.reference_samples,
                   "Also predict the mean ΔE00 compare measures against a tracer reference of this many paths per pixel");
+  cmd->add_flag("--target-against-reference", o->plan.target_against_reference,
+                "With --reference-spp: plan Cycles' samples for the target as compare measures it against that "
+                "reference, its noise counted");
   cmd->add_option("--object-target-de00", o->plan.object_target_de00,
                   "Cycles: the mean ΔE00 no object may be predicted above; the samples grow until none is (default: twice "
                   "--target-de00)");
@@ -73,6 +76,10 @@ Action add_plan(CLI::App& app) {
       throw InputError(fmt::format("--object-target-de00: must be > 0, got {:g}", o->plan.object_target_de00));
     if (o->plan.reference_samples < 0)
       throw InputError(fmt::format("--reference-spp: must be >= 1, got {}", o->plan.reference_samples));
+    if (o->plan.target_against_reference && o->plan.reference_samples <= 0)
+      throw InputError("--target-against-reference: needs --reference-spp, the reference's paths per pixel");
+    if (o->plan.target_against_reference && o->plan.renderer != plan::Renderer::Cycles)
+      throw InputError("--target-against-reference: it plans Cycles' samples, for --renderer cycles");
     const Scene scene = load_scene(o->scene);
     // Before the preview render: neither output may be an input (the scene, its meshes and tables, the pilots) or
     // the other.
@@ -95,6 +102,9 @@ Action add_plan(CLI::App& app) {
       o->plan.cycles_pilot_tracer_noise_at_one = r.tracer_at_one;
       o->plan.cycles_object_noise_ratio = r.object_ratio;
       o->plan.cycles_group_guided_delta_e = r.group_guided_delta_e;
+      o->plan.cycles_pixel_noise = r.pixel_noise;
+      o->plan.cycles_pixel_noise_width = r.width;
+      o->plan.cycles_pixel_noise_height = r.height;
       o->plan.cycles_noise_ratio_from = fmt::format(
           "Cycles pilots {} and {} ({} samples): mean ΔE00 {:.3f} between them against the tracer's {:.3f}, ratio ± "
           "2 standard errors",

@@ -132,6 +132,8 @@ int run(const SceneBandsOptions& o) {
     report["bands"]["cycles_guided_groups"] = given->cycles_guided_groups;
   if (given && given->cycles_guided_threshold > 0)  // their adaptive sampling's noise threshold
     report["bands"]["cycles_guided_threshold"] = given->cycles_guided_threshold;
+  if (given && given->cycles_light_tree)  // Cycles' light tree in the add-on's renders, where the plan chose it
+    report["bands"]["cycles_light_tree"] = *given->cycles_light_tree;
   Json spectra_json = Json::object();
   for (const NamedSpectrum& s : spectra) spectra_json[s.name] = spectrum_entry(s.spectrum, bands);
   report["spectra"] = spectra_json;

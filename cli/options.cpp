@@ -34,7 +34,7 @@ std::optional<BandPlanFile> band_plan_file_option(const std::string& bands, cons
                                                   std::string_view file_option) {
   if (!bands.empty() && !file.empty())
     throw InputError(fmt::format("{}: give either --bands or {}, not both", file_option, file_option));
-  if (!bands.empty()) return BandPlanFile{Bands::parse(bands, "--bands"), {}, {}, 0.0};
+  if (!bands.empty()) return BandPlanFile{Bands::parse(bands, "--bands"), {}, {}, 0.0, std::nullopt};
   if (!file.empty()) return read_band_plan_file(file);
   return std::nullopt;
 }

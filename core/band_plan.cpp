@@ -18,7 +18,8 @@ BandPlanFile read_band_plan_file(const std::filesystem::path& file) {
   const std::string format = root["format"].string();
   if (format != "chromatrace-bands/1") root["format"].fail(fmt::format("must be \"chromatrace-bands/1\", got \"{}\"", format));
   root.expect_object(
-      {"format", "edges_nm", "reconstruction", "cycles_samples", "cycles_guided_groups", "cycles_guided_threshold"});
+      {"format", "edges_nm", "reconstruction", "cycles_samples", "cycles_guided_groups", "cycles_guided_threshold",
+       "cycles_light_tree"});
   const JsonNode edges_node = root["edges_nm"];
   std::vector<double> edges;
   for (const JsonNode& edge : edges_node.elements()) {
@@ -31,7 +32,7 @@ BandPlanFile read_band_plan_file(const std::filesystem::path& file) {
   if (edges.back() <= 360.0 || edges.front() >= 830.0)
     edges_node.fail(fmt::format("bands [{}, {}] nm do not overlap the visible range 360-830 nm (wavelengths in nm?)",
                                 edges.front(), edges.back()));
-  BandPlanFile plan{Bands::from_edges(std::move(edges), edges_node.location()), {}, {}, 0.0};
+  BandPlanFile plan{Bands::from_edges(std::move(edges), edges_node.location()), {}, {}, 0.0, std::nullopt};
   if (const auto r = root.find("reconstruction")) plan.bands = read_reconstruction(*r, plan.bands);
   if (const auto samples = root.find("cycles_samples")) {
     const std::vector<JsonNode> groups = samples->elements();
@@ -56,6 +57,7 @@ BandPlanFile read_band_plan_file(const std::filesystem::path& file) {
     if (plan.cycles_guided_groups.empty()) threshold->fail("needs cycles_guided_groups: it is their adaptive sampling's");
     plan.cycles_guided_threshold = threshold->number_in(1e-4, 1.0);
   }
+  if (const auto light_tree = root.find("cycles_light_tree")) plan.cycles_light_tree = light_tree->boolean();
   return plan;
 }
 

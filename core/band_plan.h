@@ -6,7 +6,8 @@
 //
 //   {"format": "chromatrace-bands/1", "edges_nm": [380, 400, 420, 440, 450, 460, 480, 520, 600, 780],
 //    "reconstruction": {"lo_nm": 380, "step_nm": 1, "matrix": [[m_00, ..., m_08], ...]},
-//    "cycles_samples": [256, 32, 32], "cycles_guided_groups": [1, 2], "cycles_guided_threshold": 0.01}
+//    "cycles_samples": [256, 32, 32], "cycles_guided_groups": [1, 2], "cycles_guided_threshold": 0.01,
+//    "cycles_light_tree": false}
 //
 // N + 1 strictly increasing edges give N contiguous bands [edge_i, edge_i+1) that must overlap the visible
 // range 360–830 nm. The reconstruction's matrix has one row per fine band [lo + j·step, lo + (j+1)·step) and one
@@ -18,10 +19,14 @@
 // cycles_guided_threshold, optional (with cycles_guided_groups), renders the guided groups with Cycles' adaptive
 // sampling: every pixel gets the group's samples, and a pixel whose noise stays above the threshold (Cycles'
 // adaptive_threshold: objects' edges and highlights, which the reconstruction leaves at their own samples) gets
-// more, up to the guides' samples. Errors name the file and the JSON path ("plan.json: edges_nm[3]: ...").
+// more, up to the guides' samples. cycles_light_tree, optional, turns Cycles' light tree (Blender 3.5 on) on or off in
+// the add-on's renders of the bands, whatever the scene has: the add-on's plan turns it off where its pilots found the
+// scene less noisy without it (docs/plan.md, "Cycles' light tree, planned"). Errors name the file and the JSON path
+// ("plan.json: edges_nm[3]: ...").
 
 #include <cstddef>
 #include <filesystem>
+#include <optional>
 #include <vector>
 
 #include "core/json_input.h"
@@ -36,6 +41,7 @@ struct BandPlanFile {
   std::vector<int> cycles_samples;
   std::vector<std::size_t> cycles_guided_groups;  // in increasing order
   double cycles_guided_threshold = 0;             // 0: the guided groups render their samples, no more
+  std::optional<bool> cycles_light_tree;          // absent: Cycles' light tree as the scene has it
 };
 BandPlanFile read_band_plan_file(const std::filesystem::path& file);
 Bands read_band_plan(const std::filesystem::path& file);  // the bands alone

@@ -252,6 +252,9 @@ NoiseRatio measure_cycles_noise(const Scene& scene, const std::filesystem::path&
   if (!(traced > 0))
     throw InputError(fmt::format("{}: the tracer's renders of {} at its size and samples show no noise to compare with",
                                  ia.file, scene.source));
+  out.pixel_noise = cycles_de;
+  out.width = ia.width;
+  out.height = ia.height;
   out.cycles = cycles;
   out.tracer = traced;
   out.tracer_at_one = traced / std::sqrt(2.0) * std::sqrt(static_cast<double>(out.samples));

@@ -81,6 +81,15 @@ class Model {
   // that `carry` marks, the others noiseless, the band values read as the plan reads them, on exact colours: their
   // part in the noise's colour error.
   double band_noise(const std::vector<int>& edges, int max_bounces, const std::vector<bool>& carry) const;
+  // Mean ΔE00 of a plan's bands and bounce limit with Cycles' noise (and a reference's) added pixel by pixel, in
+  // quadrature there: over the preview's pixels, √(b² + n² + r²) with b the pixel's ΔE00 of the bands (evaluate's),
+  // n Cycles' noise there as `cycles_noise` (per preview pixel: the pilots'; empty: the preview's own) has it,
+  // scaled to a mean of `noise_only`, and r the preview's noise scaled to a mean of `reference` (a tracer
+  // reference's). Where the noise is strong (dim pixels, a highlight) is seldom where the bands miss (the sky seen
+  // directly, one colour of a texture), and the mean of the sum is then above the quadrature of the means
+  // (Minkowski's inequality): docs/plan.md, "Bands and noise, pixel by pixel".
+  double joint_error(const std::vector<int>& edges, int max_bounces, double noise_only, double reference,
+                     const std::vector<double>& cycles_noise) const;
   bool reconstructs() const { return reconstruct_; }
   std::pair<double, double> evaluate_exact(int max_bounces) const;  // exact spectra, truncated bounces
   // Per surface id: the mean ΔE00 over its pixels of the preview of a plan's bands and bounce limit, as evaluate's
@@ -99,6 +108,7 @@ class Model {
   // Mean ΔE00 of the preview's Monte Carlo noise (one render against the truth) and its paths per pixel.
   double preview_noise() const { return preview_noise_; }
   int preview_samples() const { return preview_samples_; }
+  std::array<int, 2> preview_size() const { return preview_size_; }
   double mean_albedo() const { return mean_albedo_; }
 
  private:
@@ -127,8 +137,10 @@ class Model {
                                        const std::vector<double>& band_scale) const;
   // Mean and 95th percentile over the preview's pixels of ΔE00 against the exact colours, `noise` (per preview
   // pixel) added to the tested colours.
+  // `per_pixel` receives each of pixels_' ΔE00.
   std::pair<double, double> score(const Templates& templates, int max_bounces,
-                                  const std::vector<Vec3d>* noise = nullptr, std::vector<double>* by_id = nullptr) const;
+                                  const std::vector<Vec3d>* noise = nullptr, std::vector<double>* by_id = nullptr,
+                                  std::vector<double>* per_pixel = nullptr) const;
   std::optional<BandReconstruction> fit_reconstruction(const TemplateSpectra& banded, const std::vector<int>& edges,
                                                        int max_bounces) const;
   // Appends to `t` (tristimulus values, not yet at unit luminance) the templates of the textured surfaces' colours, in
@@ -174,9 +186,11 @@ class Model {
   std::vector<int> grid_edges_;
   double hit_fraction_ = 0, mean_albedo_ = 0, preview_noise_ = 0;
   std::vector<double> preview_noise_by_id_;
+  std::vector<double> preview_pixel_noise_;  // each preview pixel's ΔE00 between its two renders, over √2
   std::vector<std::size_t> pixels_by_id_;
   int preview_samples_ = 0;
   std::size_t pixel_count_ = 0;
+  std::array<int, 2> preview_size_{0, 0};  // width, height
 };
 
 Model::Model(const Scene& scene, const PlanOptions& options, std::vector<std::string>& notes, int reference_bounces) {
@@ -344,6 +358,7 @@ void Model::read_preview(const Preview& preview, const std::vector<bool>& near_l
   const auto *dd = layer("diffuse_direct"), *gd = layer("glossy_direct"), *di = layer("diffuse_indirect"),
              *gi = layer("glossy_indirect");
   pixel_count_ = N;
+  preview_size_ = {preview.image.width, preview.image.height};
   std::size_t hits = 0;
   for (std::size_t p = 0; p < N; ++p) {
     Pixel px;
@@ -441,6 +456,9 @@ void Model::measure_preview_noise(const Preview& preview) {
     b[p] = preview.colour(second.layers[0], p);
   }
   preview_noise_ = N ? delta_e_between(a, b, white_).mean / std::sqrt(2.0) : 0.0;
+  preview_pixel_noise_.resize(N);
+  for (std::size_t p = 0; p < N; ++p)
+    preview_pixel_noise_[p] = delta_e_2000(xyz_to_lab(a[p], white_), xyz_to_lab(b[p], white_)) / std::sqrt(2.0);
   preview_noise_by_id_.assign(surfaces_.size(), 0.0);
   pixels_by_id_.assign(surfaces_.size(), 0);
   for (const Pixel& px : pixels_) {
@@ -487,7 +505,8 @@ std::vector<Vec3d> Model::noise_tristimulus(const std::vector<int>& edges,
 }
 
 std::pair<double, double> Model::score(const Templates& templates, int max_bounces,
-                                        const std::vector<Vec3d>* noise, std::vector<double>* by_id) const {
+                                        const std::vector<Vec3d>* noise, std::vector<double>* by_id,
+                                        std::vector<double>* per_pixel) const {
   std::vector<double> de(pixels_.size());
   for (std::size_t p = 0; p < pixels_.size(); ++p) {
     const Sample& s = samples_[p];
@@ -499,6 +518,7 @@ std::pair<double, double> Model::score(const Templates& templates, int max_bounc
       for (int c = 0; c < 3; ++c) x[c] += (*noise)[pixels_[p].index][c];
     de[p] = delta_e_2000(lab_exact_[p], xyz_to_lab(x, white_));
   }
+  if (per_pixel) *per_pixel = de;
   if (by_id) {
     by_id->assign(surfaces_.size(), 0.0);
     std::vector<std::size_t> count(surfaces_.size(), 0);
@@ -603,6 +623,21 @@ double Model::band_noise(const std::vector<int>& edges, int max_bounces, const s
   for (std::size_t i = 0; i < carry.size(); ++i) scale[i] = carry[i] ? 1.0 : 0.0;
   const std::vector<Vec3d> noise = noise_tristimulus(edges, weights, scale);
   return score(exact_, kmax_, &noise).first;
+}
+
+double Model::joint_error(const std::vector<int>& edges, int max_bounces, double noise_only, double reference,
+                          const std::vector<double>& cycles_noise) const {
+  std::vector<double> bands;
+  score(banded_templates(edges, max_bounces, reconstruct_, nullptr).templates, std::min(max_bounces, kmax_), nullptr,
+        nullptr, &bands);
+  // Cycles' noise where the pilots have it (given at the preview's size), else where the preview has its own; the
+  // reference's where the preview has it. Each pair's difference per pixel is one draw of the noise there, as a
+  // render's error is one draw.
+  const std::vector<double>& tracer = preview_pixel_noise_;
+  const std::vector<double>& cycles = cycles_noise.size() == tracer.size() ? cycles_noise : tracer;
+  std::vector<double> n(pixels_.size()), r(pixels_.size());
+  for (std::size_t p = 0; p < pixels_.size(); ++p) n[p] = cycles[pixels_[p].index], r[p] = tracer[pixels_[p].index];
+  return pixel_by_pixel_mean(bands, n, noise_only, r, reference, pixel_count_);
 }
 
 Model::BandedTemplates Model::banded_templates(const std::vector<int>& edges, int max_bounces, bool reconstruct,
@@ -834,6 +869,53 @@ std::vector<int> cycles_samples_for(const CyclesNoise& noise, double bands_error
   return samples;
 }
 
+// The mean ΔE00 of bands, bounces and Cycles' noise at `samples` per group, added pixel by pixel
+// (Model::joint_error): each band's noise as its group's samples give it (1/√N_g), the whole at the noise's mean
+// noise.at(samples) and, given a reference's noise (a tracer render's, at `reference` mean ΔE00), that too.
+double joint_at(const Model& model, const std::vector<int>& edges, int max_bounces, const CyclesNoise& noise,
+                const std::vector<int>& samples, const PlanOptions& options, double reference = 0) {
+  const bool pilots = std::array{options.cycles_pixel_noise_width, options.cycles_pixel_noise_height} ==
+                          model.preview_size() &&
+                      options.cycles_pixel_noise.size() == static_cast<std::size_t>(options.cycles_pixel_noise_width) *
+                                                               static_cast<std::size_t>(options.cycles_pixel_noise_height);
+  static const std::vector<double> none;
+  return model.joint_error(edges, max_bounces, noise.at(samples), reference, pilots ? options.cycles_pixel_noise : none);
+}
+
+// The noise of the tracer reference the target is measured against (PlanOptions::target_against_reference): the
+// tracer's at one path over √paths; 0 otherwise.
+double reference_noise(const CyclesNoise& noise, const PlanOptions& options) {
+  return options.target_against_reference && options.reference_samples > 0
+             ? noise.at_one / std::sqrt(static_cast<double>(options.reference_samples))
+             : 0.0;
+}
+
+// `samples` (cycles_samples_for's, from the quadrature law) raised by one factor for every group until the joint
+// error (joint_at) is at most the target: the fewest such, to a sample.
+std::vector<int> raised_for_joint(const Model& model, const std::vector<int>& edges, int max_bounces,
+                                  const CyclesNoise& noise, std::vector<int> samples, const PlanOptions& options,
+                                  double reference) {
+  const double target = options.target_de00;
+  auto joint = [&](const std::vector<int>& n) { return joint_at(model, edges, max_bounces, noise, n, options, reference); };
+  if (samples.empty() || joint(samples) <= target) return samples;
+  auto times = [&](double f) {
+    std::vector<int> n(samples);
+    for (int& x : n) x = static_cast<int>(std::ceil(x * f - 1e-9));
+    return n;
+  };
+  double lo = 1, hi = 2;
+  while (joint(times(hi)) > target) {
+    lo = hi, hi *= 2;
+    if (hi > 1 << 16) return {};  // the bands' error alone is within the target, but not by a margin noise leaves
+  }
+  const int most = *std::max_element(samples.begin(), samples.end());
+  while ((hi - lo) * most > 1) {
+    const double mid = 0.5 * (lo + hi);
+    (joint(times(mid)) > target ? lo : hi) = mid;
+  }
+  return times(hi);
+}
+
 // The luminance fraction that arrives after more than k events, k = 0 .. the model's depth − 1, over the preview;
 // with `surfaces_only`, over the pixels not on or next to a light (where the light's own emission does not count).
 std::vector<double> energy_after(const Model& model, bool surfaces_only = false) {
@@ -908,6 +990,20 @@ void limit_objects(Plan& plan, const Scene& scene, const Model& model, const std
 }
 
 }  // namespace
+
+double pixel_by_pixel_mean(const std::vector<double>& bands, const std::vector<double>& noise, double noise_mean,
+                           const std::vector<double>& reference, double reference_mean, std::size_t pixel_count) {
+  if (pixel_count == 0) return 0.0;
+  auto scale = [&](const std::vector<double>& level, double mean) {
+    const double sum = std::accumulate(level.begin(), level.end(), 0.0);
+    return sum > 0 ? mean * static_cast<double>(pixel_count) / sum : 0.0;
+  };
+  const double c = scale(noise, noise_mean), t = scale(reference, reference_mean);
+  double sum = 0;
+  for (std::size_t p = 0; p < bands.size(); ++p)
+    sum += std::sqrt(bands[p] * bands[p] + std::pow(c * noise[p], 2) + std::pow(t * reference[p], 2));
+  return sum / static_cast<double>(pixel_count);
+}
 
 PiecewiseLinearSpectrum scene_light_spectrum(const Scene& scene) {
   std::vector<double> nm, v;
@@ -1015,8 +1111,13 @@ Plan make_plan(const Scene& scene, const PlanOptions& options) {
       break;
     }
     const int min_samples = options.cycles_min_samples > 0 ? options.cycles_min_samples : kCyclesMinSamples;
-    const std::vector<int> samples = cycles_samples_for(cycles_noise(model, trial_edges, plan.max_bounces, ratio, options), a_val,
-                                                        options.target_de00, min_samples);
+    const CyclesNoise trial_noise = cycles_noise(model, trial_edges, plan.max_bounces, ratio, options);
+    // Planned for what compare measures against a tracer reference, its noise is part of the error to hold.
+    const double reference = reference_noise(trial_noise, options);
+    const std::vector<int> samples = raised_for_joint(
+        model, trial_edges, plan.max_bounces, trial_noise,
+        cycles_samples_for(trial_noise, std::hypot(a_val, reference), options.target_de00, min_samples), options,
+        reference);
     plan.trials.back().cycles_samples = samples;
     const bool cheaper = !samples.empty() && (chosen_samples.empty() || total(samples) < total(chosen_samples));
     if (!chosen || cheaper) {
@@ -1046,7 +1147,11 @@ Plan make_plan(const Scene& scene, const PlanOptions& options) {
     CyclesNoise noise = cycles_noise(model, edges, plan.max_bounces, ratio, options);
     limit_objects(plan, scene, model, edges, noise, options);
     const auto& n = plan.cycles_samples;
-    auto with = [&](double noise_de00) { return std::hypot(plan.predicted_mean, noise_de00); };
+    // Bands and noise added pixel by pixel (joint_at) at the ratio `noise` holds, against a reference of
+    // `reference` mean ΔE00 of noise if given.
+    auto with = [&](double reference = 0) {
+      return joint_at(model, edges, plan.max_bounces, noise, n, options, reference);
+    };
     plan.cycles_noise_ratio = ratio;
     plan.tracer_noise_at_one = noise.at_one;
     plan.tracer_noise_from_pilots = options.cycles_pilot_tracer_noise_at_one > 0;
@@ -1059,21 +1164,22 @@ Plan make_plan(const Scene& scene, const PlanOptions& options) {
       plan.cycles_guide_group = static_cast<int>(std::min_element(r.begin(), r.end()) - r.begin());
     }
     plan.cycles_noise_only = noise.at(n);
-    plan.cycles_predicted_mean = with(plan.cycles_noise_only);
+    plan.cycles_predicted_mean = with();
+    plan.cycles_predicted_in_quadrature = std::hypot(plan.predicted_mean, plan.cycles_noise_only);
     // The range: the ratio's (measured on the pilots, or over the test scenes), and the noise model's own accuracy.
     std::array<double, 2> range = options.cycles_noise_ratio_range;
     if (!(options.cycles_noise_ratio > 0)) range = {kCyclesNoiseRatioLow, kCyclesNoiseRatioHigh};
     if (!(range[1] > 0)) range = {ratio, ratio};
+    // Against a tracer reference of N paths, its noise too (the tracer's at one path over √N).
+    const double reference =
+        options.reference_samples > 0 ? noise.at_one / std::sqrt(static_cast<double>(options.reference_samples)) : 0;
+    if (reference > 0) plan.cycles_predicted_against_reference = with(reference);
     noise.ratio = range[0] / (1 + kCyclesNoiseModelAccuracy);
-    plan.cycles_predicted_low = with(noise.at(n));
+    plan.cycles_predicted_low = with();
+    if (reference > 0) plan.cycles_against_reference_low = with(reference);
     noise.ratio = range[1] * (1 + kCyclesNoiseModelAccuracy);
-    plan.cycles_predicted_high = with(noise.at(n));
-    if (options.reference_samples > 0) {
-      const double reference = noise.at_one / std::sqrt(static_cast<double>(options.reference_samples));
-      plan.cycles_predicted_against_reference = std::hypot(plan.cycles_predicted_mean, reference);
-      plan.cycles_against_reference_low = std::hypot(plan.cycles_predicted_low, reference);
-      plan.cycles_against_reference_high = std::hypot(plan.cycles_predicted_high, reference);
-    }
+    plan.cycles_predicted_high = with();
+    if (reference > 0) plan.cycles_against_reference_high = with(reference);
   }
   {
     std::vector<int> scene_edges;
@@ -1174,6 +1280,7 @@ Json report_document(const Plan& plan, const Scene& scene, const PlanOptions& op
            {"mean_de00", plan.cycles_predicted_mean},
            {"mean_de00_range", {plan.cycles_predicted_low, plan.cycles_predicted_high}},
            {"noise_only_mean_de00", plan.cycles_noise_only},
+           {"mean_de00_in_quadrature", plan.cycles_predicted_in_quadrature},
            {"noise_ratio_to_tracer", plan.cycles_noise_ratio},
            {"tracer_noise_at_one_sample", plan.tracer_noise_at_one},
            {"tracer_noise_from", plan.tracer_noise_from_pilots ? "the tracer's renders beside the Cycles pilots (their size and samples)"
@@ -1190,6 +1297,7 @@ Json report_document(const Plan& plan, const Scene& scene, const PlanOptions& op
     if (options.reference_samples > 0)
       c["against_tracer_reference"] = Json{
           {"samples", options.reference_samples},
+          {"the_target", options.target_against_reference},  // the samples were planned for this, not the mean above
           {"mean_de00", plan.cycles_predicted_against_reference},
           {"mean_de00_range", {plan.cycles_against_reference_low, plan.cycles_against_reference_high}}};
     c["object_limit_mean_de00"] = plan.object_target_de00;

@@ -72,9 +72,17 @@ struct PlanOptions {
   // Each band group's ΔE00 as a guide as the pilots measured it (NoiseRatio::group_guided_delta_e), for the bands of
   // cycles_group_shares_edges_nm: the plan names the group of the least the guide of a guided render.
   std::vector<double> cycles_group_guided_delta_e;
+  // Where Cycles' noise is on the pilots (NoiseRatio::pixel_noise), which are of the preview's size: the plan adds
+  // the noise to the bands' error pixel by pixel where it is (Model::joint_error). Empty, or of another size: where
+  // the tracer's preview has its noise.
+  std::vector<double> cycles_pixel_noise;
+  int cycles_pixel_noise_width = 0, cycles_pixel_noise_height = 0;
   // Also predict the mean ΔE00 that comparing the Cycles render with a tracer reference of this many paths per
   // pixel measures (its noise counts too); 0: not.
   int reference_samples = 0;
+  // Cycles: the target is that prediction, the reference's noise counted with the render's, where it is otherwise the
+  // render's own error: for a render to be validated against such a reference (bench_plan_cycles.py).
+  bool target_against_reference = false;
   // Cycles: the mean ΔE00 no object of the preview may be predicted above (its bands, bounces and noise); the samples
   // grow until none is. 0: twice target_de00.
   double object_target_de00 = 0;
@@ -141,6 +149,9 @@ struct Plan {
   double cycles_predicted_mean = 0;               // mean ΔE00 of bands, bounces and noise at cycles_samples
   double cycles_predicted_low = 0, cycles_predicted_high = 0;  // the same over the ratio's range
   double cycles_noise_only = 0;                   // the noise alone at cycles_samples (exact spectra)
+  // The bands' error and the noise's in quadrature of their means: what cycles_predicted_mean, which adds them pixel
+  // by pixel, would be if the noise were as strong wherever the bands miss.
+  double cycles_predicted_in_quadrature = 0;
   // Each object the preview sees enough of (limit_objects in plan.cpp): its predicted mean ΔE00 at cycles_samples,
   // and the factor by which the samples grew so that none exceeds object_target_de00 (1: the mean's samples did).
   struct ObjectPrediction {
@@ -195,6 +206,15 @@ PiecewiseLinearSpectrum scene_light_spectrum(const Scene& scene);
 // twice alike (its seeds 1 and 2, the scene's bounce limit) and the ratio is that of the mean ΔE00 between the two
 // of each (measure_delta_e's statistic, under the white of the first of each pair), its standard error from their
 // pixels'.
+// The mean ΔE00 over `pixel_count` pixels (those past bands.size() without error) of a render's error when its
+// bands' error (`bands`, ΔE00 per pixel), its noise and a reference's add in quadrature pixel by pixel:
+// Σ √(b² + (c·n)² + (t·r)²) / pixel_count, with c and t such that c·n and t·r have the means `noise_mean` and
+// `reference_mean` over the pixels (n and r give where each noise is, in any units). At least the quadrature of the
+// three means, and equal to it where the three are in the same proportion at every pixel (Minkowski's inequality);
+// at most their sum.
+double pixel_by_pixel_mean(const std::vector<double>& bands, const std::vector<double>& noise, double noise_mean,
+                           const std::vector<double>& reference, double reference_mean, std::size_t pixel_count);
+
 struct NoiseRatio {
   double ratio = 0, se = 0;
   double cycles = 0, tracer = 0;  // mean ΔE00 between the two renders of each
@@ -215,6 +235,10 @@ struct NoiseRatio {
   // image and over each object the first pilot holds at least kPilotObjectPixels of, each once. It ranks the groups
   // as guides; it is not the guided render's error, to which its few-sample pixels (objects' edges, highlights) add.
   std::vector<double> group_guided_delta_e;
+  // Where Cycles' noise is: each pixel's ΔE00 between the pilots (linearised, as `cycles` averages it), row by row at
+  // their width × height.
+  std::vector<double> pixel_noise;
+  int width = 0, height = 0;
 };
 constexpr std::size_t kPilotObjectPixels = 16;
 NoiseRatio measure_cycles_noise(const Scene& scene, const std::filesystem::path& a, const std::filesystem::path& b,

@@ -38,6 +38,9 @@ def _parser():
     p.add_argument("--plan-edge-step", type=float, metavar="NM",
                    help="with --plan: band edges on multiples of NM nm (chromatrace plan --edge-step; 5 lets compare "
                         "hold the render against a reference of 5 nm bands)")
+    p.add_argument("--plan-reference-spp", type=int, metavar="N",
+                   help="with --plan: the target is the mean ΔE00 compare will measure against a tracer reference of N "
+                        "paths per pixel, its noise counted (for a render to be validated against one)")
     p.add_argument("--plan-out", metavar="FILE",
                    help="with --plan: also write the plan's band file (bands, reconstruction, each group's samples) to "
                         "FILE, to render the same plan again with --bands-file and --max-bounces")
@@ -114,6 +117,10 @@ def parse_batch_args(argv):
                 raise BadInput(f"{option}: --plan chooses the bands, bounce limit and samples; give one of them")
     if args.plan_edge_step is not None and args.plan is None:
         raise BadInput("--plan-edge-step: needs --plan (the plan whose band edges it places)")
+    if args.plan_reference_spp is not None and args.plan is None:
+        raise BadInput("--plan-reference-spp: needs --plan (the plan whose target it is)")
+    if args.plan_reference_spp is not None and args.plan_reference_spp < 1:
+        raise BadInput(f"--plan-reference-spp: must be >= 1, got {args.plan_reference_spp}")
     if args.plan_out is not None and args.plan is None:
         raise BadInput("--plan-out: needs --plan (the plan it writes)")
     if args.bands and args.bands_file:

@@ -87,6 +87,8 @@ def cache_description(scene, request, plan, resolution):
         "samples": plan.samples if plan.planned_samples else request.samples,
         # The guided groups' adaptive sampling, where the band plan asks for it (absent otherwise, as before).
         **({"adaptive": plan.adaptive} if any(plan.adaptive) else {}),
+        # Cycles' light tree where the band plan sets it (absent otherwise, as before: then the scene's own, below).
+        **({"light_tree": plan.light_tree} if plan.light_tree is not None else {}),
         "seed": request.seed, "max_bounces": request.max_bounces,
         "device": request.device, "variants": plan.variants, "point_filter": request.point_filter,
         "resolution": resolution,

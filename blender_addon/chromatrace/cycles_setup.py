@@ -123,6 +123,16 @@ def apply(journal, scene, view_layer, samples, seed, point_filter, resolution, p
     _set_if(journal, getattr(view_layer, "cycles", None), "denoising_store_passes", False)
 
 
+def set_light_tree(journal, scene, on):
+    """Cycles' light tree on or off, as the band plan asks (its cycles_light_tree: planning.py turns it off where the
+    pilots found the scene less noisy without it). A Blender before 3.5 has none: off is what it does anyway."""
+    if hasattr(scene.cycles, "use_light_tree"):
+        journal.set(scene.cycles, "use_light_tree", bool(on))
+    elif on:
+        raise BadInput("cycles_light_tree: the band plan asks for Cycles' light tree, which this Blender "
+                       "(before 3.5) does not have")
+
+
 def set_samples(journal, scene, samples, adaptive=None):
     """One band group's samples per pixel. With `adaptive` (threshold, most samples: bands.guided_adaptive), Cycles'
     adaptive sampling: every pixel gets `samples`, and one whose noise stays above the threshold up to the most;

@@ -115,14 +115,16 @@ def _plan(args, scene, chromatrace_tool, work, log):
                    on_world=args.on_world)
     pilot_size = plan_scene.pilot_resolution(scene, spectral_render.Request.from_scene(
         scene, **{k: v for k, v in request.items() if v is not None}))
+    both = bool(getattr(scene.cycles, "use_light_tree", False))  # pilots with Cycles' light tree and without it
     log(f"planning for a mean ΔE00 of {args.plan:g}: chromatrace plan, then two pilot renders of "
         f"{'x'.join(map(str, pilot_size))} at {planning.PILOT_SAMPLES} "
-        "samples for Cycles' noise")
+        f"samples for Cycles' noise{', with its light tree and again without it' if both else ''}")
     start, start_cpu = time.monotonic(), _cpu_seconds()
     with _stdout_silenced(args.quiet):
         try:
             planned = plan_scene.plan_open_scene(scene, chromatrace_tool, args.plan, work, scene_file=args.scene,
-                                                 edge_step=args.plan_edge_step, **request)
+                                                 edge_step=args.plan_edge_step,
+                                                 reference_spp=args.plan_reference_spp, **request)
         except BadInput as e:
             message = str(e)
             if not message.startswith("--plan"):

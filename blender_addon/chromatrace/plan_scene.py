@@ -10,7 +10,7 @@ from . import cache, planning, scene_export, spectral_render
 from .errors import BadInput
 
 
-def plan_open_scene(scene, tool, target, work, scene_file=None, edge_step=None, **request):
+def plan_open_scene(scene, tool, target, work, scene_file=None, edge_step=None, reference_spp=None, **request):
     """Planned (planning.py) for `scene`. `request`: the render's Request settings the pilots keep (resolution,
     device, on_mixing_nodes, on_world). BadInput when the scene cannot be planned."""
     approximations = []
@@ -31,7 +31,9 @@ def plan_open_scene(scene, tool, target, work, scene_file=None, edge_step=None, 
         pilot.log = lambda message: None
         spectral_render.SpectralRender(scene, pilot, tool).run()
 
-    planned = planning.plan_render(scene_file, target, work, render_pilot, tool, edge_step)
+    planned = planning.plan_render(scene_file, target, work, render_pilot, tool, edge_step,
+                                   light_tree=bool(getattr(scene.cycles, "use_light_tree", False)),
+                                   reference_spp=reference_spp)
     planned.approximations = approximations  # what the plan's scene file holds only approximately: said as notes
     return planned
 
@@ -48,8 +50,7 @@ def keep(planned, cache_root, name):
     safe = "".join(c if c.isalnum() or c in "-_." else "_" for c in name) or "scene"
     bands_file = os.path.join(folder, f"{safe}.json")
     for source, target in ((planned.bands_file, bands_file),
-                           (os.path.join(os.path.dirname(planned.bands_file), "plan-report.json"),
-                            os.path.join(folder, f"{safe}.report.json"))):
+                           (planned.report_file, os.path.join(folder, f"{safe}.report.json"))):
         shutil.copyfile(source, target + ".partial")
         os.replace(target + ".partial", target)
     return bands_file

@@ -78,6 +78,8 @@ def apply_settings(journal, scene, request, plan, resolution):
     view_layer = plan.view_layer
     cycles_setup.apply(journal, scene, view_layer, request.samples, request.seed, request.point_filter,
                        resolution, plan.passes)
+    if plan.light_tree is not None:
+        cycles_setup.set_light_tree(journal, scene, plan.light_tree)
     plan.device = cycles_setup.select_device(journal, scene, _cycles_preferences(), request.device)
     _set_world(journal, scene.world, plan)
     for ob in plan.lights:  # its Temperature is in the light's spectrum (node_resolution.owner_inputs)

@@ -94,6 +94,7 @@ class SpectralRender:
                           adaptive=guided_adaptive(groups, bands["bands"].get("cycles_samples"),
                                                    bands["bands"].get("cycles_guided_groups"),
                                                    bands["bands"].get("cycles_guided_threshold")),
+                          light_tree=bands["bands"].get("cycles_light_tree"),
                           light_groups=light_groups, assignments=assignments, total=total, components=planned,
                           variants=components.render_variants(request.max_bounces, "bounces" in request.families),
                           passes=components.passes_needed(planned),
@@ -303,7 +304,9 @@ class SpectralRender:
         return attributes | {
             "chromatrace.renderer": (f"Cycles (Blender {bpy.app.version_string}) via the chromatrace add-on: "
                                      f"{plan.per_render} band(s) per render, max {request.max_bounces} bounces, "
-                                     f"on {request.device}"),
+                                     + ("" if plan.light_tree is None else
+                                        f"light tree {'on' if plan.light_tree else 'off'} (the band plan's), ")
+                                     + f"on {request.device}"),
             "chromatrace.device": getattr(plan, "device", request.device),
             # One number, or one per band group where the band plan gives each group its own (docs/spectral-exr.md).
             "chromatrace.samples": ",".join(map(str, plan.samples)) if len(set(plan.samples)) > 1 else str(plan.samples[0]),

@@ -66,12 +66,15 @@ class Tool:
             args += ["--bands-file", bands_file]
         return self.run(*args, json_output=True)
 
-    def plan(self, scene_file, target, output, report, pilots=None, edge_step=None):
+    def plan(self, scene_file, target, output, report, pilots=None, edge_step=None, reference_spp=None):
         """`chromatrace plan` for Cycles: the band-plan file and the report; with two pilot renders, Cycles' noise
-        measured on them."""
+        measured on them; with `reference_spp`, the target is as compare measures it against a tracer reference of
+        that many paths, its noise counted."""
         args = ["plan", scene_file, "--target-de00", repr(float(target)), "-o", output, "--report", report, "--quiet"]
         if edge_step:
             args += ["--edge-step", repr(float(edge_step))]
+        if reference_spp:
+            args += ["--reference-spp", str(int(reference_spp)), "--target-against-reference"]
         if pilots:
             args += ["--cycles-pilot", *pilots]
         return self.run(*args)

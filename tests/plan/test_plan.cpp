@@ -522,14 +522,40 @@ TEST_F(Plan, BandPlanFileCarriesTheSamplesOfEachCyclesBandGroup) {
   no_samples["cycles_guided_groups"] = {1};
   write_file_atomically(file, no_samples.dump());
   EXPECT_THROW(read_band_plan_file(file), InputError);
+  // Cycles' light tree, which the add-on's plan may turn off: absent unless given, a boolean when given.
+  write_file_atomically(file, band_plan_document(bands).dump());
+  EXPECT_FALSE(read_band_plan_file(file).cycles_light_tree.has_value());
+  for (const bool on : {false, true}) {
+    Json light_tree = band_plan_document(bands, {256, 32, 32});
+    light_tree["cycles_light_tree"] = on;
+    write_file_atomically(file, light_tree.dump());
+    EXPECT_EQ(read_band_plan_file(file).cycles_light_tree, std::optional<bool>(on));
+  }
+  EXPECT_NE(error_with({{"cycles_light_tree", "off"}}).find("cycles_light_tree"), std::string::npos);
+}
+
+// Bands' error and noise added pixel by pixel, known answers: in the same proportion everywhere the quadrature of the
+// means; apart (one pixel all bands, the other all noise) their mean, each pixel's own; unlit pixels count as none;
+// where the noise is only scales it (its units do not matter); the reference's noise adds like Cycles'.
+TEST(PixelByPixel, IsTheQuadratureOfTheMeansOnlyWhereTheyAreInProportion) {
+  using plan::pixel_by_pixel_mean;
+  EXPECT_NEAR(pixel_by_pixel_mean({0.3, 0.6, 0.9}, {1, 2, 3}, 0.8, {0, 0, 0}, 0, 3), std::hypot(0.6, 0.8), 1e-12);
+  EXPECT_NEAR(pixel_by_pixel_mean({1, 0}, {0, 5}, 0.5, {0, 0}, 0, 2), 1.0, 1e-12);  // quadrature: 0.707
+  EXPECT_NEAR(pixel_by_pixel_mean({1, 0}, {0, 5}, 0.25, {0, 0}, 0, 4), 0.5, 1e-12);  // two more pixels, unlit
+  EXPECT_NEAR(pixel_by_pixel_mean({1, 0}, {0, 0.001}, 0.5, {0, 0}, 0, 2), 1.0, 1e-12);
+  EXPECT_NEAR(pixel_by_pixel_mean({0, 0}, {1, 3}, 0.5, {1, 3}, 1.2, 2), 1.3, 1e-12);  // hypot(0.5, 1.2) = 1.3
+  EXPECT_NEAR(pixel_by_pixel_mean({0.5, 0.5}, {1, 1}, 0, {1, 1}, 0, 2), 0.5, 1e-12);  // no noise: the bands' alone
 }
 
 // For Cycles, plan gives samples to each band group of three with the bands: Cycles' noise `ratio` × the tracer's
 // at equal samples, f_g a group's share of its variance, adds to the bands' and bounces' error B in quadrature, so
 // the fewest samples in all for the target T have N_g = k·√f_g (no group under a quarter of the most) with
-// ratio² · noise(1)² · Σ f_g / N_g = T² − B². Known answers of that law: the predicted error is the target (each
-// N_g rounded up: at most it, within 1 %); samples scale with ratio² and with
-// 1 / (T² − B²); every group gets at least a quarter of the most; the band file carries them; the tracer gets none.
+// ratio² · noise(1)² · Σ f_g / N_g = T² − B². The bands' error and the noise are then added pixel by pixel
+// (Model::joint_error), which can only raise the mean (Minkowski's inequality), and every group's samples grow by
+// one factor until that is at the target. Known answers: the predicted error is the target (each N_g rounded up:
+// at most it, within 1 %), between the quadrature of B and the noise N and their sum; samples scale with ratio²;
+// a looser target takes fewer; every group gets at least a quarter of the most; the band file carries them; the
+// tracer gets none.
 TEST_F(Plan, CyclesSamplesPerBandGroupMeetTheTargetWithTheBands) {
   const fs::path bands = dir_ / "plan.json";
   auto plan = [&](std::vector<std::string> extra) {
@@ -552,30 +578,38 @@ TEST_F(Plan, CyclesSamplesPerBandGroupMeetTheTargetWithTheBands) {
   EXPECT_EQ(read_band_plan_file(bands).cycles_samples, n);
   EXPECT_TRUE(one["target_met"].get<bool>());
   const double bands_error = one["prediction"]["mean_de00"].get<double>(), noise = c["noise_only_mean_de00"].get<double>();
-  EXPECT_NEAR(c["mean_de00"].get<double>(), std::hypot(bands_error, noise), 1e-9);
-  EXPECT_LE(c["mean_de00"].get<double>(), 1.0);
-  EXPECT_GT(c["mean_de00"].get<double>(), 0.99);  // rounding up a few hundred samples moves it by well under 1 %
+  const double mean = c["mean_de00"].get<double>();
+  EXPECT_NEAR(c["mean_de00_in_quadrature"].get<double>(), std::hypot(bands_error, noise), 1e-9);
+  EXPECT_GE(mean, std::hypot(bands_error, noise) - 1e-9);
+  EXPECT_LE(mean, bands_error + noise + 1e-9);
+  EXPECT_LE(mean, 1.0);
+  EXPECT_GT(mean, 0.99);  // raised to the sample, a few hundred of them: well under 1 % below the target
   const int most = *std::max_element(n.begin(), n.end());
   for (int g : n) EXPECT_GE(4 * g, most);
   EXPECT_EQ(c["noise_ratio_to_tracer"].get<double>(), 1.0);
-  // A given ratio: the range is the noise model's own accuracy alone.
-  EXPECT_NEAR(c["mean_de00_range"][0].get<double>(),
-              std::hypot(bands_error, noise / (1 + plan::kCyclesNoiseModelAccuracy)), 1e-9);
-  EXPECT_NEAR(c["mean_de00_range"][1].get<double>(),
-              std::hypot(bands_error, noise * (1 + plan::kCyclesNoiseModelAccuracy)), 1e-9);
-  // Twice the noise: four times the samples (each within the rounding of one sample per group).
+  // A given ratio: the range is the noise model's own accuracy alone, each end the same sum at that noise.
+  for (const auto& [end, factor] : {std::pair{0, 1 / (1 + plan::kCyclesNoiseModelAccuracy)},
+                                    std::pair{1, 1 + plan::kCyclesNoiseModelAccuracy}}) {
+    const double e = c["mean_de00_range"][end].get<double>();
+    EXPECT_GE(e, std::hypot(bands_error, noise * factor) - 1e-9) << end;
+    EXPECT_LE(e, bands_error + noise * factor + 1e-9) << end;
+  }
+  EXPECT_LT(c["mean_de00_range"][0].get<double>(), mean);
+  EXPECT_GT(c["mean_de00_range"][1].get<double>(), mean);
+  // Twice the noise: four times the samples (the sum is at the target at the same noise; each within the rounding of
+  // one sample per group, twice: the law's and the factor's).
   const auto twice = mean_plan({"--cycles-noise-ratio", "2"})["prediction"]["cycles"]["samples_per_band_group"].get<std::vector<int>>();
   ASSERT_EQ(twice.size(), n.size());
-  for (std::size_t g = 0; g < n.size(); ++g) EXPECT_NEAR(twice[g], 4.0 * n[g], 4.0) << g;
-  // A looser target: the noise's budget T² − B² grows, the samples fall by its ratio (same bands and bounces).
+  for (std::size_t g = 0; g < n.size(); ++g) EXPECT_NEAR(twice[g], 4.0 * n[g], 8.0) << g;
+  // A looser target: fewer samples in every group, the same bands and bounces, that target met.
   const Json loose = mean_plan({"--cycles-noise-ratio", "1", "--target-de00", "1.5"});
   ASSERT_EQ(loose["settings"]["bands"], one["settings"]["bands"]);
-  const double b2 = loose["prediction"]["mean_de00"].get<double>();
   const auto fewer = loose["prediction"]["cycles"]["samples_per_band_group"].get<std::vector<int>>();
-  const double scale = (1.0 - bands_error * bands_error) / (1.5 * 1.5 - b2 * b2);
-  for (std::size_t g = 0; g < n.size(); ++g) EXPECT_NEAR(fewer[g], scale * n[g], 1.0) << g;
+  for (std::size_t g = 0; g < n.size(); ++g) EXPECT_LT(fewer[g], n[g]) << g;
+  EXPECT_LE(loose["prediction"]["cycles"]["mean_de00"].get<double>(), 1.5);
+  EXPECT_GT(loose["prediction"]["cycles"]["mean_de00"].get<double>(), 1.485);
   // The default ratio is the measured median, stated over the measured range; against a reference of N paths its
-  // noise adds in quadrature too.
+  // noise adds pixel by pixel too: at least in quadrature, at most their sum.
   const Json median = mean_plan({"--reference-spp", "4096"});
   const Json& m = median["prediction"]["cycles"];
   EXPECT_EQ(m["noise_ratio_to_tracer"].get<double>(), plan::kCyclesNoiseRatio);
@@ -583,8 +617,23 @@ TEST_F(Plan, CyclesSamplesPerBandGroupMeetTheTargetWithTheBands) {
   EXPECT_GT(m["mean_de00_range"][1].get<double>(), m["mean_de00"].get<double>());
   const double reference_noise = median["prediction"]["noise_mean_de00_at_scene_samples"].get<double>() *
                                  std::sqrt(median["scene_settings"]["samples"].get<double>() / 4096);
-  EXPECT_NEAR(m["against_tracer_reference"]["mean_de00"].get<double>(),
-              std::hypot(m["mean_de00"].get<double>(), reference_noise), 1e-9);
+  const double against = m["against_tracer_reference"]["mean_de00"].get<double>();
+  EXPECT_GE(against, std::hypot(m["mean_de00"].get<double>(), reference_noise) - 1e-9);
+  EXPECT_LE(against, m["mean_de00"].get<double>() + reference_noise + 1e-9);
+  EXPECT_FALSE(m["against_tracer_reference"]["the_target"].get<bool>());
+  // Planned for the target as measured against that reference: it is that prediction which meets the target, with
+  // more samples than the render's own error needs.
+  const Json against_plan = mean_plan({"--reference-spp", "4096", "--target-against-reference"});
+  const Json& a = against_plan["prediction"]["cycles"]["against_tracer_reference"];
+  EXPECT_TRUE(a["the_target"].get<bool>());
+  EXPECT_LE(a["mean_de00"].get<double>(), 1.0);
+  EXPECT_GT(a["mean_de00"].get<double>(), 0.99);
+  const auto more = against_plan["prediction"]["cycles"]["samples_per_band_group"].get<std::vector<int>>();
+  const auto own = m["samples_per_band_group"].get<std::vector<int>>();
+  if (against_plan["settings"]["bands"] == median["settings"]["bands"]) {
+    for (std::size_t g = 0; g < own.size(); ++g) EXPECT_GT(more[g], own[g]) << g;
+  }
+  EXPECT_EQ(run_chromatrace({"plan", kBox.string(), "--target-against-reference"}).exit_code, 2);
   // The tracer traces every band on each path: no groups, no samples of Cycles.
   const Json tracer = plan({"--renderer", "tracer", "-o", bands.string()});
   EXPECT_FALSE(tracer["prediction"].contains("cycles"));

@@ -302,6 +302,8 @@ class BatchArgs(unittest.TestCase):
             (["--scene", self.scene, "--plan", "1", "--explain"], "--explain"),
             (["--scene", self.scene, "--out", self.out, "--plan-edge-step", "5"], "--plan-edge-step"),
             (["--scene", self.scene, "--out", self.out, "--plan-out", self.out + ".json"], "--plan-out"),
+            (["--scene", self.scene, "--out", self.out, "--plan-reference-spp", "4096"], "--plan-reference-spp"),
+            (["--scene", self.scene, "--out", self.out, "--plan", "1", "--plan-reference-spp", "0"], "--plan-reference-spp"),
         ]
         for argv, option in cases:
             with self.assertRaises(BadInput, msg=argv) as caught:
@@ -340,6 +342,13 @@ class Planning(unittest.TestCase):
         self.assertIsNone(header["guide_band_group"])  # the report names none: no pilots measured the groups
         report["prediction"]["cycles"]["guide_band_group"] = 1
         self.assertEqual(json.loads(planning.Planned("plan.json", report).header())["guide_band_group"], 1)
+        # Planned for the target as compare measures it against a tracer reference: said beside the render's own.
+        against = {"samples": 4096, "the_target": True, "mean_de00": 0.997, "mean_de00_range": [0.85, 1.31]}
+        report["prediction"]["cycles"]["against_tracer_reference"] = against
+        self.assertIn("predicted mean ΔE00 1.00 (0.79-1.28) (1.00 (0.85-1.31) against a tracer reference of 4096 paths, "
+                      "the target), Cycles' noise", planning.Planned("plan.json", report).summary())
+        against["the_target"] = False  # only predicted (plan --reference-spp alone): not said
+        self.assertNotIn("reference", planning.Planned("plan.json", report).summary())
 
     def test_the_worst_object_said_with_the_samples_it_took(self):
         objects = [{"name": "floor", "object_id": 1, "mean_de00": 0.8}, {"name": "ceiling", "object_id": 2, "mean_de00": 1.96}]
@@ -354,6 +363,60 @@ class Planning(unittest.TestCase):
         self.assertEqual(json.loads(planned.header())["worst_object"]["name"], "ceiling")
         report["prediction"]["cycles"] = dict(cycles, samples_raised_for_objects=1.0)
         self.assertTrue(planning.Planned("plan.json", report).summary().endswith("(objects held to 2)"))
+
+    def test_the_light_tree_is_left_off_where_its_pilots_need_fewer_samples_without_it(self):
+        """plan_render with a scene that uses Cycles' light tree: pilots with it and without it, and the plan of
+        fewer samples in all taken (the scene's own where they tie), its band file and summary saying so."""
+        class Tool:  # chromatrace plan: samples from the pilots' light tree, as `samples` gives them
+            def __init__(self, samples):
+                self.samples, self.calls = samples, 0
+
+            def plan(self, scene_file, target, out, report_file, pilots=None, edge_step=None, reference_spp=None):
+                self.calls += 1
+                self.reference_spp = reference_spp
+                light_tree = None
+                if pilots:
+                    with open(pilots[0]) as f:
+                        light_tree = json.load(f).get("cycles_light_tree")
+                samples = self.samples[light_tree] if pilots else None
+                with open(out, "w") as f:
+                    json.dump({"format": "chromatrace-bands/1", "edges_nm": [400, 500, 600, 700],
+                               **({"cycles_samples": samples} if samples else {})}, f)
+                cycles = {"mean_de00": 0.99, "mean_de00_range": [0.8, 1.3], "noise_only_mean_de00": 0.9,
+                          "noise_ratio_to_tracer": 0.5, "tracer_noise_at_one_sample": 20.0}
+                with open(report_file, "w") as f:
+                    json.dump({"target_met": True, "notes": [], "target_de00": target, "camera": "cie1931",
+                               "settings": {"band_count": 3, "max_bounces": 3, "cycles_samples": samples},
+                               "prediction": {"mean_de00": 0.4, **({"cycles": cycles} if pilots else {})}}, f)
+
+        def render_pilot(bands_file, seed, output):  # the pilot "renders" the bands file it was given
+            rendered.append((bands_file, seed))
+            with open(bands_file) as f, open(output, "w") as out:
+                out.write(f.read())
+
+        for samples, light_tree, chosen in (({None: [300], False: [150]}, True, False),
+                                            ({None: [150], False: [300]}, True, None),
+                                            ({None: [200], False: [200]}, True, None),
+                                            ({None: [300], False: [150]}, False, None)):
+            with tempfile.TemporaryDirectory() as work:
+                rendered, tool = [], Tool(samples)
+                planned = planning.plan_render("scene.json", 1.0, work, render_pilot, tool, light_tree=light_tree,
+                                               reference_spp=4096)
+                self.assertEqual(tool.reference_spp, 4096)  # every plan is for the target against that reference
+                self.assertEqual(len(rendered), 4 if light_tree else 2)
+                self.assertEqual(tool.calls, 3 if light_tree else 2)
+                self.assertEqual(planned.light_tree, chosen)
+                self.assertEqual(planned.samples, samples[chosen])
+                with open(planned.bands_file) as f:
+                    document = json.load(f)
+                self.assertEqual(document.get("cycles_light_tree", "absent"), "absent" if chosen is None else chosen)
+                self.assertEqual(json.loads(planned.header())["cycles_light_tree"], chosen)
+                if chosen is False:
+                    self.assertTrue(planned.summary().endswith("; Cycles' light tree off: 150 samples in all (300 with "
+                                                               "it as the scene has it)"), planned.summary())
+                else:
+                    self.assertNotIn("light tree", planned.summary())
+                self.assertTrue(os.path.isfile(planned.report_file))
 
 
 class Ply(unittest.TestCase):
