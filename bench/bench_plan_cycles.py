@@ -33,9 +33,9 @@ For each:
    --plan-reference-spp REFERENCE_SPP (chromatrace plan, two pilot renders for Cycles' noise, plan again: bands,
    bounce limit and each band group's samples, for the target as compare measures it against the reference below,
    whose own noise counts; where the scene uses Cycles' light tree, the pilots and the plan again without it, and the
-   plan of fewer samples taken), path-type components. Its cost: the CPU seconds of its Cycles renders (band groups and the one-sample
-   object-id render) from the batch's progress lines, and apart the planning's (the batch's "planning:" line: the
-   two runs of chromatrace plan and the pilots), which does not grow with the image.
+   plan of fewer samples taken), path-type components. Its cost: the CPU seconds of its Cycles renders (band groups
+   and the one-sample object-id render) from the batch's progress lines, and apart the planning's (the batch's
+   "planning:" line: the runs of chromatrace plan and the pilots), which does not grow with the image.
 2. One plain RGB Cycles render of the same imported scene, --samples per pixel and the same resolution, the scene's
    bounce limit, in a Blender started the same way (bench_blender.py's PLAIN): what a user renders without
    chromatrace.

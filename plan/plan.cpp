@@ -870,8 +870,9 @@ std::vector<int> cycles_samples_for(const CyclesNoise& noise, double bands_error
 }
 
 // The mean ΔE00 of bands, bounces and Cycles' noise at `samples` per group, added pixel by pixel
-// (Model::joint_error): each band's noise as its group's samples give it (1/√N_g), the whole at the noise's mean
-// noise.at(samples) and, given a reference's noise (a tracer render's, at `reference` mean ΔE00), that too.
+// (Model::joint_error): the noise where the pilots have it (PlanOptions::cycles_pixel_noise, where they are of the
+// preview's size; else where the preview has it), at its predicted mean noise.at(samples), and given a reference's
+// noise (a tracer render's, at `reference` mean ΔE00) that too.
 double joint_at(const Model& model, const std::vector<int>& edges, int max_bounces, const CyclesNoise& noise,
                 const std::vector<int>& samples, const PlanOptions& options, double reference = 0) {
   const bool pilots = std::array{options.cycles_pixel_noise_width, options.cycles_pixel_noise_height} ==
