@@ -81,15 +81,22 @@ class Model {
   // that `carry` marks, the others noiseless, the band values read as the plan reads them, on exact colours: their
   // part in the noise's colour error.
   double band_noise(const std::vector<int>& edges, int max_bounces, const std::vector<bool>& carry) const;
-  // Mean ΔE00 of a plan's bands and bounce limit with Cycles' noise (and a reference's) added pixel by pixel, in
-  // quadrature there: over the preview's pixels, √(b² + n² + r²) with b the pixel's ΔE00 of the bands (evaluate's),
-  // n Cycles' noise there as `cycles_noise` (per preview pixel: the pilots'; empty: the preview's own) has it,
-  // scaled to a mean of `noise_only`, and r the preview's noise scaled to a mean of `reference` (a tracer
-  // reference's). Where the noise is strong (dim pixels, a highlight) is seldom where the bands miss (the sky seen
-  // directly, one colour of a texture), and the mean of the sum is then above the quadrature of the means
-  // (Minkowski's inequality): docs/plan.md, "Bands and noise, pixel by pixel".
-  double joint_error(const std::vector<int>& edges, int max_bounces, double noise_only, double reference,
-                     const std::vector<double>& cycles_noise) const;
+  // What the mean ΔE00 of a plan's bands and bounce limit with Cycles' noise (and a reference's) added pixel by pixel
+  // needs, which does not change with the samples: each of the preview's pixels' ΔE00 of the bands (evaluate's) and
+  // where each noise is — Cycles' as `cycles_noise` (per preview pixel: the pilots'; empty: the preview's own) has
+  // it, the reference's where the preview has it. Where the noise is strong (dim pixels, a highlight) is seldom where
+  // the bands miss (the sky seen directly, one colour of a texture), and the mean of the sum is then above the
+  // quadrature of the means (Minkowski's inequality): docs/plan.md, "Bands and noise, pixel by pixel".
+  struct PixelErrors {
+    std::vector<double> bands, cycles, tracer;
+    std::size_t pixel_count = 0;
+    // The mean ΔE00 with Cycles' noise at a mean of `noise` and the reference's at `reference`
+    // (pixel_by_pixel_mean).
+    double mean(double noise, double reference = 0) const {
+      return pixel_by_pixel_mean(bands, cycles, noise, tracer, reference, pixel_count);
+    }
+  };
+  PixelErrors pixel_errors(const std::vector<int>& edges, int max_bounces, const std::vector<double>& cycles_noise) const;
   bool reconstructs() const { return reconstruct_; }
   std::pair<double, double> evaluate_exact(int max_bounces) const;  // exact spectra, truncated bounces
   // Per surface id: the mean ΔE00 over its pixels of the preview of a plan's bands and bounce limit, as evaluate's
@@ -625,19 +632,20 @@ double Model::band_noise(const std::vector<int>& edges, int max_bounces, const s
   return score(exact_, kmax_, &noise).first;
 }
 
-double Model::joint_error(const std::vector<int>& edges, int max_bounces, double noise_only, double reference,
-                          const std::vector<double>& cycles_noise) const {
-  std::vector<double> bands;
+Model::PixelErrors Model::pixel_errors(const std::vector<int>& edges, int max_bounces,
+                                      const std::vector<double>& cycles_noise) const {
+  PixelErrors e;
   score(banded_templates(edges, max_bounces, reconstruct_, nullptr).templates, std::min(max_bounces, kmax_), nullptr,
-        nullptr, &bands);
-  // Cycles' noise where the pilots have it (given at the preview's size), else where the preview has its own; the
-  // reference's where the preview has it. Each pair's difference per pixel is one draw of the noise there, as a
-  // render's error is one draw.
+        nullptr, &e.bands);
+  // Each pair's difference per pixel is one draw of the noise there, as a render's error is one draw.
   const std::vector<double>& tracer = preview_pixel_noise_;
   const std::vector<double>& cycles = cycles_noise.size() == tracer.size() ? cycles_noise : tracer;
-  std::vector<double> n(pixels_.size()), r(pixels_.size());
-  for (std::size_t p = 0; p < pixels_.size(); ++p) n[p] = cycles[pixels_[p].index], r[p] = tracer[pixels_[p].index];
-  return pixel_by_pixel_mean(bands, n, noise_only, r, reference, pixel_count_);
+  e.cycles.resize(pixels_.size());
+  e.tracer.resize(pixels_.size());
+  for (std::size_t p = 0; p < pixels_.size(); ++p)
+    e.cycles[p] = cycles[pixels_[p].index], e.tracer[p] = tracer[pixels_[p].index];
+  e.pixel_count = pixel_count_;
+  return e;
 }
 
 Model::BandedTemplates Model::banded_templates(const std::vector<int>& edges, int max_bounces, bool reconstruct,
@@ -869,35 +877,28 @@ std::vector<int> cycles_samples_for(const CyclesNoise& noise, double bands_error
   return samples;
 }
 
-// The mean ΔE00 of bands, bounces and Cycles' noise at `samples` per group, added pixel by pixel
-// (Model::joint_error): the noise where the pilots have it (PlanOptions::cycles_pixel_noise, where they are of the
-// preview's size; else where the preview has it), at its predicted mean noise.at(samples), and given a reference's
-// noise (a tracer render's, at `reference` mean ΔE00) that too.
-double joint_at(const Model& model, const std::vector<int>& edges, int max_bounces, const CyclesNoise& noise,
-                const std::vector<int>& samples, const PlanOptions& options, double reference = 0) {
+// A plan's bands' errors per pixel and where the noise is (Model::pixel_errors): Cycles' where the pilots have it
+// (PlanOptions::cycles_pixel_noise, where they are of the preview's size), else where the preview has it.
+Model::PixelErrors pixel_errors_of(const Model& model, const std::vector<int>& edges, int max_bounces,
+                                   const PlanOptions& options) {
   const bool pilots = std::array{options.cycles_pixel_noise_width, options.cycles_pixel_noise_height} ==
                           model.preview_size() &&
                       options.cycles_pixel_noise.size() == static_cast<std::size_t>(options.cycles_pixel_noise_width) *
                                                                static_cast<std::size_t>(options.cycles_pixel_noise_height);
-  static const std::vector<double> none;
-  return model.joint_error(edges, max_bounces, noise.at(samples), reference, pilots ? options.cycles_pixel_noise : none);
+  return model.pixel_errors(edges, max_bounces, pilots ? options.cycles_pixel_noise : std::vector<double>{});
 }
 
-// The noise of the tracer reference the target is measured against (PlanOptions::target_against_reference): the
-// tracer's at one path over √paths; 0 otherwise.
-double reference_noise(const CyclesNoise& noise, const PlanOptions& options) {
-  return options.target_against_reference && options.reference_samples > 0
-             ? noise.at_one / std::sqrt(static_cast<double>(options.reference_samples))
-             : 0.0;
+// A tracer reference's noise at `paths` per pixel: the tracer's at one path over √paths.
+double reference_noise(const CyclesNoise& noise, int paths) {
+  return paths > 0 ? noise.at_one / std::sqrt(static_cast<double>(paths)) : 0.0;
 }
 
-// `samples` (cycles_samples_for's, from the quadrature law) raised by one factor for every group until the joint
-// error (joint_at) is at most the target: the fewest such, to a sample.
-std::vector<int> raised_for_joint(const Model& model, const std::vector<int>& edges, int max_bounces,
-                                  const CyclesNoise& noise, std::vector<int> samples, const PlanOptions& options,
-                                  double reference) {
-  const double target = options.target_de00;
-  auto joint = [&](const std::vector<int>& n) { return joint_at(model, edges, max_bounces, noise, n, options, reference); };
+// `samples` (cycles_samples_for's, from the quadrature law) raised by one factor for every group until the mean
+// ΔE00 of bands and noise added pixel by pixel, with a reference's noise of `reference` mean ΔE00, is at most the
+// target: the fewest such, to a sample.
+std::vector<int> raised_for_joint(const Model::PixelErrors& errors, const CyclesNoise& noise, std::vector<int> samples,
+                                  double target, double reference) {
+  auto joint = [&](const std::vector<int>& n) { return errors.mean(noise.at(n), reference); };
   if (samples.empty() || joint(samples) <= target) return samples;
   auto times = [&](double f) {
     std::vector<int> n(samples);
@@ -1114,11 +1115,12 @@ Plan make_plan(const Scene& scene, const PlanOptions& options) {
     const int min_samples = options.cycles_min_samples > 0 ? options.cycles_min_samples : kCyclesMinSamples;
     const CyclesNoise trial_noise = cycles_noise(model, trial_edges, plan.max_bounces, ratio, options);
     // Planned for what compare measures against a tracer reference, its noise is part of the error to hold.
-    const double reference = reference_noise(trial_noise, options);
+    const double reference =
+        options.target_against_reference ? reference_noise(trial_noise, options.reference_samples) : 0.0;
     const std::vector<int> samples = raised_for_joint(
-        model, trial_edges, plan.max_bounces, trial_noise,
-        cycles_samples_for(trial_noise, std::hypot(a_val, reference), options.target_de00, min_samples), options,
-        reference);
+        pixel_errors_of(model, trial_edges, plan.max_bounces, options), trial_noise,
+        cycles_samples_for(trial_noise, std::hypot(a_val, reference), options.target_de00, min_samples),
+        options.target_de00, reference);
     plan.trials.back().cycles_samples = samples;
     const bool cheaper = !samples.empty() && (chosen_samples.empty() || total(samples) < total(chosen_samples));
     if (!chosen || cheaper) {
@@ -1148,11 +1150,10 @@ Plan make_plan(const Scene& scene, const PlanOptions& options) {
     CyclesNoise noise = cycles_noise(model, edges, plan.max_bounces, ratio, options);
     limit_objects(plan, scene, model, edges, noise, options);
     const auto& n = plan.cycles_samples;
-    // Bands and noise added pixel by pixel (joint_at) at the ratio `noise` holds, against a reference of
-    // `reference` mean ΔE00 of noise if given.
-    auto with = [&](double reference = 0) {
-      return joint_at(model, edges, plan.max_bounces, noise, n, options, reference);
-    };
+    // Bands and noise added pixel by pixel at the ratio `noise` holds, against a reference of `reference` mean ΔE00
+    // of noise if given.
+    const Model::PixelErrors errors = pixel_errors_of(model, edges, plan.max_bounces, options);
+    auto with = [&](double reference = 0) { return errors.mean(noise.at(n), reference); };
     plan.cycles_noise_ratio = ratio;
     plan.tracer_noise_at_one = noise.at_one;
     plan.tracer_noise_from_pilots = options.cycles_pilot_tracer_noise_at_one > 0;
@@ -1172,8 +1173,7 @@ Plan make_plan(const Scene& scene, const PlanOptions& options) {
     if (!(options.cycles_noise_ratio > 0)) range = {kCyclesNoiseRatioLow, kCyclesNoiseRatioHigh};
     if (!(range[1] > 0)) range = {ratio, ratio};
     // Against a tracer reference of N paths, its noise too (the tracer's at one path over √N).
-    const double reference =
-        options.reference_samples > 0 ? noise.at_one / std::sqrt(static_cast<double>(options.reference_samples)) : 0;
+    const double reference = reference_noise(noise, options.reference_samples);
     if (reference > 0) plan.cycles_predicted_against_reference = with(reference);
     noise.ratio = range[0] / (1 + kCyclesNoiseModelAccuracy);
     plan.cycles_predicted_low = with();

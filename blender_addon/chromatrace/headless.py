@@ -115,7 +115,7 @@ def _plan(args, scene, chromatrace_tool, work, log):
                    on_world=args.on_world)
     pilot_size = plan_scene.pilot_resolution(scene, spectral_render.Request.from_scene(
         scene, **{k: v for k, v in request.items() if v is not None}))
-    both = bool(getattr(scene.cycles, "use_light_tree", False))  # pilots with Cycles' light tree and without it
+    both = plan_scene.uses_light_tree(scene)  # pilots with Cycles' light tree and without it
     log(f"planning for a mean ΔE00 of {args.plan:g}: chromatrace plan, then two pilot renders of "
         f"{'x'.join(map(str, pilot_size))} at {planning.PILOT_SAMPLES} "
         f"samples for Cycles' noise{', with its light tree and again without it' if both else ''}")

@@ -32,10 +32,14 @@ def plan_open_scene(scene, tool, target, work, scene_file=None, edge_step=None, 
         spectral_render.SpectralRender(scene, pilot, tool).run()
 
     planned = planning.plan_render(scene_file, target, work, render_pilot, tool, edge_step,
-                                   light_tree=bool(getattr(scene.cycles, "use_light_tree", False)),
-                                   reference_spp=reference_spp)
+                                   light_tree=uses_light_tree(scene), reference_spp=reference_spp)
     planned.approximations = approximations  # what the plan's scene file holds only approximately: said as notes
     return planned
+
+
+def uses_light_tree(scene):
+    """The scene's Cycles samples lights with its light tree (Blender 3.5 on): the plan then tries it off too."""
+    return bool(getattr(scene.cycles, "use_light_tree", False))
 
 
 def pilot_resolution(scene, request):
